@@ -1,0 +1,175 @@
+//! The platform catalog: the sensor and actuator kinds the simulated Khepera
+//! provides. The compiler checks `robot { ... }` declarations against this
+//! table, so the names live in exactly one place.
+//!
+//! Every sensor reading of one action is a flat array of [`CHANNELS`] floats
+//! (the *percept*). A declared sensor `ir[8] proximity` occupies the first 8
+//! channels of the `proximity` kind; module inputs, expressions and scripted
+//! behaviors refer to channels by index.
+
+use serde::{Deserialize, Serialize};
+
+/// Number of percept channels the simulator fills each action.
+pub const CHANNELS: usize = 18;
+/// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`, arm, claw).
+pub const ACT_SLOTS: usize = 4;
+
+/// Channel index of the first proximity (IR) sensor.
+pub const CH_IR: usize = 0;
+/// Channel index of the first ambient-light sensor.
+pub const CH_LIGHT: usize = 8;
+/// Channel index of the battery level.
+pub const CH_BATTERY: usize = 16;
+/// Channel index of the gripper's optical barrier.
+pub const CH_BARRIER: usize = 17;
+
+/// Actuator slot of the left wheel's commanded speed (normalised to -1..1).
+pub const ACT_LEFT: usize = 0;
+/// Actuator slot of the right wheel's commanded speed (normalised to -1..1).
+pub const ACT_RIGHT: usize = 1;
+/// Actuator slot of the arm (0 up, 1 down).
+pub const ACT_ARM: usize = 2;
+/// Actuator slot of the claw (0 open, 1 closed).
+pub const ACT_CLAW: usize = 3;
+
+/// Bearings of the 8 Khepera IR / ambient sensors, in degrees, counter-clockwise
+/// from the robot's heading (K-Team order: 0 = left 90, ..., 5 = right 90,
+/// 6 = back right, 7 = back left).
+pub const SENSOR_BEARING_DEG: [f32; 8] = [90.0, 45.0, 10.0, -10.0, -45.0, -90.0, -170.0, 170.0];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum SensorKind {
+    /// Reflected-IR proximity, 0 (nothing) .. 1 (saturated, very close).
+    Proximity,
+    /// Ambient light from the same photodiodes, 0 dark .. 1 bright.
+    Ambient,
+    /// Battery level, 0 empty .. 1 full.
+    Level,
+    /// Optical barrier between the gripper's arms, 0 or 1.
+    Optical,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum ActuatorKind {
+    /// Two wheel speeds, normalised to -1..1 of `v_max`.
+    Speed,
+    /// Gripper arm, `up` or `down`.
+    Lift,
+    /// Gripper claw, `open` or `closed`.
+    Grip,
+}
+
+/// One row of the sensor catalog.
+#[derive(Clone, Copy, Debug)]
+pub struct SensorInfo {
+    pub kind: SensorKind,
+    /// The keyword that names the kind in a `.bat` file.
+    pub keyword: &'static str,
+    /// Most elements a sensor of this kind may have.
+    pub max_count: usize,
+    /// First percept channel.
+    pub channel: usize,
+    /// One-line description for docs and `--help`.
+    pub doc: &'static str,
+}
+
+/// One row of the actuator catalog.
+#[derive(Clone, Copy, Debug)]
+pub struct ActuatorInfo {
+    pub kind: ActuatorKind,
+    pub keyword: &'static str,
+    /// Number of actuator slots (2 for wheels, 1 otherwise).
+    pub count: usize,
+    /// First actuator slot.
+    pub slot: usize,
+    /// Names of the discrete states (empty for continuous actuators).
+    pub states: &'static [&'static str],
+    pub doc: &'static str,
+}
+
+pub const SENSORS: [SensorInfo; 4] = [
+    SensorInfo {
+        kind: SensorKind::Proximity,
+        keyword: "proximity",
+        max_count: 8,
+        channel: CH_IR,
+        doc: "reflected infrared, 0 far .. 1 touching; 6 front and 2 back",
+    },
+    SensorInfo {
+        kind: SensorKind::Ambient,
+        keyword: "ambient",
+        max_count: 8,
+        channel: CH_LIGHT,
+        doc: "ambient light on the same photodiodes, 0 dark .. 1 bright",
+    },
+    SensorInfo {
+        kind: SensorKind::Level,
+        keyword: "level",
+        max_count: 1,
+        channel: CH_BATTERY,
+        doc: "battery level, 0 empty .. 1 full",
+    },
+    SensorInfo {
+        kind: SensorKind::Optical,
+        keyword: "optical",
+        max_count: 1,
+        channel: CH_BARRIER,
+        doc: "optical barrier between the gripper's arms, 0 or 1",
+    },
+];
+
+pub const ACTUATORS: [ActuatorInfo; 3] = [
+    ActuatorInfo {
+        kind: ActuatorKind::Speed,
+        keyword: "speed",
+        count: 2,
+        slot: ACT_LEFT,
+        states: &[],
+        doc: "left and right wheel speed, -1..1 of v_max",
+    },
+    ActuatorInfo {
+        kind: ActuatorKind::Lift,
+        keyword: "lift",
+        count: 1,
+        slot: ACT_ARM,
+        states: &["up", "down"],
+        doc: "gripper arm",
+    },
+    ActuatorInfo {
+        kind: ActuatorKind::Grip,
+        keyword: "grip",
+        count: 1,
+        slot: ACT_CLAW,
+        states: &["open", "closed"],
+        doc: "gripper claw",
+    },
+];
+
+/// Looks a sensor kind up by its keyword.
+pub fn sensor_by_keyword(keyword: &str) -> Option<&'static SensorInfo> {
+    SENSORS.iter().find(|s| s.keyword == keyword)
+}
+
+/// Looks an actuator kind up by its keyword.
+pub fn actuator_by_keyword(keyword: &str) -> Option<&'static ActuatorInfo> {
+    ACTUATORS.iter().find(|a| a.keyword == keyword)
+}
+
+pub fn sensor_info(kind: SensorKind) -> &'static SensorInfo {
+    SENSORS.iter().find(|s| s.kind == kind).expect("every kind is in the catalog")
+}
+
+pub fn actuator_info(kind: ActuatorKind) -> &'static ActuatorInfo {
+    ACTUATORS.iter().find(|a| a.kind == kind).expect("every kind is in the catalog")
+}
+
+/// The bearing (radians, counter-clockwise from the heading) a channel looks
+/// along, for the `toward(...)` primitive; `None` for channels without a
+/// direction (battery, barrier).
+pub fn channel_bearing(channel: usize) -> Option<f32> {
+    match channel {
+        c if c < CH_LIGHT => Some(SENSOR_BEARING_DEG[c - CH_IR].to_radians()),
+        c if c < CH_BATTERY => Some(SENSOR_BEARING_DEG[c - CH_LIGHT].to_radians()),
+        _ => None,
+    }
+}

@@ -1,0 +1,1 @@
+//! The incremental GA over stages (placeholder until the evolution issue lands).

@@ -1,0 +1,19 @@
+//! `shaping-runtime`: executes compiled shaping programs.
+//!
+//! - [`program`]: the `Program` types, the compiler's target (serde, no spans);
+//! - [`catalog`]: the sensors and actuators of the simulated platform;
+//! - [`expr`]: compiled expressions (reinforcement, fitness, `until`);
+//! - [`genome`]: bit-string genomes and decoding;
+//! - [`sim`]: the simulated Khepera world;
+//! - [`controller`]: modules, winner-take-all, behaviors, CRBP, episodes;
+//! - [`evolve`]: the incremental GA over stages, with checkpoints as data.
+//!
+//! This crate never depends on the compiler and does no file I/O.
+
+pub mod catalog;
+pub mod controller;
+pub mod evolve;
+pub mod expr;
+pub mod genome;
+pub mod program;
+pub mod sim;

@@ -1,0 +1,426 @@
+//! The `Program`: what the compiler produces and the runtime executes.
+//!
+//! Plain owned data, serde-serialisable, no source spans. One [`Stage`] holds
+//! everything needed to run that stage on its own: the robot's declared
+//! sensors and actuators, the world, the modules and links, the genome layout
+//! (every gene of this stage and of the stages it extends, with the frozen
+//! ones marked), the fitness and what to do (evolve or test).
+//!
+//! Channel indices (`u16`) refer to the percept array of [`crate::catalog`];
+//! gene indices (`u32`) refer to `Stage::layout.genes`; module indices (`u16`)
+//! refer to `Stage::modules` (declaration order, earlier stages' modules first).
+
+use serde::{Deserialize, Serialize};
+
+use crate::catalog::{ActuatorKind, SensorKind};
+use crate::expr::Expr;
+
+/// Bumped whenever the serialized shape changes incompatibly.
+pub const FORMAT_VERSION: u32 = 1;
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Program {
+    pub format: u32,
+    /// The architecture's name (the file stem, or the `robot` name).
+    pub name: String,
+    /// Stages in dependency order: a stage's `parent` always comes before it.
+    pub stages: Vec<Stage>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Stage {
+    pub name: String,
+    /// Index of the stage this one extends, if any.
+    pub parent: Option<usize>,
+    /// Declared sensors, in declaration order (earlier stages' first).
+    pub sensors: Vec<SensorDecl>,
+    pub actuators: Vec<ActuatorDecl>,
+    pub world: World,
+    pub modules: Vec<Module>,
+    /// Links between modules (the activation of `from` at the previous action,
+    /// times `weight`, is added to `to`'s activation network).
+    pub links: Vec<Link>,
+    pub layout: GenomeLayout,
+    pub fitness: Fitness,
+    pub run: StageRun,
+    pub inheritance: Inheritance,
+}
+
+/// A named sensor of the robot: `count` consecutive channels from `channel`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SensorDecl {
+    pub name: String,
+    pub kind: SensorKind,
+    pub count: u16,
+    pub channel: u16,
+    /// Index of the stage that added it.
+    pub stage: u16,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ActuatorDecl {
+    pub name: String,
+    pub kind: ActuatorKind,
+    pub stage: u16,
+}
+
+// ---------------------------------------------------------------- world
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct World {
+    /// Arena size in mm: width (x, west to east) and depth (y, south to north).
+    pub arena: [f32; 2],
+    pub body: Body,
+    pub charger: Option<Charger>,
+    pub battery: Option<Battery>,
+    pub objects: Option<Objects>,
+}
+
+/// The robot's body and motion parameters.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Body {
+    /// Body radius, mm (Khepera: 27.5).
+    pub radius: f32,
+    /// Distance between the wheels, mm (53).
+    pub wheel_base: f32,
+    /// Wheel speed for a command of 1.0, mm/s (80).
+    pub v_max: f32,
+    /// Duration of one action, ms (250).
+    pub action_ms: f32,
+    /// Multiplicative uniform wheel noise, e.g. 0.05 for +-5 %.
+    pub wheel_noise: f32,
+    /// Additive uniform sensor noise amplitude (0.01).
+    pub sensor_noise: f32,
+}
+
+impl Default for Body {
+    fn default() -> Self {
+        Body {
+            radius: 27.5,
+            wheel_base: 53.0,
+            v_max: 80.0,
+            action_ms: 250.0,
+            wheel_noise: 0.05,
+            sensor_noise: 0.01,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Wall {
+    North,
+    South,
+    East,
+    West,
+}
+
+/// The recharging bar, centred on a wall, with an optional lamp above it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Charger {
+    pub wall: Wall,
+    /// Bar length, mm.
+    pub length: f32,
+    /// Lamp height above the bar, mm; `None` for no lamp.
+    pub lamp_height: Option<f32>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Battery {
+    /// Actions a full battery lasts.
+    pub capacity: u32,
+    /// Actions in contact with the bar (while recharging) to refill completely.
+    pub recharge: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Objects {
+    pub count: u32,
+    /// Diameter, mm.
+    pub diameter: f32,
+    /// Virtual objects add sensor readings and can be gripped, but never block.
+    pub virtual_: bool,
+}
+
+// ---------------------------------------------------------------- modules
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Module {
+    pub name: String,
+    /// Index of the stage that introduced this module.
+    pub stage: u16,
+    /// Percept channels feeding the activation network (in order).
+    pub inputs: Vec<u16>,
+    /// Activation network: `inputs.len()` inputs, one sigmoid output; the
+    /// link-weighted sum of the other modules' previous activations is added
+    /// to the output neuron's net input.
+    pub activation: Network,
+    pub behavior: Behavior,
+    pub learning: Option<Learning>,
+    /// Reinforcement program: +1 reward, -1 punishment, 0 no signal (the value's
+    /// sign is used). Evaluated after each action the module drove, unless the
+    /// behavior is a script containing `reinforce` steps, which deliver it.
+    pub reinforce: Option<Expr>,
+}
+
+/// A feed-forward network of sigmoid units.
+///
+/// Parameter order in `params`:
+/// - `hidden == 0`: for each output `o`: `bias_o, w_o0, w_o1, ..., w_o(n-1)`;
+/// - `hidden > 0`: for each hidden unit `h`: `bias_h, w_h0 .. w_h(n-1)`; then
+///   for each output `o`: `bias_o, w_o,h0 .. w_o,h(hidden-1)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Network {
+    pub inputs: u16,
+    pub hidden: u16,
+    pub outputs: u16,
+    pub params: Vec<Param>,
+}
+
+impl Network {
+    /// Number of parameters a network of this shape has.
+    pub fn param_count(inputs: usize, hidden: usize, outputs: usize) -> usize {
+        if hidden == 0 {
+            outputs * (inputs + 1)
+        } else {
+            hidden * (inputs + 1) + outputs * (hidden + 1)
+        }
+    }
+}
+
+/// Where one weight comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Param {
+    /// Decoded from gene `i` of the stage's layout.
+    Gene(u32),
+    /// A constant.
+    Fixed(f32),
+    /// Drawn uniformly in `lo..hi` at the start of each episode from the
+    /// individual's RNG (e.g. a behavior network that learns from random weights).
+    Random { lo: f32, hi: f32 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Behavior {
+    Script(Script),
+    Neural(NeuralBehavior),
+}
+
+/// A neural behavior generator: percept channels to motor outputs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NeuralBehavior {
+    pub inputs: Vec<u16>,
+    pub net: Network,
+    pub decode: Decode,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Decode {
+    /// Each output is a bit (sampled with probability = output when the module
+    /// learns by CRBP, else `output > 0.5`); the bits, first output most
+    /// significant, index the table of `[left, right]` wheel speeds (-1..1).
+    /// The paper's obstacle avoidance: 2 outputs, table
+    /// `[back, left turn, right turn, forward]` for bits `00, 01, 10, 11`.
+    Table(Vec<[f32; 2]>),
+    /// Two outputs `y` give wheel speeds `(2y - 1) * scale`.
+    Linear { scale: f32 },
+}
+
+/// A programmed behavior: steps executed one after another, one per action
+/// (a step with a duration spans several actions). While the module keeps
+/// winning, the script continues where it was; after its last step it starts
+/// again. When another module wins, the script is reset to its first step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Script {
+    pub steps: Vec<Step>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Step {
+    pub action: Action,
+    pub end: StepEnd,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Action {
+    /// Set both wheel speeds (-1..1): `forward(v)`, `back(v)`, `turn left`, `stop`, ...
+    Wheels { left: f32, right: f32 },
+    /// Steer toward the direction of the vector sum of these channels
+    /// (each along its sensor's bearing): turn in place when the direction is
+    /// more than ~20 degrees off the heading, else drive forward at `speed`.
+    Toward { channels: Vec<u16>, speed: f32 },
+    /// Move the arm: `true` = down.
+    Arm(bool),
+    /// Move the claw: `true` = closed.
+    Claw(bool),
+    /// Stop the wheels; with `charge`, also ask the charger to recharge.
+    Wait { charge: bool },
+    /// Deliver the module's reinforcement: the value of this expression.
+    /// Takes no time: the next step runs in the same action.
+    Reinforce(Expr),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StepEnd {
+    /// The step lasts this many actions (1 for a plain step).
+    Actions(u32),
+    /// The step repeats until `cond` is true after an action, at most `within` actions.
+    Until { cond: Expr, within: u32 },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Learning {
+    pub target: LearnTarget,
+    /// CRBP learning rate after a reward.
+    pub rate_reward: f32,
+    /// CRBP learning rate after a punishment.
+    pub rate_punish: f32,
+    pub when: LearnWhen,
+    /// Window (in reinforcement signals) of the performance indicator.
+    pub window: u32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LearnTarget {
+    Behavior,
+    Activation,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum LearnWhen {
+    Always,
+    /// Learn while the performance indicator (rolling mean of the last
+    /// `window` reinforcements) is below `threshold`.
+    Below {
+        threshold: f32,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Link {
+    pub from: u16,
+    pub to: u16,
+    pub weight: Param,
+}
+
+// ---------------------------------------------------------------- genome
+
+/// The genome layout of a stage: every gene of this stage and of the stages
+/// it extends, in bit order. Genes of earlier stages come first (stage-major)
+/// and are `frozen`: crossover and mutation never change them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GenomeLayout {
+    pub genes: Vec<Gene>,
+    /// Total length in bits.
+    pub bits: u32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Gene {
+    /// First bit.
+    pub offset: u32,
+    pub bits: u8,
+    /// Decoded range: `lo + (hi - lo) * g / (2^bits - 1)`.
+    pub lo: f32,
+    pub hi: f32,
+    /// Stage that introduced the gene.
+    pub stage: u16,
+    /// Module the gene belongs to (for a link: the receiving module).
+    pub module: u16,
+    pub role: GeneRole,
+    /// True when an earlier stage introduced the gene.
+    pub frozen: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GeneRole {
+    /// Output bias of the activation network.
+    Bias,
+    /// Weight from input `input` (index into `Module::inputs`) to the output
+    /// (or, with a hidden layer, to hidden unit `hidden`).
+    Weight { input: u16, hidden: Option<u16> },
+    /// Bias of hidden unit `hidden`.
+    HiddenBias { hidden: u16 },
+    /// Weight from hidden unit `hidden` to the output.
+    HiddenOut { hidden: u16 },
+    /// Link weight from module `from` into the gene's module.
+    Link { from: u16 },
+}
+
+// ---------------------------------------------------------------- fitness and run
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fitness {
+    /// Evaluated after every action and summed over the life.
+    pub per_action: Option<Expr>,
+    /// Points per event, added to the sum.
+    pub bonuses: Vec<Bonus>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bonus {
+    pub event: Event,
+    pub points: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Event {
+    /// An object was gripped.
+    Grip,
+    /// An object was released outside the arena.
+    ReleaseOutside,
+    /// The battery was refilled at the charger.
+    Recharge,
+    /// A move was undone by a collision.
+    Collision,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StageRun {
+    Evolve(Evolution),
+    /// No evolution: the best individual of the parent stage lives `actions`
+    /// actions in this stage's world, with local learning on or off.
+    Test {
+        actions: u32,
+        learning: bool,
+    },
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Evolution {
+    pub population: u32,
+    pub generations: u32,
+    /// Life length in actions.
+    pub actions: u32,
+    pub seed: u64,
+    pub selection: Selection,
+    /// Probability of one-point crossover per pair.
+    pub crossover: f32,
+    /// Bit-flip probability per evolvable bit.
+    pub mutation: f32,
+    /// Best individuals copied unchanged.
+    pub elitism: u32,
+    /// Episodes averaged per evaluation.
+    pub evaluations: u32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Selection {
+    /// The best `keep` individuals each make `population / keep` offspring.
+    Truncation { keep: u32 },
+    /// Fitness-proportional.
+    Roulette,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Inheritance {
+    /// Learned weights are not written back to the genome.
+    Darwinian,
+    /// Learned activation weights are written back (re-encoded) to the genome.
+    Lamarckian,
+}
+
+impl Program {
+    pub fn stage(&self, name: &str) -> Option<(usize, &Stage)> {
+        self.stages.iter().enumerate().find(|(_, s)| s.name == name)
+    }
+}
