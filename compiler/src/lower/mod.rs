@@ -91,6 +91,8 @@ pub(crate) struct ModuleSt {
     pub learning: Option<Learning>,
     pub learn_span: Option<Span>,
     pub reinforce: Option<Expr>,
+    /// A `reinforce` clause was written (even if it had errors).
+    pub reinforce_declared: bool,
     pub script_reinforces: bool,
 }
 
@@ -123,6 +125,8 @@ struct StageSt {
     run: StageRun,
     fitness: Fitness,
     fitness_declared: bool,
+    /// A missing fitness was reported (by this stage or an ancestor).
+    fitness_reported: bool,
     modules: Vec<ModuleSt>,
     links: Vec<LinkSt>,
     genes: Vec<Gene>,
@@ -138,6 +142,8 @@ pub(crate) struct Lower<'a> {
     module_origin: HashMap<String, String>,
     /// Names of the processed stages, by program index.
     stage_names: Vec<String>,
+    /// Hardware whose declaration failed: not reported again where used.
+    poisoned: std::collections::HashSet<String>,
 }
 
 const DEFAULT_BITS: u8 = 4;
@@ -168,6 +174,7 @@ pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
         hw_origin: HashMap::new(),
         module_origin: HashMap::new(),
         stage_names: Vec::new(),
+        poisoned: Default::default(),
     };
     let program = lw.program(file_name);
     if lw.errors.is_empty() {
@@ -189,6 +196,9 @@ impl<'a> Lower<'a> {
 
     /// Reports an unknown sensor or actuator name, or one a later stage adds.
     pub(crate) fn unknown_hardware(&mut self, hw: &Hw, what: &'static str, name: &ast::Name) {
+        if self.poisoned.contains(&name.text) {
+            return;
+        }
         if let Some(origin) = self.hw_origin.get(&name.text) {
             self.errors.push(Error::MissingHardware {
                 span: name.span.into(),
@@ -222,7 +232,7 @@ impl<'a> Lower<'a> {
                     span: q.span.into(),
                     expected: "a count",
                     found: unit_desc(u),
-                    help: Some(format!("{what} is a number of actions or items")),
+                    help: Some(format!("{what} is a whole number, with no unit or `actions`")),
                 });
                 return None;
             }
@@ -354,16 +364,20 @@ impl<'a> Lower<'a> {
         }
         // Parents.
         let mut parent: Vec<Option<usize>> = vec![None; file.stages.len()];
+        let mut orphan = vec![false; file.stages.len()];
         for (i, s) in file.stages.iter().enumerate() {
             if let Some(p) = &s.extends {
                 match by_name.get(p.text.as_str()) {
                     Some(&j) => parent[i] = Some(j),
-                    None => self.errors.push(Error::Unknown {
-                        span: p.span.into(),
-                        what: "stage",
-                        name: p.text.clone(),
-                        help: did_you_mean(&p.text, file.stages.iter().map(|s| s.name.text.as_str())),
-                    }),
+                    None => {
+                        orphan[i] = true;
+                        self.errors.push(Error::Unknown {
+                            span: p.span.into(),
+                            what: "stage",
+                            name: p.text.clone(),
+                            help: did_you_mean(&p.text, file.stages.iter().map(|s| s.name.text.as_str())),
+                        });
+                    }
                 }
             }
         }
@@ -459,7 +473,13 @@ impl<'a> Lower<'a> {
                 Some(p) => states[p].clone(),
                 None => self.root_state(s),
             };
+            // A stage whose parent is unknown is checked as if it had none;
+            // its errors would mostly be consequences of the missing parent.
+            let saved = self.errors.len();
             let (state, stage) = self.stage(decl, s, parent_index, base);
+            if orphan[i] {
+                self.errors.truncate(saved);
+            }
             states.push(state);
             stages.push(stage);
         }
@@ -487,6 +507,7 @@ impl<'a> Lower<'a> {
             run: StageRun::Evolve(default_evolution()),
             fitness: Fitness { per_action: None, bonuses: Vec::new() },
             fitness_declared: false,
+            fitness_reported: false,
             modules: Vec::new(),
             links: Vec::new(),
             genes: Vec::new(),
@@ -532,6 +553,7 @@ impl<'a> Lower<'a> {
             }
             if h.is_sensor {
                 let Some(info) = catalog::sensor_by_keyword(&h.kind.text) else {
+                    self.poisoned.insert(h.name.text.clone());
                     let kinds: Vec<&str> = catalog::SENSORS.iter().map(|s| s.keyword).collect();
                     self.errors.push(Error::Unknown {
                         span: h.kind.span.into(),
@@ -549,18 +571,18 @@ impl<'a> Lower<'a> {
                             self.value_error(
                                 sp,
                                 format!(
-                                    "a `{}` sensor has 1 to {} elements, not {n}",
+                                    "a sensor of kind `{}` has 1 to {} elements, not {n}",
                                     info.keyword, info.max_count
                                 ),
-                                "too many elements",
+                                "wrong number of elements",
                                 None,
                             );
-                            continue;
                         }
-                        n as u16
+                        (n as usize).clamp(1, info.max_count) as u16
                     }
                 };
                 if let Some(other) = st.sensors.iter().find(|x| x.kind == info.kind) {
+                    self.poisoned.insert(h.name.text.clone());
                     self.errors.push(Error::Conflict {
                         span: h.span.into(),
                         other: other.span.into(),
@@ -583,6 +605,7 @@ impl<'a> Lower<'a> {
                 });
             } else {
                 let Some(info) = catalog::actuator_by_keyword(&h.kind.text) else {
+                    self.poisoned.insert(h.name.text.clone());
                     let kinds: Vec<&str> = catalog::ACTUATORS.iter().map(|a| a.keyword).collect();
                     self.errors.push(Error::Unknown {
                         span: h.kind.span.into(),
@@ -597,14 +620,17 @@ impl<'a> Lower<'a> {
                     if n as usize != info.count {
                         self.value_error(
                             sp,
-                            format!("a `{}` actuator has {} elements, not {n}", info.keyword, info.count),
-                            "wrong count",
+                            format!(
+                                "an actuator of kind `{}` has {} elements, not {n}",
+                                info.keyword, info.count
+                            ),
+                            "wrong number of elements",
                             None,
                         );
-                        continue;
                     }
                 }
                 if let Some(other) = st.actuators.iter().find(|x| x.kind == info.kind) {
+                    self.poisoned.insert(h.name.text.clone());
                     self.errors.push(Error::Conflict {
                         span: h.span.into(),
                         other: other.span.into(),
@@ -731,7 +757,8 @@ impl<'a> Lower<'a> {
                 self.fitness(&hw, &mut st, f);
             }
         }
-        if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared {
+        if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared && !st.fitness_reported {
+            st.fitness_reported = true;
             self.value_error(
                 decl.name.span,
                 format!("stage `{sname}` evolves but has no fitness"),

@@ -41,6 +41,7 @@ impl Lower<'_> {
                 learning: None,
                 learn_span: None,
                 reinforce: None,
+                reinforce_declared: false,
                 script_reinforces: false,
             },
         };
@@ -112,11 +113,11 @@ impl Lower<'_> {
                     st.behavior = match b {
                         ast::BehaviorDecl::Script(steps, _) => {
                             let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
-                            let steps: Vec<Step> =
+                            let lowered: Vec<Step> =
                                 steps.iter().filter_map(|x| self.step(hw, x, &scope)).collect();
                             st.script_reinforces =
-                                steps.iter().any(|x| matches!(x.action, Action::Reinforce(_)));
-                            Some(Behavior::Script(Script { steps }))
+                                steps.iter().any(|x| matches!(x.action, ast::ActionDecl::Reinforce(..)));
+                            Some(Behavior::Script(Script { steps: lowered }))
                         }
                         ast::BehaviorDecl::Neural(n) => {
                             let (nb, genes) = self.neural(hw, n, &inputs);
@@ -132,6 +133,7 @@ impl Lower<'_> {
                 ModuleItem::Reinforce(e, _) => {
                     let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
                     st.reinforce = self.expr(hw, e, &scope);
+                    st.reinforce_declared = true;
                 }
                 _ => {}
             }
@@ -153,7 +155,7 @@ impl Lower<'_> {
     /// Checks that concern the whole module.
     pub(super) fn check_module(&mut self, m: &ModuleSt) {
         if let (Some(l), Some(span)) = (&m.learning, m.learn_span) {
-            if m.reinforce.is_none() && !m.script_reinforces {
+            if !m.reinforce_declared && !m.script_reinforces {
                 self.value_error(
                     span,
                     format!("module `{}` learns but has no reinforcement program", m.name),

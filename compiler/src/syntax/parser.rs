@@ -210,16 +210,18 @@ fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
         pest::error::InputLocation::Span((a, _)) => a,
     };
     let pos = pos.min(src.len());
-    let (span, found) = token_at(src, pos);
+    let (mut span, found) = token_at(src, pos);
+    if pos == src.len() {
+        // Point at the last token, so that the label shows.
+        let end = src.trim_end().len();
+        let start = src[..end].char_indices().next_back().map(|(i, _)| i).unwrap_or(0);
+        span = Span::new(start, end.max(start));
+    }
     let expected = match &e.variant {
         pest::error::ErrorVariant::ParsingError { positives, .. } => {
             let mut names: Vec<&str> = positives.iter().filter_map(|r| describe(*r)).collect();
             names.sort_unstable();
             names.dedup();
-            if names.len() > 8 {
-                names.truncate(8);
-                names.push("...");
-            }
             match names.len() {
                 0 => "something else".to_string(),
                 1 => names[0].to_string(),
@@ -233,9 +235,11 @@ fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
     Error::Syntax { span: span.into(), expected, found }
 }
 
+/// The span of a pair, without the whitespace a trailing optional part
+/// may have skipped.
 fn span(p: &Pair<Rule>) -> Span {
     let s = p.as_span();
-    Span::new(s.start(), s.end())
+    Span::new(s.start(), s.start() + p.as_str().trim_end().len())
 }
 
 fn name(p: Pair<Rule>) -> Name {

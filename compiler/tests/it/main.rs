@@ -4,6 +4,7 @@
 
 mod examples;
 mod layout;
+mod ui;
 
 use std::path::Path;
 
