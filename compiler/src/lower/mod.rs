@@ -147,6 +147,11 @@ pub(crate) struct Lower<'a> {
 }
 
 const DEFAULT_BITS: u8 = 4;
+/// Most modules in a stage (module indices are `u16`, and `links all`
+/// makes n * (n - 1) links).
+const MAX_MODULES: usize = 256;
+/// Most stages in a file (stage indices are `u16`; real files have a few).
+const MAX_STAGES: usize = 64;
 const DEFAULT_WINDOW: u32 = 30;
 const DEFAULT_LAMP_HEIGHT: f32 = 150.0;
 const DEFAULT_RECHARGE: u32 = 20;
@@ -334,6 +339,15 @@ impl<'a> Lower<'a> {
                 "no stage in this file",
                 Some("add `stage NAME { ... }` with the modules to train".into()),
             );
+        }
+        if let Some(extra) = file.stages.get(MAX_STAGES) {
+            self.value_error(
+                extra.name.span,
+                format!("the file has more than {MAX_STAGES} stages"),
+                "one stage too many",
+                None,
+            );
+            return Program { format: FORMAT_VERSION, name, stages: Vec::new() };
         }
         // Stage names and where later hardware / modules come from.
         let mut by_name: HashMap<&str, usize> = HashMap::new();
@@ -732,6 +746,15 @@ impl<'a> Lower<'a> {
                         name: m.name.text.clone(),
                     });
                     continue;
+                }
+                if st.modules.len() >= MAX_MODULES && !st.modules.iter().any(|x| x.name == m.name.text) {
+                    self.value_error(
+                        m.name.span,
+                        format!("stage `{sname}` has more than {MAX_MODULES} modules"),
+                        "one module too many",
+                        None,
+                    );
+                    break;
                 }
                 declared_here.insert(m.name.text.clone(), m.name.span);
                 self.module(&hw, &mut st.modules, m, s);
@@ -1224,6 +1247,8 @@ impl<'a> Lower<'a> {
             });
             None
         };
+        let mut link_index: HashMap<(u16, u16), usize> =
+            st.links.iter().enumerate().map(|(k, x)| ((x.from, x.to), k)).collect();
         for item in &decl.items {
             let I::Link(l) = item else { continue };
             let (from, to) = (lookup(self, &l.from), lookup(self, &l.to));
@@ -1232,7 +1257,7 @@ impl<'a> Lower<'a> {
                 ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
                 ast::LinkKind::Fixed(w) => Err(*w as f32),
             };
-            if let Some(old) = st.links.iter().find(|x| x.from == from && x.to == to) {
+            if let Some(old) = link_index.get(&(from, to)).map(|&k| &st.links[k]) {
                 if old.stage == s {
                     self.errors.push(Error::Duplicate {
                         span: l.span.into(),
@@ -1251,6 +1276,7 @@ impl<'a> Lower<'a> {
                 }
                 continue;
             }
+            link_index.insert((from, to), st.links.len());
             st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: l.span });
         }
         let mut all_span: Option<Span> = None;
@@ -1273,7 +1299,7 @@ impl<'a> Lower<'a> {
             let n = st.modules.len() as u16;
             for to in 0..n {
                 for from in 0..n {
-                    if from != to && !st.links.iter().any(|x| x.from == from && x.to == to) {
+                    if from != to && !link_index.contains_key(&(from, to)) {
                         st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: *span });
                     }
                 }
@@ -1300,6 +1326,18 @@ impl<'a> Lower<'a> {
             bits += spec.bits as u32;
             Param::Gene(genes.len() as u32 - 1)
         };
+        // The links this stage introduces, by receiving module, from modules in order.
+        let mut incoming: Vec<Vec<usize>> = vec![Vec::new(); st.modules.len()];
+        for (k, l) in st.links.iter().enumerate() {
+            if l.stage == s {
+                if let Some(v) = incoming.get_mut(l.to as usize) {
+                    v.push(k);
+                }
+            }
+        }
+        for v in &mut incoming {
+            v.sort_by_key(|&k| st.links[k].from);
+        }
         for mi in 0..st.modules.len() {
             let m = &mut st.modules[mi];
             if m.stage == s {
@@ -1327,11 +1365,7 @@ impl<'a> Lower<'a> {
                         .collect();
                 }
             }
-            let mut incoming: Vec<usize> = (0..st.links.len())
-                .filter(|&k| st.links[k].to == mi as u16 && st.links[k].stage == s)
-                .collect();
-            incoming.sort_by_key(|&k| st.links[k].from);
-            for k in incoming {
+            for &k in &incoming[mi] {
                 let l = &mut st.links[k];
                 l.param = Some(match l.kind {
                     Ok(range) => push(&mut genes, genome.links, range, l.to, GeneRole::Link { from: l.from }),

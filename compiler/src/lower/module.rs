@@ -12,14 +12,17 @@ impl Lower<'_> {
     /// Declares a new module, or changes an inherited one.
     pub(super) fn module(&mut self, hw: &Hw, modules: &mut Vec<ModuleSt>, m: &ast::ModuleDecl, s: u16) {
         // Repeated clauses.
-        for (i, item) in m.items.iter().enumerate() {
-            if let Some(first) = m.items[..i].iter().find(|x| x.keyword() == item.keyword()) {
+        let mut seen: std::collections::HashMap<&str, &ModuleItem> = std::collections::HashMap::new();
+        for item in &m.items {
+            if let Some(first) = seen.get(item.keyword()).copied() {
                 self.errors.push(Error::Duplicate {
                     span: item.span().into(),
                     first: first.span().into(),
                     what: "clause",
                     name: item.keyword().into(),
                 });
+            } else {
+                seen.insert(item.keyword(), item);
             }
         }
         let existing = modules.iter().position(|x| x.name == m.name.text);

@@ -22,10 +22,14 @@ const CALL_LIMIT: usize = 20_000_000;
 /// Parses a file. On a syntax error, returns that one error (the checker
 /// reports every error of a file that parses).
 pub fn parse(src: &str) -> Result<File, Vec<Error>> {
+    parse_with_limit(src, CALL_LIMIT)
+}
+
+fn parse_with_limit(src: &str, call_limit: usize) -> Result<File, Vec<Error>> {
     if let Some(err) = check_nesting(src) {
         return Err(vec![err]);
     }
-    pest::set_call_limit(std::num::NonZeroUsize::new(CALL_LIMIT));
+    pest::set_call_limit(std::num::NonZeroUsize::new(call_limit));
     let mut pairs = match BatParser::parse(Rule::file, src) {
         Ok(p) => p,
         Err(e) => return Err(vec![syntax_error(src, e)]),
@@ -845,5 +849,27 @@ fn link_kind(p: Pair<Rule>) -> LinkKind {
     match it.next() {
         Some(k) if k.as_rule() == Rule::k_fixed => LinkKind::Fixed(it.next().map(|n| num(&n)).unwrap_or(0.0)),
         _ => LinkKind::Evolvable(it.next().and_then(|r| r.into_inner().nth(1)).map(range)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exceeding_the_call_limit_is_a_diagnostic() {
+        let src = "robot r { sensor ir[8] proximity }\nstage s { module m { sense ir behavior stop } }";
+        let errors = parse_with_limit(src, 50).unwrap_err();
+        assert!(matches!(&errors[..], [Error::TooComplex { .. }]), "{errors:?}");
+        assert!(errors[0].to_string().starts_with("the file is too complex to parse"));
+        assert!(parse_with_limit(src, CALL_LIMIT).is_ok());
+    }
+
+    #[test]
+    fn nesting_is_measured_outside_comments() {
+        let deep = "(".repeat(MAX_NESTING + 1);
+        assert!(check_nesting(&deep).is_some());
+        assert!(check_nesting(&format!("// {deep}\n/* {deep} */")).is_none());
+        assert!(check_nesting(&"(".repeat(MAX_NESTING)).is_none());
     }
 }

@@ -74,3 +74,29 @@ fn huge_files() {
     let src = "x".repeat(4_000_000);
     let _ = fails(&src);
 }
+
+#[test]
+fn too_many_modules() {
+    let mut src = String::from(
+        "robot r { sensor ir[8] proximity actuator wheels[2] speed }\nstage s {\n fitness per action 1\n",
+    );
+    for i in 0..300 {
+        src.push_str(&format!(" module m{i} {{ sense ir behavior forward }}\n"));
+    }
+    src.push_str(" links all evolvable\n}");
+    assert!(fails(&src).contains("more than 256 modules"));
+}
+
+#[test]
+fn too_many_stages_and_clauses() {
+    let mut src = String::from("robot r { sensor ir[8] proximity actuator wheels[2] speed }\n");
+    src.push_str("stage s0 { fitness per action 1 module m { sense ir behavior forward } }\n");
+    for i in 1..100_000 {
+        src.push_str(&format!("stage s{i} extends s{} {{ }}\n", i - 1));
+    }
+    assert!(fails(&src).contains("more than 64 stages"));
+    let mut src = String::from("robot r { sensor ir[8] proximity actuator wheels[2] speed }\nstage s { fitness per action 1 module m { behavior forward ");
+    src.push_str(&"sense ir ".repeat(100_000));
+    src.push_str("} }");
+    assert!(fails(&src).contains("declared twice"));
+}
