@@ -1338,7 +1338,7 @@ impl<'a> Lower<'a> {
         for v in &mut incoming {
             v.sort_by_key(|&k| st.links[k].from);
         }
-        for mi in 0..st.modules.len() {
+        for (mi, incoming) in incoming.iter().enumerate() {
             let m = &mut st.modules[mi];
             if m.stage == s {
                 if let Source::Evolvable(range) = m.source.clone() {
@@ -1365,7 +1365,7 @@ impl<'a> Lower<'a> {
                         .collect();
                 }
             }
-            for &k in &incoming[mi] {
+            for &k in incoming {
                 let l = &mut st.links[k];
                 l.param = Some(match l.kind {
                     Ok(range) => push(&mut genes, genome.links, range, l.to, GeneRole::Link { from: l.from }),
