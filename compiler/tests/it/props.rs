@@ -110,7 +110,11 @@ fn extra_stage(parent: usize, modules: &[(u8, u8, bool)], links: bool) -> String
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+    // 256 cases, or PROPTEST_CASES for a longer search.
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn any_string_compiles_or_gives_a_diagnostic(src in any::<String>()) {
