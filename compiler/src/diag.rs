@@ -262,3 +262,23 @@ pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str
         .min_by_key(|(d, _)| *d)
         .map(|(_, c)| format!("did you mean `{c}`?"))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn edit_distances() {
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("wander", "wander"), 0);
+        assert_eq!(edit_distance("wandr", "wander"), 1);
+        assert_eq!(edit_distance("ligth", "light"), 2);
+    }
+
+    #[test]
+    fn suggestions_are_close_names_only() {
+        assert_eq!(did_you_mean("wandr", ["avoid", "wander"]), Some("did you mean `wander`?".into()));
+        assert_eq!(did_you_mean("ligth", ["light", "ir"]), Some("did you mean `light`?".into()));
+        assert_eq!(did_you_mean("xyz", ["light", "ir"]), None);
+    }
+}

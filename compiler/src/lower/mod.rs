@@ -1172,6 +1172,13 @@ impl<'a> Lower<'a> {
                         ops.extend(x.ops);
                         ops.push(Op::Add);
                         let depth = Expr::required_depth(&ops).unwrap_or(old.depth.max(x.depth) + 1);
+                        if depth as usize > shaping_runtime::expr::MAX_STACK {
+                            self.errors.push(Error::StackTooDeep {
+                                span: e.span.into(),
+                                depth: depth as usize,
+                                max: shaping_runtime::expr::MAX_STACK,
+                            });
+                        }
                         Expr { ops, depth }
                     }
                 });
@@ -1493,4 +1500,44 @@ fn format_num(v: f64, unit: Option<Unit>) -> String {
 fn stem(file_name: &str) -> String {
     let base = file_name.rsplit(['/', '\\']).next().unwrap_or(file_name);
     base.strip_suffix(".bat").unwrap_or(base).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn network_roles_follow_the_parameter_order_of_network() {
+        for (i, h, o) in [(0, 0, 1), (3, 0, 1), (8, 0, 2), (2, 3, 1), (4, 2, 3)] {
+            let roles = network_roles(i, h, o);
+            assert_eq!(roles.len(), Network::param_count(i, h, o));
+        }
+        assert_eq!(
+            network_roles(2, 0, 1),
+            [
+                GeneRole::Bias,
+                GeneRole::Weight { input: 0, hidden: None },
+                GeneRole::Weight { input: 1, hidden: None }
+            ]
+        );
+        assert_eq!(
+            network_roles(1, 2, 1),
+            [
+                GeneRole::HiddenBias { hidden: 0 },
+                GeneRole::Weight { input: 0, hidden: Some(0) },
+                GeneRole::HiddenBias { hidden: 1 },
+                GeneRole::Weight { input: 0, hidden: Some(1) },
+                GeneRole::Bias,
+                GeneRole::HiddenOut { hidden: 0 },
+                GeneRole::HiddenOut { hidden: 1 },
+            ]
+        );
+    }
+
+    #[test]
+    fn stems() {
+        assert_eq!(stem("examples/khepera.bat"), "khepera");
+        assert_eq!(stem("C:\\x\\a.bat"), "a");
+        assert_eq!(stem("noext"), "noext");
+    }
 }
