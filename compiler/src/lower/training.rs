@@ -1,0 +1,261 @@
+//! What a stage does (evolve or test), the evolution settings and the fitness.
+
+use shaping_runtime::catalog::ActuatorKind;
+use shaping_runtime::expr::{Expr, Op};
+use shaping_runtime::program::*;
+
+use super::*;
+use crate::diag::{did_you_mean, Error};
+use crate::syntax::ast;
+use crate::syntax::Span;
+
+impl Lower<'_> {
+    pub(super) fn run(&mut self, st: &mut StageSt, decl: &ast::StageDecl, has_parent: bool) {
+        use ast::StageItem as I;
+        let mut evolve_span = None;
+        let mut test_span: Option<Span> = None;
+        for item in &decl.items {
+            match item {
+                I::Evolve(settings, sp) => {
+                    if let Some(t) = test_span {
+                        self.conflict_run(*sp, t);
+                    }
+                    evolve_span = Some(*sp);
+                    self.evolve(st, settings);
+                    st.run = StageRun::Evolve(st.evolution.clone());
+                }
+                I::Test { actions, learning, span } => {
+                    if let Some(e) = evolve_span.or(test_span) {
+                        self.conflict_run(*span, e);
+                    }
+                    test_span = Some(*span);
+                    if !has_parent {
+                        self.value_error(
+                            *span,
+                            format!(
+                                "stage `{}` tests the best individual, but extends no stage",
+                                decl.name.text
+                            ),
+                            "nothing to test",
+                            Some(
+                                "a `test` stage must extend the stage whose best individual it tests".into(),
+                            ),
+                        );
+                    }
+                    if let Some(n) = self.count(actions, "the test length", 1) {
+                        st.run = StageRun::Test { actions: n as u32, learning: *learning };
+                    }
+                }
+                _ => {}
+            }
+        }
+        if evolve_span.is_none() && test_span.is_none() {
+            if let StageRun::Evolve(_) = st.run {
+                st.run = StageRun::Evolve(st.evolution.clone());
+            }
+        }
+    }
+
+    pub(super) fn conflict_run(&mut self, span: Span, other: Span) {
+        self.errors.push(Error::Conflict {
+            span: span.into(),
+            other: other.into(),
+            message: "a stage either evolves or tests, not both".into(),
+            label: "this".into(),
+            other_label: "conflicts with this".into(),
+        });
+    }
+
+    pub(super) fn evolve(&mut self, st: &mut StageSt, settings: &[ast::Setting]) {
+        const NAMES: [&str; 10] = [
+            "population",
+            "generations",
+            "actions",
+            "seed",
+            "selection",
+            "crossover",
+            "mutation",
+            "elitism",
+            "evaluations",
+            "inheritance",
+        ];
+        let ev = &mut st.evolution;
+        let mut keep_span = None;
+        for set in settings {
+            let n = set.name.text.as_str();
+            match (&set.value, n) {
+                (ast::SettingValue::Truncation(q), _) => {
+                    if let Some(k) = self.count(q, "`keep`", 1) {
+                        ev.selection = Selection::Truncation { keep: k as u32 };
+                        keep_span = Some(q.span);
+                    }
+                }
+                (ast::SettingValue::Word(w), "selection") => {
+                    if w.text == "roulette" {
+                        ev.selection = Selection::Roulette;
+                    } else {
+                        self.errors.push(Error::Unknown {
+                            span: w.span.into(),
+                            what: "selection",
+                            name: w.text.clone(),
+                            help: Some("write `selection truncation keep N` or `selection roulette`".into()),
+                        });
+                    }
+                }
+                (ast::SettingValue::Word(w), "inheritance") => match w.text.as_str() {
+                    "darwinian" => st.inheritance = Inheritance::Darwinian,
+                    "lamarckian" => st.inheritance = Inheritance::Lamarckian,
+                    _ => self.errors.push(Error::Unknown {
+                        span: w.span.into(),
+                        what: "inheritance",
+                        name: w.text.clone(),
+                        help: did_you_mean(&w.text, ["darwinian", "lamarckian"]).or_else(|| {
+                            Some("write `inheritance darwinian` or `inheritance lamarckian`".into())
+                        }),
+                    }),
+                },
+                (
+                    ast::SettingValue::Quantity(q),
+                    "population" | "generations" | "actions" | "elitism" | "evaluations" | "seed",
+                ) => {
+                    let min = if n == "elitism" || n == "seed" { 0 } else { 1 };
+                    if let Some(v) = self.count(q, &format!("`{n}`"), min) {
+                        match n {
+                            "population" => ev.population = v as u32,
+                            "generations" => ev.generations = v as u32,
+                            "actions" => ev.actions = v as u32,
+                            "elitism" => ev.elitism = v as u32,
+                            "evaluations" => ev.evaluations = v as u32,
+                            _ => ev.seed = v,
+                        }
+                    }
+                }
+                (ast::SettingValue::Quantity(q), "crossover" | "mutation") => {
+                    if let Some(v) = self.plain(q, &format!("`{n}`"), 0.0, 1.0) {
+                        if n == "crossover" {
+                            ev.crossover = v;
+                        } else {
+                            ev.mutation = v;
+                        }
+                    }
+                }
+                _ if NAMES.contains(&n) => {
+                    self.value_error(
+                        set.span,
+                        format!("`{n}` has the wrong kind of value"),
+                        "wrong value",
+                        Some(evolve_help(n)),
+                    );
+                }
+                _ => self.errors.push(Error::Unknown {
+                    span: set.name.span.into(),
+                    what: "evolution setting",
+                    name: n.to_string(),
+                    help: did_you_mean(n, NAMES),
+                }),
+            }
+        }
+        if let (Selection::Truncation { keep }, Some(sp)) = (ev.selection, keep_span) {
+            if keep > ev.population {
+                let pop = ev.population;
+                self.value_error(
+                    sp,
+                    format!("truncation keeps {keep} individuals of a population of {pop}"),
+                    "more than the population",
+                    None,
+                );
+            }
+        }
+        if ev.elitism > ev.population {
+            let (e, p) = (ev.elitism, ev.population);
+            let sp = settings.iter().find(|s| s.name.text == "elitism").map(|s| s.span).unwrap_or_default();
+            self.value_error(
+                sp,
+                format!("elitism keeps {e} individuals of a population of {p}"),
+                "more than the population",
+                None,
+            );
+        }
+    }
+
+    pub(super) fn fitness(&mut self, hw: &Hw, st: &mut StageSt, f: &ast::FitnessDecl) {
+        let mut per_action: Option<Expr> = if f.adds { st.fitness.per_action.clone() } else { None };
+        let mut bonuses = if f.adds { st.fitness.bonuses.clone() } else { Vec::new() };
+        for e in &f.per_action {
+            if let Some(x) = self.expr(hw, e, &Scope { only: None }) {
+                per_action = Some(match per_action {
+                    None => x,
+                    Some(old) => {
+                        let mut ops = old.ops;
+                        ops.extend(x.ops);
+                        ops.push(Op::Add);
+                        let depth = Expr::required_depth(&ops).unwrap_or(old.depth.max(x.depth) + 1);
+                        if depth as usize > shaping_runtime::expr::MAX_STACK {
+                            self.errors.push(Error::StackTooDeep {
+                                span: e.span.into(),
+                                depth: depth as usize,
+                                max: shaping_runtime::expr::MAX_STACK,
+                            });
+                        }
+                        Expr { ops, depth }
+                    }
+                });
+            }
+        }
+        const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
+        for b in &f.bonuses {
+            let event = match b.event.text.as_str() {
+                "grip" => Event::Grip,
+                "release outside" => Event::ReleaseOutside,
+                "recharge" => Event::Recharge,
+                "collision" => Event::Collision,
+                other => {
+                    self.errors.push(Error::Unknown {
+                        span: b.event.span.into(),
+                        what: "event",
+                        name: other.to_string(),
+                        help: did_you_mean(other, EVENTS)
+                            .or_else(|| Some(format!("the events are {}", expr::backticked(&EVENTS)))),
+                    });
+                    continue;
+                }
+            };
+            let needs_claw = matches!(event, Event::Grip | Event::ReleaseOutside);
+            if needs_claw && !hw.actuators.iter().any(|a| a.kind == ActuatorKind::Grip) {
+                self.errors.push(Error::MissingHardware {
+                    span: b.event.span.into(),
+                    stage: hw.stage.clone(),
+                    what: "actuator of kind",
+                    name: "grip".into(),
+                    help: Some(
+                        "objects are gripped and released by a `grip` actuator (`actuator claw grip`)".into(),
+                    ),
+                });
+            }
+            if event == Event::Recharge && !hw.has_charger {
+                self.errors.push(Error::MissingHardware {
+                    span: b.event.span.into(),
+                    stage: hw.stage.clone(),
+                    what: "world item",
+                    name: "charger".into(),
+                    help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
+                });
+            }
+            if !b.points.is_finite() {
+                self.value_error(b.span, "bonus points must be a finite number".into(), "not finite", None);
+            }
+            bonuses.push(Bonus { event, points: b.points as f32 });
+        }
+        st.fitness = Fitness { per_action, bonuses };
+        st.fitness_declared = true;
+    }
+}
+
+pub(super) fn evolve_help(n: &str) -> String {
+    match n {
+        "selection" => "write `selection truncation keep N` or `selection roulette`".into(),
+        "inheritance" => "write `inheritance darwinian` or `inheritance lamarckian`".into(),
+        "crossover" | "mutation" => format!("`{n}` is a probability, e.g. `{n} 0.1`"),
+        _ => format!("`{n}` is a whole number, e.g. `{n} 100`"),
+    }
+}
