@@ -16,6 +16,8 @@ pub enum Error {
         span: SourceSpan,
         expected: String,
         found: String,
+        #[help]
+        help: Option<String>,
     },
 
     #[error("the file is too complex to parse: {reason}")]

@@ -12,6 +12,39 @@ use crate::diag::Error;
 #[grammar = "../../grammar/shaping.pest"]
 struct BatParser;
 
+/// The reserved words of the grammar's `keyword` rule.
+const RESERVED: [&str; 29] = [
+    "robot",
+    "sensor",
+    "actuator",
+    "genome",
+    "stage",
+    "extends",
+    "module",
+    "sense",
+    "activation",
+    "behavior",
+    "learn",
+    "reinforce",
+    "links",
+    "link",
+    "world",
+    "evolve",
+    "test",
+    "fitness",
+    "and",
+    "or",
+    "not",
+    "prev",
+    "until",
+    "within",
+    "for",
+    "uses",
+    "per",
+    "adds",
+    "changes",
+];
+
 /// Deepest nesting of brackets (and `? :`) accepted before parsing.
 const MAX_NESTING: usize = 48;
 /// Most grammar nodes in one expression (bounds every recursion over it).
@@ -237,7 +270,15 @@ fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
             return Error::TooComplex { span: span.into(), reason: message.to_lowercase() };
         }
     };
-    Error::Syntax { span: span.into(), expected, found }
+    let word = found.trim_matches('`');
+    let help = if RESERVED.contains(&word) && expected.contains("a name") {
+        Some(format!("`{word}` is a reserved word; choose another name"))
+    } else if pos == src.len() {
+        Some("the file ends too early: is a `}` or `)` missing?".to_string())
+    } else {
+        None
+    };
+    Error::Syntax { span: span.into(), expected, found, help }
 }
 
 /// The span of a pair, without the whitespace a trailing optional part
@@ -871,5 +912,20 @@ mod tests {
         assert!(check_nesting(&deep).is_some());
         assert!(check_nesting(&format!("// {deep}\n/* {deep} */")).is_none());
         assert!(check_nesting(&"(".repeat(MAX_NESTING)).is_none());
+    }
+}
+
+#[cfg(test)]
+mod keyword_tests {
+    use super::*;
+
+    /// `RESERVED` (used for help messages) matches the grammar's `keyword` rule.
+    #[test]
+    fn reserved_words_match_the_grammar() {
+        for w in RESERVED {
+            assert!(BatParser::parse(Rule::ident, w).map(|p| p.as_str() != w).unwrap_or(true), "{w}");
+            assert!(BatParser::parse(Rule::keyword, w).is_ok(), "{w}");
+        }
+        assert!(BatParser::parse(Rule::ident, "forwarder").is_ok());
     }
 }
