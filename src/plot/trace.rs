@@ -10,7 +10,6 @@ use super::ActivationTrace;
 
 const BAND: u32 = 56;
 const WIDTH: u32 = 1200;
-const LABEL_W: u32 = 150;
 const X_LABEL_H: u32 = 52;
 const MARGIN_TOP: u32 = 8;
 const MARGIN_BOTTOM: u32 = 14;
@@ -47,6 +46,13 @@ pub(super) struct Trace<'a> {
 }
 
 impl Trace<'_> {
+    /// Width of the band names at the left: a generous guess from the
+    /// longest name (about 9 px per character at 15 px), within 90..=300.
+    fn label_w(&self) -> u32 {
+        let longest = self.t.modules.iter().map(|m| m.chars().count()).chain([11]).max().unwrap_or(11);
+        (longest as u32).saturating_mul(9).saturating_add(24).clamp(90, 300)
+    }
+
     fn bands(&self) -> usize {
         self.t.modules.len()
             + usize::from(!self.t.battery.is_empty())
@@ -111,7 +117,7 @@ impl Figure for Trace<'_> {
             .margin_top(MARGIN_TOP)
             .margin_bottom(MARGIN_BOTTOM)
             .x_label_area_size(if text { X_LABEL_H } else { 0 })
-            .y_label_area_size(if text { LABEL_W } else { 0 })
+            .y_label_area_size(if text { self.label_w() } else { 0 })
             .build_cartesian_2d(-0.5..(n as f64 - 0.5), 0.0..nb as f64)?;
         let mut mesh = chart.configure_mesh();
         mesh.disable_y_mesh()
