@@ -182,7 +182,7 @@ impl Figure for Multi<'_> {
         marks(root, &chart, &stage_marks(self.stages), text)?;
 
         let names = [("best", best_colour()), ("mean", mean_colour())];
-        for (k, (name, c)) in names.into_iter().enumerate() {
+        for (k, (name, c)) in names.into_iter().enumerate().filter(|_| !sum.is_empty()) {
             let mut poly: Vec<(f64, f64)> = sum.iter().map(|s| (s.0, s.1[k].2)).collect();
             poly.extend(sum.iter().rev().map(|s| (s.0, s.1[k].1)));
             let a = chart.draw_series(std::iter::once(Polygon::new(poly, c.mix(0.18).filled())))?;

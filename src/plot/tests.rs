@@ -325,6 +325,9 @@ fn odd_values_are_drawn_not_refused() {
     assert_written(&d.stem("a"));
     let runs = vec![vec![GenPoint { generation: 0, best: 1.0, mean: 1.0 }]];
     multi_seed_fitness(&d.stem("b"), "", &runs, &[]).unwrap();
+    let nan = vec![vec![GenPoint { generation: 0, best: f32::NAN, mean: f32::NAN }]];
+    multi_seed_fitness(&d.stem("b"), "", &nan, &[]).unwrap();
+    assert_written(&d.stem("b"));
     rolling_reinforcement(&d.stem("c"), "", &[("x".into(), vec![0.0; 5])], 30, &[(900, "far".into())])
         .unwrap();
     let sc = TrajectoryScene { arena: [400.0, 600.0], body_radius: 27.5, ..TrajectoryScene::default() };
