@@ -504,5 +504,5 @@ fn episodes_are_deterministic_by_seed_and_trace_does_not_change_them() {
     assert_eq!(t.rows.len() as u32, a.actions);
     assert_eq!(t.modules, vec!["wander", "avoid", "follow", "recharge"]);
     let json = serde_json::to_string(&t.rows[0]).unwrap();
-    assert!(json.contains("\"pose\":["), "{json}");
+    assert!(json.contains("\"pose\":{\"x\":"), "{json}");
 }

@@ -65,7 +65,7 @@ pub mod script;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::{Serialize, Serializer};
+use serde::Serialize;
 
 use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
 use crate::expr::{Env, Expr};
@@ -131,7 +131,6 @@ pub struct TraceRow {
     /// Each module's performance indicator after this action.
     pub performance: Vec<f32>,
     /// Pose after the action.
-    #[serde(serialize_with = "serialize_pose")]
     pub pose: Pose,
     /// Objects gripped so far in the episode.
     pub grips: u32,
@@ -141,10 +140,6 @@ pub struct TraceRow {
     pub recharged: bool,
     /// The move of this action was undone by a collision.
     pub collided: bool,
-}
-
-fn serialize_pose<S: Serializer>(p: &Pose, s: S) -> Result<S::Ok, S::Error> {
-    [p.x, p.y, p.theta].serialize(s)
 }
 
 /// A stage or genome the controller cannot run.
@@ -206,6 +201,9 @@ impl Robot for Sim {
     }
     fn pose(&self) -> Pose {
         Sim::pose(self)
+    }
+    fn holding(&self) -> Option<bool> {
+        Some(Sim::holding(self))
     }
 }
 
