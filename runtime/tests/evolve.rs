@@ -459,6 +459,12 @@ fn bad_input_is_an_error_not_a_panic() {
     let mut cp = start_stage(&program, 0, 1, None).unwrap();
     let err = step_generation(&program, &mut cp, &nan).unwrap_err();
     assert!(matches!(err, EvolveError::NonFiniteFitness { index: 0, generation: 0, .. }), "{err}");
+    // A failed generation leaves the checkpoint as it was.
+    step_generation(&program, &mut cp, &ones).unwrap();
+    let before = cp.clone();
+    let err = step_generation(&program, &mut cp, &nan).unwrap_err();
+    assert!(matches!(err, EvolveError::NonFiniteFitness { generation: 1, .. }), "{err}");
+    assert_eq!(cp, before);
 
     let mut truncated = start_stage(&program, 0, 1, None).unwrap();
     truncated.population[3].bits.pop();

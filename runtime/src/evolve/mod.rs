@@ -216,15 +216,18 @@ pub fn step_generation(
     check_population(st, cp)?;
     let mask = frozen_mask(&st.layout);
     let g = cp.generation;
-    if g > 0 {
+    // The checkpoint is only modified once the generation succeeded, so an
+    // error leaves it as it was.
+    let mut population = if g > 0 {
         let mut rng = seed::rng(seed::breed_seed(cp.seed, cp.stage, g));
-        cp.population = next_generation(evo, &mask, &cp.population, &cp.fitness, &mut rng);
-    }
+        next_generation(evo, &mask, &cp.population, &cp.fitness, &mut rng)
+    } else {
+        cp.population.clone()
+    };
 
     let (run_seed, stage) = (cp.seed, cp.stage);
     let episodes = evo.evaluations.max(1);
-    let results: Vec<(f32, Option<Genome>)> = cp
-        .population
+    let results: Vec<(f32, Option<Genome>)> = population
         .par_iter()
         .enumerate()
         .map(|(i, genome)| {
@@ -269,10 +272,10 @@ pub fn step_generation(
     let (best_index, worst_index) = (ranked[0], ranked[ranked.len() - 1]);
     let best = fitness[best_index];
     if cp.best.as_ref().is_none_or(|(_, f)| best > *f) {
-        cp.best = Some((cp.population[best_index].clone(), best));
+        cp.best = Some((population[best_index].clone(), best));
     }
     if st.inheritance == Inheritance::Lamarckian {
-        for (genome, learned) in cp.population.iter_mut().zip(&learned_all) {
+        for (genome, learned) in population.iter_mut().zip(&learned_all) {
             if let Some(l) = learned {
                 for (bit, (&frozen, &v)) in genome.bits.iter_mut().zip(mask.iter().zip(&l.bits)) {
                     if !frozen {
@@ -292,6 +295,7 @@ pub fn step_generation(
         worst: fitness[worst_index],
         best_index: best_index as u32,
     };
+    cp.population = population;
     cp.fitness = fitness;
     cp.generation = g + 1;
     cp.history.push(stats.clone());
