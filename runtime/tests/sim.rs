@@ -1,0 +1,407 @@
+//! Behaviour of the simulated Khepera world.
+
+use proptest::prelude::*;
+use shaping_runtime::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT};
+use shaping_runtime::program::{Battery, Body, Charger, Objects, Wall, World};
+use shaping_runtime::sim::{Command, ObjectState, Pose, Sim};
+
+/// The paper's arena with every noise source off.
+fn world() -> World {
+    World {
+        arena: [400.0, 600.0],
+        body: Body { wheel_noise: 0.0, sensor_noise: 0.0, ..Body::default() },
+        charger: Some(Charger { wall: Wall::North, length: 200.0, lamp_height: Some(150.0) }),
+        battery: Some(Battery { capacity: 200, recharge: 20 }),
+        objects: None,
+    }
+}
+
+fn with_objects(count: u32, diameter: f32, virtual_: bool) -> World {
+    World { objects: Some(Objects { count, diameter, virtual_ }), ..world() }
+}
+
+fn wheels(l: f32, r: f32) -> Command {
+    Command { wheels: [l, r], ..Command::default() }
+}
+
+fn percept(sim: &mut Sim) -> [f32; CHANNELS] {
+    let mut p = [0.0; CHANNELS];
+    sim.sense(&mut p);
+    p
+}
+
+fn dist(a: Pose, b: Pose) -> f32 {
+    ((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt()
+}
+
+#[test]
+fn straight_motion_covers_v_max_times_action_time() {
+    let w = world();
+    let mut sim = Sim::new(&w, 1);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.3 }));
+    let out = sim.step(&wheels(1.0, 1.0));
+    assert!(!out.collided);
+    let p = sim.pose();
+    let expected = w.body.v_max * w.body.action_ms / 1000.0;
+    assert!((dist(p, Pose { x: 200.0, y: 300.0, theta: 0.0 }) - expected).abs() < 1e-3, "{p:?}");
+    assert!((p.theta - 0.3).abs() < 1e-6);
+    assert!((p.x - 200.0 - expected * 0.3f32.cos()).abs() < 1e-3);
+    // Half speed backwards: half the distance, the other way.
+    sim.step(&wheels(-0.5, -0.5));
+    assert!((dist(sim.pose(), p) - expected / 2.0).abs() < 1e-3);
+}
+
+#[test]
+fn wheel_noise_changes_the_distance_by_at_most_its_amplitude() {
+    let w = World { body: Body { wheel_noise: 0.05, ..world().body }, ..world() };
+    let mut seen = Vec::new();
+    for seed in 0..20 {
+        let mut sim = Sim::new(&w, seed);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+        sim.step(&wheels(1.0, 1.0));
+        let d = dist(sim.pose(), Pose { x: 200.0, y: 300.0, theta: 0.0 });
+        assert!((19.0 - 1e-3..=21.0 + 1e-3).contains(&d), "{d}");
+        seen.push(d);
+    }
+    assert!(seen.iter().any(|&d| (d - seen[0]).abs() > 0.05), "noise never varied: {seen:?}");
+}
+
+#[test]
+fn turning_in_place_keeps_the_position() {
+    let mut sim = Sim::new(&world(), 2);
+    let start = Pose { x: 100.0, y: 100.0, theta: 0.0 };
+    assert!(sim.set_pose(start));
+    sim.step(&wheels(-1.0, 1.0));
+    let p = sim.pose();
+    assert!(dist(p, start) < 1e-3);
+    // 20 mm per wheel on a 53 mm axle: 40/53 rad counter-clockwise.
+    assert!((p.theta - 40.0 / 53.0).abs() < 1e-4, "{}", p.theta);
+    sim.step(&wheels(1.0, -1.0));
+    assert!(sim.pose().theta.abs() < 1e-4);
+}
+
+#[test]
+fn an_arc_follows_the_exact_update() {
+    let mut sim = Sim::new(&world(), 3);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    sim.step(&wheels(0.5, 1.0));
+    // dl = 10, dr = 20: phi = 10/53, R = 15/phi.
+    let phi: f32 = 10.0 / 53.0;
+    let r = 15.0 / phi;
+    let p = sim.pose();
+    assert!((p.x - (200.0 + r * phi.sin())).abs() < 1e-3);
+    assert!((p.y - (300.0 + r * (1.0 - phi.cos()))).abs() < 1e-3);
+    assert!((p.theta - phi).abs() < 1e-5);
+}
+
+#[test]
+fn a_wall_stops_the_robot_and_reports_a_collision() {
+    let mut sim = Sim::new(&world(), 4);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 60.0, theta: -std::f32::consts::FRAC_PI_2 }));
+    let mut collided = false;
+    for _ in 0..5 {
+        collided |= sim.step(&wheels(1.0, 1.0)).collided;
+        assert!(sim.pose().y >= 27.5);
+    }
+    assert!(collided);
+    // It ends up touching the wall (within one substep).
+    assert!(sim.pose().y < 27.5 + 1.5, "{:?}", sim.pose());
+}
+
+#[test]
+fn start_poses_are_clear_of_walls_and_objects_and_vary() {
+    let w = with_objects(8, 25.0, false);
+    let mut xs = Vec::new();
+    for seed in 0..50 {
+        let sim = Sim::new(&w, seed);
+        let p = sim.pose();
+        assert!(p.x >= 67.5 && p.x <= 332.5 && p.y >= 67.5 && p.y <= 532.5, "{p:?}");
+        let scene = sim.scene();
+        assert_eq!(scene.objects.len(), 8);
+        for (i, o) in scene.objects.iter().enumerate() {
+            assert!(o.x >= 42.5 && o.x <= 357.5 && o.y >= 42.5 && o.y <= 557.5, "{o:?}");
+            let d = ((o.x - p.x).powi(2) + (o.y - p.y).powi(2)).sqrt();
+            assert!(d >= 27.5 + 12.5, "robot overlaps object: {d}");
+            for q in &scene.objects[..i] {
+                assert!(((o.x - q.x).powi(2) + (o.y - q.y).powi(2)).sqrt() >= 25.0);
+            }
+        }
+        xs.push(p.x);
+    }
+    xs.sort_by(f32::total_cmp);
+    assert!(xs[49] - xs[0] > 100.0);
+}
+
+#[test]
+fn same_seed_same_trajectory_other_seed_other() {
+    let w = World { body: Body::default(), ..with_objects(4, 10.0, true) };
+    let run = |seed: u64| {
+        let mut sim = Sim::new(&w, seed);
+        let mut trace = Vec::new();
+        for t in 0..200 {
+            let a = (t as f32 * 0.37).sin();
+            let mut p = [0.0; CHANNELS];
+            sim.sense(&mut p);
+            sim.step(&wheels(0.8, a));
+            trace.push((sim.pose(), p));
+        }
+        trace
+    };
+    assert_eq!(run(7), run(7));
+    assert_ne!(run(7), run(8));
+}
+
+#[test]
+fn front_sensors_rise_toward_a_wall_and_back_ones_do_not() {
+    let mut sim = Sim::new(&world(), 5);
+    // Facing east, approaching the east wall from 120 mm (centre) away.
+    assert!(sim.set_pose(Pose { x: 280.0, y: 300.0, theta: 0.0 }));
+    let mut prev = percept(&mut sim);
+    assert!(prev[..8].iter().all(|&v| v < 0.02), "{prev:?}");
+    for _ in 0..5 {
+        sim.step(&wheels(1.0, 1.0));
+        let p = percept(&mut sim);
+        for s in 1..=4 {
+            assert!(p[CH_IR + s] >= prev[CH_IR + s], "sensor {s} fell: {p:?}");
+        }
+        assert!(p[CH_IR + 6] < 0.02 && p[CH_IR + 7] < 0.02, "{p:?}");
+        prev = p;
+    }
+    // Touching: the front pair saturates.
+    assert!(prev[CH_IR + 2] > 0.95 && prev[CH_IR + 3] > 0.95, "{prev:?}");
+}
+
+#[test]
+fn a_small_object_gives_weaker_readings_than_a_large_one() {
+    let read = |diameter: f32| {
+        let mut sim = Sim::new(&with_objects(1, diameter, true), 6);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+        // Object surface 22 mm ahead of the body surface.
+        assert!(sim.set_object(0, 200.0 + 27.5 + 22.0 + diameter / 2.0, 300.0));
+        percept(&mut sim)
+    };
+    let small = read(10.0);
+    let large = read(25.0);
+    let s = small[CH_IR + 2] + small[CH_IR + 3];
+    let l = large[CH_IR + 2] + large[CH_IR + 3];
+    assert!(s > 0.05 && s < l, "small {s}, large {l}");
+}
+
+#[test]
+fn light_rises_toward_the_lamp() {
+    let mut sim = Sim::new(&world(), 9);
+    // Facing north, driving from the south wall to the bar under the lamp.
+    assert!(sim.set_pose(Pose { x: 200.0, y: 40.0, theta: std::f32::consts::FRAC_PI_2 }));
+    let first = percept(&mut sim);
+    let front = |p: &[f32; CHANNELS]| p[CH_LIGHT + 2] + p[CH_LIGHT + 3];
+    assert!(front(&first) > 0.01, "no gradient at the far wall: {first:?}");
+    assert!(front(&first) < 0.4, "{first:?}");
+    let mut prev = first;
+    for _ in 0..30 {
+        sim.step(&wheels(1.0, 1.0));
+        let p = percept(&mut sim);
+        assert!(front(&p) >= front(&prev) - 1e-6);
+        prev = p;
+    }
+    assert!(front(&prev) > 1.9, "{prev:?}");
+    // The back sensors face away from the lamp.
+    assert!(prev[CH_LIGHT + 6] + prev[CH_LIGHT + 7] < 0.01, "{prev:?}");
+}
+
+#[test]
+fn no_lamp_means_darkness() {
+    let w =
+        World { charger: Some(Charger { wall: Wall::North, length: 200.0, lamp_height: None }), ..world() };
+    let mut sim = Sim::new(&w, 1);
+    let p = percept(&mut sim);
+    assert!(p[CH_LIGHT..CH_LIGHT + 8].iter().all(|&v| v == 0.0));
+}
+
+#[test]
+fn the_battery_drains_and_recharges_only_at_the_bar_while_charging() {
+    let w = world();
+    let mut sim = Sim::new(&w, 10);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    assert_eq!(sim.battery(), 1.0);
+    for _ in 0..100 {
+        sim.step(&Command { charge: true, ..Command::default() });
+    }
+    assert!((sim.battery() - 0.5).abs() < 1e-6, "charging away from the bar drains: {}", sim.battery());
+    assert!((percept(&mut sim)[CH_BATTERY] - 0.5).abs() < 1e-6);
+    // At the bar (north wall, body touching) without asking: still drains.
+    assert!(sim.set_pose(Pose { x: 200.0, y: 600.0 - 27.5 - 1.0, theta: 0.0 }));
+    sim.step(&Command::default());
+    assert!((sim.battery() - 0.495).abs() < 1e-6);
+    // At the bar and charging: 1/20 per action, `recharged` once when full.
+    let mut recharged = 0;
+    for _ in 0..11 {
+        let out = sim.step(&Command { charge: true, ..Command::default() });
+        recharged += u32::from(out.recharged);
+    }
+    assert_eq!(sim.battery(), 1.0);
+    assert_eq!(recharged, 1);
+    // Next to the wall but beside the bar: no charging.
+    assert!(sim.set_pose(Pose { x: 50.0, y: 600.0 - 27.5 - 1.0, theta: 0.0 }));
+    sim.step(&Command { charge: true, ..Command::default() });
+    assert!(sim.battery() < 1.0);
+}
+
+#[test]
+fn an_empty_battery_kills_and_no_battery_never_does() {
+    let mut sim = Sim::new(&world(), 11);
+    for _ in 0..199 {
+        sim.step(&wheels(0.0, 0.0));
+        assert!(sim.alive());
+    }
+    sim.step(&wheels(0.0, 0.0));
+    assert!(!sim.alive());
+    assert_eq!(sim.battery(), 0.0);
+    let before = sim.pose();
+    sim.step(&wheels(1.0, 1.0));
+    assert_eq!(sim.pose(), before, "a dead robot does not move");
+
+    let mut immortal = Sim::new(&World { battery: None, ..world() }, 11);
+    for _ in 0..1000 {
+        immortal.step(&wheels(0.0, 0.0));
+    }
+    assert!(immortal.alive());
+    assert_eq!(immortal.battery(), 1.0);
+}
+
+/// The scripted grip: approach, arm down, back until the barrier, close.
+/// Returns the number of grips and whether the barrier was ever seen.
+fn grip_sequence(sim: &mut Sim) -> (u32, bool) {
+    let mut grips = 0;
+    // Forward until a front sensor reads 0.5 (or 10 actions).
+    for _ in 0..10 {
+        let p = percept(sim);
+        if p[CH_IR + 1..=CH_IR + 4].iter().any(|&v| v >= 0.5) {
+            break;
+        }
+        sim.step(&wheels(0.5, 0.5));
+    }
+    sim.step(&Command { arm: Some(true), ..Command::default() });
+    let mut seen = false;
+    for _ in 0..5 {
+        if percept(sim)[CH_BARRIER] == 1.0 {
+            seen = true;
+            break;
+        }
+        sim.step(&wheels(-0.2, -0.2));
+    }
+    seen |= percept(sim)[CH_BARRIER] == 1.0;
+    grips += sim.step(&Command { claw: Some(true), ..Command::default() }).grips;
+    grips += sim.step(&Command { arm: Some(false), ..Command::default() }).grips;
+    (grips, seen)
+}
+
+#[test]
+fn a_scripted_grip_catches_an_object_but_not_a_wall() {
+    for (diameter, virtual_) in [(10.0, false), (10.0, true), (25.0, false)] {
+        let mut sim = Sim::new(&with_objects(1, diameter, virtual_), 12);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.1 }));
+        assert!(sim.set_object(0, 260.0, 303.0));
+        let (grips, seen) = grip_sequence(&mut sim);
+        assert!(seen, "barrier never seen for {diameter} mm virtual={virtual_}");
+        assert_eq!(grips, 1);
+        assert!(sim.holding() && sim.claw_closed() && !sim.arm_down());
+        assert_eq!(sim.scene().objects[0].state, ObjectState::Held);
+        assert_eq!(percept(&mut sim)[CH_BARRIER], 1.0, "the barrier stays on while holding");
+    }
+    // The same in front of a wall: no barrier, no grip.
+    let mut sim = Sim::new(&with_objects(1, 10.0, false), 12);
+    assert!(sim.set_pose(Pose { x: 300.0, y: 300.0, theta: 0.0 }));
+    assert!(sim.set_object(0, 100.0, 100.0));
+    let (grips, seen) = grip_sequence(&mut sim);
+    assert!(!seen);
+    assert_eq!(grips, 0);
+    assert!(!sim.holding());
+}
+
+#[test]
+fn releasing_at_a_wall_throws_out_and_elsewhere_drops() {
+    for virtual_ in [false, true] {
+        let mut sim = Sim::new(&with_objects(1, 10.0, virtual_), 13);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+        assert!(sim.set_object(0, 200.0 + 27.5 + 15.0, 300.0));
+        sim.step(&Command { arm: Some(true), ..Command::default() });
+        assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 1);
+        sim.step(&Command { arm: Some(false), ..Command::default() });
+        // Open in the middle of the arena: dropped in front.
+        let out = sim.step(&Command { claw: Some(false), ..Command::default() });
+        assert_eq!(out.releases_outside, 0);
+        assert!(!sim.holding());
+        let o = sim.scene().objects[0];
+        assert_eq!(o.state, ObjectState::Floor);
+        assert!((o.x - (200.0 + 27.5 + 17.5)).abs() < 1e-3 && (o.y - 300.0).abs() < 1e-3, "{o:?}");
+        // Grip it again, carry it to the east wall, open: outside.
+        sim.step(&Command { arm: Some(true), ..Command::default() });
+        assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 1);
+        sim.step(&Command { arm: Some(false), ..Command::default() });
+        for _ in 0..15 {
+            sim.step(&wheels(1.0, 1.0));
+        }
+        assert!(sim.pose().x > 400.0 - 27.5 - 20.0, "{:?}", sim.pose());
+        let out = sim.step(&Command { claw: Some(false), ..Command::default() });
+        assert_eq!(out.releases_outside, 1);
+        assert!(!sim.holding());
+        let o = sim.scene().objects[0];
+        if virtual_ {
+            assert_eq!(o.state, ObjectState::Floor, "a virtual object comes back");
+            assert!(o.x >= 35.0 && o.x <= 365.0);
+        } else {
+            assert_eq!(o.state, ObjectState::Outside);
+        }
+    }
+}
+
+#[test]
+fn physical_objects_block_and_virtual_ones_do_not() {
+    for virtual_ in [false, true] {
+        let mut sim = Sim::new(&with_objects(1, 25.0, virtual_), 14);
+        assert!(sim.set_pose(Pose { x: 100.0, y: 300.0, theta: 0.0 }));
+        assert!(sim.set_object(0, 200.0, 300.0));
+        let mut collided = false;
+        for _ in 0..10 {
+            collided |= sim.step(&wheels(1.0, 1.0)).collided;
+        }
+        assert_eq!(collided, !virtual_);
+        let x = sim.pose().x;
+        if virtual_ {
+            assert!((x - 300.0).abs() < 1e-2);
+        } else {
+            assert!(x <= 200.0 - 40.0 && x > 200.0 - 42.0, "{x}");
+        }
+    }
+}
+
+fn arb_command() -> impl Strategy<Value = Command> {
+    (-1.5f32..1.5, -1.5f32..1.5, any::<Option<bool>>(), any::<Option<bool>>(), any::<bool>())
+        .prop_map(|(l, r, arm, claw, charge)| Command { wheels: [l, r], arm, claw, charge })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+    #[test]
+    fn never_leaves_the_arena_nor_enters_a_physical_object(
+        seed in any::<u64>(),
+        cmds in prop::collection::vec(arb_command(), 1..300),
+    ) {
+        let w = World { body: Body::default(), battery: None, ..with_objects(8, 25.0, false) };
+        let mut sim = Sim::new(&w, seed);
+        let mut p = [0.0; CHANNELS];
+        for cmd in &cmds {
+            sim.sense(&mut p);
+            prop_assert!(p.iter().all(|v| (0.0..=1.0).contains(v)));
+            sim.step(cmd);
+            let pose = sim.pose();
+            prop_assert!(pose.x >= 27.5 && pose.x <= 400.0 - 27.5, "{:?}", pose);
+            prop_assert!(pose.y >= 27.5 && pose.y <= 600.0 - 27.5, "{:?}", pose);
+            for o in sim.scene().objects.iter().filter(|o| o.state == ObjectState::Floor) {
+                let d = ((o.x - pose.x).powi(2) + (o.y - pose.y).powi(2)).sqrt();
+                prop_assert!(d >= 27.5 + 12.5 - 1e-3, "inside an object: {}", d);
+            }
+        }
+    }
+}
