@@ -215,6 +215,7 @@ pub fn step_generation(
 ) -> Result<GenStats, EvolveError> {
     let st = get_stage(program, cp.stage)?;
     let evo = evolution(st)?;
+    validate_evolution(st, evo)?;
     check_population(st, cp)?;
     let mask = frozen_mask(&st.layout);
     let g = cp.generation;
