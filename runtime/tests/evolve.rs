@@ -442,6 +442,10 @@ fn bad_input_is_an_error_not_a_panic() {
     let err = start_stage(&zero, 0, 1, None).unwrap_err();
     assert!(err.to_string().contains("`first`") && err.to_string().contains("population"), "{err}");
 
+    let mut empty = start_stage(&program, 0, 1, None).unwrap();
+    empty.population.clear();
+    assert!(matches!(step_generation(&zero, &mut empty, &ones), Err(EvolveError::InvalidParameter { .. })));
+
     let mut frozen_first = program.clone();
     frozen_first.stages[0].layout = layout(10, 2);
     assert!(matches!(

@@ -34,6 +34,7 @@
 pub mod error;
 pub mod fingerprint;
 pub mod ga;
+pub mod glue;
 pub mod seed;
 
 use rayon::prelude::*;
@@ -42,6 +43,7 @@ use serde::{Deserialize, Serialize};
 pub use error::EvolveError;
 pub use fingerprint::stage_fingerprint;
 pub use ga::{frozen_mask, next_generation, ranking};
+pub use glue::{evaluate_with_controller, EvalOptions};
 
 use crate::genome::Genome;
 use crate::program::{Evolution, Inheritance, Program, Selection, Stage, StageRun};
@@ -213,6 +215,7 @@ pub fn step_generation(
 ) -> Result<GenStats, EvolveError> {
     let st = get_stage(program, cp.stage)?;
     let evo = evolution(st)?;
+    validate_evolution(st, evo)?;
     check_population(st, cp)?;
     let mask = frozen_mask(&st.layout);
     let g = cp.generation;
