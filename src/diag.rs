@@ -2,7 +2,9 @@
 
 use std::io::IsTerminal;
 
-use miette::{Diagnostic, GraphicalReportHandler, GraphicalTheme, JSONReportHandler};
+use miette::{
+    Diagnostic, GraphicalReportHandler, GraphicalTheme, JSONReportHandler, ThemeCharacters, ThemeStyles,
+};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum ErrorFormat {
@@ -26,9 +28,12 @@ pub fn render(diag: &dyn Diagnostic, format: ErrorFormat) -> String {
             };
             GraphicalReportHandler::new_themed(theme).with_width(100).render_report(&mut out, diag)
         }
-        ErrorFormat::Plain => GraphicalReportHandler::new_themed(GraphicalTheme::ascii())
-            .with_width(100)
-            .render_report(&mut out, diag),
+        ErrorFormat::Plain => GraphicalReportHandler::new_themed(GraphicalTheme {
+            characters: ThemeCharacters::ascii(),
+            styles: ThemeStyles::none(),
+        })
+        .with_width(100)
+        .render_report(&mut out, diag),
         ErrorFormat::Json => JSONReportHandler::new().render_report(&mut out, diag),
     };
     if result.is_err() {

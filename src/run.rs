@@ -181,13 +181,13 @@ fn evolve_stage(
             cp
         }
         None => evolve::start_stage(program, index, seed, parent)
-            .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?,
+            .map_err(|e| CliError::io(format!("error: {e}")))?,
     };
     let bar = progress_bar(args, stage, evo.generations, cp.generation);
     let eval = evaluator(stage, evo.actions);
     while !evolve::is_finished(program, &cp) {
         let stats = evolve::step_generation(program, &mut cp, &eval)
-            .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
+            .map_err(|e| CliError::io(format!("error: {e}")))?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats);
@@ -230,7 +230,7 @@ fn test_stage(
         Evaluation { fitness: r.fitness, learned: r.learned }
     };
     let outcome = evolve::test_best(program, index, seed, parent, &eval)
-        .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
+        .map_err(|e| CliError::io(format!("error: {e}")))?;
     // The same episode again, traced (same seed, same result).
     let mut trace = Trace::default();
     let opts = EpisodeOptions { actions, learning, seed: outcome.seed };
