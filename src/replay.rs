@@ -24,10 +24,12 @@ pub struct ReplayArgs {
 
 /// Reads a genome given as a bit string or as the path of a file holding one.
 fn parse_genome(arg: &str) -> Result<Genome, CliError> {
+    if arg.trim().is_empty() {
+        // A stage without evolvable values has an empty genome.
+        return Ok(Genome { bits: Vec::new() });
+    }
     if let Some(g) = Genome::from_bitstring(arg) {
-        if !g.bits.is_empty() {
-            return Ok(g);
-        }
+        return Ok(g);
     }
     let path = Path::new(arg);
     let bytes = load::read_bytes(path)?;
