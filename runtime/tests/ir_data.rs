@@ -261,11 +261,11 @@ fn fit(start: Params, pts: &[Point], knees: (f32, f32)) -> (Params, f32) {
 fn points(wall: &Table, cyl: &Table, s: usize) -> Vec<Point> {
     let mut pts = Vec::new();
     for (table, is_wall) in [(wall, true), (cyl, false)] {
-        for t in 0..DISTANCES {
-            for b in 0..BEARINGS {
+        for (t, rows) in table.iter().enumerate() {
+            for (b, row) in rows.iter().enumerate() {
                 let a = direction(b);
                 let dist = BODY + distance(t) + if is_wall { 0.0 } else { CYL_RADIUS };
-                pts.push(Point { wall: is_wall, dir: [a.cos(), a.sin()], dist, value: table[t][b][s] });
+                pts.push(Point { wall: is_wall, dir: [a.cos(), a.sin()], dist, value: row[s] });
             }
         }
     }
