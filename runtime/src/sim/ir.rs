@@ -211,22 +211,19 @@ impl SatTable {
         for (i, x) in v.iter_mut().enumerate().take(TABLE_LEN) {
             *x = saturate(Z_MIN + i as f32 / Z_SCALE, knee);
         }
-        v[TABLE_LEN] = v[TABLE_LEN - 1];
+        // Exactly 0 below the table and 1 above it.
+        v[0] = 0.0;
+        v[TABLE_LEN - 1] = 1.0;
+        v[TABLE_LEN] = 1.0;
         SatTable { v }
     }
 
+    /// [`saturate`] at `z`, interpolated (no branches on the value).
     #[inline]
     pub fn get(&self, z: f32) -> f32 {
-        if z <= Z_MIN {
-            return 0.0;
-        }
-        if z >= Z_MAX {
-            return 1.0;
-        }
-        let t = (z - Z_MIN) * Z_SCALE;
-        let i = t as usize;
+        let t = ((z - Z_MIN) * Z_SCALE).clamp(0.0, (TABLE_LEN - 1) as f32);
+        let i = (t as usize).min(TABLE_LEN - 1);
         let f = t - i as f32;
-        let i = i.min(TABLE_LEN - 1);
         self.v[i] + (self.v[i + 1] - self.v[i]) * f
     }
 }

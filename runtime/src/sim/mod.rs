@@ -16,7 +16,7 @@
 pub mod ir;
 mod scene;
 
-use rand::{Rng, SeedableRng};
+use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT};
@@ -133,6 +133,23 @@ fn uniform(rng: &mut ChaCha8Rng, lo: f32, hi: f32) -> f32 {
         lo + (hi - lo) * u
     } else {
         lo
+    }
+}
+
+/// Two uniform draws in `-n..n` from one 32-bit word (16 bits each: plenty
+/// for noise, and half the generator work).
+fn noise_pair(rng: &mut ChaCha8Rng, n: f32) -> (f32, f32) {
+    let u: u32 = rng.random();
+    let scale = 2.0 * n / 65535.0;
+    ((u & 0xffff) as f32 * scale - n, (u >> 16) as f32 * scale - n)
+}
+
+/// `sin(x) / x`, given `sin(x)`.
+fn sinc(x: f32, sin_x: f32) -> f32 {
+    if x.abs() < 1e-4 {
+        1.0 - x * x / 6.0
+    } else {
+        sin_x / x
     }
 }
 
@@ -313,14 +330,20 @@ impl Sim {
         let mut light = [0.0f32; ir::SENSORS];
         self.sense_light(&mut light);
         let n = self.sensor_noise;
+        if n > 0.0 {
+            // 16 bits of randomness per channel, one generator call.
+            let mut bits = [0u8; 4 * ir::SENSORS];
+            self.rng.fill_bytes(&mut bits);
+            let scale = 2.0 * n / 65535.0;
+            let noise = |k: usize| f32::from(u16::from_le_bytes([bits[2 * k], bits[2 * k + 1]])) * scale - n;
+            for s in 0..ir::SENSORS {
+                irv[s] += noise(s);
+                light[s] += noise(ir::SENSORS + s);
+            }
+        }
         for s in 0..ir::SENSORS {
-            let (a, b) = if n > 0.0 {
-                (uniform(&mut self.rng, -n, n), uniform(&mut self.rng, -n, n))
-            } else {
-                (0.0, 0.0)
-            };
-            out[CH_IR + s] = (irv[s] + a).clamp(0.0, 1.0);
-            out[CH_LIGHT + s] = (light[s] + b).clamp(0.0, 1.0);
+            out[CH_IR + s] = irv[s].clamp(0.0, 1.0);
+            out[CH_LIGHT + s] = light[s].clamp(0.0, 1.0);
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
@@ -545,31 +568,62 @@ impl Sim {
         let mut dl = finite_or(wheels[0], 0.0).clamp(-1.0, 1.0) * self.travel;
         let mut dr = finite_or(wheels[1], 0.0).clamp(-1.0, 1.0) * self.travel;
         if self.wheel_noise > 0.0 {
-            let n = self.wheel_noise;
-            dl *= 1.0 + uniform(&mut self.rng, -n, n);
-            dr *= 1.0 + uniform(&mut self.rng, -n, n);
+            let (a, b) = noise_pair(&mut self.rng, self.wheel_noise);
+            dl *= 1.0 + a;
+            dr *= 1.0 + b;
         }
         if dl == 0.0 && dr == 0.0 {
             return false;
         }
         let start = self.pose;
-        let end = self.arc(start, dl, dr);
-        let mid = self.arc(start, dl / 2.0, dr / 2.0);
-        if self.free(end.x, end.y) && self.free(mid.x, mid.y) {
-            self.set_pose_unchecked(end);
+        // The exact arc in chord form (the same as `arc`): the centre moves by
+        // `d * sinc(phi / 2)` along `theta + phi / 2`, and halfway by
+        // `d / 2 * sinc(phi / 4)` along `theta + phi / 4`. One `sin_cos` of
+        // `phi / 4` and the cached heading give everything by double angles.
+        let d = (dl + dr) / 2.0;
+        let phi = (dr - dl) / (2.0 * self.half_axle);
+        let q = phi / 4.0;
+        let (s1, c1) = q.sin_cos();
+        let (s2, c2) = (2.0 * s1 * c1, c1 * c1 - s1 * s1);
+        let (s4, c4) = (2.0 * s2 * c2, c2 * c2 - s2 * s2);
+        let (c0, s0) = (self.cos_t, self.sin_t);
+        let rot = |c: f32, s: f32| (c0 * c - s0 * s, s0 * c + c0 * s);
+        let (ce, se) = rot(c2, s2);
+        let len = d * sinc(2.0 * q, s2);
+        let (ex, ey) = (start.x + len * ce, start.y + len * se);
+        let (cm, sm) = rot(c1, s1);
+        let half = d / 2.0 * sinc(q, s1);
+        let (mx, my) = (start.x + half * cm, start.y + half * sm);
+        if self.free(ex, ey) && self.free(mx, my) {
+            let (ct, st) = rot(c4, s4);
+            let norm = 1.0 / (ct * ct + st * st).sqrt();
+            self.pose = Pose { x: ex, y: ey, theta: wrap_angle(start.theta + phi) };
+            self.cos_t = ct * norm;
+            self.sin_t = st * norm;
             return false;
         }
+        // Retrace in `n` equal sub-arcs: each moves the centre by the chord
+        // `len` along the current heading turned by half its angle, then
+        // turns the heading by its angle (rotations, no more `sin_cos`).
         let n = ((dl.abs().max(dr.abs()) / SUBSTEP).ceil() as u32).clamp(1, 10_000);
-        let (sl, sr) = (dl / n as f32, dr / n as f32);
-        let mut pose = start;
-        for _ in 0..n {
-            let next = self.arc(pose, sl, sr);
-            if !self.free(next.x, next.y) {
+        let sub = phi / n as f32;
+        let (sh, ch) = (sub / 2.0).sin_cos();
+        let (sf, cf) = (2.0 * sh * ch, ch * ch - sh * sh);
+        let len = d / n as f32 * sinc(sub / 2.0, sh);
+        let (mut x, mut y, mut c, mut s) = (start.x, start.y, c0, s0);
+        let mut k = 0;
+        while k < n {
+            let (nx, ny) = (x + len * (c * ch - s * sh), y + len * (s * ch + c * sh));
+            if !self.free(nx, ny) {
                 break;
             }
-            pose = next;
+            (x, y, c, s) = (nx, ny, c * cf - s * sf, s * cf + c * sf);
+            k += 1;
         }
-        self.set_pose_unchecked(pose);
+        let norm = 1.0 / (c * c + s * s).sqrt();
+        self.pose = Pose { x, y, theta: wrap_angle(start.theta + sub * k as f32) };
+        self.cos_t = c * norm;
+        self.sin_t = s * norm;
         true
     }
 
