@@ -576,7 +576,7 @@ impl Sim {
             return false;
         }
         let start = self.pose;
-        // The exact arc in chord form (the same as `arc`): the centre moves by
+        // The exact arc (spec 1.3) in chord form: the centre moves by
         // `d * sinc(phi / 2)` along `theta + phi / 2`, and halfway by
         // `d / 2 * sinc(phi / 4)` along `theta + phi / 4`. One `sin_cos` of
         // `phi / 4` and the cached heading give everything by double angles.
@@ -625,19 +625,6 @@ impl Sim {
         self.cos_t = c * norm;
         self.sin_t = s * norm;
         true
-    }
-
-    /// The exact differential-drive arc for wheel travels `dl`, `dr` (mm).
-    fn arc(&self, p: Pose, dl: f32, dr: f32) -> Pose {
-        let d = (dl + dr) / 2.0;
-        let phi = (dr - dl) / (2.0 * self.half_axle);
-        let (s0, c0) = p.theta.sin_cos();
-        if phi.abs() < 1e-6 {
-            return Pose { x: p.x + d * c0, y: p.y + d * s0, theta: p.theta };
-        }
-        let r = d / phi;
-        let (s1, c1) = (p.theta + phi).sin_cos();
-        Pose { x: p.x + r * (s1 - s0), y: p.y - r * (c1 - c0), theta: wrap_angle(p.theta + phi) }
     }
 
     pub fn pose(&self) -> Pose {
