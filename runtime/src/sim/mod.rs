@@ -66,7 +66,7 @@ pub const CATCH_NEAR: f32 = 5.0;
 /// ... to this far, mm ...
 pub const CATCH_FAR: f32 = 30.0;
 /// ... and at most this far to either side of the heading, mm.
-pub const CATCH_HALF_WIDTH: f32 = 8.0;
+pub const CATCH_HALF_WIDTH: f32 = 15.0;
 /// Opening the claw throws the object out when the body surface is this
 /// close to a wall, mm ...
 pub const RELEASE_REACH: f32 = 20.0;
@@ -624,7 +624,7 @@ impl Sim {
         self.pose = Pose { x, y, theta: wrap_angle(start.theta + sub * k as f32) };
         self.cos_t = c * norm;
         self.sin_t = s * norm;
-        true
+        k < n
     }
 
     pub fn pose(&self) -> Pose {
