@@ -465,3 +465,53 @@ fn toward_ir_then_back_until_barrier_grips_a_small_object() {
         }
     }
 }
+
+fn arb_f32() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        4 => -50.0f32..1000.0,
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => Just(0.0f32),
+    ]
+}
+
+fn arb_world() -> impl Strategy<Value = World> {
+    (
+        (arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32()),
+        (any::<Option<(u32, u32)>>(), any::<Option<(u32, bool)>>(), arb_f32(), arb_f32(), arb_f32()),
+    )
+        .prop_map(|((w, d, radius, axle, v, ms, wn, sn), (battery, objects, diam, bar, lamp))| World {
+            arena: [w, d],
+            body: Body {
+                radius,
+                wheel_base: axle,
+                v_max: v,
+                action_ms: ms,
+                wheel_noise: wn,
+                sensor_noise: sn,
+            },
+            charger: Some(Charger { wall: Wall::East, length: bar, lamp_height: Some(lamp) }),
+            battery: battery
+                .map(|(capacity, recharge)| Battery { capacity: capacity % 1000, recharge: recharge % 100 }),
+            objects: objects.map(|(count, virtual_)| Objects { count: count % 64, diameter: diam, virtual_ }),
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Any declared world, however odd, simulates without panicking and
+    /// yields readings in 0..1.
+    #[test]
+    fn odd_worlds_never_panic(w in arb_world(), seed in any::<u64>(), cmds in prop::collection::vec(arb_command(), 0..20)) {
+        let mut sim = Sim::new(&w, seed);
+        let mut p = [0.0; CHANNELS];
+        for cmd in &cmds {
+            sim.sense(&mut p);
+            prop_assert!(p.iter().all(|v| (0.0..=1.0).contains(v)), "{:?}", p);
+            sim.step(cmd);
+        }
+        let _ = sim.scene();
+        prop_assert!((0.0..=1.0).contains(&sim.battery()));
+    }
+}

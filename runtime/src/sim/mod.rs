@@ -81,6 +81,9 @@ pub const MAX_OBJECTS: usize = 1024;
 const SUBSTEP: f32 = 1.0;
 /// Attempts at a random free position before giving up.
 const PLACE_TRIES: u32 = 1000;
+/// Attempts for all the objects of a world together (a crowded world is
+/// filled quickly, overlaps allowed, instead of slowly).
+const PLACE_BUDGET: u32 = 20_000;
 
 /// One object of the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,13 +129,13 @@ pub struct Sim {
     held: Option<usize>,
 }
 
-/// A uniform draw in `lo..hi` that never panics (returns `lo` if `hi <= lo`).
+/// A uniform draw in `lo..hi` that never panics (the middle if `hi <= lo`).
 fn uniform(rng: &mut ChaCha8Rng, lo: f32, hi: f32) -> f32 {
     let u: f32 = rng.random();
     if hi > lo {
         lo + (hi - lo) * u
     } else {
-        lo
+        (lo + hi) / 2.0
     }
 }
 
@@ -225,8 +228,10 @@ impl Sim {
             held: None,
         };
         // Objects first, then the robot somewhere free.
+        let mut budget = PLACE_BUDGET;
         for _ in 0..count {
-            let (x, y) = sim.free_spot(&mut rng, None);
+            let ((x, y), used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
+            budget = budget.saturating_sub(used);
             sim.objects.push(Obj { x, y, state: ObjectState::Floor });
         }
         let margin = radius + START_CLEARANCE;
@@ -251,12 +256,15 @@ impl Sim {
 
     /// A random position for an object centre, at least [`OBJECT_CLEARANCE`]
     /// from the walls and not overlapping other floor objects (nor the robot
-    /// when `robot` is given). Gives up after a while and returns the last try.
-    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Pose>) -> (f32, f32) {
+    /// when `robot` is given). Gives up after `tries` (at least one) and
+    /// returns the last try; also returns the number of tries used.
+    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Pose>, tries: u32) -> ((f32, f32), u32) {
         let r = self.obj_radius;
         let m = r + OBJECT_CLEARANCE;
         let mut spot = (self.width / 2.0, self.depth / 2.0);
-        for _ in 0..PLACE_TRIES {
+        let mut used = 0;
+        while used < tries.max(1) {
+            used += 1;
             let x = uniform(rng, m, self.width - m);
             let y = uniform(rng, m, self.depth - m);
             spot = (x, y);
@@ -271,7 +279,7 @@ impl Sim {
                 break;
             }
         }
-        spot
+        (spot, used)
     }
 
     fn set_pose_unchecked(&mut self, pose: Pose) {
@@ -515,7 +523,7 @@ impl Sim {
             out.releases_outside += 1;
             if self.obj_virtual {
                 let mut rng = self.rng.clone();
-                let (x, y) = self.free_spot(&mut rng, Some(self.pose));
+                let ((x, y), _) = self.free_spot(&mut rng, Some(self.pose), PLACE_TRIES);
                 self.rng = rng;
                 self.objects[i] = Obj { x, y, state: ObjectState::Floor };
             } else {
