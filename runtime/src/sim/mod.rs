@@ -9,6 +9,22 @@
 //! placement, wheel and sensor noise) comes from one `ChaCha8Rng` seeded with
 //! the `seed` given to [`Sim::new`], so the same seed and commands give the
 //! same trajectory. [`Sim::sense`] and [`Sim::step`] never allocate.
+//!
+//! The models, in brief (constants below and in [`ir`]):
+//! - motion: exact differential-drive arc per action, wheel travel
+//!   `command * v_max * action_ms` times `1 +- wheel_noise`; a move whose end
+//!   or middle would overlap a wall or a physical object is retraced in 1 mm
+//!   substeps and stops before the overlap (`Outcome::collided`);
+//! - IR: [`ir::KHEPERA`], fitted to real readings; walls and floor objects
+//!   add up, clamped at 1, plus `+-sensor_noise`;
+//! - light: a lamp above the bar's middle, irradiance falling as
+//!   `1 / (rho^2 + h^2)` times a `cos(1.5 a)` lobe around each sensor's axis;
+//! - battery: integer charge, `-1/capacity` per action, `+1/recharge` per
+//!   action asked to charge with the body within [`CONTACT`] mm of the bar;
+//! - gripper: arm and claw change at the start of the action; closing the
+//!   claw on an object in the catch zone grips it; opening it with a wall
+//!   ahead throws the object out (a virtual one comes back elsewhere),
+//!   otherwise drops it in front.
 
 // Loops over the 8 sensors index several parallel arrays.
 #![allow(clippy::needless_range_loop)]
@@ -65,7 +81,10 @@ pub const CONTACT: f32 = 3.0;
 pub const CATCH_NEAR: f32 = 5.0;
 /// ... to this far, mm ...
 pub const CATCH_FAR: f32 = 30.0;
-/// ... and at most this far to either side of the heading, mm.
+/// ... and at most this far to either side of the heading, mm: half the open
+/// claw's gap (about 27-29 mm on the K-Team gripper), which also covers the
+/// +-20 degree dead band of `toward(...)` at catch distance (the spec's +-8
+/// mm made a `toward(ir); arm down; back until barrier` sequence miss).
 pub const CATCH_HALF_WIDTH: f32 = 15.0;
 /// Opening the claw throws the object out when the body surface is this
 /// close to a wall, mm ...
