@@ -18,9 +18,11 @@
 //! Cylinders of other radii than the measured 12.5 mm: we assume the returned
 //! light scales with the fraction `r / (r + r0)` of the beam a cylinder of
 //! radius `r` intercepts (a wall is the limit `r -> inf`); relative to the
-//! measured cylinder that shifts `reach` by `decay * ln(g(r) / g(12.5))`. A
-//! 10 mm object therefore gives weaker, shorter-range readings (about 2.4 mm
-//! less reach), a very large one approaches the wall response.
+//! measured cylinder that shifts `reach` by `decay * ln(g(r) / g(12.5))`.
+//! With `r0 = 13` mm a 10 mm object reads 0.57 times as much as the 25 mm
+//! one at the same distance (about 1.2 mm less reach with the fitted decay of
+//! ~2.1 mm), and larger cylinders read more, up to 2 times (the limit of the
+//! assumption). Held objects are off the floor and read nothing.
 
 // Loops over the 8 sensors index several parallel arrays.
 #![allow(clippy::needless_range_loop)]
@@ -31,9 +33,10 @@ use std::sync::OnceLock;
 pub const SENSORS: usize = 8;
 /// Radius of the cylinder the cylinder constants were measured with, mm.
 pub const REF_CYLINDER_RADIUS: f32 = 12.5;
-/// How far beyond the body surface any surface can still be seen, mm
-/// (the real readings are at noise level by 41 mm).
-pub const RANGE: f32 = 45.0;
+/// How far beyond the body surface a surface is still considered, mm. The
+/// front sensors are at noise level by 41 mm, the most sensitive back ones
+/// still read ~0.07 at 43 mm; beyond 60 mm the model gives < 0.002.
+pub const RANGE: f32 = 60.0;
 /// The nearest measured distance from the body surface, mm; objects closer
 /// than this (virtual ones under the body) read as if at this distance.
 pub const NEAREST: f32 = 5.0;
@@ -74,18 +77,18 @@ pub struct IrModel {
 /// sharing the sensor geometry between the two surfaces; it prints this
 /// constant. `cylinder_r0` is an assumption, not fitted (one diameter only).
 pub const KHEPERA: IrModel = IrModel {
-    position_deg: [68.0, 43.0, 13.0, -13.0, -43.0, -68.0, -158.0, 158.0],
-    axis_deg: [72.0, 44.0, 8.0, -16.0, -44.0, -72.0, -168.0, 168.0],
+    position_deg: [70.25, 41.81, 11.06, -15.25, -43.00, -69.31, -164.75, 167.44],
+    axis_deg: [67.06, 42.62, 2.31, -16.75, -46.62, -84.06, -178.19, 163.44],
     wall: Response {
-        reach: [24.0, 24.0, 22.0, 21.0, 24.0, 27.0, 24.0, 27.0],
-        decay: [5.0; SENSORS],
-        focus: [8.0; SENSORS],
-        knee: 2.0,
+        reach: [22.03, 21.59, 20.50, 17.94, 23.00, 26.19, 20.66, 25.31],
+        decay: [3.50, 3.92, 3.59, 3.28, 3.78, 4.80, 3.64, 5.03],
+        focus: [5.28, 5.53, 6.50, 6.94, 6.12, 4.62, 4.53, 3.50],
+        knee: 3.0,
     },
     cylinder: Response {
-        reach: [19.0, 19.0, 18.0, 17.0, 19.0, 21.0, 19.0, 21.0],
-        decay: [3.5; SENSORS],
-        focus: [12.0; SENSORS],
+        reach: [18.34, 18.38, 17.00, 15.16, 19.47, 21.53, 17.06, 21.06],
+        decay: [2.22, 2.36, 2.09, 1.97, 2.12, 2.80, 2.25, 2.95],
+        focus: [4.34, 4.56, 4.03, 3.94, 5.97, 4.41, 3.81, 3.56],
         knee: 2.0,
     },
     cylinder_r0: 13.0,
@@ -211,22 +214,19 @@ impl SatTable {
         for (i, x) in v.iter_mut().enumerate().take(TABLE_LEN) {
             *x = saturate(Z_MIN + i as f32 / Z_SCALE, knee);
         }
-        v[TABLE_LEN] = v[TABLE_LEN - 1];
+        // Exactly 0 below the table and 1 above it.
+        v[0] = 0.0;
+        v[TABLE_LEN - 1] = 1.0;
+        v[TABLE_LEN] = 1.0;
         SatTable { v }
     }
 
+    /// [`saturate`] at `z`, interpolated (no branches on the value).
     #[inline]
     pub fn get(&self, z: f32) -> f32 {
-        if z <= Z_MIN {
-            return 0.0;
-        }
-        if z >= Z_MAX {
-            return 1.0;
-        }
-        let t = (z - Z_MIN) * Z_SCALE;
-        let i = t as usize;
+        let t = ((z - Z_MIN) * Z_SCALE).clamp(0.0, (TABLE_LEN - 1) as f32);
+        let i = (t as usize).min(TABLE_LEN - 1);
         let f = t - i as f32;
-        let i = i.min(TABLE_LEN - 1);
         self.v[i] + (self.v[i + 1] - self.v[i]) * f
     }
 }
