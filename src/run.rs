@@ -6,11 +6,11 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
+use shaping_runtime::controller::{episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace};
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Program, Stage, StageRun};
-use shaping_runtime::sim::Sim;
+use shaping_runtime::sim::{Scene, Sim};
 
 use crate::load::{self, create_dir, write_atomic, CliError};
 use crate::report;
@@ -213,6 +213,48 @@ fn evolve_stage(
     Ok(cp)
 }
 
+/// One life of a test stage's individual: `actions` in the world of the stage
+/// it extends ("before"), then `actions` in the stage's own world ("after"),
+/// with one controller, so what local learning acquired before the change
+/// carries over (the paper's section 4.9).
+pub struct BeforeAfter {
+    pub trace: Trace,
+    /// Index of the first action in the changed world.
+    pub switch: u32,
+    pub before: EpisodeResult,
+    pub after: EpisodeResult,
+    /// The changed world at its start, for the trajectory picture.
+    pub scene: Scene,
+}
+
+pub fn before_after(
+    parent: &Stage,
+    stage: &Stage,
+    genome: &Genome,
+    actions: u32,
+    learning: bool,
+    seed: u64,
+) -> Result<BeforeAfter, CliError> {
+    let (sim_seed, rng) = episode_rngs(seed);
+    let mut ctl = Controller::new(stage, genome, rng)
+        .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
+    let opts = EpisodeOptions { actions, learning, seed };
+    let mut first = Trace::default();
+    let before = ctl.run(&mut Sim::new(&parent.world, sim_seed), &opts, Some(&mut first));
+    let mut second = Trace::default();
+    let after_seed = sim_seed ^ 0x9e37_79b9_7f4a_7c15;
+    let mut sim = Sim::new(&stage.world, after_seed);
+    let scene = sim.scene();
+    let after = ctl.run(&mut sim, &opts, Some(&mut second));
+    let switch = first.rows.len() as u32;
+    let mut trace = first;
+    trace.rows.extend(second.rows.into_iter().map(|mut r| {
+        r.action += switch;
+        r
+    }));
+    Ok(BeforeAfter { trace, switch, before, after, scene })
+}
+
 #[allow(clippy::too_many_arguments)]
 fn test_stage(
     program: &Program,
@@ -229,35 +271,71 @@ fn test_stage(
         let r = run_episode(stage, genome, &EpisodeOptions { actions, learning, seed: episode }, None);
         Evaluation { fitness: r.fitness, learned: r.learned }
     };
+    // Checks that the parent fits and picks its best individual and the episode seed.
     let outcome = evolve::test_best(program, index, seed, parent, &eval)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
-    // The same episode again, traced (same seed, same result).
-    let mut trace = Trace::default();
-    let opts = EpisodeOptions { actions, learning, seed: outcome.seed };
-    let r = run_episode(stage, &outcome.genome, &opts, Some(&mut trace));
-    let scene = Sim::new(&stage.world, outcome.seed).scene();
-    report::episode_files(dir, &stage.name, stage, &trace, &scene, &[])?;
+    let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
+    let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
+    let mark = [(ba.switch, format!("world of `{}`", stage.name))];
+    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.scene, &mark)?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
+    let perf = |r: &EpisodeResult| {
+        serde_json::json!({
+            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
+            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
+        })
+    };
+    let (b, a) = (&ba.before, &ba.after);
     let summary = serde_json::json!({
-        "stage": stage.name, "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
-        "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
-        "learning": learning, "parent_fitness": outcome.parent_fitness, "seed": outcome.seed,
+        "stage": stage.name, "learning": learning, "seed": outcome.seed,
+        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
+        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
+        "before": perf(b), "after": perf(a),
+        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
     });
     write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
     if args.json {
         println!("{summary}");
     } else if !args.quiet {
         eprintln!(
-            "stage {:<12} test of the best for {} actions: fitness {:.3}, {} grips, {} released outside  -> {}",
+            "stage {:<12} test of the best, {} actions before and {} after the change: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
             stage.name,
-            r.actions,
-            r.fitness,
-            r.grips,
-            r.releases_outside,
+            b.actions,
+            a.actions,
+            b.fitness,
+            a.fitness,
+            b.grips,
+            a.grips,
             dir.display()
         );
     }
     Ok(())
+}
+
+/// Mean reinforcement of each learning module over the life before the world
+/// changed, the first 100 actions after it, and the rest after it.
+fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json::Value {
+    let mean = |v: &[f32]| {
+        let xs: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+        if xs.is_empty() {
+            serde_json::Value::Null
+        } else {
+            serde_json::json!(xs.iter().sum::<f32>() / xs.len() as f32)
+        }
+    };
+    let mut out = serde_json::Map::new();
+    for (i, name) in report::learning_modules(stage) {
+        let sig = report::reinforcement_signals(trace, i);
+        let s = (switch as usize).min(sig.len());
+        let early = (s + 100).min(sig.len());
+        out.insert(
+            name,
+            serde_json::json!({
+                "before": mean(&sig[..s]), "after_first_100": mean(&sig[s..early]), "after_rest": mean(&sig[early..]),
+            }),
+        );
+    }
+    serde_json::Value::Object(out)
 }
 
 fn progress_bar(args: &RunArgs, stage: &Stage, generations: u32, done: u32) -> ProgressBar {

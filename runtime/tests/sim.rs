@@ -334,9 +334,11 @@ fn releasing_at_a_wall_throws_out_and_elsewhere_drops() {
         let o = sim.scene().objects[0];
         assert_eq!(o.state, ObjectState::Floor);
         assert!((o.x - (200.0 + 27.5 + 17.5)).abs() < 1e-3 && (o.y - 300.0).abs() < 1e-3, "{o:?}");
-        // Grip it again, carry it to the east wall, open: outside.
+        // Grip it again (no new grip event: the same object), carry it to
+        // the east wall, open: outside.
         sim.step(&Command { arm: Some(true), ..Command::default() });
-        assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 1);
+        assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 0);
+        assert!(sim.holding());
         sim.step(&Command { arm: Some(false), ..Command::default() });
         for _ in 0..15 {
             sim.step(&wheels(1.0, 1.0));
@@ -571,4 +573,20 @@ fn sensor_noise_stays_within_its_amplitude() {
     }
     // Half the draws are negative and clamp to 0.
     assert!((600..1000).contains(&nonzero), "{nonzero}");
+}
+
+#[test]
+fn regripping_a_dropped_object_is_not_a_new_grip() {
+    let mut sim = Sim::new(&with_objects(1, 10.0, true), 13);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    assert!(sim.set_object(0, 200.0 + 27.5 + 15.0, 300.0));
+    sim.step(&Command { arm: Some(true), ..Command::default() });
+    assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 1);
+    // Open in the middle of the arena (the object drops in front), close again.
+    let open = sim.step(&Command { claw: Some(false), ..Command::default() });
+    assert_eq!(open.releases_outside, 0);
+    assert!(!sim.holding());
+    let again = sim.step(&Command { claw: Some(true), ..Command::default() });
+    assert!(sim.holding(), "the dropped object is in the catch zone and is gripped again");
+    assert_eq!(again.grips, 0, "the same object gripped twice counts once");
 }

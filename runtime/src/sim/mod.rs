@@ -22,7 +22,8 @@
 //! - battery: integer charge, `-1/capacity` per action, `+1/recharge` per
 //!   action asked to charge with the body within [`CONTACT`] mm of the bar;
 //! - gripper: arm and claw change at the start of the action; closing the
-//!   claw on an object in the catch zone grips it; opening it with a wall
+//!   claw on an object in the catch zone grips it (a grip event only the
+//!   first time for each object); opening it with a wall
 //!   ahead throws the object out (a virtual one comes back elsewhere),
 //!   otherwise drops it in front.
 
@@ -110,6 +111,9 @@ struct Obj {
     x: f32,
     y: f32,
     state: ObjectState,
+    /// Gripped before: gripping it again (after a drop inside the arena) is
+    /// not a new grip event, so fitness cannot be farmed on one object.
+    gripped: bool,
 }
 
 /// One simulated episode's world state.
@@ -251,7 +255,7 @@ impl Sim {
         for _ in 0..count {
             let ((x, y), used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
             budget = budget.saturating_sub(used);
-            sim.objects.push(Obj { x, y, state: ObjectState::Floor });
+            sim.objects.push(Obj { x, y, state: ObjectState::Floor, gripped: false });
         }
         let margin = radius + START_CLEARANCE;
         let mut pose = Pose { x: width / 2.0, y: depth / 2.0, theta: 0.0 };
@@ -505,9 +509,11 @@ impl Sim {
             Some(true) if !self.claw_closed => {
                 if self.held.is_none() && self.arm_down {
                     if let Some(i) = self.catchable() {
-                        self.objects[i].state = ObjectState::Held;
+                        let obj = &mut self.objects[i];
+                        obj.state = ObjectState::Held;
+                        out.grips += u32::from(!obj.gripped);
+                        obj.gripped = true;
                         self.held = Some(i);
-                        out.grips += 1;
                     }
                 }
                 self.claw_closed = true;
@@ -544,7 +550,7 @@ impl Sim {
                 let mut rng = self.rng.clone();
                 let ((x, y), _) = self.free_spot(&mut rng, Some(self.pose), PLACE_TRIES);
                 self.rng = rng;
-                self.objects[i] = Obj { x, y, state: ObjectState::Floor };
+                self.objects[i] = Obj { x, y, state: ObjectState::Floor, gripped: false };
             } else {
                 self.objects[i].state = ObjectState::Outside;
             }
@@ -558,7 +564,7 @@ impl Sim {
         if !self.obj_virtual && (x - self.pose.x).powi(2) + (y - self.pose.y).powi(2) < d * d {
             return false;
         }
-        self.objects[i] = Obj { x, y, state: ObjectState::Floor };
+        self.objects[i] = Obj { x, y, state: ObjectState::Floor, gripped: true };
         self.held = None;
         true
     }
