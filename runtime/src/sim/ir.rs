@@ -74,18 +74,18 @@ pub struct IrModel {
 /// sharing the sensor geometry between the two surfaces; it prints this
 /// constant. `cylinder_r0` is an assumption, not fitted (one diameter only).
 pub const KHEPERA: IrModel = IrModel {
-    position_deg: [68.0, 43.0, 13.0, -13.0, -43.0, -68.0, -158.0, 158.0],
-    axis_deg: [72.0, 44.0, 8.0, -16.0, -44.0, -72.0, -168.0, 168.0],
+    position_deg: [70.25, 41.81, 11.06, -15.25, -43.00, -69.31, -164.75, 167.44],
+    axis_deg: [67.06, 42.62, 2.31, -16.75, -46.62, -84.06, -178.19, 163.44],
     wall: Response {
-        reach: [24.0, 24.0, 22.0, 21.0, 24.0, 27.0, 24.0, 27.0],
-        decay: [5.0; SENSORS],
-        focus: [8.0; SENSORS],
-        knee: 2.0,
+        reach: [22.03, 21.59, 20.50, 17.94, 23.00, 26.19, 20.66, 25.31],
+        decay: [3.50, 3.92, 3.59, 3.28, 3.78, 4.80, 3.64, 5.03],
+        focus: [5.28, 5.53, 6.50, 6.94, 6.12, 4.62, 4.53, 3.50],
+        knee: 3.0,
     },
     cylinder: Response {
-        reach: [19.0, 19.0, 18.0, 17.0, 19.0, 21.0, 19.0, 21.0],
-        decay: [3.5; SENSORS],
-        focus: [12.0; SENSORS],
+        reach: [18.34, 18.38, 17.00, 15.16, 19.47, 21.53, 17.06, 21.06],
+        decay: [2.22, 2.36, 2.09, 1.97, 2.12, 2.80, 2.25, 2.95],
+        focus: [4.34, 4.56, 4.03, 3.94, 5.97, 4.41, 3.81, 3.56],
         knee: 2.0,
     },
     cylinder_r0: 13.0,
