@@ -200,10 +200,10 @@ fn fixed_activation(bias: f32, w: f32, sensors: &[usize]) -> Network {
     Network { inputs: 9, hidden: 0, outputs: 1, params: p }
 }
 
-/// Wander (forward, constant activation 0.5) and grip (the test script;
-/// activation net over ir + barrier starting at `sigmoid(-0.5 + ir2 + ir3)`,
-/// which is above 0.5 for anything in front; CRBP on it, always).
-fn trial_stage(rate_reward: f32, rate_punish: f32) -> Stage {
+/// Wander (forward, constant activation `sigmoid(wander_bias)`) and grip (the
+/// test script; activation net over ir + barrier starting at
+/// `sigmoid(init.0 + init.1 * (the init.2 sensors))`; CRBP on it, always).
+fn trial_stage(rate_reward: f32, rate_punish: f32, init: (f32, f32, &[usize]), wander_bias: f32) -> Stage {
     let mut s = testkit::bare_stage("grip-trials", testkit::arena_world());
     s.world.battery = None;
     s.world.objects = Some(Objects { count: 1, diameter: 10.0, virtual_: true });
@@ -215,9 +215,9 @@ fn trial_stage(rate_reward: f32, rate_punish: f32) -> Stage {
         inputs.clone(),
         testkit::script(Action::Wheels { left: 0.5, right: 0.5 }),
     );
-    wander.activation = fixed_activation(0.0, 0.0, &[]);
+    wander.activation = fixed_activation(wander_bias, 0.0, &[]);
     let mut grip = testkit::module("grip", 0, inputs, Behavior::Script(grip_trial_script()));
-    grip.activation = fixed_activation(-0.5, 1.0, &[2, 3]);
+    grip.activation = fixed_activation(init.0, init.1, init.2);
     grip.learning = Some(testkit::crbp(LearnTarget::Activation, rate_reward, rate_punish, 30));
     s.modules = vec![wander, grip];
     s
@@ -292,16 +292,36 @@ fn trial_with_percept(
 
 /// Figure 10 analogue: trials with the robot in front of either a 10 mm
 /// object or a wall (distance 10..25 mm, angle +-0.5 rad, lateral offset
-/// +-5 mm); the grip module tries when its activation beats
-/// wander's constant 0.5 and learns by CRBP on its activation network from
-/// the barrier alone. Over 800 trials on each of 5 seeds: the rolling mean of
+/// +-5 mm); the grip module (activation initially `sigmoid(-0.5 + ir2 +
+/// ir3)`, CRBP rates 1.0 / 0.5) tries when its activation beats wander's
+/// constant `sigmoid(-1)` and learns on its activation network from the
+/// barrier alone. Over 800 trials on each of 5 seeds: the rolling mean of
 /// its reinforcements rises, it stops trying walls but keeps trying objects,
 /// and its activation on the object patterns it was rewarded for and on the
 /// wall patterns it was punished for diverges.
 #[test]
 fn figure10_grip_learns_to_tell_objects_from_walls() {
+    let s = trial_stage(1.0, 0.5, (-0.5, 1.0, &[2, 3]), -1.0);
+    figure10(&s, true);
+}
+
+#[test]
+#[ignore = "exploration"]
+fn figure10_explore() {
+    for (init, wb) in [
+        ((-0.5, 1.0, &[2usize, 3][..]), -1.0),
+        ((0.0, 1.0, &[2usize, 3][..]), -0.5),
+        ((-0.5, 1.0, &[2usize, 3][..]), -0.5),
+    ] {
+        for (rr, rp) in [(1.0, 0.3), (1.0, 0.5), (0.5, 0.5)] {
+            println!("init {init:?} wander {wb} rates {rr}/{rp}");
+            figure10(&trial_stage(rr, rp, init, wb), false);
+        }
+    }
+}
+
+fn figure10(s: &Stage, check: bool) {
     use rand::{Rng, SeedableRng};
-    let s = trial_stage(1.0, 0.3);
     println!("figure 10: grip reinforcement mean per 100 trials; attempt rate wall/object, first and last 200 trials");
     let mut blocks = vec![Vec::new(); 8];
     for seed in 1..=5u64 {
@@ -317,7 +337,7 @@ fn figure10_grip_learns_to_tell_objects_from_walls() {
             let gap = rng.random_range(10.0..25.0);
             let angle = rng.random_range(-0.5..0.5f32);
             let lateral = rng.random_range(-5.0..5.0);
-            let (r, seen) = trial_with_percept(&mut c, &s, seed * 1000 + t, object, gap, angle, lateral);
+            let (r, seen) = trial_with_percept(&mut c, s, seed * 1000 + t, object, gap, angle, lateral);
             if r != 0.0 && t < 200 {
                 patterns[object as usize].push(seen);
             }
@@ -357,10 +377,13 @@ fn figure10_grip_learns_to_tell_objects_from_walls() {
             patterns[1].len(),
             patterns[0].len()
         );
-        assert!(row[7] > row[0] + 0.25, "seed {seed}: grip reinforcement did not rise: {row:?}");
-        assert!(w1 < w0 / 2.0, "seed {seed}: still tries walls: {w0} -> {w1}");
-        assert!(o1 > 0.7, "seed {seed}: stopped trying objects: {o0} -> {o1}");
-        assert!(gap1 > gap0 + 0.1, "seed {seed}: activations did not diverge: {gap0} -> {gap1}");
+        if !check {
+            continue;
+        }
+        assert!(row[7] > row[0] + 0.4, "seed {seed}: grip reinforcement did not rise: {row:?}");
+        assert!(w1 < w0 / 3.0, "seed {seed}: still tries walls: {w0} -> {w1}");
+        assert!(o1 > 0.8, "seed {seed}: stopped trying objects: {o0} -> {o1}");
+        assert!(gap1 > gap0 + 0.2, "seed {seed}: activations did not diverge: {gap0} -> {gap1}");
     }
     let medians: Vec<String> = blocks
         .iter_mut()
