@@ -326,7 +326,7 @@ fn figure10(s: &Stage, check: bool) {
     let mut blocks = vec![Vec::new(); 8];
     for seed in 1..=5u64 {
         let (_, crng) = episode_rngs(seed);
-        let mut c = Controller::new(&s, &Genome::zeros(0), crng).unwrap();
+        let mut c = Controller::new(s, &Genome::zeros(0), crng).unwrap();
         let initial = c.clone();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed + 100);
         // (trial, object?, reinforcement)
