@@ -506,3 +506,41 @@ fn episodes_are_deterministic_by_seed_and_trace_does_not_change_them() {
     let json = serde_json::to_string(&t.rows[0]).unwrap();
     assert!(json.contains("\"pose\":{\"x\":"), "{json}");
 }
+
+/// End to end on the simulator: `toward(light)` brings the robot to the
+/// charger under the lamp and the recharge module (activation
+/// `sigmoid(-7.8 + 4 (ir2 + ir3))`, i.e. only in contact with the bar) waits
+/// there with `charge`, so the robot outlives its 200-action battery.
+#[test]
+fn follow_light_then_recharge_keeps_the_robot_alive() {
+    let mut s = testkit::navigation();
+    // follow: constant 0.5; wander and avoid off.
+    let fixed = |v: &[(usize, f32)], n: usize| {
+        let mut p = vec![Param::Fixed(0.0); n + 1];
+        for &(i, w) in v {
+            p[i] = Param::Fixed(w);
+        }
+        p
+    };
+    s.modules[0].activation.params = fixed(&[(0, -10.0)], 8);
+    s.modules[1].activation.params = fixed(&[(0, -10.0)], 8);
+    s.modules[2].activation.params = fixed(&[(0, 0.0)], 9);
+    s.modules[3].activation.params = fixed(&[(0, -7.8), (3, 4.0), (4, 4.0)], 7);
+    s.links.clear();
+    let mut recharged = 0;
+    for seed in 0..5 {
+        let mut t = Trace::default();
+        let g = Genome::zeros(s.layout.bits as usize);
+        let r = run_episode(&s, &g, &EpisodeOptions { actions: 300, learning: true, seed }, Some(&mut t));
+        let last = t.rows.last().unwrap();
+        assert!(last.pose.y > 500.0, "seed {seed}: the light leads to the north wall: {:?}", last.pose);
+        if r.recharges > 0 {
+            recharged += 1;
+            assert_eq!(r.actions, 300, "seed {seed}: a recharged robot lives the whole episode");
+            assert!(t.rows.iter().any(|row| row.recharged && row.winner == 3));
+        } else {
+            assert_eq!(r.actions, 200, "seed {seed}: without recharge the battery lasts 200 actions");
+        }
+    }
+    assert!(recharged >= 3, "only {recharged} of 5 episodes recharged");
+}
