@@ -59,6 +59,7 @@
 //! (Darwinian) unless the stage is `Lamarckian`: then the learned activation
 //! weights that are genes are written back into [`EpisodeResult::learned`].
 
+mod fast_expr;
 mod net;
 mod perf;
 pub mod script;
@@ -75,6 +76,7 @@ use crate::program::{
 };
 use crate::sim::{Command, Outcome, Pose, Sim};
 
+pub use fast_expr::FastExpr;
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
@@ -211,7 +213,7 @@ impl Robot for Sim {
 
 #[derive(Clone, Debug)]
 enum Gen<'s> {
-    Script(ScriptRun<'s>),
+    Script(ScriptRun),
     Neural { net: Net, decode: &'s Decode, bits: Vec<u8> },
 }
 
@@ -222,7 +224,7 @@ struct Mod<'s> {
     links: Vec<(usize, f32)>,
     gen: Gen<'s>,
     learning: Option<Learning>,
-    reinforce: Option<&'s Expr>,
+    reinforce: Option<FastExpr>,
     /// The script's `reinforce` steps deliver the reinforcement instead of `reinforce`.
     script_reinforces: bool,
     perf: Rolling,
@@ -281,6 +283,7 @@ pub struct Controller<'s> {
     slots: [f32; ACT_SLOTS],
     last_winner: Option<usize>,
     holding: bool,
+    fitness: Option<FastExpr>,
 }
 
 impl<'s> Controller<'s> {
@@ -333,7 +336,7 @@ impl<'s> Controller<'s> {
                 links: Vec::new(),
                 gen,
                 learning: m.learning.clone(),
-                reinforce: m.reinforce.as_ref(),
+                reinforce: m.reinforce.as_ref().map(FastExpr::new),
                 script_reinforces,
                 perf: Rolling::new(window),
             });
@@ -357,6 +360,7 @@ impl<'s> Controller<'s> {
             slots: [0.0; ACT_SLOTS],
             last_winner: None,
             holding: false,
+            fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
         })
     }
 
@@ -518,7 +522,7 @@ impl<'s> Controller<'s> {
             s.after_action(&env);
         }
         if !module.script_reinforces {
-            if let Some(e) = module.reinforce {
+            if let Some(e) = &module.reinforce {
                 r = script::sign(e.eval(&env));
             }
         }
@@ -554,7 +558,7 @@ impl<'s> Controller<'s> {
                 }
             }
         }
-        let fitness = self.stage.fitness.per_action.as_ref().map_or(0.0, |e| e.eval(&env));
+        let fitness = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
         self.before = self.now;
         self.now = self.next;
         ActionReport { winner, command: cmd, outcome, reinforcement: r, fitness }
