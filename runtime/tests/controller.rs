@@ -468,6 +468,14 @@ fn lamarckian_inheritance_writes_learned_activation_genes_back() {
     assert_eq!(learned.gene_int(&s.layout.genes[1]), 7, "input 0 was 0: weight unchanged");
     assert!(learned.gene_int(&s.layout.genes[2]) < 7, "{}", learned.to_bitstring());
 
+    // Frozen genes (earlier stages) are never written back.
+    s.layout.genes[0].frozen = true;
+    let mut c = Controller::new(&s, &genome, ChaCha8Rng::seed_from_u64(1)).unwrap();
+    c.run(&mut robot, &opts, None);
+    let learned = c.write_back(&genome);
+    assert_eq!(learned.gene_int(&s.layout.genes[0]), 7, "frozen bias kept");
+    assert!(learned.gene_int(&s.layout.genes[2]) < 7);
+
     // run_episode returns the written-back genome only for Lamarckian stages.
     assert_eq!(run_episode(&s, &genome, &opts, None).learned, None);
     s.inheritance = Inheritance::Lamarckian;

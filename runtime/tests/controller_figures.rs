@@ -394,3 +394,51 @@ fn figure10(s: &Stage, check: bool) {
         .collect();
     println!("  median over seeds, per 100 trials: {}", medians.join(" "));
 }
+
+#[test]
+#[ignore = "diagnostic: where the plateau of figure 5 comes from (reinforcement mix of the learned policy)"]
+fn figure5_signal_mix() {
+    let s = avoid_stage(avoid_reinforcement(0.5), 0.2, 0.05);
+    for seed in 1..=3 {
+        let (sim_seed, rng) = episode_rngs(seed);
+        let mut c = Controller::new(&s, &Genome::zeros(0), rng).unwrap();
+        let mut sim = Sim::new(&s.world, sim_seed);
+        c.start(&mut sim);
+        // counts over the last 2000 of 5000 actions: [approach, leave, close, free fwd, free back, none], collisions
+        let mut k = [0u32; 6];
+        let mut coll = 0;
+        let mut acts = [0u32; 4];
+        for a in 0..5000 {
+            let before = *c.percept();
+            let rep = c.act(&mut sim);
+            if a < 3000 {
+                continue;
+            }
+            let p = c.percept();
+            let i = p[..8].iter().copied().fold(0.0, f32::max);
+            let q = before[..8].iter().copied().fold(0.0, f32::max);
+            let idx = if i - q > 0.02 {
+                0
+            } else if q - i > 0.02 {
+                1
+            } else if i > 0.5 {
+                2
+            } else if i < 0.1 {
+                if rep.reinforcement > 0.0 {
+                    3
+                } else if rep.reinforcement < 0.0 {
+                    4
+                } else {
+                    5
+                }
+            } else {
+                5
+            };
+            k[idx] += 1;
+            coll += rep.outcome.collided as u32;
+            let w = rep.command.wheels;
+            acts[((w[0] > 0.0) as usize) << 1 | (w[1] > 0.0) as usize] += 1;
+        }
+        println!("seed {seed}: approach {} leave {} close {} free-fwd {} free-back {} none {} | collisions {coll} | back/left/right/fwd {acts:?}", k[0], k[1], k[2], k[3], k[4], k[5]);
+    }
+}

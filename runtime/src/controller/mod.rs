@@ -57,7 +57,8 @@
 //! by module in declaration order: activation network, behavior network; then
 //! links). Learned weights are thrown away at the end of the episode
 //! (Darwinian) unless the stage is `Lamarckian`: then the learned activation
-//! weights that are genes are written back into [`EpisodeResult::learned`].
+//! weights that are (unfrozen) genes are written back into
+//! [`EpisodeResult::learned`].
 
 mod fast_expr;
 mod net;
@@ -621,13 +622,17 @@ impl<'s> Controller<'s> {
     }
 
     /// The genome with the learned activation weights that are genes written
-    /// back (nearest encodable value).
+    /// back (nearest encodable value). Frozen genes (from earlier stages) are
+    /// left as they are: a later stage never changes what an earlier one froze.
     pub fn write_back(&self, genome: &Genome) -> Genome {
         let mut g = genome.clone();
         for (m, module) in self.stage.modules.iter().enumerate() {
             for (p, &w) in module.activation.params.iter().zip(&self.mods[m].activation.w) {
                 if let Param::Gene(i) = *p {
-                    g.encode(&self.stage.layout.genes[i as usize], w);
+                    let gene = &self.stage.layout.genes[i as usize];
+                    if !gene.frozen {
+                        g.encode(gene, w);
+                    }
                 }
             }
         }
