@@ -1,16 +1,30 @@
 //! `shaping-compiler`: parses, checks and lowers `.bat` architecture files to a
 //! runtime [`Program`]. Text in, `Program` or diagnostics out: no file I/O.
+//!
+//! ```text
+//! text --syntax--> AST (spans) --lower (checks, collects every error)--> Program
+//! ```
+//!
+//! - [`syntax`]: the pest grammar (`grammar/shaping.pest`), AST and spans;
+//! - [`lower`]: resolves names, checks everything, derives genome layouts;
+//! - [`layout`]: readable renderings of a compiled stage (layout table, DOT graph);
+//! - [`diag`]: the error enum and the [`Diagnostics`] collection.
 
+pub mod diag;
+pub mod layout;
+pub mod lower;
+pub mod syntax;
+
+pub use diag::{Diagnostics, Error};
+pub use layout::{render_graph, render_layout};
 pub use shaping_runtime::program::Program;
 
-/// Every diagnostic of one compilation (placeholder until the compiler lands).
-#[derive(Debug)]
-pub struct CompileError {
-    pub message: String,
-}
-
-/// Compiles the source of one architecture file.
-pub fn compile(source: &str, file_name: &str) -> Result<Program, CompileError> {
-    let _ = (source, file_name);
-    Err(CompileError { message: "the compiler is not written yet".into() })
+/// Compiles the source of one architecture file. `file_name` names the
+/// source in diagnostics and gives the program its default name (its stem).
+pub fn compile(source: &str, file_name: &str) -> Result<Program, Diagnostics> {
+    let file = match syntax::parse(source) {
+        Ok(f) => f,
+        Err(errors) => return Err(Diagnostics::new(file_name, source, errors)),
+    };
+    lower::lower(&file, file_name).map_err(|errors| Diagnostics::new(file_name, source, errors))
 }

@@ -1,0 +1,256 @@
+//! Diagnostics: one error enum, and the collection a compilation returns.
+//!
+//! Messages are lowercase, without a final period, with user names in
+//! backticks. Every variant labels the source; the [`Diagnostics`] holding
+//! them owns the named source once.
+
+use miette::{Diagnostic, LabeledSpan, NamedSource, SourceSpan};
+use thiserror::Error;
+
+/// One problem in an architecture file.
+#[derive(Clone, Debug, Error, Diagnostic)]
+pub enum Error {
+    #[error("expected {expected}, found {found}")]
+    Syntax {
+        #[label("unexpected here")]
+        span: SourceSpan,
+        expected: String,
+        found: String,
+    },
+
+    #[error("the file is too complex to parse: {reason}")]
+    TooComplex {
+        #[label("parsing gave up here")]
+        span: SourceSpan,
+        reason: String,
+    },
+
+    #[error("{what} deeper than {limit} levels")]
+    #[diagnostic(help("split the construct into simpler parts"))]
+    TooDeep {
+        #[label("too deep")]
+        span: SourceSpan,
+        what: &'static str,
+        limit: usize,
+    },
+
+    #[error("unknown {what} `{name}`")]
+    Unknown {
+        #[label("not declared")]
+        span: SourceSpan,
+        what: &'static str,
+        name: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("{what} `{name}` is declared twice")]
+    Duplicate {
+        #[label("declared again here")]
+        span: SourceSpan,
+        #[label("first declared here")]
+        first: SourceSpan,
+        what: &'static str,
+        name: String,
+    },
+
+    #[error("index {index} is out of range for `{name}`, which has {count} elements")]
+    IndexOutOfRange {
+        #[label("out of range")]
+        span: SourceSpan,
+        name: String,
+        index: u64,
+        count: usize,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("the range `{range}` is {why}")]
+    BadRange {
+        #[label("{why} range")]
+        span: SourceSpan,
+        range: String,
+        why: &'static str,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("expected {expected}, found {found}")]
+    Type {
+        #[label("{found}")]
+        span: SourceSpan,
+        expected: String,
+        found: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("a gene has 1 to 16 bits, not {value}")]
+    Bits {
+        #[label("bits out of range")]
+        span: SourceSpan,
+        value: String,
+    },
+
+    #[error("stages extend each other in a cycle: {cycle}")]
+    #[diagnostic(help("a stage can only extend a stage that does not depend on it"))]
+    Cycle {
+        #[label("this stage is part of the cycle")]
+        span: SourceSpan,
+        cycle: String,
+        #[label(collection)]
+        others: Vec<LabeledSpan>,
+    },
+
+    #[error("the reinforcement program of `{module}` reads `{sensor}`, which the module does not sense")]
+    NotSensed {
+        #[label("read here")]
+        span: SourceSpan,
+        #[label("the module's inputs")]
+        sense: Option<SourceSpan>,
+        module: String,
+        sensor: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("`until` has no bound")]
+    #[diagnostic(help("add `within N actions` so that the step cannot run forever"))]
+    UnboundedUntil {
+        #[label("this condition may never become true")]
+        span: SourceSpan,
+    },
+
+    #[error("stage `{stage}` has no {what} `{name}`")]
+    MissingHardware {
+        #[label("used here")]
+        span: SourceSpan,
+        stage: String,
+        what: &'static str,
+        name: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("stage `{stage}` changes {what}, frozen by stage `{by}`")]
+    #[diagnostic(help("a later stage may add modules and links, but the genes of earlier stages are masked; declare a new module instead"))]
+    Frozen {
+        #[label("changed here")]
+        span: SourceSpan,
+        #[label("frozen here")]
+        frozen: SourceSpan,
+        stage: String,
+        by: String,
+        what: String,
+    },
+
+    #[error("expected {expected}, found {found}")]
+    Unit {
+        #[label("wrong unit")]
+        span: SourceSpan,
+        expected: &'static str,
+        found: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("{message}")]
+    Value {
+        #[label("{label}")]
+        span: SourceSpan,
+        message: String,
+        label: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    #[error("the expression needs {depth} stack slots, more than {max}")]
+    #[diagnostic(help("simplify it, for example by aggregating fewer values at once"))]
+    StackTooDeep {
+        #[label("too deep")]
+        span: SourceSpan,
+        depth: usize,
+        max: usize,
+    },
+
+    #[error("{message}")]
+    Conflict {
+        #[label("{label}")]
+        span: SourceSpan,
+        #[label("{other_label}")]
+        other: SourceSpan,
+        message: String,
+        label: String,
+        other_label: String,
+    },
+}
+
+/// Every diagnostic of one compilation, with the source they point into.
+#[derive(Debug, Error, Diagnostic)]
+#[error("could not compile `{name}`: {}", count(.errors.len()))]
+pub struct Diagnostics {
+    name: String,
+    #[source_code]
+    source_code: NamedSource<String>,
+    #[related]
+    errors: Vec<Error>,
+}
+
+fn count(n: usize) -> String {
+    if n == 1 {
+        "1 error".into()
+    } else {
+        format!("{n} errors")
+    }
+}
+
+impl Diagnostics {
+    pub fn new(file_name: &str, source: &str, errors: Vec<Error>) -> Diagnostics {
+        Diagnostics {
+            name: file_name.to_string(),
+            source_code: NamedSource::new(file_name, source.to_string()),
+            errors,
+        }
+    }
+
+    /// Number of errors.
+    pub fn len(&self) -> usize {
+        self.errors.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.errors.is_empty()
+    }
+
+    /// The errors, in source order.
+    pub fn errors(&self) -> &[Error] {
+        &self.errors
+    }
+}
+
+/// Levenshtein distance, for "did you mean" suggestions.
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// The closest candidate within a small edit distance, as a help message.
+pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
+    let limit = name.chars().count().div_ceil(3).max(1);
+    candidates
+        .into_iter()
+        .map(|c| (edit_distance(name, c), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| format!("did you mean `{c}`?"))
+}

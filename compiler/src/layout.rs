@@ -1,0 +1,194 @@
+//! Readable renderings of a compiled stage: the genome layout as a text
+//! table, and the architecture as a Graphviz graph.
+
+use std::fmt::Write as _;
+
+use shaping_runtime::program::{Behavior, GeneRole, Param, Program, Stage};
+
+/// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
+fn channel_name(stage: &Stage, c: u16) -> String {
+    match stage.sensors.iter().find(|s| s.channel <= c && c < s.channel + s.count) {
+        Some(s) if s.count == 1 => s.name.clone(),
+        Some(s) => format!("{}[{}]", s.name, c - s.channel),
+        None => format!("channel {c}"),
+    }
+}
+
+fn role_text(stage: &Stage, gene: u32) -> String {
+    let g = &stage.layout.genes[gene as usize];
+    let module = stage.modules.get(g.module as usize);
+    let mname =
+        |i: u16| stage.modules.get(i as usize).map(|m| m.name.clone()).unwrap_or_else(|| format!("#{i}"));
+    let neural = module.and_then(|m| match &m.behavior {
+        Behavior::Neural(nb) if nb.net.params.contains(&Param::Gene(gene)) => Some(nb),
+        _ => None,
+    });
+    let input = |i: u16| -> String {
+        let chans = match (neural, module) {
+            (Some(nb), _) => nb.inputs.get(i as usize).copied(),
+            (None, Some(m)) => m.inputs.get(i as usize).copied(),
+            _ => None,
+        };
+        chans.map(|c| channel_name(stage, c)).unwrap_or_else(|| format!("input {i}"))
+    };
+    let text = match g.role {
+        GeneRole::Bias => "bias".to_string(),
+        GeneRole::Weight { input: i, hidden: None } => format!("weight {}", input(i)),
+        GeneRole::Weight { input: i, hidden: Some(h) } => format!("weight {} -> h{h}", input(i)),
+        GeneRole::HiddenBias { hidden } => format!("bias h{hidden}"),
+        GeneRole::HiddenOut { hidden } => format!("weight h{hidden} -> out"),
+        GeneRole::Link { from } => format!("link {} -> {}", mname(from), mname(g.module)),
+    };
+    match neural {
+        Some(nb) if nb.net.outputs > 1 => {
+            let pos = nb.net.params.iter().position(|p| *p == Param::Gene(gene)).unwrap_or(0);
+            let per_out =
+                if nb.net.hidden == 0 { nb.net.inputs as usize + 1 } else { nb.net.hidden as usize + 1 };
+            let before =
+                if nb.net.hidden == 0 { 0 } else { nb.net.hidden as usize * (nb.net.inputs as usize + 1) };
+            if pos >= before {
+                format!("behavior out{} {text}", (pos - before) / per_out)
+            } else {
+                format!("behavior {text}")
+            }
+        }
+        Some(_) => format!("behavior {text}"),
+        None => text,
+    }
+}
+
+/// The genome layout of stage `stage` (index into `program.stages`) as a
+/// text table: offset, bits, introducing stage, module, role, range, and
+/// whether the gene is frozen; then totals.
+pub fn render_layout(program: &Program, stage: usize) -> String {
+    let mut out = String::new();
+    let Some(st) = program.stages.get(stage) else {
+        let _ = writeln!(out, "no stage {stage}: `{}` has {} stages", program.name, program.stages.len());
+        return out;
+    };
+    let _ = writeln!(
+        out,
+        "genome layout of stage `{}` ({} of {}) in `{}`",
+        st.name,
+        stage + 1,
+        program.stages.len(),
+        program.name
+    );
+    let rows: Vec<[String; 7]> = st
+        .layout
+        .genes
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            [
+                g.offset.to_string(),
+                g.bits.to_string(),
+                program.stages.get(g.stage as usize).map(|s| s.name.clone()).unwrap_or_default(),
+                st.modules.get(g.module as usize).map(|m| m.name.clone()).unwrap_or_default(),
+                role_text(st, i as u32),
+                format!("{:.2}..{:.2}", g.lo, g.hi),
+                if g.frozen { "frozen" } else { "evolvable" }.to_string(),
+            ]
+        })
+        .collect();
+    let header = ["offset", "bits", "stage", "module", "role", "range", "state"];
+    let mut widths: Vec<usize> = header.iter().map(|h| h.len()).collect();
+    for r in &rows {
+        for (w, c) in widths.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |out: &mut String, cells: &[&str]| {
+        let mut s = String::new();
+        for (i, (c, w)) in cells.iter().zip(&widths).enumerate() {
+            if i < 2 {
+                let _ = write!(s, "{c:>w$}  ");
+            } else {
+                let _ = write!(s, "{c:<w$}  ");
+            }
+        }
+        let _ = writeln!(out, "{}", s.trim_end());
+    };
+    line(&mut out, &header);
+    for r in &rows {
+        let cells: Vec<&str> = r.iter().map(String::as_str).collect();
+        line(&mut out, &cells);
+    }
+    let frozen: Vec<_> = st.layout.genes.iter().filter(|g| g.frozen).collect();
+    let fbits: u32 = frozen.iter().map(|g| g.bits as u32).sum();
+    let n = st.layout.genes.len();
+    let _ = writeln!(
+        out,
+        "genes: {n}, bits: {}, frozen: {} genes ({fbits} bits), evolvable: {} genes ({} bits)",
+        st.layout.bits,
+        frozen.len(),
+        n - frozen.len(),
+        st.layout.bits - fbits
+    );
+    out
+}
+
+fn dot_escape(s: &str) -> String {
+    s.replace('\\', "\\\\").replace('"', "\\\"")
+}
+
+/// The architecture of stage `stage` as a Graphviz DOT graph: sensors
+/// (boxes), modules (ellipses; grey when an earlier stage froze them), the
+/// inputs of every module, and the links between modules.
+pub fn render_graph(program: &Program, stage: usize) -> String {
+    let mut out = String::new();
+    let Some(st) = program.stages.get(stage) else {
+        let _ = writeln!(out, "digraph empty {{}}");
+        return out;
+    };
+    let _ = writeln!(out, "digraph \"{}\" {{", dot_escape(&format!("{}/{}", program.name, st.name)));
+    let _ = writeln!(out, "  rankdir=LR;");
+    let _ = writeln!(out, "  node [fontname=\"Helvetica\"];");
+    let _ = writeln!(out, "  edge [fontname=\"Helvetica\", fontsize=10];");
+    for s in &st.sensors {
+        let label = if s.count == 1 { s.name.clone() } else { format!("{}[{}]", s.name, s.count) };
+        let _ =
+            writeln!(out, "  \"s:{}\" [shape=box, label=\"{}\"];", dot_escape(&s.name), dot_escape(&label));
+    }
+    for (i, m) in st.modules.iter().enumerate() {
+        let kind = match m.behavior {
+            Behavior::Script(_) => "script",
+            Behavior::Neural(_) => "neural",
+        };
+        let style = if (m.stage as usize) < stage { ", style=filled, fillcolor=\"#dddddd\"" } else { "" };
+        let _ = writeln!(
+            out,
+            "  \"m:{i}\" [shape=ellipse, label=\"{}\\n({kind})\"{style}];",
+            dot_escape(&m.name)
+        );
+        let mut seen: Vec<&str> = Vec::new();
+        for &c in &m.inputs {
+            if let Some(s) = st.sensors.iter().find(|s| s.channel <= c && c < s.channel + s.count) {
+                if !seen.contains(&s.name.as_str()) {
+                    seen.push(&s.name);
+                    let n = m.inputs.iter().filter(|&&x| s.channel <= x && x < s.channel + s.count).count();
+                    let label = if s.count == 1 || n == s.count as usize {
+                        String::new()
+                    } else {
+                        format!(" [label=\"{n} of {}\"]", s.count)
+                    };
+                    let _ = writeln!(out, "  \"s:{}\" -> \"m:{i}\"{label};", dot_escape(&s.name));
+                }
+            }
+        }
+    }
+    for l in &st.links {
+        let label = match l.weight {
+            Param::Gene(g) => format!("gene {g}"),
+            Param::Fixed(w) => format!("{w:.2}"),
+            Param::Random { lo, hi } => format!("random {lo:.2}..{hi:.2}"),
+        };
+        let frozen =
+            matches!(l.weight, Param::Gene(g) if st.layout.genes.get(g as usize).is_some_and(|x| x.frozen));
+        let style = if frozen { ", color=\"#999999\"" } else { "" };
+        let _ =
+            writeln!(out, "  \"m:{}\" -> \"m:{}\" [style=dashed, label=\"{label}\"{style}];", l.from, l.to);
+    }
+    let _ = writeln!(out, "}}");
+    out
+}

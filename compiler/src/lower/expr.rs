@@ -1,0 +1,324 @@
+//! Type checking and lowering of expressions to postfix [`Expr`] code.
+//!
+//! Types: a *number*, or an *array* (a whole sensor such as `ir`, a slice
+//! `ir[0..5]`, or `prev` of one). Arrays are only accepted by the
+//! aggregates `max min sum mean`; a one-element array is a number.
+
+use shaping_runtime::expr::{Expr, Op, MAX_STACK};
+
+use super::{Hw, Lower};
+use crate::diag::{did_you_mean, Error};
+use crate::syntax::ast::{self, BinOp, ExprKind, UnOp};
+use crate::syntax::Span;
+
+/// Which sensors an expression may read.
+pub struct Scope<'a> {
+    /// `Some((module, channels, sense span))`: only these channels (a
+    /// reinforcement program reads what its module senses).
+    pub only: Option<(&'a str, &'a [u16], Option<Span>)>,
+}
+
+enum Val {
+    /// Emitted onto the code.
+    Num,
+    /// Not yet emitted: the element loads, and a description for messages.
+    Arr(Vec<Op>, String),
+    /// An error was reported.
+    Err,
+}
+
+const FUNCTIONS: [&str; 6] = ["max", "min", "sum", "mean", "abs", "sign"];
+
+impl Lower<'_> {
+    /// Lowers an expression that must give a number; `None` after an error.
+    pub(super) fn expr(&mut self, hw: &Hw, e: &ast::Expr, scope: &Scope) -> Option<Expr> {
+        let before = self.errors.len();
+        let mut ops = Vec::new();
+        let v = self.go(hw, e, scope, false, &mut ops);
+        self.expect_num(v, e.span, &mut ops);
+        if self.errors.len() > before {
+            return None;
+        }
+        let depth = Expr::required_depth(&ops)?;
+        if depth as usize > MAX_STACK {
+            self.errors.push(Error::StackTooDeep {
+                span: e.span.into(),
+                depth: depth as usize,
+                max: MAX_STACK,
+            });
+            return None;
+        }
+        Some(Expr { ops, depth })
+    }
+
+    fn expect_num(&mut self, v: Val, span: Span, ops: &mut Vec<Op>) -> bool {
+        match v {
+            Val::Num => true,
+            Val::Arr(loads, _) if loads.len() == 1 => {
+                ops.extend(loads);
+                true
+            }
+            Val::Arr(loads, desc) => {
+                self.errors.push(Error::Type {
+                    span: span.into(),
+                    expected: "a number".into(),
+                    found: format!("{desc} of {} values", loads.len()),
+                    help: Some("pick one element (`ir[0]`) or aggregate the array (`max(ir)`)".into()),
+                });
+                false
+            }
+            Val::Err => false,
+        }
+    }
+
+    fn go(&mut self, hw: &Hw, e: &ast::Expr, scope: &Scope, prev: bool, ops: &mut Vec<Op>) -> Val {
+        match &e.kind {
+            ExprKind::Number(v, unit) => {
+                if let Some(u) = unit {
+                    self.errors.push(Error::Unit {
+                        span: e.span.into(),
+                        expected: "a plain number",
+                        found: format!("`{}`", u.as_str()),
+                        help: Some("expressions compute on plain numbers (sensor values are 0..1)".into()),
+                    });
+                    return Val::Err;
+                }
+                ops.push(Op::Const(*v as f32));
+                Val::Num
+            }
+            ExprKind::Ref(name, index) => self.reference(hw, name, index.as_ref(), e.span, scope, prev, ops),
+            ExprKind::Unary(op, inner) => match op {
+                UnOp::Prev => self.go(hw, inner, scope, true, ops),
+                UnOp::Neg | UnOp::Not => {
+                    let v = self.go(hw, inner, scope, prev, ops);
+                    if !self.expect_num(v, inner.span, ops) {
+                        return Val::Err;
+                    }
+                    ops.push(if *op == UnOp::Neg { Op::Neg } else { Op::Not });
+                    Val::Num
+                }
+            },
+            ExprKind::Binary(op, a, b) => {
+                let va = self.go(hw, a, scope, prev, ops);
+                let ok_a = self.expect_num(va, a.span, ops);
+                let vb = self.go(hw, b, scope, prev, ops);
+                let ok_b = self.expect_num(vb, b.span, ops);
+                if !(ok_a && ok_b) {
+                    return Val::Err;
+                }
+                ops.push(match op {
+                    BinOp::Add => Op::Add,
+                    BinOp::Sub => Op::Sub,
+                    BinOp::Mul => Op::Mul,
+                    BinOp::Div => Op::Div,
+                    BinOp::Lt => Op::Lt,
+                    BinOp::Le => Op::Le,
+                    BinOp::Gt => Op::Gt,
+                    BinOp::Ge => Op::Ge,
+                    BinOp::Eq => Op::Eq,
+                    BinOp::Ne => Op::Ne,
+                    BinOp::And => Op::And,
+                    BinOp::Or => Op::Or,
+                });
+                Val::Num
+            }
+            ExprKind::Cond(c, a, b) => {
+                let mut ok = true;
+                for part in [c, a, b] {
+                    let v = self.go(hw, part, scope, prev, ops);
+                    ok &= self.expect_num(v, part.span, ops);
+                }
+                if !ok {
+                    return Val::Err;
+                }
+                ops.push(Op::Select);
+                Val::Num
+            }
+            ExprKind::Call(f, args) => self.call(hw, f, args, e.span, scope, prev, ops),
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn call(
+        &mut self,
+        hw: &Hw,
+        f: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &Scope,
+        prev: bool,
+        ops: &mut Vec<Op>,
+    ) -> Val {
+        match f.text.as_str() {
+            "abs" | "sign" => {
+                if args.len() != 1 {
+                    self.errors.push(Error::Value {
+                        span: span.into(),
+                        message: format!("`{}` takes 1 argument, found {}", f.text, args.len()),
+                        label: "wrong number of arguments".into(),
+                        help: None,
+                    });
+                    return Val::Err;
+                }
+                let v = self.go(hw, &args[0], scope, prev, ops);
+                if !self.expect_num(v, args[0].span, ops) {
+                    return Val::Err;
+                }
+                ops.push(if f.text == "abs" { Op::Abs } else { Op::Sign });
+                Val::Num
+            }
+            "max" | "min" | "sum" | "mean" => {
+                let mut n = 0usize;
+                let mut ok = true;
+                for a in args {
+                    match self.go(hw, a, scope, prev, ops) {
+                        Val::Num => n += 1,
+                        Val::Arr(loads, _) => {
+                            n += loads.len();
+                            ops.extend(loads);
+                        }
+                        Val::Err => ok = false,
+                    }
+                }
+                if !ok {
+                    return Val::Err;
+                }
+                let n = u16::try_from(n).unwrap_or(u16::MAX);
+                ops.push(match f.text.as_str() {
+                    "max" => Op::Max(n),
+                    "min" => Op::Min(n),
+                    "sum" => Op::Sum(n),
+                    _ => Op::Mean(n),
+                });
+                Val::Num
+            }
+            _ => {
+                self.errors.push(Error::Unknown {
+                    span: f.span.into(),
+                    what: "function",
+                    name: f.text.clone(),
+                    help: did_you_mean(&f.text, FUNCTIONS)
+                        .or_else(|| Some(format!("the functions are {}", backticked(&FUNCTIONS)))),
+                });
+                Val::Err
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn reference(
+        &mut self,
+        hw: &Hw,
+        name: &ast::Name,
+        index: Option<&ast::Index>,
+        span: Span,
+        scope: &Scope,
+        prev: bool,
+        ops: &mut Vec<Op>,
+    ) -> Val {
+        if let Some(s) = hw.sensors.iter().find(|s| s.name == name.text) {
+            let Some((first, last)) = self.elements(&s.name, s.count as usize, index) else {
+                return Val::Err;
+            };
+            let channels: Vec<u16> = (first..=last).map(|i| s.channel + i as u16).collect();
+            if let Some((module, allowed, sense)) = scope.only {
+                if let Some(c) = channels.iter().find(|c| !allowed.contains(c)) {
+                    let elem =
+                        if s.count == 1 { s.name.clone() } else { format!("{}[{}]", s.name, c - s.channel) };
+                    self.errors.push(Error::NotSensed {
+                        span: span.into(),
+                        sense: sense.map(Into::into),
+                        module: module.to_string(),
+                        sensor: elem,
+                        help: Some(format!(
+                            "add it to the `sense` list of `{module}`, or read only what it senses"
+                        )),
+                    });
+                    return Val::Err;
+                }
+            }
+            let loads: Vec<Op> =
+                channels.iter().map(|&c| if prev { Op::Prev(c) } else { Op::Chan(c) }).collect();
+            if index.is_some_and(|i| i.last.is_none()) || s.count == 1 {
+                ops.extend(loads);
+                return Val::Num;
+            }
+            let desc = match index {
+                Some(i) => format!("the slice `{}[{}..{}]`", s.name, i.first, i.last.unwrap_or(i.first)),
+                None => format!("the array `{}`", s.name),
+            };
+            return Val::Arr(loads, desc);
+        }
+        if let Some(a) = hw.actuators.iter().find(|a| a.name == name.text) {
+            if prev {
+                self.errors.push(Error::Value {
+                    span: span.into(),
+                    message: format!("`prev` reads sensors only, and `{}` is an actuator", a.name),
+                    label: "no previous value".into(),
+                    help: None,
+                });
+                return Val::Err;
+            }
+            let Some((first, last)) = self.elements(&a.name, a.count as usize, index) else {
+                return Val::Err;
+            };
+            let loads: Vec<Op> = (first..=last).map(|i| Op::Act(a.slot + i as u16)).collect();
+            if index.is_some_and(|i| i.last.is_none()) || a.count == 1 {
+                ops.extend(loads);
+                return Val::Num;
+            }
+            return Val::Arr(loads, format!("the array `{}`", a.name));
+        }
+        self.unknown_hardware(hw, "sensor", name);
+        Val::Err
+    }
+
+    /// Checks an index against an array of `count` elements; gives the
+    /// inclusive element range.
+    pub(super) fn elements(
+        &mut self,
+        name: &str,
+        count: usize,
+        index: Option<&ast::Index>,
+    ) -> Option<(u64, u64)> {
+        let Some(ix) = index else {
+            return Some((0, count.saturating_sub(1) as u64));
+        };
+        let last = ix.last.unwrap_or(ix.first);
+        if last < ix.first {
+            self.errors.push(Error::BadRange {
+                span: ix.span.into(),
+                range: format!("{}..{}", ix.first, last),
+                why: "inverted",
+                help: Some(format!("write `{}[{}..{}]`", name, last, ix.first)),
+            });
+            return None;
+        }
+        for i in [ix.first, last] {
+            if i as usize >= count || i > u16::MAX as u64 {
+                self.errors.push(Error::IndexOutOfRange {
+                    span: ix.span.into(),
+                    name: name.to_string(),
+                    index: i,
+                    count,
+                    help: Some(if count == 1 {
+                        format!("`{name}` is a single value: write `{name}` without an index")
+                    } else {
+                        format!("the elements of `{name}` are numbered 0 to {}", count - 1)
+                    }),
+                });
+                return None;
+            }
+        }
+        Some((ix.first, last))
+    }
+}
+
+pub fn backticked(names: &[&str]) -> String {
+    let quoted: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    match quoted.len() {
+        0 => String::new(),
+        1 => quoted[0].clone(),
+        n => format!("{} and {}", quoted[..n - 1].join(", "), quoted[n - 1]),
+    }
+}

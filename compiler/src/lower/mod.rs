@@ -1,0 +1,1462 @@
+//! Checking and lowering: AST to [`Program`], collecting every error.
+//!
+//! Stages are processed in dependency order. Each starts from a copy of its
+//! parent's state (sensors, actuators, world, genome settings, evolution,
+//! fitness, modules, links, genes) and applies its own declarations; then its
+//! new genes are appended to the layout (see [`Lower::allocate`]). Errors are
+//! pushed into a sink and lowering goes on with placeholders, so one mistake
+//! is reported once and every independent mistake is reported.
+
+mod expr;
+mod module;
+
+use std::collections::HashMap;
+
+use shaping_runtime::catalog::{self, ActuatorKind, SensorKind};
+use shaping_runtime::expr::{Expr, Op};
+use shaping_runtime::program::*;
+
+use crate::diag::{did_you_mean, Error};
+use crate::syntax::ast::{self, Quantity, Unit};
+use crate::syntax::Span;
+pub use expr::Scope;
+
+/// A sensor of the robot at some stage.
+#[derive(Clone, Debug)]
+pub(crate) struct SensorSt {
+    pub name: String,
+    pub kind: SensorKind,
+    pub count: u16,
+    pub channel: u16,
+    pub stage: u16,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct ActuatorSt {
+    pub name: String,
+    pub kind: ActuatorKind,
+    pub count: u16,
+    pub slot: u16,
+    pub stage: u16,
+    pub span: Span,
+}
+
+/// The hardware visible to a stage, and where later hardware comes from.
+pub(crate) struct Hw {
+    pub stage: String,
+    pub sensors: Vec<SensorSt>,
+    pub actuators: Vec<ActuatorSt>,
+    pub has_charger: bool,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GeneSpec {
+    pub bits: u8,
+    pub lo: f32,
+    pub hi: f32,
+}
+
+/// Gene settings per group.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GenomeSt {
+    pub links: GeneSpec,
+    pub weights: GeneSpec,
+    pub biases: GeneSpec,
+}
+
+/// How the weights of a network are given.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Source {
+    Evolvable(Option<(f32, f32)>),
+    Fixed(Vec<f32>),
+    Random(f32, f32),
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct ModuleSt {
+    pub name: String,
+    pub span: Span,
+    pub stage: u16,
+    pub inputs: Vec<u16>,
+    pub inputs_span: Option<Span>,
+    pub hidden: u16,
+    pub source: Source,
+    pub act_span: Option<Span>,
+    pub act_params: Vec<Param>,
+    pub behavior: Option<Behavior>,
+    /// Gene source of a neural behavior whose genes are still to allocate.
+    pub behavior_genes: Option<Option<(f32, f32)>>,
+    pub behavior_stage: u16,
+    pub learning: Option<Learning>,
+    pub learn_span: Option<Span>,
+    pub reinforce: Option<Expr>,
+    /// A `reinforce` clause was written (even if it had errors).
+    pub reinforce_declared: bool,
+    pub script_reinforces: bool,
+}
+
+#[derive(Clone, Debug)]
+pub(crate) struct LinkSt {
+    pub from: u16,
+    pub to: u16,
+    /// `Ok(gene range)` for evolvable, `Err(weight)` for fixed.
+    pub kind: Result<Option<(f32, f32)>, f32>,
+    pub param: Option<Param>,
+    pub stage: u16,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+struct WorldSt {
+    world: World,
+    /// Where each optional item was declared: charger, battery, objects.
+    spans: HashMap<&'static str, Span>,
+}
+
+#[derive(Clone, Debug)]
+struct StageSt {
+    sensors: Vec<SensorSt>,
+    actuators: Vec<ActuatorSt>,
+    world: WorldSt,
+    genome: GenomeSt,
+    evolution: Evolution,
+    inheritance: Inheritance,
+    run: StageRun,
+    fitness: Fitness,
+    fitness_declared: bool,
+    /// A missing fitness was reported (by this stage or an ancestor).
+    fitness_reported: bool,
+    modules: Vec<ModuleSt>,
+    links: Vec<LinkSt>,
+    genes: Vec<Gene>,
+    bits: u32,
+}
+
+pub(crate) struct Lower<'a> {
+    pub errors: Vec<Error>,
+    file: &'a ast::File,
+    /// Hardware name -> the stage whose `robot adds` declares it.
+    hw_origin: HashMap<String, String>,
+    /// Module name -> the first stage that declares it.
+    module_origin: HashMap<String, String>,
+    /// Names of the processed stages, by program index.
+    stage_names: Vec<String>,
+    /// Hardware whose declaration failed: not reported again where used.
+    poisoned: std::collections::HashSet<String>,
+}
+
+const DEFAULT_BITS: u8 = 4;
+const DEFAULT_WINDOW: u32 = 30;
+const DEFAULT_LAMP_HEIGHT: f32 = 150.0;
+const DEFAULT_RECHARGE: u32 = 20;
+const DEFAULT_RATES: (f32, f32) = (0.1, 0.01);
+
+fn default_evolution() -> Evolution {
+    Evolution {
+        population: 100,
+        generations: 40,
+        actions: 300,
+        seed: 1,
+        selection: Selection::Truncation { keep: 20 },
+        crossover: 0.1,
+        mutation: 0.01,
+        elitism: 1,
+        evaluations: 1,
+    }
+}
+
+/// Lowers a parsed file to a [`Program`], or every error found.
+pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
+    let mut lw = Lower {
+        errors: Vec::new(),
+        file,
+        hw_origin: HashMap::new(),
+        module_origin: HashMap::new(),
+        stage_names: Vec::new(),
+        poisoned: Default::default(),
+    };
+    let program = lw.program(file_name);
+    if lw.errors.is_empty() {
+        Ok(program)
+    } else {
+        let mut errors = lw.errors;
+        errors.sort_by_key(|e| {
+            use miette::Diagnostic;
+            e.labels().and_then(|mut l| l.next()).map(|l| l.offset()).unwrap_or(0)
+        });
+        Err(errors)
+    }
+}
+
+impl<'a> Lower<'a> {
+    fn value_error(&mut self, span: Span, message: String, label: &str, help: Option<String>) {
+        self.errors.push(Error::Value { span: span.into(), message, label: label.into(), help });
+    }
+
+    /// Reports an unknown sensor or actuator name, or one a later stage adds.
+    pub(crate) fn unknown_hardware(&mut self, hw: &Hw, what: &'static str, name: &ast::Name) {
+        if self.poisoned.contains(&name.text) {
+            return;
+        }
+        if let Some(origin) = self.hw_origin.get(&name.text) {
+            self.errors.push(Error::MissingHardware {
+                span: name.span.into(),
+                stage: hw.stage.clone(),
+                what,
+                name: name.text.clone(),
+                help: Some(format!(
+                    "`{}` is added by stage `{origin}`, which does not come before this one",
+                    name.text
+                )),
+            });
+            return;
+        }
+        let names =
+            hw.sensors.iter().map(|s| s.name.as_str()).chain(hw.actuators.iter().map(|a| a.name.as_str()));
+        self.errors.push(Error::Unknown {
+            span: name.span.into(),
+            what,
+            name: name.text.clone(),
+            help: did_you_mean(&name.text, names),
+        });
+    }
+
+    // ------------------------------------------------------------ quantities
+
+    /// A whole number, with no unit or `actions`.
+    fn count(&mut self, q: &Quantity, what: &str, min: u64) -> Option<u64> {
+        if let Some(u) = q.unit {
+            if u != Unit::Actions {
+                self.errors.push(Error::Unit {
+                    span: q.span.into(),
+                    expected: "a count",
+                    found: unit_desc(u),
+                    help: Some(format!("{what} is a whole number, with no unit or `actions`")),
+                });
+                return None;
+            }
+        }
+        if q.value.fract() != 0.0 || q.value < 0.0 || !q.value.is_finite() || q.value > u32::MAX as f64 {
+            self.value_error(q.span, format!("{what} must be a whole number"), "not a whole number", None);
+            return None;
+        }
+        let v = q.value as u64;
+        if v < min {
+            self.value_error(q.span, format!("{what} must be at least {min}"), "too small", None);
+            return None;
+        }
+        Some(v)
+    }
+
+    /// A length in mm (`mm`, `cm` or no unit), positive.
+    fn length(&mut self, q: &Quantity, what: &str) -> Option<f32> {
+        let factor = match q.unit {
+            None | Some(Unit::Mm) => 1.0,
+            Some(Unit::Cm) => 10.0,
+            Some(u) => {
+                self.errors.push(Error::Unit {
+                    span: q.span.into(),
+                    expected: "a length",
+                    found: unit_desc(u),
+                    help: Some(format!("{what} is a length in `mm` or `cm`")),
+                });
+                return None;
+            }
+        };
+        if !(q.value > 0.0 && q.value.is_finite()) {
+            self.value_error(q.span, format!("{what} must be positive"), "not positive", None);
+            return None;
+        }
+        Some((q.value * factor) as f32)
+    }
+
+    /// A plain number (no unit), within `lo..=hi`.
+    fn plain(&mut self, q: &Quantity, what: &str, lo: f64, hi: f64) -> Option<f32> {
+        if let Some(u) = q.unit {
+            self.errors.push(Error::Unit {
+                span: q.span.into(),
+                expected: "a plain number",
+                found: unit_desc(u),
+                help: Some(format!("{what} has no unit")),
+            });
+            return None;
+        }
+        self.in_range(q.value, q.span, what, lo, hi)
+    }
+
+    fn in_range(&mut self, v: f64, span: Span, what: &str, lo: f64, hi: f64) -> Option<f32> {
+        if !(v >= lo && v <= hi) {
+            self.value_error(span, format!("{what} must be between {lo} and {hi}"), "out of range", None);
+            return None;
+        }
+        Some(v as f32)
+    }
+
+    /// A value range `lo..hi` with `lo < hi`.
+    fn range(&mut self, r: &ast::Range) -> Option<(f32, f32)> {
+        if !(r.lo.is_finite() && r.hi.is_finite()) {
+            self.value_error(r.span, "range bounds must be finite numbers".into(), "not finite", None);
+            return None;
+        }
+        if r.lo >= r.hi {
+            let why = if r.lo == r.hi { "empty" } else { "inverted" };
+            self.errors.push(Error::BadRange {
+                span: r.span.into(),
+                range: format!("{}..{}", r.lo, r.hi),
+                why,
+                help: Some("a range goes from its lower to its higher bound, as in `-1..1`".into()),
+            });
+            return None;
+        }
+        Some((r.lo as f32, r.hi as f32))
+    }
+
+    // ------------------------------------------------------------ program
+
+    fn program(&mut self, file_name: &str) -> Program {
+        let file = self.file;
+        for (i, r) in file.robots.iter().enumerate().skip(1) {
+            self.errors.push(Error::Duplicate {
+                span: r.name.span.into(),
+                first: file.robots[0].name.span.into(),
+                what: "robot",
+                name: r.name.text.clone(),
+            });
+            let _ = i;
+        }
+        let name = file.robots.first().map(|r| r.name.text.clone()).unwrap_or_else(|| stem(file_name));
+        if file.stages.is_empty() {
+            let at = file.robots.first().map(|r| r.name.span).unwrap_or_default();
+            self.value_error(
+                at,
+                "the file declares no stage".into(),
+                "no stage in this file",
+                Some("add `stage NAME { ... }` with the modules to train".into()),
+            );
+        }
+        // Stage names and where later hardware / modules come from.
+        let mut by_name: HashMap<&str, usize> = HashMap::new();
+        for (i, s) in file.stages.iter().enumerate() {
+            if let Some(&j) = by_name.get(s.name.text.as_str()) {
+                self.errors.push(Error::Duplicate {
+                    span: s.name.span.into(),
+                    first: file.stages[j].name.span.into(),
+                    what: "stage",
+                    name: s.name.text.clone(),
+                });
+            } else {
+                by_name.insert(&s.name.text, i);
+            }
+            for item in &s.items {
+                match item {
+                    ast::StageItem::RobotAdds(hw, _) => {
+                        for h in hw {
+                            self.hw_origin.entry(h.name.text.clone()).or_insert_with(|| s.name.text.clone());
+                        }
+                    }
+                    ast::StageItem::Module(m) => {
+                        self.module_origin.entry(m.name.text.clone()).or_insert_with(|| s.name.text.clone());
+                    }
+                    _ => {}
+                }
+            }
+        }
+        // Parents.
+        let mut parent: Vec<Option<usize>> = vec![None; file.stages.len()];
+        let mut orphan = vec![false; file.stages.len()];
+        for (i, s) in file.stages.iter().enumerate() {
+            if let Some(p) = &s.extends {
+                match by_name.get(p.text.as_str()) {
+                    Some(&j) => parent[i] = Some(j),
+                    None => {
+                        orphan[i] = true;
+                        self.errors.push(Error::Unknown {
+                            span: p.span.into(),
+                            what: "stage",
+                            name: p.text.clone(),
+                            help: did_you_mean(&p.text, file.stages.iter().map(|s| s.name.text.as_str())),
+                        });
+                    }
+                }
+            }
+        }
+        // Cycles: walk up from every stage.
+        let mut in_cycle = vec![false; file.stages.len()];
+        for i in 0..file.stages.len() {
+            let mut path = vec![i];
+            let mut cur = i;
+            while let Some(p) = parent[cur] {
+                if let Some(pos) = path.iter().position(|&x| x == p) {
+                    let cycle = &path[pos..];
+                    if cycle.iter().all(|&c| !in_cycle[c]) {
+                        let mut members = cycle.to_vec();
+                        members.sort_unstable();
+                        for &c in &members {
+                            in_cycle[c] = true;
+                        }
+                        let first = members[0];
+                        let text: Vec<String> = {
+                            let mut order = vec![first];
+                            let mut c = first;
+                            while let Some(p) = parent[c] {
+                                if p == first {
+                                    break;
+                                }
+                                order.push(p);
+                                c = p;
+                            }
+                            order.push(first);
+                            order.iter().map(|&c| format!("`{}`", file.stages[c].name.text)).collect()
+                        };
+                        let span_of = |c: usize| {
+                            file.stages[c]
+                                .extends
+                                .as_ref()
+                                .map(|e| e.span)
+                                .unwrap_or(file.stages[c].name.span)
+                        };
+                        self.errors.push(Error::Cycle {
+                            span: span_of(first).into(),
+                            cycle: text.join(" extends "),
+                            others: members[1..]
+                                .iter()
+                                .map(|&c| {
+                                    miette::LabeledSpan::new_with_span(
+                                        Some("and this one".into()),
+                                        span_of(c),
+                                    )
+                                })
+                                .collect(),
+                        });
+                    }
+                    break;
+                }
+                path.push(p);
+                cur = p;
+            }
+        }
+        // Dependency order, stable by declaration.
+        let mut index: Vec<Option<usize>> = vec![None; file.stages.len()];
+        let mut order = Vec::new();
+        loop {
+            let mut progress = false;
+            for i in 0..file.stages.len() {
+                if index[i].is_some()
+                    || in_cycle[i]
+                    || by_name.get(file.stages[i].name.text.as_str()) != Some(&i)
+                {
+                    continue;
+                }
+                let ready = match parent[i] {
+                    None => true,
+                    Some(p) => index[p].is_some(),
+                };
+                if ready {
+                    index[i] = Some(order.len());
+                    order.push(i);
+                    progress = true;
+                }
+            }
+            if !progress {
+                break;
+            }
+        }
+        let mut states: Vec<StageSt> = Vec::new();
+        let mut stages = Vec::new();
+        for &i in &order {
+            let decl = &file.stages[i];
+            let s = stages.len() as u16;
+            self.stage_names.push(decl.name.text.clone());
+            let parent_index = parent[i].and_then(|p| index[p]);
+            let base = match parent_index {
+                Some(p) => states[p].clone(),
+                None => self.root_state(s),
+            };
+            // A stage whose parent is unknown is checked as if it had none;
+            // its errors would mostly be consequences of the missing parent.
+            let saved = self.errors.len();
+            let (state, stage) = self.stage(decl, s, parent_index, base);
+            if orphan[i] {
+                self.errors.truncate(saved);
+            }
+            states.push(state);
+            stages.push(stage);
+        }
+        Program { format: FORMAT_VERSION, name, stages }
+    }
+
+    fn root_state(&mut self, s: u16) -> StageSt {
+        let spec = GeneSpec { bits: DEFAULT_BITS, lo: -1.0, hi: 1.0 };
+        let mut st = StageSt {
+            sensors: Vec::new(),
+            actuators: Vec::new(),
+            world: WorldSt {
+                world: World {
+                    arena: [400.0, 600.0],
+                    body: Body::default(),
+                    charger: None,
+                    battery: None,
+                    objects: None,
+                },
+                spans: HashMap::new(),
+            },
+            genome: GenomeSt { links: spec, weights: spec, biases: spec },
+            evolution: default_evolution(),
+            inheritance: Inheritance::Darwinian,
+            run: StageRun::Evolve(default_evolution()),
+            fitness: Fitness { per_action: None, bonuses: Vec::new() },
+            fitness_declared: false,
+            fitness_reported: false,
+            modules: Vec::new(),
+            links: Vec::new(),
+            genes: Vec::new(),
+            bits: 0,
+        };
+        let file = self.file;
+        if let Some(r) = file.robots.first() {
+            // Report hardware errors of the robot once, for the first root stage.
+            let report = s == 0;
+            let saved = self.errors.len();
+            self.hardware(&mut st, &r.hardware, s);
+            if !report {
+                self.errors.truncate(saved);
+            }
+        }
+        for g in &file.genomes {
+            let saved = self.errors.len();
+            self.genome(&mut st.genome, g);
+            if s != 0 {
+                self.errors.truncate(saved);
+            }
+        }
+        st
+    }
+
+    fn hardware(&mut self, st: &mut StageSt, hw: &[ast::Hardware], s: u16) {
+        for h in hw {
+            let first = st
+                .sensors
+                .iter()
+                .map(|x| (&x.name, x.span))
+                .chain(st.actuators.iter().map(|x| (&x.name, x.span)))
+                .find(|(n, _)| **n == h.name.text)
+                .map(|(_, sp)| sp);
+            if let Some(first) = first {
+                self.errors.push(Error::Duplicate {
+                    span: h.name.span.into(),
+                    first: first.into(),
+                    what: if h.is_sensor { "sensor" } else { "actuator" },
+                    name: h.name.text.clone(),
+                });
+                continue;
+            }
+            if h.is_sensor {
+                let Some(info) = catalog::sensor_by_keyword(&h.kind.text) else {
+                    self.poisoned.insert(h.name.text.clone());
+                    let kinds: Vec<&str> = catalog::SENSORS.iter().map(|s| s.keyword).collect();
+                    self.errors.push(Error::Unknown {
+                        span: h.kind.span.into(),
+                        what: "sensor kind",
+                        name: h.kind.text.clone(),
+                        help: did_you_mean(&h.kind.text, kinds.iter().copied())
+                            .or_else(|| Some(format!("the sensor kinds are {}", expr::backticked(&kinds)))),
+                    });
+                    continue;
+                };
+                let count = match h.count {
+                    None => 1,
+                    Some((n, sp)) => {
+                        if n == 0 || n as usize > info.max_count {
+                            self.value_error(
+                                sp,
+                                format!(
+                                    "a sensor of kind `{}` has 1 to {} elements, not {n}",
+                                    info.keyword, info.max_count
+                                ),
+                                "wrong number of elements",
+                                None,
+                            );
+                        }
+                        (n as usize).clamp(1, info.max_count) as u16
+                    }
+                };
+                if let Some(other) = st.sensors.iter().find(|x| x.kind == info.kind) {
+                    self.poisoned.insert(h.name.text.clone());
+                    self.errors.push(Error::Conflict {
+                        span: h.span.into(),
+                        other: other.span.into(),
+                        message: format!(
+                            "sensors `{}` and `{}` are both `{}` sensors",
+                            other.name, h.name.text, info.keyword
+                        ),
+                        label: "second one here".into(),
+                        other_label: "first one here".into(),
+                    });
+                    continue;
+                }
+                st.sensors.push(SensorSt {
+                    name: h.name.text.clone(),
+                    kind: info.kind,
+                    count,
+                    channel: info.channel as u16,
+                    stage: s,
+                    span: h.span,
+                });
+            } else {
+                let Some(info) = catalog::actuator_by_keyword(&h.kind.text) else {
+                    self.poisoned.insert(h.name.text.clone());
+                    let kinds: Vec<&str> = catalog::ACTUATORS.iter().map(|a| a.keyword).collect();
+                    self.errors.push(Error::Unknown {
+                        span: h.kind.span.into(),
+                        what: "actuator kind",
+                        name: h.kind.text.clone(),
+                        help: did_you_mean(&h.kind.text, kinds.iter().copied())
+                            .or_else(|| Some(format!("the actuator kinds are {}", expr::backticked(&kinds)))),
+                    });
+                    continue;
+                };
+                if let Some((n, sp)) = h.count {
+                    if n as usize != info.count {
+                        self.value_error(
+                            sp,
+                            format!(
+                                "an actuator of kind `{}` has {} elements, not {n}",
+                                info.keyword, info.count
+                            ),
+                            "wrong number of elements",
+                            None,
+                        );
+                    }
+                }
+                if let Some(other) = st.actuators.iter().find(|x| x.kind == info.kind) {
+                    self.poisoned.insert(h.name.text.clone());
+                    self.errors.push(Error::Conflict {
+                        span: h.span.into(),
+                        other: other.span.into(),
+                        message: format!(
+                            "actuators `{}` and `{}` are both `{}` actuators",
+                            other.name, h.name.text, info.keyword
+                        ),
+                        label: "second one here".into(),
+                        other_label: "first one here".into(),
+                    });
+                    continue;
+                }
+                st.actuators.push(ActuatorSt {
+                    name: h.name.text.clone(),
+                    kind: info.kind,
+                    count: info.count as u16,
+                    slot: info.slot as u16,
+                    stage: s,
+                    span: h.span,
+                });
+            }
+        }
+    }
+
+    fn genome(&mut self, g: &mut GenomeSt, block: &ast::GenomeBlock) {
+        for set in &block.settings {
+            let bits = set.bits.as_ref().and_then(|q| {
+                let ok = q.unit.is_none() && q.value.fract() == 0.0 && (1.0..=16.0).contains(&q.value);
+                if !ok {
+                    self.errors.push(Error::Bits { span: q.span.into(), value: format_num(q.value, q.unit) });
+                    None
+                } else {
+                    Some(q.value as u8)
+                }
+            });
+            let range = set.range.as_ref().and_then(|r| self.range(r));
+            let targets: Vec<&mut GeneSpec> = match set.group.as_ref().map(|n| n.text.as_str()) {
+                Some("links") => vec![&mut g.links],
+                Some("weights") => vec![&mut g.weights],
+                Some("biases") => vec![&mut g.biases],
+                _ => vec![&mut g.links, &mut g.weights, &mut g.biases],
+            };
+            for t in targets {
+                if let Some(b) = bits {
+                    t.bits = b;
+                }
+                if let Some((lo, hi)) = range {
+                    t.lo = lo;
+                    t.hi = hi;
+                }
+            }
+        }
+    }
+
+    // ------------------------------------------------------------ one stage
+
+    fn stage(
+        &mut self,
+        decl: &ast::StageDecl,
+        s: u16,
+        parent: Option<usize>,
+        mut st: StageSt,
+    ) -> (StageSt, Stage) {
+        use ast::StageItem as I;
+        let sname = decl.name.text.clone();
+        // Hardware first: everything else may use it.
+        for item in &decl.items {
+            if let I::RobotAdds(hw, _) = item {
+                self.hardware(&mut st, hw, s);
+            }
+        }
+        for item in &decl.items {
+            if let I::Genome(g) = item {
+                self.genome(&mut st.genome, g);
+            }
+        }
+        for item in &decl.items {
+            if let I::World(w) = item {
+                self.world(&mut st.world, w, &sname);
+            }
+        }
+        self.check_charger(&st.world);
+        self.run(&mut st, decl, parent.is_some());
+        let hw = Hw {
+            stage: sname.clone(),
+            sensors: st.sensors.clone(),
+            actuators: st.actuators.clone(),
+            has_charger: st.world.world.charger.is_some(),
+        };
+        // Modules.
+        let mut declared_here: HashMap<String, Span> = HashMap::new();
+        for item in &decl.items {
+            if let I::Module(m) = item {
+                if let Some(first) = declared_here.get(&m.name.text) {
+                    self.errors.push(Error::Duplicate {
+                        span: m.name.span.into(),
+                        first: (*first).into(),
+                        what: "module",
+                        name: m.name.text.clone(),
+                    });
+                    continue;
+                }
+                declared_here.insert(m.name.text.clone(), m.name.span);
+                self.module(&hw, &mut st.modules, m, s);
+            }
+        }
+        for m in &st.modules {
+            if m.stage == s {
+                self.check_module(m);
+            }
+        }
+        if st.modules.is_empty() {
+            self.value_error(
+                decl.name.span,
+                format!("stage `{sname}` has no modules"),
+                "no modules",
+                Some("declare at least one `module NAME { ... }`".into()),
+            );
+        }
+        self.links(&mut st, decl, s);
+        // Fitness.
+        for item in &decl.items {
+            if let I::Fitness(f) = item {
+                self.fitness(&hw, &mut st, f);
+            }
+        }
+        if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared && !st.fitness_reported {
+            st.fitness_reported = true;
+            self.value_error(
+                decl.name.span,
+                format!("stage `{sname}` evolves but has no fitness"),
+                "no `fitness` for this stage",
+                Some("add `fitness per action EXPR` or declare a `test` stage".into()),
+            );
+        }
+        self.allocate(&mut st, s);
+        let stage = assemble(&st, &sname, s, parent);
+        (st, stage)
+    }
+
+    fn run(&mut self, st: &mut StageSt, decl: &ast::StageDecl, has_parent: bool) {
+        use ast::StageItem as I;
+        let mut evolve_span = None;
+        let mut test_span: Option<Span> = None;
+        for item in &decl.items {
+            match item {
+                I::Evolve(settings, sp) => {
+                    if let Some(t) = test_span {
+                        self.conflict_run(*sp, t);
+                    }
+                    evolve_span = Some(*sp);
+                    self.evolve(st, settings);
+                    st.run = StageRun::Evolve(st.evolution.clone());
+                }
+                I::Test { actions, learning, span } => {
+                    if let Some(e) = evolve_span.or(test_span) {
+                        self.conflict_run(*span, e);
+                    }
+                    test_span = Some(*span);
+                    if !has_parent {
+                        self.value_error(
+                            *span,
+                            format!(
+                                "stage `{}` tests the best individual, but extends no stage",
+                                decl.name.text
+                            ),
+                            "nothing to test",
+                            Some(
+                                "a `test` stage must extend the stage whose best individual it tests".into(),
+                            ),
+                        );
+                    }
+                    if let Some(n) = self.count(actions, "the test length", 1) {
+                        st.run = StageRun::Test { actions: n as u32, learning: *learning };
+                    }
+                }
+                _ => {}
+            }
+        }
+        if evolve_span.is_none() && test_span.is_none() {
+            if let StageRun::Evolve(_) = st.run {
+                st.run = StageRun::Evolve(st.evolution.clone());
+            }
+        }
+    }
+
+    fn conflict_run(&mut self, span: Span, other: Span) {
+        self.errors.push(Error::Conflict {
+            span: span.into(),
+            other: other.into(),
+            message: "a stage either evolves or tests, not both".into(),
+            label: "this".into(),
+            other_label: "conflicts with this".into(),
+        });
+    }
+
+    fn evolve(&mut self, st: &mut StageSt, settings: &[ast::Setting]) {
+        const NAMES: [&str; 10] = [
+            "population",
+            "generations",
+            "actions",
+            "seed",
+            "selection",
+            "crossover",
+            "mutation",
+            "elitism",
+            "evaluations",
+            "inheritance",
+        ];
+        let ev = &mut st.evolution;
+        let mut keep_span = None;
+        for set in settings {
+            let n = set.name.text.as_str();
+            match (&set.value, n) {
+                (ast::SettingValue::Truncation(q), _) => {
+                    if let Some(k) = self.count(q, "`keep`", 1) {
+                        ev.selection = Selection::Truncation { keep: k as u32 };
+                        keep_span = Some(q.span);
+                    }
+                }
+                (ast::SettingValue::Word(w), "selection") => {
+                    if w.text == "roulette" {
+                        ev.selection = Selection::Roulette;
+                    } else {
+                        self.errors.push(Error::Unknown {
+                            span: w.span.into(),
+                            what: "selection",
+                            name: w.text.clone(),
+                            help: Some("write `selection truncation keep N` or `selection roulette`".into()),
+                        });
+                    }
+                }
+                (ast::SettingValue::Word(w), "inheritance") => match w.text.as_str() {
+                    "darwinian" => st.inheritance = Inheritance::Darwinian,
+                    "lamarckian" => st.inheritance = Inheritance::Lamarckian,
+                    _ => self.errors.push(Error::Unknown {
+                        span: w.span.into(),
+                        what: "inheritance",
+                        name: w.text.clone(),
+                        help: did_you_mean(&w.text, ["darwinian", "lamarckian"]).or_else(|| {
+                            Some("write `inheritance darwinian` or `inheritance lamarckian`".into())
+                        }),
+                    }),
+                },
+                (
+                    ast::SettingValue::Quantity(q),
+                    "population" | "generations" | "actions" | "elitism" | "evaluations" | "seed",
+                ) => {
+                    let min = if n == "elitism" || n == "seed" { 0 } else { 1 };
+                    if let Some(v) = self.count(q, &format!("`{n}`"), min) {
+                        match n {
+                            "population" => ev.population = v as u32,
+                            "generations" => ev.generations = v as u32,
+                            "actions" => ev.actions = v as u32,
+                            "elitism" => ev.elitism = v as u32,
+                            "evaluations" => ev.evaluations = v as u32,
+                            _ => ev.seed = v,
+                        }
+                    }
+                }
+                (ast::SettingValue::Quantity(q), "crossover" | "mutation") => {
+                    if let Some(v) = self.plain(q, &format!("`{n}`"), 0.0, 1.0) {
+                        if n == "crossover" {
+                            ev.crossover = v;
+                        } else {
+                            ev.mutation = v;
+                        }
+                    }
+                }
+                _ if NAMES.contains(&n) => {
+                    self.value_error(
+                        set.span,
+                        format!("`{n}` has the wrong kind of value"),
+                        "wrong value",
+                        Some(evolve_help(n)),
+                    );
+                }
+                _ => self.errors.push(Error::Unknown {
+                    span: set.name.span.into(),
+                    what: "evolution setting",
+                    name: n.to_string(),
+                    help: did_you_mean(n, NAMES),
+                }),
+            }
+        }
+        if let (Selection::Truncation { keep }, Some(sp)) = (ev.selection, keep_span) {
+            if keep > ev.population {
+                let pop = ev.population;
+                self.value_error(
+                    sp,
+                    format!("truncation keeps {keep} individuals of a population of {pop}"),
+                    "more than the population",
+                    None,
+                );
+            }
+        }
+        if ev.elitism > ev.population {
+            let (e, p) = (ev.elitism, ev.population);
+            let sp = settings.iter().find(|s| s.name.text == "elitism").map(|s| s.span).unwrap_or_default();
+            self.value_error(
+                sp,
+                format!("elitism keeps {e} individuals of a population of {p}"),
+                "more than the population",
+                None,
+            );
+        }
+    }
+
+    fn world(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str) {
+        use ast::WorldItem as W;
+        for item in &block.items {
+            let key = match item {
+                W::Charger { .. } => Some("charger"),
+                W::Battery(..) | W::Recharge(..) => Some("battery"),
+                W::Objects { .. } => Some("objects"),
+                _ => None,
+            };
+            if let Some(key) = key {
+                let exists = match key {
+                    "charger" => ws.world.charger.is_some(),
+                    "battery" => ws.world.battery.is_some(),
+                    _ => ws.world.objects.is_some(),
+                };
+                match block.mode {
+                    ast::WorldMode::Adds if exists && !matches!(item, W::Recharge(..)) => {
+                        let other = ws.spans.get(key).copied().unwrap_or(item.span());
+                        self.errors.push(Error::Conflict {
+                            span: item.span().into(),
+                            other: other.into(),
+                            message: format!(
+                                "stage `{stage}` adds {}, but its world has one already",
+                                key_desc(key)
+                            ),
+                            label: "added here".into(),
+                            other_label: "already declared here".into(),
+                        });
+                        continue;
+                    }
+                    ast::WorldMode::Changes if !exists && !matches!(item, W::Recharge(..)) => {
+                        self.value_error(
+                            item.span(),
+                            format!("stage `{stage}` changes {}, but its world has none", key_desc(key)),
+                            "nothing to change",
+                            Some("use `world adds { ... }` to add them".into()),
+                        );
+                        continue;
+                    }
+                    _ => {}
+                }
+            }
+            match item {
+                W::Arena { width, depth, .. } => {
+                    let w = self.length(width, "the arena width");
+                    let d = self.length(depth, "the arena depth");
+                    if let (Some(w), Some(d)) = (w, d) {
+                        ws.world.arena = [w, d];
+                    }
+                }
+                W::Charger { length, wall, lamp, span } => {
+                    let len = self.length(length, "the charger length");
+                    let w = match wall.text.as_str() {
+                        "north" => Some(Wall::North),
+                        "south" => Some(Wall::South),
+                        "east" => Some(Wall::East),
+                        "west" => Some(Wall::West),
+                        _ => {
+                            self.errors.push(Error::Unknown {
+                                span: wall.span.into(),
+                                what: "wall",
+                                name: wall.text.clone(),
+                                help: did_you_mean(&wall.text, ["north", "south", "east", "west"]).or_else(
+                                    || Some("the walls are `north`, `south`, `east` and `west`".into()),
+                                ),
+                            });
+                            None
+                        }
+                    };
+                    let lamp_height = match lamp {
+                        None => Some(None),
+                        Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
+                        Some(Some(q)) => self.length(q, "the lamp height").map(Some),
+                    };
+                    if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
+                        ws.world.charger = Some(Charger { wall, length, lamp_height });
+                        ws.spans.insert("charger", *span);
+                    }
+                }
+                W::Battery(q, span) => {
+                    if let Some(c) = self.count(q, "the battery capacity", 1) {
+                        let recharge =
+                            ws.world.battery.as_ref().map(|b| b.recharge).unwrap_or(DEFAULT_RECHARGE);
+                        ws.world.battery = Some(Battery { capacity: c as u32, recharge });
+                        ws.spans.insert("battery", *span);
+                    }
+                }
+                W::Recharge(q, span) => {
+                    if let Some(c) = self.count(q, "the recharge time", 1) {
+                        match ws.world.battery.as_mut() {
+                            Some(b) => b.recharge = c as u32,
+                            None => {
+                                // `recharge` before `battery` in the same block.
+                                let has_battery = block.items.iter().any(|i| matches!(i, W::Battery(..)));
+                                if has_battery {
+                                    ws.world.battery = Some(Battery { capacity: 200, recharge: c as u32 });
+                                } else {
+                                    self.value_error(
+                                        *span,
+                                        "the world recharges a battery it does not have".into(),
+                                        "no battery",
+                                        Some("declare `battery N actions` too".into()),
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+                W::Objects { count, diameter, virtual_, span } => {
+                    let mut o = ws.world.objects.clone().unwrap_or(Objects {
+                        count: 8,
+                        diameter: 25.0,
+                        virtual_: false,
+                    });
+                    if let Some(c) = count.as_ref().and_then(|q| self.count(q, "the number of objects", 0)) {
+                        o.count = c as u32;
+                    }
+                    if let Some(d) = diameter.as_ref().and_then(|q| self.length(q, "the object diameter")) {
+                        o.diameter = d;
+                    }
+                    if let Some(v) = virtual_ {
+                        o.virtual_ = *v;
+                    }
+                    ws.world.objects = Some(o);
+                    ws.spans.insert("objects", *span);
+                }
+                W::Body(settings, _) => self.body(&mut ws.world.body, settings),
+            }
+        }
+    }
+
+    /// The charger must fit on its wall.
+    fn check_charger(&mut self, ws: &WorldSt) {
+        if let (Some(c), Some(sp)) = (&ws.world.charger, ws.spans.get("charger")) {
+            let wall = match c.wall {
+                Wall::North | Wall::South => ws.world.arena[0],
+                Wall::East | Wall::West => ws.world.arena[1],
+            };
+            if c.length > wall {
+                self.value_error(
+                    *sp,
+                    format!("the charger ({} mm) is longer than its wall ({} mm)", c.length, wall),
+                    "does not fit",
+                    None,
+                );
+            }
+        }
+    }
+
+    fn body(&mut self, body: &mut Body, settings: &[ast::Setting]) {
+        const NAMES: [&str; 6] = ["radius", "wheel_base", "v_max", "action", "wheel_noise", "sensor_noise"];
+        for set in settings {
+            let n = set.name.text.as_str();
+            let ast::SettingValue::Quantity(q) = &set.value else {
+                if NAMES.contains(&n) {
+                    self.value_error(set.span, format!("`{n}` needs a number"), "not a number", None);
+                } else {
+                    self.errors.push(Error::Unknown {
+                        span: set.name.span.into(),
+                        what: "body setting",
+                        name: n.into(),
+                        help: did_you_mean(n, NAMES),
+                    });
+                }
+                continue;
+            };
+            match n {
+                "radius" => body.radius = self.length(q, "the body radius").unwrap_or(body.radius),
+                "wheel_base" => body.wheel_base = self.length(q, "the wheel base").unwrap_or(body.wheel_base),
+                "v_max" => body.v_max = self.plain(q, "`v_max` (mm/s)", 1e-3, 1e4).unwrap_or(body.v_max),
+                "action" => {
+                    if q.unit != Some(Unit::Ms) && q.unit.is_some() {
+                        self.errors.push(Error::Unit {
+                            span: q.span.into(),
+                            expected: "a duration",
+                            found: unit_desc(q.unit.unwrap_or(Unit::Ms)),
+                            help: Some("the duration of an action is in `ms`".into()),
+                        });
+                    } else if let Some(v) = self.in_range(q.value, q.span, "the action duration", 1.0, 1e5) {
+                        body.action_ms = v;
+                    }
+                }
+                "wheel_noise" => {
+                    body.wheel_noise = self.plain(q, "`wheel_noise`", 0.0, 1.0).unwrap_or(body.wheel_noise)
+                }
+                "sensor_noise" => {
+                    body.sensor_noise = self.plain(q, "`sensor_noise`", 0.0, 1.0).unwrap_or(body.sensor_noise)
+                }
+                _ => self.errors.push(Error::Unknown {
+                    span: set.name.span.into(),
+                    what: "body setting",
+                    name: n.into(),
+                    help: did_you_mean(n, NAMES),
+                }),
+            }
+        }
+    }
+
+    fn fitness(&mut self, hw: &Hw, st: &mut StageSt, f: &ast::FitnessDecl) {
+        let mut per_action: Option<Expr> = if f.adds { st.fitness.per_action.clone() } else { None };
+        let mut bonuses = if f.adds { st.fitness.bonuses.clone() } else { Vec::new() };
+        for e in &f.per_action {
+            if let Some(x) = self.expr(hw, e, &Scope { only: None }) {
+                per_action = Some(match per_action {
+                    None => x,
+                    Some(old) => {
+                        let mut ops = old.ops;
+                        ops.extend(x.ops);
+                        ops.push(Op::Add);
+                        let depth = Expr::required_depth(&ops).unwrap_or(old.depth.max(x.depth) + 1);
+                        Expr { ops, depth }
+                    }
+                });
+            }
+        }
+        const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
+        for b in &f.bonuses {
+            let event = match b.event.text.as_str() {
+                "grip" => Event::Grip,
+                "release outside" => Event::ReleaseOutside,
+                "recharge" => Event::Recharge,
+                "collision" => Event::Collision,
+                other => {
+                    self.errors.push(Error::Unknown {
+                        span: b.event.span.into(),
+                        what: "event",
+                        name: other.to_string(),
+                        help: did_you_mean(other, EVENTS)
+                            .or_else(|| Some(format!("the events are {}", expr::backticked(&EVENTS)))),
+                    });
+                    continue;
+                }
+            };
+            let needs_claw = matches!(event, Event::Grip | Event::ReleaseOutside);
+            if needs_claw && !hw.actuators.iter().any(|a| a.kind == ActuatorKind::Grip) {
+                self.errors.push(Error::MissingHardware {
+                    span: b.event.span.into(),
+                    stage: hw.stage.clone(),
+                    what: "actuator of kind",
+                    name: "grip".into(),
+                    help: Some(
+                        "objects are gripped and released by a `grip` actuator (`actuator claw grip`)".into(),
+                    ),
+                });
+            }
+            if event == Event::Recharge && !hw.has_charger {
+                self.errors.push(Error::MissingHardware {
+                    span: b.event.span.into(),
+                    stage: hw.stage.clone(),
+                    what: "world item",
+                    name: "charger".into(),
+                    help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
+                });
+            }
+            if !b.points.is_finite() {
+                self.value_error(b.span, "bonus points must be a finite number".into(), "not finite", None);
+            }
+            bonuses.push(Bonus { event, points: b.points as f32 });
+        }
+        st.fitness = Fitness { per_action, bonuses };
+        st.fitness_declared = true;
+    }
+
+    fn links(&mut self, st: &mut StageSt, decl: &ast::StageDecl, s: u16) {
+        use ast::StageItem as I;
+        let names: Vec<String> = st.modules.iter().map(|m| m.name.clone()).collect();
+        let lookup = |lw: &mut Lower, n: &ast::Name| -> Option<u16> {
+            if let Some(i) = names.iter().position(|m| *m == n.text) {
+                return Some(i as u16);
+            }
+            let help = match lw.module_origin.get(&n.text) {
+                Some(origin) => Some(format!(
+                    "`{}` is declared by stage `{origin}`, which does not come before this one",
+                    n.text
+                )),
+                None => did_you_mean(&n.text, names.iter().map(String::as_str)),
+            };
+            lw.errors.push(Error::Unknown {
+                span: n.span.into(),
+                what: "module",
+                name: n.text.clone(),
+                help,
+            });
+            None
+        };
+        for item in &decl.items {
+            let I::Link(l) = item else { continue };
+            let (from, to) = (lookup(self, &l.from), lookup(self, &l.to));
+            let (Some(from), Some(to)) = (from, to) else { continue };
+            let kind = match &l.kind {
+                ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
+                ast::LinkKind::Fixed(w) => Err(*w as f32),
+            };
+            if let Some(old) = st.links.iter().find(|x| x.from == from && x.to == to) {
+                if old.stage == s {
+                    self.errors.push(Error::Duplicate {
+                        span: l.span.into(),
+                        first: old.span.into(),
+                        what: "link",
+                        name: format!("{} -> {}", l.from.text, l.to.text),
+                    });
+                } else {
+                    self.errors.push(Error::Frozen {
+                        span: l.span.into(),
+                        frozen: old.span.into(),
+                        stage: decl.name.text.clone(),
+                        by: self.stage_names[old.stage as usize].clone(),
+                        what: format!("the link `{} -> {}`", l.from.text, l.to.text),
+                    });
+                }
+                continue;
+            }
+            st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: l.span });
+        }
+        let mut all_span: Option<Span> = None;
+        for item in &decl.items {
+            let I::LinksAll(kind, span) = item else { continue };
+            if let Some(first) = all_span {
+                self.errors.push(Error::Duplicate {
+                    span: (*span).into(),
+                    first: first.into(),
+                    what: "link declaration",
+                    name: "links all".into(),
+                });
+                continue;
+            }
+            all_span = Some(*span);
+            let kind = match kind {
+                ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
+                ast::LinkKind::Fixed(w) => Err(*w as f32),
+            };
+            let n = st.modules.len() as u16;
+            for to in 0..n {
+                for from in 0..n {
+                    if from != to && !st.links.iter().any(|x| x.from == from && x.to == to) {
+                        st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: *span });
+                    }
+                }
+            }
+        }
+    }
+
+    /// Appends the genes this stage introduces, in the order of the paper's
+    /// fig. 2: for each module in order, its new activation genes (in the
+    /// parameter order of `Network`), then its new behavior genes, then its
+    /// new incoming link genes (from modules in order).
+    fn allocate(&mut self, st: &mut StageSt, s: u16) {
+        let genome = st.genome;
+        let mut genes = std::mem::take(&mut st.genes);
+        let mut bits = st.bits;
+        let mut push = |genes: &mut Vec<Gene>,
+                        spec: GeneSpec,
+                        range: Option<(f32, f32)>,
+                        module: u16,
+                        role: GeneRole|
+         -> Param {
+            let (lo, hi) = range.unwrap_or((spec.lo, spec.hi));
+            genes.push(Gene { offset: bits, bits: spec.bits, lo, hi, stage: s, module, role, frozen: false });
+            bits += spec.bits as u32;
+            Param::Gene(genes.len() as u32 - 1)
+        };
+        for mi in 0..st.modules.len() {
+            let m = &mut st.modules[mi];
+            if m.stage == s {
+                if let Source::Evolvable(range) = m.source.clone() {
+                    let roles = network_roles(m.inputs.len(), m.hidden as usize, 1);
+                    m.act_params = roles
+                        .into_iter()
+                        .map(|role| {
+                            let spec = if is_bias(role) { genome.biases } else { genome.weights };
+                            push(&mut genes, spec, range, mi as u16, role)
+                        })
+                        .collect();
+                }
+            }
+            if m.behavior_stage == s {
+                if let (Some(range), Some(Behavior::Neural(nb))) = (m.behavior_genes, m.behavior.as_mut()) {
+                    let roles =
+                        network_roles(nb.inputs.len(), nb.net.hidden as usize, nb.net.outputs as usize);
+                    nb.net.params = roles
+                        .into_iter()
+                        .map(|role| {
+                            let spec = if is_bias(role) { genome.biases } else { genome.weights };
+                            push(&mut genes, spec, range, mi as u16, role)
+                        })
+                        .collect();
+                }
+            }
+            let mut incoming: Vec<usize> = (0..st.links.len())
+                .filter(|&k| st.links[k].to == mi as u16 && st.links[k].stage == s)
+                .collect();
+            incoming.sort_by_key(|&k| st.links[k].from);
+            for k in incoming {
+                let l = &mut st.links[k];
+                l.param = Some(match l.kind {
+                    Ok(range) => push(&mut genes, genome.links, range, l.to, GeneRole::Link { from: l.from }),
+                    Err(w) => Param::Fixed(w),
+                });
+            }
+        }
+        st.genes = genes;
+        st.bits = bits;
+    }
+}
+
+fn is_bias(role: GeneRole) -> bool {
+    matches!(role, GeneRole::Bias | GeneRole::HiddenBias { .. })
+}
+
+/// The roles of a network's parameters, in `Network::params` order.
+pub(crate) fn network_roles(inputs: usize, hidden: usize, outputs: usize) -> Vec<GeneRole> {
+    let mut roles = Vec::with_capacity(Network::param_count(inputs, hidden, outputs));
+    if hidden == 0 {
+        for _ in 0..outputs {
+            roles.push(GeneRole::Bias);
+            roles.extend((0..inputs).map(|i| GeneRole::Weight { input: i as u16, hidden: None }));
+        }
+    } else {
+        for h in 0..hidden {
+            roles.push(GeneRole::HiddenBias { hidden: h as u16 });
+            roles.extend((0..inputs).map(|i| GeneRole::Weight { input: i as u16, hidden: Some(h as u16) }));
+        }
+        for _ in 0..outputs {
+            roles.push(GeneRole::Bias);
+            roles.extend((0..hidden).map(|h| GeneRole::HiddenOut { hidden: h as u16 }));
+        }
+    }
+    roles
+}
+
+fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
+    let modules = st
+        .modules
+        .iter()
+        .map(|m| Module {
+            name: m.name.clone(),
+            stage: m.stage,
+            inputs: m.inputs.clone(),
+            activation: Network {
+                inputs: m.inputs.len() as u16,
+                hidden: m.hidden,
+                outputs: 1,
+                params: m.act_params.clone(),
+            },
+            behavior: m.behavior.clone().unwrap_or(Behavior::Script(Script { steps: vec![] })),
+            learning: m.learning.clone(),
+            reinforce: m.reinforce.clone(),
+        })
+        .collect();
+    let mut links: Vec<&LinkSt> = st.links.iter().collect();
+    links.sort_by_key(|l| (l.to, l.from));
+    let links = links
+        .into_iter()
+        .map(|l| Link { from: l.from, to: l.to, weight: l.param.unwrap_or(Param::Fixed(0.0)) })
+        .collect();
+    let genes = st.genes.iter().map(|g| Gene { frozen: g.stage < s, ..g.clone() }).collect();
+    Stage {
+        name: name.to_string(),
+        parent,
+        sensors: st
+            .sensors
+            .iter()
+            .map(|x| SensorDecl {
+                name: x.name.clone(),
+                kind: x.kind,
+                count: x.count,
+                channel: x.channel,
+                stage: x.stage,
+            })
+            .collect(),
+        actuators: st
+            .actuators
+            .iter()
+            .map(|x| ActuatorDecl { name: x.name.clone(), kind: x.kind, stage: x.stage })
+            .collect(),
+        world: st.world.world.clone(),
+        modules,
+        links,
+        layout: GenomeLayout { genes, bits: st.bits },
+        fitness: st.fitness.clone(),
+        run: st.run.clone(),
+        inheritance: st.inheritance,
+    }
+}
+
+fn key_desc(key: &str) -> &'static str {
+    match key {
+        "charger" => "a charger",
+        "battery" => "a battery",
+        _ => "a set of objects",
+    }
+}
+
+fn evolve_help(n: &str) -> String {
+    match n {
+        "selection" => "write `selection truncation keep N` or `selection roulette`".into(),
+        "inheritance" => "write `inheritance darwinian` or `inheritance lamarckian`".into(),
+        "crossover" | "mutation" => format!("`{n}` is a probability, e.g. `{n} 0.1`"),
+        _ => format!("`{n}` is a whole number, e.g. `{n} 100`"),
+    }
+}
+
+fn unit_desc(u: Unit) -> String {
+    match u {
+        Unit::Mm | Unit::Cm => format!("a length (`{}`)", u.as_str()),
+        Unit::Ms => "a duration (`ms`)".into(),
+        Unit::Actions => "a count (`actions`)".into(),
+    }
+}
+
+fn format_num(v: f64, unit: Option<Unit>) -> String {
+    match unit {
+        Some(u) => format!("{v} {}", u.as_str()),
+        None => format!("{v}"),
+    }
+}
+
+fn stem(file_name: &str) -> String {
+    let base = file_name.rsplit(['/', '\\']).next().unwrap_or(file_name);
+    base.strip_suffix(".bat").unwrap_or(base).to_string()
+}

@@ -1,0 +1,570 @@
+//! Modules: inputs, activation networks, behaviors, learning, reinforcement.
+
+use shaping_runtime::catalog::{self, ActuatorKind};
+use shaping_runtime::program::*;
+
+use super::{expr::Scope, Hw, Lower, ModuleSt, Source, DEFAULT_RATES, DEFAULT_WINDOW};
+use crate::diag::{did_you_mean, Error};
+use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
+use crate::syntax::Span;
+
+impl Lower<'_> {
+    /// Declares a new module, or changes an inherited one.
+    pub(super) fn module(&mut self, hw: &Hw, modules: &mut Vec<ModuleSt>, m: &ast::ModuleDecl, s: u16) {
+        // Repeated clauses.
+        for (i, item) in m.items.iter().enumerate() {
+            if let Some(first) = m.items[..i].iter().find(|x| x.keyword() == item.keyword()) {
+                self.errors.push(Error::Duplicate {
+                    span: item.span().into(),
+                    first: first.span().into(),
+                    what: "clause",
+                    name: item.keyword().into(),
+                });
+            }
+        }
+        let existing = modules.iter().position(|x| x.name == m.name.text);
+        let mut st = match existing {
+            Some(i) => modules[i].clone(),
+            None => ModuleSt {
+                name: m.name.text.clone(),
+                span: m.name.span,
+                stage: s,
+                inputs: Vec::new(),
+                inputs_span: None,
+                hidden: 0,
+                source: Source::Evolvable(None),
+                act_span: None,
+                act_params: Vec::new(),
+                behavior: None,
+                behavior_genes: None,
+                behavior_stage: s,
+                learning: None,
+                learn_span: None,
+                reinforce: None,
+                reinforce_declared: false,
+                script_reinforces: false,
+            },
+        };
+        let inherited = existing.is_some();
+        let by = self.stage_names[st.stage as usize].clone();
+        // Inputs and activation network: frozen once evolved.
+        for item in &m.items {
+            match item {
+                ModuleItem::Sense(refs, span) => {
+                    let Some(channels) = self.sensor_refs(hw, refs) else { continue };
+                    if inherited {
+                        if channels != st.inputs {
+                            self.errors.push(Error::Frozen {
+                                span: (*span).into(),
+                                frozen: st.inputs_span.unwrap_or(st.span).into(),
+                                stage: hw.stage.clone(),
+                                by: by.clone(),
+                                what: format!("the inputs of module `{}`", st.name),
+                            });
+                        }
+                        continue;
+                    }
+                    st.inputs = channels;
+                    st.inputs_span = Some(*span);
+                }
+                ModuleItem::Activation(a) => {
+                    let Some((hidden, source)) = self.activation(a) else { continue };
+                    if inherited {
+                        if hidden != st.hidden || source != st.source {
+                            self.errors.push(Error::Frozen {
+                                span: a.span.into(),
+                                frozen: st.act_span.unwrap_or(st.span).into(),
+                                stage: hw.stage.clone(),
+                                by: by.clone(),
+                                what: format!("the activation network of module `{}`", st.name),
+                            });
+                        }
+                        continue;
+                    }
+                    st.hidden = hidden;
+                    st.source = source;
+                    st.act_span = Some(a.span);
+                }
+                _ => {}
+            }
+        }
+        if !inherited {
+            st.act_params = match &st.source {
+                Source::Evolvable(_) => Vec::new(), // genes, allocated with the stage
+                Source::Fixed(vals) => {
+                    let n = Network::param_count(st.inputs.len(), st.hidden as usize, 1);
+                    self.fixed_params(vals, n, st.act_span.unwrap_or(st.span))
+                }
+                Source::Random(lo, hi) => {
+                    let n = Network::param_count(st.inputs.len(), st.hidden as usize, 1);
+                    vec![Param::Random { lo: *lo, hi: *hi }; n]
+                }
+            };
+        }
+        // Behavior, learning, reinforcement: may change in later stages.
+        let sense_span = st.inputs_span;
+        let inputs = st.inputs.clone();
+        for item in &m.items {
+            match item {
+                ModuleItem::Behavior(b) => {
+                    st.behavior_stage = s;
+                    st.behavior_genes = None;
+                    st.script_reinforces = false;
+                    st.behavior = match b {
+                        ast::BehaviorDecl::Script(steps, _) => {
+                            let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
+                            let lowered: Vec<Step> =
+                                steps.iter().filter_map(|x| self.step(hw, x, &scope)).collect();
+                            st.script_reinforces =
+                                steps.iter().any(|x| matches!(x.action, ast::ActionDecl::Reinforce(..)));
+                            Some(Behavior::Script(Script { steps: lowered }))
+                        }
+                        ast::BehaviorDecl::Neural(n) => {
+                            let (nb, genes) = self.neural(hw, n, &inputs);
+                            st.behavior_genes = genes;
+                            nb.map(Behavior::Neural)
+                        }
+                    };
+                }
+                ModuleItem::Learn(l) => {
+                    st.learning = self.learn(l);
+                    st.learn_span = Some(l.span);
+                }
+                ModuleItem::Reinforce(e, _) => {
+                    let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
+                    st.reinforce = self.expr(hw, e, &scope);
+                    st.reinforce_declared = true;
+                }
+                _ => {}
+            }
+        }
+        if st.behavior.is_none() && !m.items.iter().any(|i| matches!(i, ModuleItem::Behavior(_))) {
+            self.value_error(
+                m.name.span,
+                format!("module `{}` has no behavior", m.name.text),
+                "no `behavior` clause",
+                Some("add `behavior STEP`, `behavior script { ... }` or `behavior neural { ... }`".into()),
+            );
+        }
+        match existing {
+            Some(i) => modules[i] = st,
+            None => modules.push(st),
+        }
+    }
+
+    /// Checks that concern the whole module.
+    pub(super) fn check_module(&mut self, m: &ModuleSt) {
+        if let (Some(l), Some(span)) = (&m.learning, m.learn_span) {
+            if !m.reinforce_declared && !m.script_reinforces {
+                self.value_error(
+                    span,
+                    format!("module `{}` learns but has no reinforcement program", m.name),
+                    "learning needs reinforcement",
+                    Some("add `reinforce EXPR` to the module, or a `reinforce` step to its script".into()),
+                );
+            }
+            if l.target == LearnTarget::Behavior && !matches!(m.behavior, Some(Behavior::Neural(_)) | None) {
+                self.value_error(
+                    span,
+                    format!("module `{}` learns on its behavior, which is a script", m.name),
+                    "CRBP needs a network",
+                    Some("learn `on activation`, or give the module a `behavior neural { ... }`".into()),
+                );
+            }
+        }
+    }
+
+    /// Resolves `ir, light[0..3]` to percept channels.
+    fn sensor_refs(&mut self, hw: &Hw, refs: &[ast::SensorRef]) -> Option<Vec<u16>> {
+        let mut channels = Vec::new();
+        let mut ok = true;
+        for r in refs {
+            match hw.sensors.iter().find(|x| x.name == r.name.text) {
+                Some(sensor) => match self.elements(&sensor.name, sensor.count as usize, r.index.as_ref()) {
+                    Some((a, b)) => channels.extend((a..=b).map(|i| sensor.channel + i as u16)),
+                    None => ok = false,
+                },
+                None => {
+                    if hw.actuators.iter().any(|a| a.name == r.name.text) {
+                        self.value_error(
+                            r.span,
+                            format!("`{}` is an actuator, not a sensor", r.name.text),
+                            "not a sensor",
+                            None,
+                        );
+                    } else {
+                        self.unknown_hardware(hw, "sensor", &r.name);
+                    }
+                    ok = false;
+                }
+            }
+        }
+        ok.then_some(channels)
+    }
+
+    fn activation(&mut self, a: &ast::ActivationDecl) -> Option<(u16, Source)> {
+        let hidden = match &a.hidden {
+            Some(q) => self.count(q, "the number of hidden units", 0)? as u16,
+            None => 0,
+        };
+        let range = match &a.range {
+            Some(r) => Some(self.range(r)?),
+            None => None,
+        };
+        let source = match &a.source {
+            None | Some(ast::WeightSource::Evolvable(_)) => Source::Evolvable(range),
+            Some(ast::WeightSource::Fixed(v, _)) => Source::Fixed(v.iter().map(|x| *x as f32).collect()),
+            Some(ast::WeightSource::Random(r, _)) => {
+                let (lo, hi) = self.range(r)?;
+                Source::Random(lo, hi)
+            }
+        };
+        if range.is_some() && !matches!(source, Source::Evolvable(_)) {
+            self.value_error(
+                a.span,
+                "only evolvable weights have a gene `range`".into(),
+                "range without genes",
+                None,
+            );
+        }
+        Some((hidden, source))
+    }
+
+    fn fixed_params(&mut self, vals: &[f32], n: usize, span: Span) -> Vec<Param> {
+        if vals.len() == 1 {
+            return vec![Param::Fixed(vals[0]); n];
+        }
+        if vals.len() != n {
+            self.value_error(
+                span,
+                format!("the network has {n} parameters, but {} fixed values are given", vals.len()),
+                "wrong number of values",
+                Some(
+                    "give one value for all parameters, or one per parameter in the order bias, weights"
+                        .into(),
+                ),
+            );
+        }
+        vals.iter().map(|v| Param::Fixed(*v)).collect()
+    }
+
+    fn speed(&mut self, v: Option<f64>, span: Span) -> f32 {
+        let v = v.unwrap_or(1.0);
+        if !(-1.0..=1.0).contains(&v) {
+            self.value_error(
+                span,
+                format!("a speed is between -1 and 1 (of `v_max`), not {v}"),
+                "speed out of range",
+                None,
+            );
+        }
+        v as f32
+    }
+
+    fn has_wheels(&mut self, hw: &Hw, span: Span) -> bool {
+        if hw.actuators.iter().any(|a| a.kind == ActuatorKind::Speed) {
+            return true;
+        }
+        self.errors.push(Error::MissingHardware {
+            span: span.into(),
+            stage: hw.stage.clone(),
+            what: "actuator of kind",
+            name: "speed".into(),
+            help: Some("declare the wheels: `actuator wheels[2] speed`".into()),
+        });
+        false
+    }
+
+    fn motion(&mut self, hw: &Hw, m: &Motion, span: Span) -> Option<[f32; 2]> {
+        if !self.has_wheels(hw, span) {
+            return None;
+        }
+        Some(match m {
+            Motion::Forward(v) => {
+                let v = self.speed(*v, span);
+                [v, v]
+            }
+            Motion::Back(v) => {
+                let v = self.speed(*v, span);
+                [-v, -v]
+            }
+            Motion::TurnLeft(v) => {
+                let v = self.speed(*v, span);
+                [-v, v]
+            }
+            Motion::TurnRight(v) => {
+                let v = self.speed(*v, span);
+                [v, -v]
+            }
+            Motion::Stop => [0.0, 0.0],
+            Motion::Wheels(name, l, r) => {
+                match hw.actuators.iter().find(|a| a.name == name.text) {
+                    Some(a) if a.kind == ActuatorKind::Speed => {}
+                    Some(a) => {
+                        self.value_error(
+                            span,
+                            format!("`{}` is not a `speed` actuator", a.name),
+                            "takes a state, not speeds",
+                            Some(format!(
+                                "write `{} {}`",
+                                a.name,
+                                catalog::actuator_info(a.kind).states.first().copied().unwrap_or("?")
+                            )),
+                        );
+                        return None;
+                    }
+                    None => {
+                        self.unknown_hardware(hw, "actuator", name);
+                        return None;
+                    }
+                }
+                [self.speed(Some(*l), span), self.speed(Some(*r), span)]
+            }
+        })
+    }
+
+    fn step(&mut self, hw: &Hw, x: &ast::StepDecl, scope: &Scope) -> Option<Step> {
+        let span = x.action.span();
+        let action = match &x.action {
+            ActionDecl::Motion(m, sp) => {
+                let [left, right] = self.motion(hw, m, *sp)?;
+                Action::Wheels { left, right }
+            }
+            ActionDecl::Toward { refs, speed, span } => {
+                self.has_wheels(hw, *span);
+                let channels = self.sensor_refs(hw, refs)?;
+                if let Some(c) = channels.iter().find(|c| catalog::channel_bearing(**c as usize).is_none()) {
+                    let name = hw
+                        .sensors
+                        .iter()
+                        .find(|s| s.channel <= *c && *c < s.channel + s.count)
+                        .map(|s| s.name.clone())
+                        .unwrap_or_default();
+                    self.value_error(
+                        *span,
+                        format!("`toward` needs sensors with a direction, and `{name}` has none"),
+                        "no direction",
+                        Some("steer toward proximity or ambient sensors, e.g. `toward(light)`".into()),
+                    );
+                    return None;
+                }
+                let speed = self.speed(*speed, *span);
+                Action::Toward { channels, speed }
+            }
+            ActionDecl::Wait(_) => Action::Wait { charge: x.uses_charger.is_some() },
+            ActionDecl::Recharge(_) => Action::Wait { charge: true },
+            ActionDecl::Reinforce(e, sp) => {
+                if x.end.is_some() {
+                    self.value_error(
+                        *sp,
+                        "`reinforce` takes no time, so it cannot last `for` or `until`".into(),
+                        "instant step",
+                        Some("put the duration on the step before it".into()),
+                    );
+                }
+                Action::Reinforce(self.expr(hw, e, scope)?)
+            }
+            ActionDecl::Set { actuator, state, span } => {
+                let Some(a) = hw.actuators.iter().find(|a| a.name == actuator.text) else {
+                    if hw.sensors.iter().any(|s| s.name == actuator.text) {
+                        self.value_error(
+                            actuator.span,
+                            format!("`{}` is a sensor, not an actuator", actuator.text),
+                            "not an actuator",
+                            None,
+                        );
+                    } else {
+                        self.unknown_hardware(hw, "actuator", actuator);
+                    }
+                    return None;
+                };
+                let info = catalog::actuator_info(a.kind);
+                if info.states.is_empty() {
+                    self.value_error(
+                        *span,
+                        format!("`{}` takes speeds, not a state", a.name),
+                        "no states",
+                        Some(format!("write `{}(0.5, 0.5)` or `forward`", a.name)),
+                    );
+                    return None;
+                }
+                let Some(i) = info.states.iter().position(|s| *s == state.text) else {
+                    self.errors.push(Error::Unknown {
+                        span: state.span.into(),
+                        what: "state",
+                        name: state.text.clone(),
+                        help: did_you_mean(&state.text, info.states.iter().copied())
+                            .or_else(|| Some(format!("`{}` is {}", a.name, info.states.join(" or ")))),
+                    });
+                    return None;
+                };
+                match a.kind {
+                    ActuatorKind::Lift => Action::Arm(i == 1),
+                    _ => Action::Claw(i == 1),
+                }
+            }
+        };
+        if let Some(sp) = x.uses_charger {
+            if !matches!(x.action, ActionDecl::Wait(_)) {
+                self.value_error(
+                    sp,
+                    "only `wait` can use the charger".into(),
+                    "not a `wait` step",
+                    Some("write `wait ... uses charger` or `recharge`".into()),
+                );
+            }
+        }
+        if matches!(action, Action::Wait { charge: true }) && !hw.has_charger {
+            self.errors.push(Error::MissingHardware {
+                span: x.uses_charger.unwrap_or(span).into(),
+                stage: hw.stage.clone(),
+                what: "world item",
+                name: "charger".into(),
+                help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
+            });
+        }
+        let end = match &x.end {
+            None => StepEnd::Actions(1),
+            Some(EndDecl::For(q)) => StepEnd::Actions(self.count(q, "a step's duration", 1)? as u32),
+            Some(EndDecl::Until { cond, within, span }) => {
+                let cond = self.expr(hw, cond, &Scope { only: None });
+                let Some(w) = within else {
+                    self.errors.push(Error::UnboundedUntil { span: (*span).into() });
+                    return None;
+                };
+                let within = self.count(w, "the bound of `until`", 1)? as u32;
+                StepEnd::Until { cond: cond?, within }
+            }
+        };
+        Some(Step { action, end })
+    }
+
+    /// A neural behavior; also gives the gene range when its weights evolve.
+    fn neural(
+        &mut self,
+        hw: &Hw,
+        n: &ast::NeuralDecl,
+        module_inputs: &[u16],
+    ) -> (Option<NeuralBehavior>, Option<Option<(f32, f32)>>) {
+        let inputs = match &n.sense {
+            Some((refs, _)) => match self.sensor_refs(hw, refs) {
+                Some(c) => c,
+                None => return (None, None),
+            },
+            None => module_inputs.to_vec(),
+        };
+        let hidden = match &n.hidden {
+            Some(q) => match self.count(q, "the number of hidden units", 0) {
+                Some(h) => h as u16,
+                None => return (None, None),
+            },
+            None => 0,
+        };
+        let (outputs, decode) = match &n.outputs {
+            None => {
+                self.value_error(
+                    n.span,
+                    "a neural behavior needs `outputs`".into(),
+                    "no `outputs`",
+                    Some("e.g. `outputs sign(2) -> forward | right | left | back`".into()),
+                );
+                return (None, None);
+            }
+            Some(ast::OutputsDecl::Linear { scale, span }) => {
+                let scale = scale.unwrap_or(1.0);
+                if !(scale > 0.0 && scale <= 1.0) {
+                    self.value_error(
+                        *span,
+                        format!("the scale is between 0 and 1, not {scale}"),
+                        "out of range",
+                        None,
+                    );
+                }
+                if !self.has_wheels(hw, *span) {
+                    return (None, None);
+                }
+                (2u16, Decode::Linear { scale: scale as f32 })
+            }
+            Some(ast::OutputsDecl::Sign { count, table, span }) => {
+                let Some(k) = self.count(count, "the number of outputs", 1) else { return (None, None) };
+                if k > 4 {
+                    self.value_error(
+                        count.span,
+                        format!("a sign decoding has 1 to 4 outputs, not {k}"),
+                        "too many outputs",
+                        None,
+                    );
+                    return (None, None);
+                }
+                let want = 1usize << k;
+                if table.len() != want {
+                    self.value_error(
+                        *span,
+                        format!("{k} sign outputs select among {want} motions, but {} are listed", table.len()),
+                        "wrong number of motions",
+                        Some("list one motion per sign pattern, from all outputs positive down to all negative".into()),
+                    );
+                    return (None, None);
+                }
+                let mut rows = Vec::with_capacity(want);
+                for (m, sp) in table {
+                    rows.push(self.motion(hw, m, *sp).unwrap_or([0.0, 0.0]));
+                }
+                // Listed from all outputs on (bits 11..1) down to all off (00..0).
+                rows.reverse();
+                (k as u16, Decode::Table(rows))
+            }
+        };
+        let count = Network::param_count(inputs.len(), hidden as usize, outputs as usize);
+        let (params, genes) = match &n.weights {
+            None => (vec![Param::Random { lo: -1.0, hi: 1.0 }; count], None),
+            Some(ast::WeightSource::Random(r, _)) => match self.range(r) {
+                Some((lo, hi)) => (vec![Param::Random { lo, hi }; count], None),
+                None => return (None, None),
+            },
+            Some(ast::WeightSource::Fixed(v, sp)) => {
+                let vals: Vec<f32> = v.iter().map(|x| *x as f32).collect();
+                (self.fixed_params(&vals, count, *sp), None)
+            }
+            Some(ast::WeightSource::Evolvable(_)) => (Vec::new(), Some(None)),
+        };
+        let net = Network { inputs: inputs.len() as u16, hidden, outputs, params };
+        (Some(NeuralBehavior { inputs, net, decode }), genes)
+    }
+
+    fn learn(&mut self, l: &ast::LearnDecl) -> Option<Learning> {
+        let target = match l.target.text.as_str() {
+            "behavior" => LearnTarget::Behavior,
+            "activation" => LearnTarget::Activation,
+            other => {
+                self.errors.push(Error::Unknown {
+                    span: l.target.span.into(),
+                    what: "learning target",
+                    name: other.into(),
+                    help: did_you_mean(other, ["behavior", "activation"])
+                        .or_else(|| Some("learn `on behavior` or `on activation`".into())),
+                });
+                return None;
+            }
+        };
+        let (rate_reward, rate_punish) = match l.rates {
+            Some((a, b, sp)) => {
+                let a = self.in_range(a, sp, "a learning rate", 0.0, 1.0);
+                let b = self.in_range(b, sp, "a learning rate", 0.0, 1.0);
+                (a?, b?)
+            }
+            None => DEFAULT_RATES,
+        };
+        let when = match l.below {
+            None => LearnWhen::Always,
+            Some(t) => LearnWhen::Below {
+                threshold: self.in_range(t, l.span, "the performance threshold", -1.0, 1.0)?,
+            },
+        };
+        let window = match &l.window {
+            Some(q) => self.count(q, "the performance window", 1)? as u32,
+            None => DEFAULT_WINDOW,
+        };
+        Some(Learning { target, rate_reward, rate_punish, when, window })
+    }
+}

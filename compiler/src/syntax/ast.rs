@@ -1,0 +1,406 @@
+//! The abstract syntax tree: plain owned data with spans, no pest types.
+
+use super::span::Span;
+
+/// A name as written, with where it was written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Name {
+    pub text: String,
+    pub span: Span,
+}
+
+/// A unit written after a number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    Mm,
+    Cm,
+    Ms,
+    Actions,
+}
+
+impl Unit {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Unit::Mm => "mm",
+            Unit::Cm => "cm",
+            Unit::Ms => "ms",
+            Unit::Actions => "actions",
+        }
+    }
+}
+
+/// A number with an optional unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quantity {
+    pub value: f64,
+    pub unit: Option<Unit>,
+    pub span: Span,
+}
+
+/// An inclusive interval `lo..hi`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Range {
+    pub lo: f64,
+    pub hi: f64,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct File {
+    pub robots: Vec<Robot>,
+    pub genomes: Vec<GenomeBlock>,
+    pub stages: Vec<StageDecl>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Robot {
+    pub name: Name,
+    pub hardware: Vec<Hardware>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Hardware {
+    pub is_sensor: bool,
+    pub name: Name,
+    /// `[N]`, with its span.
+    pub count: Option<(u64, Span)>,
+    pub kind: Name,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenomeBlock {
+    pub settings: Vec<GeneSetting>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct GeneSetting {
+    /// `links`, `weights` or `biases`; `None` for every gene.
+    pub group: Option<Name>,
+    pub bits: Option<Quantity>,
+    pub range: Option<Range>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageDecl {
+    pub name: Name,
+    pub extends: Option<Name>,
+    pub items: Vec<StageItem>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum StageItem {
+    RobotAdds(Vec<Hardware>, Span),
+    Genome(GenomeBlock),
+    World(WorldBlock),
+    Evolve(Vec<Setting>, Span),
+    Test { actions: Quantity, learning: bool, span: Span },
+    Fitness(FitnessDecl),
+    Module(ModuleDecl),
+    LinksAll(LinkKind, Span),
+    Link(LinkDecl),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WorldMode {
+    Set,
+    Adds,
+    Changes,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldBlock {
+    pub mode: WorldMode,
+    pub items: Vec<WorldItem>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum WorldItem {
+    Arena { width: Quantity, depth: Quantity, span: Span },
+    Charger { length: Quantity, wall: Name, lamp: Option<Option<Quantity>>, span: Span },
+    Battery(Quantity, Span),
+    Recharge(Quantity, Span),
+    Objects { count: Option<Quantity>, diameter: Option<Quantity>, virtual_: Option<bool>, span: Span },
+    Body(Vec<Setting>, Span),
+}
+
+impl WorldItem {
+    pub fn span(&self) -> Span {
+        match self {
+            WorldItem::Arena { span, .. }
+            | WorldItem::Charger { span, .. }
+            | WorldItem::Battery(_, span)
+            | WorldItem::Recharge(_, span)
+            | WorldItem::Objects { span, .. }
+            | WorldItem::Body(_, span) => *span,
+        }
+    }
+}
+
+/// `NAME VALUE` in `evolve { }` and `body { }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setting {
+    pub name: Name,
+    pub value: SettingValue,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum SettingValue {
+    Quantity(Quantity),
+    Word(Name),
+    /// `selection truncation keep N`
+    Truncation(Quantity),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitnessDecl {
+    pub adds: bool,
+    pub per_action: Vec<Expr>,
+    pub bonuses: Vec<BonusDecl>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct BonusDecl {
+    pub points: f64,
+    /// The event name; `release outside` is written as two words.
+    pub event: Name,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModuleDecl {
+    pub name: Name,
+    pub items: Vec<ModuleItem>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModuleItem {
+    Sense(Vec<SensorRef>, Span),
+    Activation(ActivationDecl),
+    Behavior(BehaviorDecl),
+    Learn(LearnDecl),
+    Reinforce(Expr, Span),
+}
+
+impl ModuleItem {
+    pub fn span(&self) -> Span {
+        match self {
+            ModuleItem::Sense(_, s) | ModuleItem::Reinforce(_, s) => *s,
+            ModuleItem::Activation(a) => a.span,
+            ModuleItem::Behavior(b) => b.span(),
+            ModuleItem::Learn(l) => l.span,
+        }
+    }
+
+    pub fn keyword(&self) -> &'static str {
+        match self {
+            ModuleItem::Sense(..) => "sense",
+            ModuleItem::Activation(..) => "activation",
+            ModuleItem::Behavior(..) => "behavior",
+            ModuleItem::Learn(..) => "learn",
+            ModuleItem::Reinforce(..) => "reinforce",
+        }
+    }
+}
+
+/// `ir`, `ir[3]`, `ir[0..5]`
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorRef {
+    pub name: Name,
+    pub index: Option<Index>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Index {
+    pub first: u64,
+    /// The last element of an inclusive slice.
+    pub last: Option<u64>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum WeightSource {
+    Evolvable(Span),
+    Fixed(Vec<f64>, Span),
+    Random(Range, Span),
+}
+
+impl WeightSource {
+    pub fn span(&self) -> Span {
+        match self {
+            WeightSource::Evolvable(s) | WeightSource::Fixed(_, s) | WeightSource::Random(_, s) => *s,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct ActivationDecl {
+    pub source: Option<WeightSource>,
+    pub hidden: Option<Quantity>,
+    pub range: Option<Range>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum BehaviorDecl {
+    Script(Vec<StepDecl>, Span),
+    Neural(NeuralDecl),
+}
+
+impl BehaviorDecl {
+    pub fn span(&self) -> Span {
+        match self {
+            BehaviorDecl::Script(_, s) => *s,
+            BehaviorDecl::Neural(n) => n.span,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepDecl {
+    pub action: ActionDecl,
+    pub end: Option<EndDecl>,
+    pub uses_charger: Option<Span>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum EndDecl {
+    For(Quantity),
+    Until { cond: Expr, within: Option<Quantity>, span: Span },
+}
+
+/// A wheel motion: also an entry of a neural decoding table.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Motion {
+    Forward(Option<f64>),
+    Back(Option<f64>),
+    TurnLeft(Option<f64>),
+    TurnRight(Option<f64>),
+    Stop,
+    /// `wheels(l, r)`: by the name of a `speed` actuator.
+    Wheels(Name, f64, f64),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ActionDecl {
+    Motion(Motion, Span),
+    Toward {
+        refs: Vec<SensorRef>,
+        speed: Option<f64>,
+        span: Span,
+    },
+    Wait(Span),
+    Recharge(Span),
+    Reinforce(Expr, Span),
+    /// `arm down`: an actuator and a state.
+    Set {
+        actuator: Name,
+        state: Name,
+        span: Span,
+    },
+}
+
+impl ActionDecl {
+    pub fn span(&self) -> Span {
+        match self {
+            ActionDecl::Motion(_, s)
+            | ActionDecl::Toward { span: s, .. }
+            | ActionDecl::Wait(s)
+            | ActionDecl::Recharge(s)
+            | ActionDecl::Reinforce(_, s)
+            | ActionDecl::Set { span: s, .. } => *s,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct NeuralDecl {
+    pub sense: Option<(Vec<SensorRef>, Span)>,
+    pub hidden: Option<Quantity>,
+    pub outputs: Option<OutputsDecl>,
+    pub weights: Option<WeightSource>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum OutputsDecl {
+    Sign { count: Quantity, table: Vec<(Motion, Span)>, span: Span },
+    Linear { scale: Option<f64>, span: Span },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LearnDecl {
+    pub rates: Option<(f64, f64, Span)>,
+    pub target: Name,
+    /// `None` for `always`, else the threshold.
+    pub below: Option<f64>,
+    pub window: Option<Quantity>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum LinkKind {
+    Evolvable(Option<Range>),
+    Fixed(f64),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinkDecl {
+    pub from: Name,
+    pub to: Name,
+    pub kind: LinkKind,
+    pub span: Span,
+}
+
+// ------------------------------------------------------------------ expressions
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Expr {
+    pub kind: ExprKind,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UnOp {
+    Neg,
+    Not,
+    Prev,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    And,
+    Or,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExprKind {
+    Number(f64, Option<Unit>),
+    /// A sensor or actuator, whole or indexed.
+    Ref(Name, Option<Index>),
+    Call(Name, Vec<Expr>),
+    Unary(UnOp, Box<Expr>),
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `c ? a : b`
+    Cond(Box<Expr>, Box<Expr>, Box<Expr>),
+}

@@ -1,0 +1,8 @@
+//! Text to AST: the pest grammar, the AST types and spans.
+
+pub mod ast;
+mod parser;
+pub mod span;
+
+pub use parser::parse;
+pub use span::Span;

@@ -1,0 +1,852 @@
+//! From text to AST. The only module that sees pest types.
+
+use pest::iterators::Pair;
+use pest::pratt_parser::{Assoc, Op, PrattParser};
+use pest::Parser as _;
+
+use super::ast::*;
+use super::span::Span;
+use crate::diag::Error;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "../../grammar/shaping.pest"]
+struct BatParser;
+
+/// Deepest nesting of brackets (and `? :`) accepted before parsing.
+const MAX_NESTING: usize = 48;
+/// Most grammar nodes in one expression (bounds every recursion over it).
+const MAX_EXPR_NODES: usize = 256;
+/// Budget of pest rule calls for one file.
+const CALL_LIMIT: usize = 20_000_000;
+
+/// Parses a file. On a syntax error, returns that one error (the checker
+/// reports every error of a file that parses).
+pub fn parse(src: &str) -> Result<File, Vec<Error>> {
+    if let Some(err) = check_nesting(src) {
+        return Err(vec![err]);
+    }
+    pest::set_call_limit(std::num::NonZeroUsize::new(CALL_LIMIT));
+    let mut pairs = match BatParser::parse(Rule::file, src) {
+        Ok(p) => p,
+        Err(e) => return Err(vec![syntax_error(src, e)]),
+    };
+    let mut b = Builder { pratt: pratt(), errors: Vec::new() };
+    let file =
+        pairs.next().map(|p| b.file(p)).unwrap_or(File { robots: vec![], genomes: vec![], stages: vec![] });
+    if b.errors.is_empty() {
+        Ok(file)
+    } else {
+        Err(b.errors)
+    }
+}
+
+fn pratt() -> PrattParser<Rule> {
+    PrattParser::new()
+        .op(Op::infix(Rule::cond, Assoc::Right))
+        .op(Op::infix(Rule::or, Assoc::Left))
+        .op(Op::infix(Rule::and, Assoc::Left))
+        .op(Op::infix(Rule::lt, Assoc::Left)
+            | Op::infix(Rule::le, Assoc::Left)
+            | Op::infix(Rule::gt, Assoc::Left)
+            | Op::infix(Rule::ge, Assoc::Left)
+            | Op::infix(Rule::eq, Assoc::Left)
+            | Op::infix(Rule::ne, Assoc::Left))
+        .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
+        .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
+        .op(Op::prefix(Rule::neg) | Op::prefix(Rule::not) | Op::prefix(Rule::prev))
+}
+
+/// Rejects nesting deep enough to exhaust the stack of a recursive parser.
+fn check_nesting(src: &str) -> Option<Error> {
+    let bytes = src.as_bytes();
+    let mut depth = 0usize;
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                i += 2;
+                while i < bytes.len() && !(bytes[i] == b'*' && bytes.get(i + 1) == Some(&b'/')) {
+                    i += 1;
+                }
+                i += 1;
+            }
+            b'(' | b'[' | b'{' | b'?' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Some(Error::TooDeep {
+                        span: Span::new(i, i + 1).into(),
+                        what: "brackets nest",
+                        limit: MAX_NESTING,
+                    });
+                }
+            }
+            b')' | b']' | b'}' | b':' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    None
+}
+
+fn describe(rule: Rule) -> Option<&'static str> {
+    Some(match rule {
+        Rule::EOI => "end of file",
+        Rule::ident => "a name",
+        Rule::integer => "a whole number",
+        Rule::number | Rule::quantity => "a number",
+        Rule::unsigned | Rule::literal => "a number",
+        Rule::unit => "a unit",
+        Rule::range => "a range `lo..hi`",
+        Rule::robot | Rule::robot_adds => "`robot`",
+        Rule::genome => "`genome`",
+        Rule::stage => "`stage`",
+        Rule::extends => "`extends`",
+        Rule::sensor_decl => "`sensor`",
+        Rule::actuator_decl => "`actuator`",
+        Rule::count => "`[`",
+        Rule::gene_setting | Rule::bits_setting | Rule::k_bits => "`bits`",
+        Rule::range_setting | Rule::k_range => "`range`",
+        Rule::gene_group => "`links`, `weights` or `biases`",
+        Rule::world => "`world`",
+        Rule::world_mode => "`adds` or `changes`",
+        Rule::arena => "`arena`",
+        Rule::charger => "`charger`",
+        Rule::lamp => "`with lamp`",
+        Rule::battery => "`battery`",
+        Rule::recharge_time | Rule::k_recharge | Rule::recharge_step => "`recharge`",
+        Rule::objects => "`objects`",
+        Rule::diameter => "`diameter`",
+        Rule::object_kind => "`physical` or `virtual`",
+        Rule::body => "`body`",
+        Rule::setting => "a setting",
+        Rule::evolve => "`evolve`",
+        Rule::selection => "`selection`",
+        Rule::test_run => "`test`",
+        Rule::test_learning => "`with learning` or `without learning`",
+        Rule::fitness => "`fitness`",
+        Rule::fitness_mode => "`adds`",
+        Rule::per_action => "`per action`",
+        Rule::bonus => "a bonus `N per EVENT`",
+        Rule::k_outside => "`outside`",
+        Rule::module => "`module`",
+        Rule::sense => "`sense`",
+        Rule::sensor_ref => "a sensor",
+        Rule::index => "`[`",
+        Rule::activation => "`activation`",
+        Rule::weights_source => "`evolvable`, `fixed` or `random`",
+        Rule::k_evolvable => "`evolvable`",
+        Rule::k_fixed => "`fixed`",
+        Rule::k_random => "`random`",
+        Rule::number_list => "`[`",
+        Rule::hidden | Rule::k_hidden => "`hidden`",
+        Rule::behavior => "`behavior`",
+        Rule::script => "`{`",
+        Rule::step => "a step",
+        Rule::for_end => "`for`",
+        Rule::until_end => "`until`",
+        Rule::within => "`within`",
+        Rule::uses_charger => "`uses charger`",
+        Rule::forward | Rule::k_forward => "`forward`",
+        Rule::back | Rule::k_back => "`back`",
+        Rule::turn | Rule::k_turn => "`turn`",
+        Rule::bare_turn => "`left` or `right`",
+        Rule::k_left => "`left`",
+        Rule::k_right => "`right`",
+        Rule::stop | Rule::k_stop => "`stop`",
+        Rule::set_wheels => "a wheel command",
+        Rule::speed => "`(`",
+        Rule::toward | Rule::k_toward => "`toward`",
+        Rule::wait | Rule::k_wait => "`wait`",
+        Rule::reinforce_step | Rule::reinforce => "`reinforce`",
+        Rule::set_actuator => "an actuator command",
+        Rule::neural => "`neural`",
+        Rule::outputs => "`outputs`",
+        Rule::sign_outputs => "`sign`",
+        Rule::linear_outputs => "`linear`",
+        Rule::neural_weights => "`weights`",
+        Rule::learn => "`learn`",
+        Rule::rates => "`(`",
+        Rule::learn_target => "`behavior` or `activation`",
+        Rule::learn_when | Rule::k_always => "`always` or `when`",
+        Rule::window => "`over`",
+        Rule::links_all => "`links`",
+        Rule::link => "`link`",
+        Rule::k_all => "`all`",
+        Rule::link_kind => "`evolvable` or `fixed`",
+        Rule::expr | Rule::reference | Rule::call => "an expression",
+        Rule::neg | Rule::not | Rule::prev => "an expression",
+        Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
+        Rule::lt | Rule::le | Rule::gt | Rule::ge | Rule::eq | Rule::ne => "an operator",
+        Rule::and | Rule::or | Rule::cond => "an operator",
+        _ => return None,
+    })
+}
+
+/// The token found at `pos`, for "found ..." labels.
+fn token_at(src: &str, pos: usize) -> (Span, String) {
+    let rest = &src[pos..];
+    let Some(c) = rest.chars().next() else {
+        return (Span::new(pos, pos), "end of file".into());
+    };
+    let len = if c.is_ascii_alphanumeric() || c == '_' {
+        rest.find(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.')).unwrap_or(rest.len())
+    } else {
+        c.len_utf8()
+    };
+    let text = &rest[..len];
+    let shown: String = text.chars().take(24).collect();
+    let found = if c.is_control() { "a control character".to_string() } else { format!("`{shown}`") };
+    (Span::new(pos, pos + len), found)
+}
+
+fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
+    let pos = match e.location {
+        pest::error::InputLocation::Pos(p) => p,
+        pest::error::InputLocation::Span((a, _)) => a,
+    };
+    let pos = pos.min(src.len());
+    let (mut span, found) = token_at(src, pos);
+    if pos == src.len() {
+        // Point at the last token, so that the label shows.
+        let end = src.trim_end().len();
+        let start = src[..end].char_indices().next_back().map(|(i, _)| i).unwrap_or(0);
+        span = Span::new(start, end.max(start));
+    }
+    let expected = match &e.variant {
+        pest::error::ErrorVariant::ParsingError { positives, .. } => {
+            let mut names: Vec<&str> = positives.iter().filter_map(|r| describe(*r)).collect();
+            names.sort_unstable();
+            names.dedup();
+            match names.len() {
+                0 => "something else".to_string(),
+                1 => names[0].to_string(),
+                n => format!("{} or {}", names[..n - 1].join(", "), names[n - 1]),
+            }
+        }
+        pest::error::ErrorVariant::CustomError { message } => {
+            return Error::TooComplex { span: span.into(), reason: message.to_lowercase() };
+        }
+    };
+    Error::Syntax { span: span.into(), expected, found }
+}
+
+/// The span of a pair, without the whitespace a trailing optional part
+/// may have skipped.
+fn span(p: &Pair<Rule>) -> Span {
+    let s = p.as_span();
+    Span::new(s.start(), s.start() + p.as_str().trim_end().len())
+}
+
+fn name(p: Pair<Rule>) -> Name {
+    Name { text: p.as_str().to_string(), span: span(&p) }
+}
+
+fn num(p: &Pair<Rule>) -> f64 {
+    p.as_str().parse::<f64>().unwrap_or(f64::NAN)
+}
+
+fn int(p: &Pair<Rule>) -> u64 {
+    p.as_str().parse::<u64>().unwrap_or(u64::MAX)
+}
+
+fn unit(p: &Pair<Rule>) -> Unit {
+    match p.as_str() {
+        "mm" => Unit::Mm,
+        "cm" => Unit::Cm,
+        "ms" => Unit::Ms,
+        _ => Unit::Actions,
+    }
+}
+
+fn quantity(p: Pair<Rule>) -> Quantity {
+    let sp = span(&p);
+    let mut it = p.into_inner();
+    let value = it.next().map(|n| num(&n)).unwrap_or(f64::NAN);
+    let unit = it.next().map(|u| unit(&u));
+    Quantity { value, unit, span: sp }
+}
+
+fn range(p: Pair<Rule>) -> Range {
+    let sp = span(&p);
+    let mut it = p.into_inner();
+    let lo = it.next().map(|n| num(&n)).unwrap_or(f64::NAN);
+    let hi = it.next().map(|n| num(&n)).unwrap_or(f64::NAN);
+    Range { lo, hi, span: sp }
+}
+
+fn index(p: Pair<Rule>) -> Index {
+    let sp = span(&p);
+    let mut it = p.into_inner();
+    let first = it.next().map(|n| int(&n)).unwrap_or(0);
+    let last = it.next().map(|n| int(&n));
+    Index { first, last, span: sp }
+}
+
+fn sensor_ref(p: Pair<Rule>) -> SensorRef {
+    let sp = span(&p);
+    let mut it = p.into_inner();
+    let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+    SensorRef { name: n, index: it.next().map(index), span: sp }
+}
+
+fn hardware(p: Pair<Rule>) -> Hardware {
+    let sp = span(&p);
+    let is_sensor = p.as_rule() == Rule::sensor_decl;
+    let mut n = None;
+    let mut count = None;
+    let mut kind = None;
+    for c in p.into_inner() {
+        match c.as_rule() {
+            Rule::ident if n.is_none() => n = Some(name(c)),
+            Rule::ident => kind = Some(name(c)),
+            Rule::count => {
+                let s = span(&c);
+                count = c.into_inner().next().map(|i| (int(&i), s));
+            }
+            _ => {}
+        }
+    }
+    let blank = Name { text: String::new(), span: sp };
+    Hardware { is_sensor, name: n.unwrap_or(blank.clone()), count, kind: kind.unwrap_or(blank), span: sp }
+}
+
+fn speed(p: Option<Pair<Rule>>) -> Option<f64> {
+    p.and_then(|s| s.into_inner().next()).map(|n| num(&n))
+}
+
+fn motion(p: Pair<Rule>) -> Motion {
+    let rule = p.as_rule();
+    let mut it = p.into_inner();
+    match rule {
+        Rule::forward => {
+            it.next();
+            Motion::Forward(speed(it.next()))
+        }
+        Rule::back => {
+            it.next();
+            Motion::Back(speed(it.next()))
+        }
+        Rule::turn | Rule::bare_turn => {
+            if rule == Rule::turn {
+                it.next();
+            }
+            let left = it.next().map(|d| d.as_rule() == Rule::k_left).unwrap_or(true);
+            let v = speed(it.next());
+            if left {
+                Motion::TurnLeft(v)
+            } else {
+                Motion::TurnRight(v)
+            }
+        }
+        Rule::set_wheels => {
+            let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: Span::default() });
+            let l = it.next().map(|x| num(&x)).unwrap_or(0.0);
+            let r = it.next().map(|x| num(&x)).unwrap_or(0.0);
+            Motion::Wheels(n, l, r)
+        }
+        _ => Motion::Stop,
+    }
+}
+
+fn weight_source(p: Pair<Rule>) -> WeightSource {
+    let sp = span(&p);
+    let mut it = p.into_inner();
+    let head = it.next();
+    match head.as_ref().map(|h| h.as_rule()) {
+        Some(Rule::k_fixed) => {
+            let vals = match it.next() {
+                Some(v) if v.as_rule() == Rule::number_list => v.into_inner().map(|n| num(&n)).collect(),
+                Some(v) => vec![num(&v)],
+                None => vec![],
+            };
+            WeightSource::Fixed(vals, sp)
+        }
+        Some(Rule::k_random) => {
+            let r = it.next().map(range).unwrap_or(Range { lo: -1.0, hi: 1.0, span: sp });
+            WeightSource::Random(r, sp)
+        }
+        _ => WeightSource::Evolvable(sp),
+    }
+}
+
+struct Builder {
+    pratt: PrattParser<Rule>,
+    errors: Vec<Error>,
+}
+
+impl Builder {
+    fn file(&mut self, p: Pair<Rule>) -> File {
+        let mut f = File { robots: vec![], genomes: vec![], stages: vec![] };
+        for item in p.into_inner() {
+            match item.as_rule() {
+                Rule::robot => {
+                    let sp = span(&item);
+                    let mut it = item.into_inner();
+                    let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+                    f.robots.push(Robot { name: n, hardware: it.map(hardware).collect(), span: sp });
+                }
+                Rule::genome => f.genomes.push(genome(item)),
+                Rule::stage => {
+                    let s = self.stage(item);
+                    f.stages.push(s);
+                }
+                _ => {}
+            }
+        }
+        f
+    }
+
+    fn stage(&mut self, p: Pair<Rule>) -> StageDecl {
+        let sp = span(&p);
+        let mut it = p.into_inner().peekable();
+        let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+        let mut extends = None;
+        let mut items = Vec::new();
+        for c in it {
+            let csp = span(&c);
+            match c.as_rule() {
+                Rule::extends => extends = c.into_inner().next().map(name),
+                Rule::robot_adds => {
+                    items.push(StageItem::RobotAdds(c.into_inner().map(hardware).collect(), csp))
+                }
+                Rule::genome => items.push(StageItem::Genome(genome(c))),
+                Rule::world => items.push(StageItem::World(world(c))),
+                Rule::evolve => items.push(StageItem::Evolve(c.into_inner().map(setting).collect(), csp)),
+                Rule::test_run => {
+                    let mut ti = c.into_inner();
+                    let actions =
+                        ti.next().map(quantity).unwrap_or(Quantity { value: 0.0, unit: None, span: csp });
+                    let learning = ti.next().map(|l| !l.as_str().starts_with("without")).unwrap_or(true);
+                    items.push(StageItem::Test { actions, learning, span: csp });
+                }
+                Rule::fitness => {
+                    let fit = self.fitness(c);
+                    items.push(StageItem::Fitness(fit));
+                }
+                Rule::module => {
+                    let m = self.module(c);
+                    items.push(StageItem::Module(m));
+                }
+                Rule::links_all => {
+                    let kind = c.into_inner().nth(1).map(link_kind).unwrap_or(LinkKind::Evolvable(None));
+                    items.push(StageItem::LinksAll(kind, csp));
+                }
+                Rule::link => {
+                    let mut li = c.into_inner();
+                    let blank = Name { text: String::new(), span: csp };
+                    let from = li.next().map(name).unwrap_or(blank.clone());
+                    let to = li.next().map(name).unwrap_or(blank);
+                    let kind = li.next().map(link_kind).unwrap_or(LinkKind::Evolvable(None));
+                    items.push(StageItem::Link(LinkDecl { from, to, kind, span: csp }));
+                }
+                _ => {}
+            }
+        }
+        StageDecl { name: n, extends, items, span: sp }
+    }
+
+    fn fitness(&mut self, p: Pair<Rule>) -> FitnessDecl {
+        let sp = span(&p);
+        let mut f = FitnessDecl { adds: false, per_action: vec![], bonuses: vec![], span: sp };
+        for c in p.into_inner() {
+            let csp = span(&c);
+            match c.as_rule() {
+                Rule::fitness_mode => f.adds = true,
+                Rule::per_action => {
+                    if let Some(e) = c.into_inner().next() {
+                        let e = self.expr(e);
+                        f.per_action.push(e);
+                    }
+                }
+                Rule::bonus => {
+                    let mut bi = c.into_inner();
+                    let points = bi.next().map(|n| num(&n)).unwrap_or(0.0);
+                    let mut ev = bi.next().map(name).unwrap_or(Name { text: String::new(), span: csp });
+                    if let Some(o) = bi.next() {
+                        ev.text.push_str(" outside");
+                        ev.span = ev.span.to(span(&o));
+                    }
+                    f.bonuses.push(BonusDecl { points, event: ev, span: csp });
+                }
+                _ => {}
+            }
+        }
+        f
+    }
+
+    fn module(&mut self, p: Pair<Rule>) -> ModuleDecl {
+        let sp = span(&p);
+        let mut it = p.into_inner();
+        let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+        let mut items = Vec::new();
+        for c in it {
+            let csp = span(&c);
+            match c.as_rule() {
+                Rule::sense => items.push(ModuleItem::Sense(c.into_inner().map(sensor_ref).collect(), csp)),
+                Rule::activation => {
+                    let mut a = ActivationDecl { source: None, hidden: None, range: None, span: csp };
+                    for o in c.into_inner() {
+                        match o.as_rule() {
+                            Rule::weights_source => a.source = Some(weight_source(o)),
+                            Rule::hidden => a.hidden = o.into_inner().nth(1).map(quantity),
+                            Rule::range_setting => a.range = o.into_inner().nth(1).map(range),
+                            _ => {}
+                        }
+                    }
+                    items.push(ModuleItem::Activation(a));
+                }
+                Rule::behavior => {
+                    if let Some(b) = c.into_inner().next() {
+                        let bsp = span(&b);
+                        let decl = match b.as_rule() {
+                            Rule::neural => BehaviorDecl::Neural(self.neural(b)),
+                            Rule::script => {
+                                BehaviorDecl::Script(b.into_inner().map(|s| self.step(s)).collect(), bsp)
+                            }
+                            _ => BehaviorDecl::Script(vec![self.step(b)], bsp),
+                        };
+                        items.push(ModuleItem::Behavior(decl));
+                    }
+                }
+                Rule::learn => {
+                    let mut l = LearnDecl {
+                        rates: None,
+                        target: Name { text: String::new(), span: csp },
+                        below: None,
+                        window: None,
+                        span: csp,
+                    };
+                    for o in c.into_inner() {
+                        match o.as_rule() {
+                            Rule::rates => {
+                                let rs = span(&o);
+                                let v: Vec<f64> = o.into_inner().map(|n| num(&n)).collect();
+                                if v.len() == 2 {
+                                    l.rates = Some((v[0], v[1], rs));
+                                }
+                            }
+                            Rule::learn_target => l.target = name(o),
+                            Rule::learn_when => {
+                                l.below =
+                                    o.into_inner().find(|x| x.as_rule() == Rule::number).map(|n| num(&n))
+                            }
+                            Rule::window => l.window = o.into_inner().next().map(quantity),
+                            _ => {}
+                        }
+                    }
+                    items.push(ModuleItem::Learn(l));
+                }
+                Rule::reinforce => {
+                    if let Some(e) = c.into_inner().next() {
+                        let e = self.expr(e);
+                        items.push(ModuleItem::Reinforce(e, csp));
+                    }
+                }
+                _ => {}
+            }
+        }
+        ModuleDecl { name: n, items, span: sp }
+    }
+
+    fn neural(&mut self, p: Pair<Rule>) -> NeuralDecl {
+        let sp = span(&p);
+        let mut n = NeuralDecl { sense: None, hidden: None, outputs: None, weights: None, span: sp };
+        for c in p.into_inner() {
+            let csp = span(&c);
+            match c.as_rule() {
+                Rule::sense => n.sense = Some((c.into_inner().map(sensor_ref).collect(), csp)),
+                Rule::hidden => n.hidden = c.into_inner().nth(1).map(quantity),
+                Rule::neural_weights => n.weights = c.into_inner().next().map(weight_source),
+                Rule::outputs => {
+                    if let Some(o) = c.into_inner().next() {
+                        let osp = span(&o);
+                        n.outputs = Some(if o.as_rule() == Rule::sign_outputs {
+                            let mut oi = o.into_inner();
+                            let count = oi.next().map(quantity).unwrap_or(Quantity {
+                                value: 0.0,
+                                unit: None,
+                                span: osp,
+                            });
+                            let table = oi
+                                .map(|m| {
+                                    let ms = span(&m);
+                                    (motion(m), ms)
+                                })
+                                .collect();
+                            OutputsDecl::Sign { count, table, span: osp }
+                        } else {
+                            OutputsDecl::Linear { scale: o.into_inner().next().map(|x| num(&x)), span: osp }
+                        });
+                    }
+                }
+                _ => {}
+            }
+        }
+        n
+    }
+
+    fn step(&mut self, p: Pair<Rule>) -> StepDecl {
+        let sp = span(&p);
+        let mut it = p.into_inner();
+        let action = match it.next() {
+            Some(a) => self.action(a),
+            None => ActionDecl::Wait(sp),
+        };
+        let mut end = None;
+        let mut uses_charger = None;
+        for c in it {
+            match c.as_rule() {
+                Rule::for_end => {
+                    end = c.into_inner().next().map(quantity).map(EndDecl::For);
+                }
+                Rule::until_end => {
+                    let usp = span(&c);
+                    let mut ui = c.into_inner();
+                    let cond = match ui.next() {
+                        Some(e) => self.expr(e),
+                        None => Expr { kind: ExprKind::Number(0.0, None), span: usp },
+                    };
+                    let within = ui.next().and_then(|w| w.into_inner().next()).map(quantity);
+                    end = Some(EndDecl::Until { cond, within, span: usp });
+                }
+                Rule::uses_charger => uses_charger = Some(span(&c)),
+                _ => {}
+            }
+        }
+        StepDecl { action, end, uses_charger, span: sp }
+    }
+
+    fn action(&mut self, p: Pair<Rule>) -> ActionDecl {
+        let sp = span(&p);
+        match p.as_rule() {
+            Rule::forward | Rule::back | Rule::turn | Rule::stop | Rule::set_wheels => {
+                ActionDecl::Motion(motion(p), sp)
+            }
+            Rule::toward => {
+                let mut refs = Vec::new();
+                let mut speed = None;
+                for c in p.into_inner() {
+                    match c.as_rule() {
+                        Rule::sensor_ref => refs.push(sensor_ref(c)),
+                        Rule::number => speed = Some(num(&c)),
+                        _ => {}
+                    }
+                }
+                ActionDecl::Toward { refs, speed, span: sp }
+            }
+            Rule::wait => ActionDecl::Wait(sp),
+            Rule::recharge_step => ActionDecl::Recharge(sp),
+            Rule::reinforce_step => match p.into_inner().next() {
+                Some(e) => {
+                    let e = self.expr(e);
+                    ActionDecl::Reinforce(e, sp)
+                }
+                None => ActionDecl::Wait(sp),
+            },
+            _ => {
+                let mut it = p.into_inner();
+                let blank = Name { text: String::new(), span: sp };
+                let actuator = it.next().map(name).unwrap_or(blank.clone());
+                let state = it.next().map(name).unwrap_or(blank);
+                ActionDecl::Set { actuator, state, span: sp }
+            }
+        }
+    }
+
+    /// Converts a top-level expression, refusing oversized ones before any
+    /// recursion over them.
+    fn expr(&mut self, p: Pair<Rule>) -> Expr {
+        let sp = span(&p);
+        if p.clone().into_inner().flatten().count() > MAX_EXPR_NODES {
+            self.errors.push(Error::TooDeep {
+                span: sp.into(),
+                what: "an expression has grammar nodes",
+                limit: MAX_EXPR_NODES,
+            });
+            return Expr { kind: ExprKind::Number(0.0, None), span: sp };
+        }
+        expr_inner(&self.pratt, p)
+    }
+}
+
+fn expr_inner(pratt: &PrattParser<Rule>, p: Pair<Rule>) -> Expr {
+    pratt
+        .map_primary(|prim| primary(pratt, prim))
+        .map_prefix(|op, rhs| {
+            let sp = span(&op).to(rhs.span);
+            let u = match op.as_rule() {
+                Rule::neg => UnOp::Neg,
+                Rule::not => UnOp::Not,
+                _ => UnOp::Prev,
+            };
+            Expr { kind: ExprKind::Unary(u, Box::new(rhs)), span: sp }
+        })
+        .map_infix(|lhs, op, rhs| {
+            let sp = lhs.span.to(rhs.span);
+            let b = match op.as_rule() {
+                Rule::add => BinOp::Add,
+                Rule::sub => BinOp::Sub,
+                Rule::mul => BinOp::Mul,
+                Rule::div => BinOp::Div,
+                Rule::lt => BinOp::Lt,
+                Rule::le => BinOp::Le,
+                Rule::gt => BinOp::Gt,
+                Rule::ge => BinOp::Ge,
+                Rule::eq => BinOp::Eq,
+                Rule::ne => BinOp::Ne,
+                Rule::and => BinOp::And,
+                Rule::or => BinOp::Or,
+                _ => {
+                    let then = match op.into_inner().next() {
+                        Some(e) => expr_inner(pratt, e),
+                        None => Expr { kind: ExprKind::Number(0.0, None), span: sp },
+                    };
+                    return Expr {
+                        kind: ExprKind::Cond(Box::new(lhs), Box::new(then), Box::new(rhs)),
+                        span: sp,
+                    };
+                }
+            };
+            Expr { kind: ExprKind::Binary(b, Box::new(lhs), Box::new(rhs)), span: sp }
+        })
+        .parse(p.into_inner())
+}
+
+fn primary(pratt: &PrattParser<Rule>, p: Pair<Rule>) -> Expr {
+    let sp = span(&p);
+    match p.as_rule() {
+        Rule::expr => expr_inner(pratt, p),
+        Rule::call => {
+            let mut it = p.into_inner();
+            let f = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+            let args = it.map(|a| expr_inner(pratt, a)).collect();
+            Expr { kind: ExprKind::Call(f, args), span: sp }
+        }
+        Rule::literal => {
+            let mut it = p.into_inner();
+            let v = it.next().map(|n| num(&n)).unwrap_or(0.0);
+            let u = it.next().map(|u| unit(&u));
+            Expr { kind: ExprKind::Number(v, u), span: sp }
+        }
+        _ => {
+            let mut it = p.into_inner();
+            let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+            Expr { kind: ExprKind::Ref(n, it.next().map(index)), span: sp }
+        }
+    }
+}
+
+fn genome(p: Pair<Rule>) -> GenomeBlock {
+    let sp = span(&p);
+    let settings = p
+        .into_inner()
+        .map(|s| {
+            let ssp = span(&s);
+            let mut g = GeneSetting { group: None, bits: None, range: None, span: ssp };
+            for c in s.into_inner() {
+                match c.as_rule() {
+                    Rule::gene_group => g.group = Some(name(c)),
+                    Rule::bits_setting => g.bits = c.into_inner().nth(1).map(quantity),
+                    Rule::range_setting => g.range = c.into_inner().nth(1).map(range),
+                    _ => {}
+                }
+            }
+            g
+        })
+        .collect();
+    GenomeBlock { settings, span: sp }
+}
+
+fn world(p: Pair<Rule>) -> WorldBlock {
+    let sp = span(&p);
+    let mut mode = WorldMode::Set;
+    let mut items = Vec::new();
+    for c in p.into_inner() {
+        let csp = span(&c);
+        match c.as_rule() {
+            Rule::world_mode => {
+                mode = if c.as_str() == "adds" { WorldMode::Adds } else { WorldMode::Changes }
+            }
+            Rule::arena => {
+                let mut it = c.into_inner();
+                let q0 = Quantity { value: 0.0, unit: None, span: csp };
+                let width = it.next().map(quantity).unwrap_or(q0.clone());
+                let depth = it.next().map(quantity).unwrap_or(q0);
+                items.push(WorldItem::Arena { width, depth, span: csp });
+            }
+            Rule::charger => {
+                let mut it = c.into_inner();
+                let length =
+                    it.next().map(quantity).unwrap_or(Quantity { value: 0.0, unit: None, span: csp });
+                let wall = it.next().map(name).unwrap_or(Name { text: String::new(), span: csp });
+                let lamp = it.next().map(|l| l.into_inner().next().map(quantity));
+                items.push(WorldItem::Charger { length, wall, lamp, span: csp });
+            }
+            Rule::battery => {
+                if let Some(q) = c.into_inner().next() {
+                    items.push(WorldItem::Battery(quantity(q), csp));
+                }
+            }
+            Rule::recharge_time => {
+                if let Some(q) = c.into_inner().nth(1) {
+                    items.push(WorldItem::Recharge(quantity(q), csp));
+                }
+            }
+            Rule::objects => {
+                let mut count = None;
+                let mut diameter = None;
+                let mut virtual_ = None;
+                for o in c.into_inner() {
+                    match o.as_rule() {
+                        Rule::quantity => count = Some(quantity(o)),
+                        Rule::diameter => diameter = o.into_inner().next().map(quantity),
+                        Rule::object_kind => virtual_ = Some(o.as_str() == "virtual"),
+                        _ => {}
+                    }
+                }
+                items.push(WorldItem::Objects { count, diameter, virtual_, span: csp });
+            }
+            Rule::body => items.push(WorldItem::Body(c.into_inner().map(setting).collect(), csp)),
+            _ => {}
+        }
+    }
+    WorldBlock { mode, items, span: sp }
+}
+
+fn setting(p: Pair<Rule>) -> Setting {
+    let sp = span(&p);
+    let rule = p.as_rule();
+    let mut it = p.into_inner();
+    if rule == Rule::selection {
+        let v = match it.next() {
+            Some(q) if q.as_rule() == Rule::quantity => SettingValue::Truncation(quantity(q)),
+            Some(w) => SettingValue::Word(name(w)),
+            None => SettingValue::Word(Name { text: String::new(), span: sp }),
+        };
+        return Setting {
+            name: Name { text: "selection".into(), span: Span::new(sp.start, sp.start + 9) },
+            value: v,
+            span: sp,
+        };
+    }
+    let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+    let value = match it.next() {
+        Some(q) if q.as_rule() == Rule::quantity => SettingValue::Quantity(quantity(q)),
+        Some(w) => SettingValue::Word(name(w)),
+        None => SettingValue::Word(Name { text: String::new(), span: sp }),
+    };
+    Setting { name: n, value, span: sp }
+}
+
+fn link_kind(p: Pair<Rule>) -> LinkKind {
+    let mut it = p.into_inner();
+    match it.next() {
+        Some(k) if k.as_rule() == Rule::k_fixed => LinkKind::Fixed(it.next().map(|n| num(&n)).unwrap_or(0.0)),
+        _ => LinkKind::Evolvable(it.next().and_then(|r| r.into_inner().nth(1)).map(range)),
+    }
+}

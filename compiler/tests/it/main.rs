@@ -1,0 +1,32 @@
+//! Integration tests of the compiler: data-driven snapshots and properties.
+//! Test data lives at the repository root: `examples/`, `tests/parse/`,
+//! `tests/ui/`, `tests/lower/`.
+
+mod examples;
+mod layout;
+mod ui;
+
+use std::path::Path;
+
+/// The repository root.
+pub fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+}
+
+/// Renders diagnostics as the CLI does, without colour, 80 columns.
+pub fn render(d: &dyn miette::Diagnostic) -> String {
+    let mut s = String::new();
+    miette::GraphicalReportHandler::new_themed(miette::GraphicalTheme::unicode_nocolor())
+        .with_width(80)
+        .render_report(&mut s, d)
+        .expect("rendering to a string cannot fail");
+    s
+}
+
+/// Compiles a file of the repository, panicking with the rendered diagnostics.
+pub fn compile_ok(src: &str, name: &str) -> shaping_compiler::Program {
+    match shaping_compiler::compile(src, name) {
+        Ok(p) => p,
+        Err(e) => panic!("{name} does not compile:\n{}", render(&e)),
+    }
+}

@@ -1,0 +1,105 @@
+// khepera.bat: the experiment of "Incremental Robot Shaping" (Urzelai,
+// Floreano, Dorigo, Colombetti 1998), in three stages.
+//
+//   navigation  wander, avoid obstacles, follow the light, recharge
+//   collect     + a gripper: pick objects up and drop them outside the arena
+//   bigger      the objects grow from 10 to 25 mm: no evolution, the
+//               modules re-adapt by local learning only
+
+robot khepera {
+  sensor ir[8]      proximity   // 6 front, 2 back: 0 far .. 1 touching
+  sensor light[8]   ambient     // 0 dark .. 1 bright
+  sensor battery    level       // 0 empty .. 1 full
+  actuator wheels[2] speed      // -1..1 of v_max
+}
+
+// Every evolved value is a 4-bit gene decoded into -1..1 (paper, fig. 2).
+genome { bits 4  range -1..1 }
+
+stage navigation {
+  world {
+    arena 400mm x 600mm
+    charger 200mm on north wall with lamp
+    battery 200 actions, recharge 20 actions
+  }
+  evolve { population 100  generations 40  actions 300  seed 1 }
+  // Straight, fast motion away from obstacles (Floreano & Mondada 1994),
+  // scaled so that a perfect life of 300 actions scores 1.
+  fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) / 300
+
+  module wander {
+    sense ir
+    behavior forward(1.0)
+  }
+
+  // Learns to avoid obstacles from random weights: rewarded when the
+  // closest obstacle gets farther, punished when it gets closer.
+  module avoid {
+    sense ir
+    behavior neural {
+      outputs sign(2) -> forward | right | left | back
+      weights random -0.5..0.5
+    }
+    learn crbp(0.1, 0.01) on behavior always over 30 actions
+    reinforce sign(max(prev ir) - max(ir))
+  }
+
+  module follow {
+    sense light, battery
+    behavior toward(light)
+  }
+
+  module recharge {
+    sense ir[0..5], battery
+    behavior wait until battery >= 1 within 40 actions uses charger
+  }
+
+  links all evolvable
+}
+
+stage collect extends navigation {
+  robot adds {
+    sensor barrier optical   // between the gripper's arms: 0 or 1
+    actuator arm lift        // up | down
+    actuator claw grip       // open | closed
+  }
+  world adds { objects 8 diameter 10mm virtual }
+  evolve { generations 40 }
+  fitness adds 0.5 per grip, 1.0 per release outside
+
+  // Approach, lower the arm and look between the arms: an object (barrier
+  // on) is rewarded, a wall punished; then grip and lift.
+  module grip {
+    sense ir, barrier
+    behavior script {
+      toward(ir)
+      arm down
+      back until barrier within 5 actions
+      reinforce barrier ? 1 : -1
+      claw closed
+      arm up
+    }
+    learn crbp(0.1, 0.01) on activation always
+  }
+
+  // Drop the object when facing a wall: rewarded when nothing is between
+  // the arms any more after opening the claw.
+  module release {
+    sense ir, barrier
+    behavior script {
+      toward(ir)
+      claw open
+      reinforce barrier ? -1 : 1
+      arm down
+      arm up
+    }
+    learn crbp(0.1, 0.01) on activation always
+  }
+
+  links all evolvable
+}
+
+stage bigger extends collect {
+  world changes { objects diameter 25mm }
+  test best for 300 actions with learning
+}

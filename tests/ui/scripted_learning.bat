@@ -1,0 +1,10 @@
+robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s {
+  fitness per action wheels[0]
+  module m {
+    sense ir
+    behavior forward
+    learn crbp on behavior always
+    reinforce prev wheels[0] > 0 ? 1 : -1
+  }
+}

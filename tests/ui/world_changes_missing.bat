@@ -1,0 +1,8 @@
+robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s {
+  fitness per action wheels[0]
+  module m { sense ir behavior forward }
+}
+stage t extends s {
+  world changes { objects diameter 25mm  charger 100mm on south wall }
+}
