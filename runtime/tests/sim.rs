@@ -1,7 +1,7 @@
 //! Behaviour of the simulated Khepera world.
 
 use proptest::prelude::*;
-use shaping_runtime::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT};
+use shaping_runtime::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT, SENSOR_BEARING_DEG};
 use shaping_runtime::program::{Battery, Body, Charger, Objects, Wall, World};
 use shaping_runtime::sim::{Command, ObjectState, Pose, Sim};
 
@@ -403,5 +403,115 @@ proptest! {
                 prop_assert!(d >= 27.5 + 12.5 - 1e-3, "inside an object: {}", d);
             }
         }
+    }
+}
+
+/// `toward(ir)`: steer toward the vector sum of the IR readings along their
+/// bearings; turn in place when it is more than 20 degrees off, else forward.
+fn toward_ir(p: &[f32; CHANNELS], speed: f32) -> Command {
+    let (mut x, mut y) = (0.0f32, 0.0f32);
+    for (s, deg) in SENSOR_BEARING_DEG.iter().enumerate() {
+        let b = deg.to_radians();
+        x += p[CH_IR + s] * b.cos();
+        y += p[CH_IR + s] * b.sin();
+    }
+    let off = y.atan2(x);
+    if x * x + y * y > 1e-6 && off.abs() > 20f32.to_radians() {
+        let t = 0.3 * off.signum();
+        wheels(-t, t)
+    } else {
+        wheels(speed, speed)
+    }
+}
+
+/// From a random pose in front of a 10 mm object (within 15 degrees of the
+/// heading, 5..25 mm from the body), with wheel and sensor noise on:
+/// `toward(ir); arm down; back until barrier within 5 actions; close`.
+/// Returns whether it gripped.
+fn toward_grip(virtual_: bool, seed: u64, back: f32) -> bool {
+    let w = World { body: Body::default(), ..with_objects(1, 10.0, virtual_) };
+    let mut sim = Sim::new(&w, seed);
+    let mut rng = seed.wrapping_add(1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    let mut next = || {
+        rng ^= rng >> 29;
+        rng = rng.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        (rng >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let heading = (next() - 0.5) * 6.0;
+    let bearing = (next() - 0.5) * 30f32.to_radians();
+    let range = 27.5 + 5.0 + 5.0 + 20.0 * next();
+    let a = heading + bearing;
+    assert!(sim.set_object(0, 200.0 + range * a.cos(), 300.0 + range * a.sin()));
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: heading }));
+    let p = percept(&mut sim);
+    sim.step(&toward_ir(&p, 0.5));
+    sim.step(&Command { arm: Some(true), ..Command::default() });
+    for _ in 0..5 {
+        if percept(&mut sim)[CH_BARRIER] == 1.0 {
+            break;
+        }
+        sim.step(&wheels(-back, -back));
+    }
+    sim.step(&Command { claw: Some(true), ..Command::default() }).grips == 1
+}
+
+#[test]
+fn toward_ir_then_back_until_barrier_grips_a_small_object() {
+    for virtual_ in [false, true] {
+        for back in [0.2, 0.5] {
+            let ok = (0..100).filter(|&seed| toward_grip(virtual_, seed, back)).count();
+            println!("virtual={virtual_} back={back}: {ok}/100 gripped");
+            assert!(ok >= 98, "virtual={virtual_} back={back}: only {ok}/100 gripped");
+        }
+    }
+}
+
+fn arb_f32() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        4 => -50.0f32..1000.0,
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => Just(0.0f32),
+    ]
+}
+
+fn arb_world() -> impl Strategy<Value = World> {
+    (
+        (arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32(), arb_f32()),
+        (any::<Option<(u32, u32)>>(), any::<Option<(u32, bool)>>(), arb_f32(), arb_f32(), arb_f32()),
+    )
+        .prop_map(|((w, d, radius, axle, v, ms, wn, sn), (battery, objects, diam, bar, lamp))| World {
+            arena: [w, d],
+            body: Body {
+                radius,
+                wheel_base: axle,
+                v_max: v,
+                action_ms: ms,
+                wheel_noise: wn,
+                sensor_noise: sn,
+            },
+            charger: Some(Charger { wall: Wall::East, length: bar, lamp_height: Some(lamp) }),
+            battery: battery
+                .map(|(capacity, recharge)| Battery { capacity: capacity % 1000, recharge: recharge % 100 }),
+            objects: objects.map(|(count, virtual_)| Objects { count: count % 64, diameter: diam, virtual_ }),
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// Any declared world, however odd, simulates without panicking and
+    /// yields readings in 0..1.
+    #[test]
+    fn odd_worlds_never_panic(w in arb_world(), seed in any::<u64>(), cmds in prop::collection::vec(arb_command(), 0..20)) {
+        let mut sim = Sim::new(&w, seed);
+        let mut p = [0.0; CHANNELS];
+        for cmd in &cmds {
+            sim.sense(&mut p);
+            prop_assert!(p.iter().all(|v| (0.0..=1.0).contains(v)), "{:?}", p);
+            sim.step(cmd);
+        }
+        let _ = sim.scene();
+        prop_assert!((0.0..=1.0).contains(&sim.battery()));
     }
 }

@@ -9,6 +9,22 @@
 //! placement, wheel and sensor noise) comes from one `ChaCha8Rng` seeded with
 //! the `seed` given to [`Sim::new`], so the same seed and commands give the
 //! same trajectory. [`Sim::sense`] and [`Sim::step`] never allocate.
+//!
+//! The models, in brief (constants below and in [`ir`]):
+//! - motion: exact differential-drive arc per action, wheel travel
+//!   `command * v_max * action_ms` times `1 +- wheel_noise`; a move whose end
+//!   or middle would overlap a wall or a physical object is retraced in 1 mm
+//!   substeps and stops before the overlap (`Outcome::collided`);
+//! - IR: [`ir::KHEPERA`], fitted to real readings; walls and floor objects
+//!   add up, clamped at 1, plus `+-sensor_noise`;
+//! - light: a lamp above the bar's middle, irradiance falling as
+//!   `1 / (rho^2 + h^2)` times a `cos(1.5 a)` lobe around each sensor's axis;
+//! - battery: integer charge, `-1/capacity` per action, `+1/recharge` per
+//!   action asked to charge with the body within [`CONTACT`] mm of the bar;
+//! - gripper: arm and claw change at the start of the action; closing the
+//!   claw on an object in the catch zone grips it; opening it with a wall
+//!   ahead throws the object out (a virtual one comes back elsewhere),
+//!   otherwise drops it in front.
 
 // Loops over the 8 sensors index several parallel arrays.
 #![allow(clippy::needless_range_loop)]
@@ -16,7 +32,7 @@
 pub mod ir;
 mod scene;
 
-use rand::{Rng, SeedableRng};
+use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT};
@@ -65,8 +81,11 @@ pub const CONTACT: f32 = 3.0;
 pub const CATCH_NEAR: f32 = 5.0;
 /// ... to this far, mm ...
 pub const CATCH_FAR: f32 = 30.0;
-/// ... and at most this far to either side of the heading, mm.
-pub const CATCH_HALF_WIDTH: f32 = 8.0;
+/// ... and at most this far to either side of the heading, mm: half the open
+/// claw's gap (about 27-29 mm on the K-Team gripper), which also covers the
+/// +-20 degree dead band of `toward(...)` at catch distance (the spec's +-8
+/// mm made a `toward(ir); arm down; back until barrier` sequence miss).
+pub const CATCH_HALF_WIDTH: f32 = 15.0;
 /// Opening the claw throws the object out when the body surface is this
 /// close to a wall, mm ...
 pub const RELEASE_REACH: f32 = 20.0;
@@ -81,6 +100,9 @@ pub const MAX_OBJECTS: usize = 1024;
 const SUBSTEP: f32 = 1.0;
 /// Attempts at a random free position before giving up.
 const PLACE_TRIES: u32 = 1000;
+/// Attempts for all the objects of a world together (a crowded world is
+/// filled quickly, overlaps allowed, instead of slowly).
+const PLACE_BUDGET: u32 = 20_000;
 
 /// One object of the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -126,13 +148,30 @@ pub struct Sim {
     held: Option<usize>,
 }
 
-/// A uniform draw in `lo..hi` that never panics (returns `lo` if `hi <= lo`).
+/// A uniform draw in `lo..hi` that never panics (the middle if `hi <= lo`).
 fn uniform(rng: &mut ChaCha8Rng, lo: f32, hi: f32) -> f32 {
     let u: f32 = rng.random();
     if hi > lo {
         lo + (hi - lo) * u
     } else {
-        lo
+        (lo + hi) / 2.0
+    }
+}
+
+/// Two uniform draws in `-n..n` from one 32-bit word (16 bits each: plenty
+/// for noise, and half the generator work).
+fn noise_pair(rng: &mut ChaCha8Rng, n: f32) -> (f32, f32) {
+    let u: u32 = rng.random();
+    let scale = 2.0 * n / 65535.0;
+    ((u & 0xffff) as f32 * scale - n, (u >> 16) as f32 * scale - n)
+}
+
+/// `sin(x) / x`, given `sin(x)`.
+fn sinc(x: f32, sin_x: f32) -> f32 {
+    if x.abs() < 1e-4 {
+        1.0 - x * x / 6.0
+    } else {
+        sin_x / x
     }
 }
 
@@ -208,8 +247,10 @@ impl Sim {
             held: None,
         };
         // Objects first, then the robot somewhere free.
+        let mut budget = PLACE_BUDGET;
         for _ in 0..count {
-            let (x, y) = sim.free_spot(&mut rng, None);
+            let ((x, y), used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
+            budget = budget.saturating_sub(used);
             sim.objects.push(Obj { x, y, state: ObjectState::Floor });
         }
         let margin = radius + START_CLEARANCE;
@@ -234,12 +275,15 @@ impl Sim {
 
     /// A random position for an object centre, at least [`OBJECT_CLEARANCE`]
     /// from the walls and not overlapping other floor objects (nor the robot
-    /// when `robot` is given). Gives up after a while and returns the last try.
-    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Pose>) -> (f32, f32) {
+    /// when `robot` is given). Gives up after `tries` (at least one) and
+    /// returns the last try; also returns the number of tries used.
+    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Pose>, tries: u32) -> ((f32, f32), u32) {
         let r = self.obj_radius;
         let m = r + OBJECT_CLEARANCE;
         let mut spot = (self.width / 2.0, self.depth / 2.0);
-        for _ in 0..PLACE_TRIES {
+        let mut used = 0;
+        while used < tries.max(1) {
+            used += 1;
             let x = uniform(rng, m, self.width - m);
             let y = uniform(rng, m, self.depth - m);
             spot = (x, y);
@@ -254,7 +298,7 @@ impl Sim {
                 break;
             }
         }
-        spot
+        (spot, used)
     }
 
     fn set_pose_unchecked(&mut self, pose: Pose) {
@@ -313,14 +357,20 @@ impl Sim {
         let mut light = [0.0f32; ir::SENSORS];
         self.sense_light(&mut light);
         let n = self.sensor_noise;
+        if n > 0.0 {
+            // 16 bits of randomness per channel, one generator call.
+            let mut bits = [0u8; 4 * ir::SENSORS];
+            self.rng.fill_bytes(&mut bits);
+            let scale = 2.0 * n / 65535.0;
+            let noise = |k: usize| f32::from(u16::from_le_bytes([bits[2 * k], bits[2 * k + 1]])) * scale - n;
+            for s in 0..ir::SENSORS {
+                irv[s] += noise(s);
+                light[s] += noise(ir::SENSORS + s);
+            }
+        }
         for s in 0..ir::SENSORS {
-            let (a, b) = if n > 0.0 {
-                (uniform(&mut self.rng, -n, n), uniform(&mut self.rng, -n, n))
-            } else {
-                (0.0, 0.0)
-            };
-            out[CH_IR + s] = (irv[s] + a).clamp(0.0, 1.0);
-            out[CH_LIGHT + s] = (light[s] + b).clamp(0.0, 1.0);
+            out[CH_IR + s] = irv[s].clamp(0.0, 1.0);
+            out[CH_LIGHT + s] = light[s].clamp(0.0, 1.0);
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
@@ -492,7 +542,7 @@ impl Sim {
             out.releases_outside += 1;
             if self.obj_virtual {
                 let mut rng = self.rng.clone();
-                let (x, y) = self.free_spot(&mut rng, Some(self.pose));
+                let ((x, y), _) = self.free_spot(&mut rng, Some(self.pose), PLACE_TRIES);
                 self.rng = rng;
                 self.objects[i] = Obj { x, y, state: ObjectState::Floor };
             } else {
@@ -545,45 +595,63 @@ impl Sim {
         let mut dl = finite_or(wheels[0], 0.0).clamp(-1.0, 1.0) * self.travel;
         let mut dr = finite_or(wheels[1], 0.0).clamp(-1.0, 1.0) * self.travel;
         if self.wheel_noise > 0.0 {
-            let n = self.wheel_noise;
-            dl *= 1.0 + uniform(&mut self.rng, -n, n);
-            dr *= 1.0 + uniform(&mut self.rng, -n, n);
+            let (a, b) = noise_pair(&mut self.rng, self.wheel_noise);
+            dl *= 1.0 + a;
+            dr *= 1.0 + b;
         }
         if dl == 0.0 && dr == 0.0 {
             return false;
         }
         let start = self.pose;
-        let end = self.arc(start, dl, dr);
-        let mid = self.arc(start, dl / 2.0, dr / 2.0);
-        if self.free(end.x, end.y) && self.free(mid.x, mid.y) {
-            self.set_pose_unchecked(end);
-            return false;
-        }
-        let n = ((dl.abs().max(dr.abs()) / SUBSTEP).ceil() as u32).clamp(1, 10_000);
-        let (sl, sr) = (dl / n as f32, dr / n as f32);
-        let mut pose = start;
-        for _ in 0..n {
-            let next = self.arc(pose, sl, sr);
-            if !self.free(next.x, next.y) {
-                break;
-            }
-            pose = next;
-        }
-        self.set_pose_unchecked(pose);
-        true
-    }
-
-    /// The exact differential-drive arc for wheel travels `dl`, `dr` (mm).
-    fn arc(&self, p: Pose, dl: f32, dr: f32) -> Pose {
+        // The exact arc (spec 1.3) in chord form: the centre moves by
+        // `d * sinc(phi / 2)` along `theta + phi / 2`, and halfway by
+        // `d / 2 * sinc(phi / 4)` along `theta + phi / 4`. One `sin_cos` of
+        // `phi / 4` and the cached heading give everything by double angles.
         let d = (dl + dr) / 2.0;
         let phi = (dr - dl) / (2.0 * self.half_axle);
-        let (s0, c0) = p.theta.sin_cos();
-        if phi.abs() < 1e-6 {
-            return Pose { x: p.x + d * c0, y: p.y + d * s0, theta: p.theta };
+        let q = phi / 4.0;
+        let (s1, c1) = q.sin_cos();
+        let (s2, c2) = (2.0 * s1 * c1, c1 * c1 - s1 * s1);
+        let (s4, c4) = (2.0 * s2 * c2, c2 * c2 - s2 * s2);
+        let (c0, s0) = (self.cos_t, self.sin_t);
+        let rot = |c: f32, s: f32| (c0 * c - s0 * s, s0 * c + c0 * s);
+        let (ce, se) = rot(c2, s2);
+        let len = d * sinc(2.0 * q, s2);
+        let (ex, ey) = (start.x + len * ce, start.y + len * se);
+        let (cm, sm) = rot(c1, s1);
+        let half = d / 2.0 * sinc(q, s1);
+        let (mx, my) = (start.x + half * cm, start.y + half * sm);
+        if self.free(ex, ey) && self.free(mx, my) {
+            let (ct, st) = rot(c4, s4);
+            let norm = 1.0 / (ct * ct + st * st).sqrt();
+            self.pose = Pose { x: ex, y: ey, theta: wrap_angle(start.theta + phi) };
+            self.cos_t = ct * norm;
+            self.sin_t = st * norm;
+            return false;
         }
-        let r = d / phi;
-        let (s1, c1) = (p.theta + phi).sin_cos();
-        Pose { x: p.x + r * (s1 - s0), y: p.y - r * (c1 - c0), theta: wrap_angle(p.theta + phi) }
+        // Retrace in `n` equal sub-arcs: each moves the centre by the chord
+        // `len` along the current heading turned by half its angle, then
+        // turns the heading by its angle (rotations, no more `sin_cos`).
+        let n = ((dl.abs().max(dr.abs()) / SUBSTEP).ceil() as u32).clamp(1, 10_000);
+        let sub = phi / n as f32;
+        let (sh, ch) = (sub / 2.0).sin_cos();
+        let (sf, cf) = (2.0 * sh * ch, ch * ch - sh * sh);
+        let len = d / n as f32 * sinc(sub / 2.0, sh);
+        let (mut x, mut y, mut c, mut s) = (start.x, start.y, c0, s0);
+        let mut k = 0;
+        while k < n {
+            let (nx, ny) = (x + len * (c * ch - s * sh), y + len * (s * ch + c * sh));
+            if !self.free(nx, ny) {
+                break;
+            }
+            (x, y, c, s) = (nx, ny, c * cf - s * sf, s * cf + c * sf);
+            k += 1;
+        }
+        let norm = 1.0 / (c * c + s * s).sqrt();
+        self.pose = Pose { x, y, theta: wrap_angle(start.theta + sub * k as f32) };
+        self.cos_t = c * norm;
+        self.sin_t = s * norm;
+        k < n
     }
 
     pub fn pose(&self) -> Pose {
