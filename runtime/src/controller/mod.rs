@@ -536,13 +536,14 @@ impl<'s> Controller<'s> {
                     match l.target {
                         LearnTarget::Activation => {
                             let t = if r > 0.0 { 1.0 } else { 0.0 };
-                            module.activation.train(|_| t, rate);
+                            module.activation.train(&self.now, |_| t, rate);
                         }
                         LearnTarget::Behavior => {
                             if let Gen::Neural { net, bits, .. } = &mut module.gen {
                                 let bits = &*bits;
                                 let reward = r > 0.0;
                                 net.train(
+                                    &self.now,
                                     |o| {
                                         let b = bits[o] as f32;
                                         if reward {
