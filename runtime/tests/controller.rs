@@ -513,6 +513,8 @@ fn episodes_are_deterministic_by_seed_and_trace_does_not_change_them() {
     assert_eq!(t.modules, vec!["wander", "avoid", "follow", "recharge"]);
     let json = serde_json::to_string(&t.rows[0]).unwrap();
     assert!(json.contains("\"pose\":{\"x\":"), "{json}");
+    let back: Trace = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
+    assert_eq!(back, t);
 }
 
 /// End to end on the simulator: `toward(light)` brings the robot to the

@@ -67,7 +67,7 @@ pub mod script;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
 use crate::expr::{Env, Expr};
@@ -94,7 +94,7 @@ pub struct EpisodeOptions {
 }
 
 /// What one episode produced.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EpisodeResult {
     /// Sum over the actions of the per-action fitness term, plus the bonuses
     /// times the event counts.
@@ -110,14 +110,14 @@ pub struct EpisodeResult {
 }
 
 /// Per-action record of an episode (for replays, plots and tests).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Trace {
     /// Module names, in declaration order (the columns of the per-module vectors).
     pub modules: Vec<String>,
     pub rows: Vec<TraceRow>,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TraceRow {
     /// Action number, from 0.
     pub action: u32,
