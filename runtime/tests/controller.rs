@@ -564,3 +564,42 @@ fn follow_light_then_recharge_keeps_the_robot_alive() {
     println!("{recharged} of 5 episodes recharged");
     assert!(recharged >= 3, "only {recharged} of 5 episodes recharged");
 }
+
+#[test]
+fn linear_decoding_gives_continuous_speeds_without_learning_and_sampled_ones_with() {
+    // bias_0 = 1 (y0 = 0.731), bias_1 = -1 (y1 = 0.269), no inputs used.
+    let params = vec![Param::Fixed(1.0), Param::Fixed(0.0), Param::Fixed(0.0), Param::Fixed(-1.0)]
+        .into_iter()
+        .chain([Param::Fixed(0.0), Param::Fixed(0.0)])
+        .collect();
+    let mut s = neural_stage(expr(vec![Op::Const(0.0)]), None, params);
+    let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
+    nb.decode = Decode::Linear { scale: 0.5 };
+    let mut c = controller(&s, 1);
+    let mut robot = Puppet::default();
+    c.start(&mut robot);
+    let w = c.act(&mut robot).command.wheels;
+    let y0 = sigmoid(1.0);
+    assert!(
+        (w[0] - (2.0 * y0 - 1.0) * 0.5).abs() < 1e-6 && (w[1] + (2.0 * y0 - 1.0) * 0.5).abs() < 1e-6,
+        "{w:?}"
+    );
+
+    s.modules[0].learning = Some(testkit::crbp(LearnTarget::Behavior, 0.0, 0.0, 30));
+    let mut c = controller(&s, 1);
+    c.start(&mut robot);
+    for _ in 0..20 {
+        let w = c.act(&mut robot).command.wheels;
+        assert!(w.iter().all(|&v| v == 0.5 || v == -0.5), "sampled bits give full +-scale: {w:?}");
+    }
+}
+
+#[test]
+fn decode_tables_must_have_a_row_per_bit_pattern() {
+    let mut s = neural_stage(expr(vec![Op::Const(0.0)]), None, zero_params());
+    let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
+    nb.decode = Decode::Table(vec![[1.0, 1.0]; 3]);
+    let g = Genome::zeros(0);
+    let err = Controller::new(&s, &g, ChaCha8Rng::seed_from_u64(1)).err();
+    assert!(matches!(err, Some(ControllerError::BadModule { .. })), "{err:?}");
+}

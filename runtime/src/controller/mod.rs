@@ -49,8 +49,18 @@
 //!
 //! Learning is on when `EpisodeOptions::learning` is set, the module declares
 //! a [`Learning`], and either it learns `Always` or its performance indicator
-//! (rolling mean of its last `window` non-zero reinforcements; 0 before any)
-//! is below the threshold.
+//! (rolling mean of its last `window` non-zero reinforcements; 0 before any;
+//! a module with a reinforcement program but no learning uses a window of 30)
+//! is below the threshold at the start of the action.
+//!
+//! # Entry points
+//!
+//! [`run_episode`] (the contract used by the GA and the CLI) builds a
+//! [`Controller`] and a [`Sim`] from the episode seed ([`episode_rngs`]) and
+//! runs them. [`validate`] checks a stage once; [`try_run_episode`] reports
+//! what [`run_episode`] would silently score 0. [`Controller::act`] runs one
+//! action on anything implementing [`Robot`] (the simulator, or a test's
+//! hand-driven robot).
 //!
 //! Initial weights: `Param::Gene` decoded from the genome, `Param::Fixed`,
 //! `Param::Random` drawn from the controller's RNG when it is built (module
