@@ -82,15 +82,15 @@ stage collect extends navigation {
     learn crbp(0.1, 0.01) on activation always
   }
 
-  // Drop the object when facing a wall: rewarded when nothing is between
-  // the arms any more after opening the claw.
+  // Drop the object outside: turn to the closest obstacle and open the
+  // claw. Releasing while both front sensors see a wall puts the object
+  // outside the arena, and is rewarded; releasing elsewhere is punished.
   module release {
     sense ir, barrier
     behavior script {
       toward(ir)
+      reinforce ir[2] > 0.5 and ir[3] > 0.5 ? 1 : -1
       claw open
-      reinforce barrier ? -1 : 1
-      arm down
       arm up
     }
     learn crbp(0.1, 0.01) on activation always

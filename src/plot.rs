@@ -23,7 +23,9 @@ use std::fmt;
 use std::io;
 use std::path::{Path, PathBuf};
 
+#[allow(unused_imports)]
 pub use render::font_path;
+#[allow(unused_imports)]
 pub use series::rolling_mean;
 
 /// Best and mean fitness of one generation.
@@ -112,6 +114,7 @@ impl PlotError {
     }
 
     /// The file (or stem) the error is about.
+    #[allow(dead_code)]
     pub fn path(&self) -> &Path {
         match self {
             PlotError::Input { path, .. } | PlotError::Io { path, .. } | PlotError::Draw { path, .. } => path,

@@ -34,6 +34,14 @@ pub enum Error {
         limit: usize,
     },
 
+    #[error("the expression has more than {limit} parts")]
+    #[diagnostic(help("split it, for example into several fitness terms"))]
+    TooLarge {
+        #[label("too large")]
+        span: SourceSpan,
+        limit: usize,
+    },
+
     #[error("unknown {what} `{name}`")]
     Unknown {
         #[label("not declared")]

@@ -515,3 +515,60 @@ proptest! {
         prop_assert!((0.0..=1.0).contains(&sim.battery()));
     }
 }
+
+#[test]
+fn the_lookup_tables_agree_with_the_exact_model() {
+    use shaping_runtime::sim::ir::KHEPERA;
+    let mut sim = Sim::new(&with_objects(1, 10.0, true), 15);
+    assert!(sim.set_object(0, 100.0, 500.0));
+    // Up to the culling range (60 mm).
+    for k in 0..240 {
+        let d = 0.5 + 0.25 * k as f32;
+        let theta = k as f32 * 0.7;
+        // Near the west wall only.
+        assert!(sim.set_pose(Pose { x: 27.5 + d, y: 300.0, theta }));
+        let p = percept(&mut sim);
+        // The west wall's outward normal (-1, 0) in the robot frame.
+        let normal = [-theta.cos(), theta.sin()];
+        for s in 0..8 {
+            let exact = KHEPERA.wall_reading(s, 27.5, 27.5 + d, normal).min(1.0);
+            assert!((p[CH_IR + s] - exact).abs() < 2e-3, "wall d={d} s={s}: {} vs {exact}", p[CH_IR + s]);
+        }
+        // A 10 mm object alone, at the same distance.
+        assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta }));
+        let (bx, by) = (200.0 + (27.5 + d + 5.0) * 0.3f32.cos(), 300.0 + (27.5 + d + 5.0) * 0.3f32.sin());
+        assert!(sim.set_object(0, bx, by));
+        let p = percept(&mut sim);
+        let rel = [
+            (bx - 200.0) * theta.cos() + (by - 300.0) * theta.sin(),
+            -(bx - 200.0) * theta.sin() + (by - 300.0) * theta.cos(),
+        ];
+        for s in 0..8 {
+            let exact = KHEPERA.cylinder_reading(s, 27.5, rel, 5.0).min(1.0);
+            if d >= 5.0 {
+                assert!(
+                    (p[CH_IR + s] - exact).abs() < 2e-3,
+                    "object d={d} s={s}: {} vs {exact}",
+                    p[CH_IR + s]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn sensor_noise_stays_within_its_amplitude() {
+    let w = World { body: Body { sensor_noise: 0.01, ..world().body }, charger: None, ..world() };
+    let mut sim = Sim::new(&w, 16);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    let mut nonzero = 0;
+    for _ in 0..100 {
+        let p = percept(&mut sim);
+        for v in &p[..16] {
+            assert!((0.0..=0.01).contains(v), "{v}");
+            nonzero += usize::from(*v > 0.0);
+        }
+    }
+    // Half the draws are negative and clamp to 0.
+    assert!((600..1000).contains(&nonzero), "{nonzero}");
+}

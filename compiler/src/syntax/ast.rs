@@ -3,10 +3,16 @@
 use super::span::Span;
 
 /// A name as written, with where it was written.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Name {
     pub text: String,
     pub span: Span,
+}
+
+impl std::fmt::Debug for Name {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:?}@{:?}", self.text, self.span)
+    }
 }
 
 /// A unit written after a number.
@@ -364,10 +370,61 @@ pub struct LinkDecl {
 
 // ------------------------------------------------------------------ expressions
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Expr {
     pub kind: ExprKind,
     pub span: Span,
+}
+
+/// Expressions print as s-expressions, with the span of the whole:
+/// `(+ 1 (* 2 ir[3]))@10..22`.
+impl std::fmt::Debug for Expr {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}@{:?}", self.sexpr(), self.span)
+    }
+}
+
+impl Expr {
+    /// The expression as an s-expression, without spans.
+    pub fn sexpr(&self) -> String {
+        match &self.kind {
+            ExprKind::Number(v, None) => format!("{v}"),
+            ExprKind::Number(v, Some(u)) => format!("{v}{}", u.as_str()),
+            ExprKind::Ref(n, None) => n.text.clone(),
+            ExprKind::Ref(n, Some(Index { first, last: None, .. })) => format!("{}[{first}]", n.text),
+            ExprKind::Ref(n, Some(Index { first, last: Some(l), .. })) => format!("{}[{first}..{l}]", n.text),
+            ExprKind::Call(n, args) => {
+                let args: Vec<String> = args.iter().map(Expr::sexpr).collect();
+                format!("({} {})", n.text, args.join(" "))
+            }
+            ExprKind::Unary(op, e) => {
+                let op = match op {
+                    UnOp::Neg => "neg",
+                    UnOp::Not => "not",
+                    UnOp::Prev => "prev",
+                };
+                format!("({op} {})", e.sexpr())
+            }
+            ExprKind::Binary(op, a, b) => {
+                let op = match op {
+                    BinOp::Add => "+",
+                    BinOp::Sub => "-",
+                    BinOp::Mul => "*",
+                    BinOp::Div => "/",
+                    BinOp::Lt => "<",
+                    BinOp::Le => "<=",
+                    BinOp::Gt => ">",
+                    BinOp::Ge => ">=",
+                    BinOp::Eq => "==",
+                    BinOp::Ne => "!=",
+                    BinOp::And => "and",
+                    BinOp::Or => "or",
+                };
+                format!("({op} {} {})", a.sexpr(), b.sexpr())
+            }
+            ExprKind::Cond(c, a, b) => format!("(? {} {} {})", c.sexpr(), a.sexpr(), b.sexpr()),
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -45,6 +45,7 @@ fn pratt() -> PrattParser<Rule> {
         .op(Op::infix(Rule::cond, Assoc::Right))
         .op(Op::infix(Rule::or, Assoc::Left))
         .op(Op::infix(Rule::and, Assoc::Left))
+        .op(Op::prefix(Rule::not))
         .op(Op::infix(Rule::lt, Assoc::Left)
             | Op::infix(Rule::le, Assoc::Left)
             | Op::infix(Rule::gt, Assoc::Left)
@@ -53,7 +54,7 @@ fn pratt() -> PrattParser<Rule> {
             | Op::infix(Rule::ne, Assoc::Left))
         .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
         .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
-        .op(Op::prefix(Rule::neg) | Op::prefix(Rule::not) | Op::prefix(Rule::prev))
+        .op(Op::prefix(Rule::neg) | Op::prefix(Rule::prev))
 }
 
 /// Rejects nesting deep enough to exhaust the stack of a recursive parser.
@@ -663,11 +664,7 @@ impl Builder {
     fn expr(&mut self, p: Pair<Rule>) -> Expr {
         let sp = span(&p);
         if p.clone().into_inner().flatten().count() > MAX_EXPR_NODES {
-            self.errors.push(Error::TooDeep {
-                span: sp.into(),
-                what: "an expression has grammar nodes",
-                limit: MAX_EXPR_NODES,
-            });
+            self.errors.push(Error::TooLarge { span: sp.into(), limit: MAX_EXPR_NODES });
             return Expr { kind: ExprKind::Number(0.0, None), span: sp };
         }
         expr_inner(&self.pratt, p)

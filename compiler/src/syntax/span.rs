@@ -2,7 +2,7 @@
 
 /// A byte range `start..end` of the source. Made at the parser boundary;
 /// every AST node that can be blamed in a diagnostic carries one.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Span {
     pub start: usize,
     pub end: usize,
@@ -22,5 +22,11 @@ impl Span {
 impl From<Span> for miette::SourceSpan {
     fn from(s: Span) -> miette::SourceSpan {
         miette::SourceSpan::new(s.start.into(), s.end.saturating_sub(s.start))
+    }
+}
+
+impl std::fmt::Debug for Span {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}..{}", self.start, self.end)
     }
 }

@@ -2,8 +2,12 @@
 //! Test data lives at the repository root: `examples/`, `tests/parse/`,
 //! `tests/ui/`, `tests/lower/`.
 
+mod docs;
 mod examples;
 mod layout;
+mod limits;
+mod parse;
+mod props;
 mod ui;
 
 use std::path::Path;

@@ -11,7 +11,7 @@ fn ui() {
         match shaping_compiler::compile(&src, &name) {
             Ok(_) => panic!("{name} compiles, but every file in tests/ui must fail"),
             Err(d) => {
-                assert!(d.len() >= 1);
+                assert!(!d.is_empty());
                 insta::assert_snapshot!(format!("{src}\n{}", render(&d)));
             }
         }

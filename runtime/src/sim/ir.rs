@@ -33,9 +33,10 @@ use std::sync::OnceLock;
 pub const SENSORS: usize = 8;
 /// Radius of the cylinder the cylinder constants were measured with, mm.
 pub const REF_CYLINDER_RADIUS: f32 = 12.5;
-/// How far beyond the body surface any surface can still be seen, mm
-/// (the real readings are at noise level by 41 mm).
-pub const RANGE: f32 = 45.0;
+/// How far beyond the body surface a surface is still considered, mm. The
+/// front sensors are at noise level by 41 mm, the most sensitive back ones
+/// still read ~0.07 at 43 mm; beyond 60 mm the model gives < 0.002.
+pub const RANGE: f32 = 60.0;
 /// The nearest measured distance from the body surface, mm; objects closer
 /// than this (virtual ones under the body) read as if at this distance.
 pub const NEAREST: f32 = 5.0;

@@ -1,0 +1,227 @@
+//! Properties: compiling never panics; appending a stage never changes the
+//! layouts of the stages before it; `Program` survives a JSON round trip.
+
+use proptest::prelude::*;
+use shaping_compiler::{compile, Program};
+
+use crate::root;
+
+/// Words and symbols of the language, to build inputs that get deep into
+/// the grammar (random strings mostly stop at the first character).
+const TOKENS: &[&str] = &[
+    "robot",
+    "r",
+    "{",
+    "}",
+    "sensor",
+    "ir",
+    "[8]",
+    "[",
+    "]",
+    "proximity",
+    "actuator",
+    "wheels",
+    "speed",
+    "stage",
+    "s",
+    "t",
+    "extends",
+    "module",
+    "m",
+    "sense",
+    "behavior",
+    "forward",
+    "back",
+    "turn",
+    "left",
+    "until",
+    "within",
+    "for",
+    "3",
+    "actions",
+    "mm",
+    "0.5",
+    "-1",
+    "..",
+    ",",
+    ";",
+    "(",
+    ")",
+    "max",
+    "prev",
+    "?",
+    ":",
+    "+",
+    "*",
+    "and",
+    "not",
+    "fitness",
+    "per",
+    "action",
+    "links",
+    "all",
+    "evolvable",
+    "link",
+    "->",
+    "genome",
+    "bits",
+    "range",
+    "world",
+    "arena",
+    "x",
+    "evolve",
+    "population",
+    "test",
+    "best",
+    "learn",
+    "crbp",
+    "on",
+    "always",
+    "reinforce",
+    "neural",
+    "outputs",
+    "sign",
+    "|",
+    "script",
+    "// c\n",
+];
+
+fn khepera() -> String {
+    std::fs::read_to_string(root().join("examples/khepera.bat")).unwrap()
+}
+
+/// A stage appended to `khepera.bat`, built from generated choices.
+fn extra_stage(parent: usize, modules: &[(u8, u8, bool)], links: bool) -> String {
+    let parent = ["navigation", "collect", "bigger"][parent];
+    let mut s =
+        format!("stage extra extends {parent} {{\n  evolve {{ generations 3 }}\n  genome {{ bits 5 }}\n");
+    for (i, &(first, len, hidden)) in modules.iter().enumerate() {
+        let first = first % 8;
+        let last = (first + len % 4).min(7);
+        let hidden = if hidden { "activation hidden 2" } else { "" };
+        s += &format!(
+            "  module x{i} {{ sense ir[{first}..{last}] {hidden} behavior turn left for 2 actions }}\n"
+        );
+    }
+    if links {
+        s += "  links all evolvable range -2..2\n";
+    }
+    s + "}\n"
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn any_string_compiles_or_gives_a_diagnostic(src in any::<String>()) {
+        if let Err(d) = compile(&src, "any.bat") {
+            prop_assert!(!d.is_empty());
+        }
+    }
+
+    #[test]
+    fn any_token_soup_compiles_or_gives_a_diagnostic(tokens in prop::collection::vec(prop::sample::select(TOKENS), 0..120)) {
+        let src = tokens.join(" ");
+        if let Err(d) = compile(&src, "soup.bat") {
+            prop_assert!(!d.is_empty());
+            // Rendering never panics either.
+            let _ = crate::render(&d);
+        }
+    }
+
+    #[test]
+    fn mutated_example_compiles_or_gives_a_diagnostic(at in 0usize..4000, len in 0usize..40, insert in prop::sample::select(TOKENS)) {
+        let mut src = khepera();
+        let at = at.min(src.len());
+        let end = (at + len).min(src.len());
+        if src.is_char_boundary(at) && src.is_char_boundary(end) {
+            src.replace_range(at..end, insert);
+        }
+        if let Err(d) = compile(&src, "mutated.bat") {
+            prop_assert!(!d.is_empty());
+        }
+    }
+
+    #[test]
+    fn appending_a_stage_leaves_earlier_layouts_unchanged(
+        parent in 0usize..3,
+        modules in prop::collection::vec((any::<u8>(), any::<u8>(), any::<bool>()), 1..4),
+        links in any::<bool>(),
+    ) {
+        let base = compile(&khepera(), "khepera.bat").unwrap();
+        let src = khepera() + &extra_stage(parent, &modules, links);
+        let grown = match compile(&src, "khepera.bat") {
+            Ok(p) => p,
+            Err(d) => return Err(TestCaseError::fail(crate::render(&d))),
+        };
+        prop_assert_eq!(grown.stages.len(), base.stages.len() + 1);
+        for (a, b) in base.stages.iter().zip(&grown.stages) {
+            prop_assert_eq!(&a.layout, &b.layout);
+            prop_assert_eq!(a, b);
+        }
+        // The new stage starts with its parent's genes, all frozen.
+        let new = grown.stages.last().unwrap();
+        let old = &grown.stages[parent].layout;
+        prop_assert_eq!(new.layout.genes.len() > old.genes.len(), true);
+        for (g, o) in new.layout.genes.iter().zip(&old.genes) {
+            prop_assert!(g.frozen);
+            prop_assert_eq!((g.offset, g.bits, g.module, g.role), (o.offset, o.bits, o.module, o.role));
+        }
+        for g in &new.layout.genes[old.genes.len()..] {
+            prop_assert!(!g.frozen);
+            prop_assert_eq!(g.bits, 5);
+        }
+        // Gene offsets are contiguous.
+        let mut offset = 0;
+        for g in &new.layout.genes {
+            prop_assert_eq!(g.offset, offset);
+            offset += g.bits as u32;
+        }
+        prop_assert_eq!(offset, new.layout.bits);
+        prop_assert!(serde_roundtrip(&grown));
+    }
+}
+
+fn serde_roundtrip(p: &Program) -> bool {
+    let json = serde_json::to_string(p).unwrap();
+    let back: Program = serde_json::from_str(&json).unwrap();
+    back == *p
+}
+
+#[test]
+fn examples_survive_a_json_round_trip() {
+    for name in ["khepera.bat", "scratch.bat", "tutorial.bat"] {
+        let src = std::fs::read_to_string(root().join("examples").join(name)).unwrap();
+        let p = crate::compile_ok(&src, name);
+        assert!(serde_roundtrip(&p), "{name}");
+    }
+}
+
+#[test]
+fn every_expression_is_valid_for_the_runtime() {
+    use shaping_runtime::program::{Action, Behavior, StepEnd};
+    let src = khepera();
+    let p = crate::compile_ok(&src, "khepera.bat");
+    let mut n = 0;
+    for st in &p.stages {
+        let mut exprs: Vec<&shaping_runtime::expr::Expr> = st.fitness.per_action.iter().collect();
+        for m in &st.modules {
+            exprs.extend(m.reinforce.iter());
+            if let Behavior::Script(s) = &m.behavior {
+                for step in &s.steps {
+                    if let Action::Reinforce(e) = &step.action {
+                        exprs.push(e);
+                    }
+                    if let StepEnd::Until { cond, .. } = &step.end {
+                        exprs.push(cond);
+                    }
+                }
+            }
+        }
+        for e in exprs {
+            assert!(e.is_valid(), "{e:?}");
+            n += 1;
+        }
+    }
+    assert!(n >= 10);
+}
