@@ -5,7 +5,9 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use shaping_runtime::catalog::CHANNELS;
 use shaping_runtime::controller::{run_episode, EpisodeOptions};
+use shaping_runtime::sim::{Command, Sim};
 use shaping_runtime::testkit;
 
 fn navigation(c: &mut Criterion) {
@@ -23,6 +25,22 @@ fn navigation(c: &mut Criterion) {
             b.iter(|| black_box(run_episode(black_box(&stage), black_box(&genome), &opts, None)))
         });
     }
+    // The simulator alone (sense + step, constant forward command) over the
+    // same world, for the controller's share of the time.
+    stage.world.battery = None;
+    group.throughput(Throughput::Elements(300));
+    group.bench_function("sim_only_300_actions", |b| {
+        b.iter(|| {
+            let mut sim = Sim::new(black_box(&stage.world), 7);
+            let mut p = [0.0f32; CHANNELS];
+            let cmd = Command { wheels: [1.0, 0.9], ..Command::default() };
+            for _ in 0..300 {
+                sim.sense(&mut p);
+                black_box(sim.step(black_box(&cmd)));
+            }
+            black_box(p)
+        })
+    });
     group.finish();
 }
 

@@ -303,9 +303,10 @@ pub fn barrier_select(hit: f32, miss: f32) -> Expr {
     expr(vec![Op::Chan(CH_BARRIER as u16), Op::Const(hit), Op::Const(miss), Op::Select])
 }
 
-/// The grip script: turn toward what the IR sees until it is close in front,
-/// lower the arm, back until the barrier sees something (at most 4 actions),
-/// reinforce `barrier ? 1 : -1`, close the claw, lift the arm.
+/// The grip script (the paper's sequence): turn toward what the IR sees until
+/// it is close in front, lower the arm, back until the barrier sees something
+/// (at most 4 actions; the approach usually ends too close for the catch
+/// zone), reinforce `barrier ? 1 : -1`, close the claw, lift the arm.
 pub fn grip_script() -> Script {
     let step = |action, end| Step { action, end };
     let barrier = expr(vec![Op::Chan(CH_BARRIER as u16)]);
@@ -324,17 +325,27 @@ pub fn grip_script() -> Script {
     }
 }
 
+/// `min(ir[2], ir[3]) > level`: something wide and close in front (a wall).
+pub fn wall_ahead(level: f32) -> Expr {
+    expr(vec![Op::Chan(CH_IR as u16 + 2), Op::Chan(CH_IR as u16 + 3), Op::Min(2), Op::Const(level), Op::Gt])
+}
+
 /// The release script: turn toward what the IR sees until it is close in
-/// front, reinforce `barrier ? -1 : 1`, open the claw.
+/// front, reinforce `min(ir[2], ir[3]) > 0.5 ? 1 : -1` (both front sensors
+/// high: a wall, where an object is thrown out; the simulator's barrier stays
+/// on while an object is held, so it cannot tell walls here), open the claw.
 pub fn release_script() -> Script {
     let step = |action, end| Step { action, end };
+    let wall = wall_ahead(0.5);
+    let reinforce =
+        expr(wall.ops.iter().copied().chain([Op::Const(1.0), Op::Const(-1.0), Op::Select]).collect());
     Script {
         steps: vec![
             step(
                 Action::Toward { channels: chans(CH_IR, 8), speed: 0.5 },
                 StepEnd::Until { cond: front_above(0.5), within: 10 },
             ),
-            step(Action::Reinforce(barrier_select(-1.0, 1.0)), StepEnd::Actions(1)),
+            step(Action::Reinforce(reinforce), StepEnd::Actions(1)),
             step(Action::Claw(false), StepEnd::Actions(1)),
         ],
     }

@@ -468,6 +468,14 @@ fn lamarckian_inheritance_writes_learned_activation_genes_back() {
     assert_eq!(learned.gene_int(&s.layout.genes[1]), 7, "input 0 was 0: weight unchanged");
     assert!(learned.gene_int(&s.layout.genes[2]) < 7, "{}", learned.to_bitstring());
 
+    // Frozen genes (earlier stages) are never written back.
+    s.layout.genes[0].frozen = true;
+    let mut c = Controller::new(&s, &genome, ChaCha8Rng::seed_from_u64(1)).unwrap();
+    c.run(&mut robot, &opts, None);
+    let learned = c.write_back(&genome);
+    assert_eq!(learned.gene_int(&s.layout.genes[0]), 7, "frozen bias kept");
+    assert!(learned.gene_int(&s.layout.genes[2]) < 7);
+
     // run_episode returns the written-back genome only for Lamarckian stages.
     assert_eq!(run_episode(&s, &genome, &opts, None).learned, None);
     s.inheritance = Inheritance::Lamarckian;
@@ -505,4 +513,93 @@ fn episodes_are_deterministic_by_seed_and_trace_does_not_change_them() {
     assert_eq!(t.modules, vec!["wander", "avoid", "follow", "recharge"]);
     let json = serde_json::to_string(&t.rows[0]).unwrap();
     assert!(json.contains("\"pose\":{\"x\":"), "{json}");
+    let back: Trace = serde_json::from_str(&serde_json::to_string(&t).unwrap()).unwrap();
+    assert_eq!(back, t);
+}
+
+/// End to end on the simulator: `toward(light)` brings the robot to the
+/// charger under the lamp; the recharge module (activation
+/// `sigmoid(-7 + 4 (ir2 + ir3))`, i.e. only very close to a wall) creeps into
+/// contact and waits there with `charge`, so the robot outlives its
+/// 200-action battery.
+#[test]
+fn follow_light_then_recharge_keeps_the_robot_alive() {
+    let mut s = testkit::navigation();
+    // follow: constant 0.5; wander and avoid off.
+    let fixed = |v: &[(usize, f32)], n: usize| {
+        let mut p = vec![Param::Fixed(0.0); n + 1];
+        for &(i, w) in v {
+            p[i] = Param::Fixed(w);
+        }
+        p
+    };
+    s.modules[0].activation.params = fixed(&[(0, -10.0)], 8);
+    s.modules[1].activation.params = fixed(&[(0, -10.0)], 8);
+    s.modules[2].activation.params = fixed(&[(0, 0.0)], 9);
+    s.modules[3].activation.params = fixed(&[(0, -7.0), (3, 4.0), (4, 4.0)], 7);
+    // Creep into contact with the bar, then wait there charging.
+    let full = expr(vec![Op::Chan(CH_BATTERY as u16), Op::Const(1.0), Op::Ge]);
+    s.modules[3].behavior = Behavior::Script(Script {
+        steps: vec![
+            Step { action: Action::Wheels { left: 0.3, right: 0.3 }, end: StepEnd::Actions(2) },
+            Step { action: Action::Wait { charge: true }, end: StepEnd::Until { cond: full, within: 40 } },
+        ],
+    });
+    s.links.clear();
+    let mut recharged = 0;
+    for seed in 0..5 {
+        let mut t = Trace::default();
+        let g = Genome::zeros(s.layout.bits as usize);
+        let r = run_episode(&s, &g, &EpisodeOptions { actions: 300, learning: true, seed }, Some(&mut t));
+        let last = t.rows.last().unwrap();
+        assert!(last.pose.y > 500.0, "seed {seed}: the light leads to the north wall: {:?}", last.pose);
+        if r.recharges > 0 {
+            recharged += 1;
+            assert_eq!(r.actions, 300, "seed {seed}: a recharged robot lives the whole episode");
+            assert!(t.rows.iter().any(|row| row.recharged && row.winner == 3));
+        } else {
+            assert_eq!(r.actions, 200, "seed {seed}: without recharge the battery lasts 200 actions");
+        }
+    }
+    println!("{recharged} of 5 episodes recharged");
+    assert!(recharged >= 3, "only {recharged} of 5 episodes recharged");
+}
+
+#[test]
+fn linear_decoding_gives_continuous_speeds_without_learning_and_sampled_ones_with() {
+    // bias_0 = 1 (y0 = 0.731), bias_1 = -1 (y1 = 0.269), no inputs used.
+    let params = vec![Param::Fixed(1.0), Param::Fixed(0.0), Param::Fixed(0.0), Param::Fixed(-1.0)]
+        .into_iter()
+        .chain([Param::Fixed(0.0), Param::Fixed(0.0)])
+        .collect();
+    let mut s = neural_stage(expr(vec![Op::Const(0.0)]), None, params);
+    let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
+    nb.decode = Decode::Linear { scale: 0.5 };
+    let mut c = controller(&s, 1);
+    let mut robot = Puppet::default();
+    c.start(&mut robot);
+    let w = c.act(&mut robot).command.wheels;
+    let y0 = sigmoid(1.0);
+    assert!(
+        (w[0] - (2.0 * y0 - 1.0) * 0.5).abs() < 1e-6 && (w[1] + (2.0 * y0 - 1.0) * 0.5).abs() < 1e-6,
+        "{w:?}"
+    );
+
+    s.modules[0].learning = Some(testkit::crbp(LearnTarget::Behavior, 0.0, 0.0, 30));
+    let mut c = controller(&s, 1);
+    c.start(&mut robot);
+    for _ in 0..20 {
+        let w = c.act(&mut robot).command.wheels;
+        assert!(w.iter().all(|&v| v == 0.5 || v == -0.5), "sampled bits give full +-scale: {w:?}");
+    }
+}
+
+#[test]
+fn decode_tables_must_have_a_row_per_bit_pattern() {
+    let mut s = neural_stage(expr(vec![Op::Const(0.0)]), None, zero_params());
+    let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
+    nb.decode = Decode::Table(vec![[1.0, 1.0]; 3]);
+    let g = Genome::zeros(0);
+    let err = Controller::new(&s, &g, ChaCha8Rng::seed_from_u64(1)).err();
+    assert!(matches!(err, Some(ControllerError::BadModule { .. })), "{err:?}");
 }

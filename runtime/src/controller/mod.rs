@@ -49,23 +49,35 @@
 //!
 //! Learning is on when `EpisodeOptions::learning` is set, the module declares
 //! a [`Learning`], and either it learns `Always` or its performance indicator
-//! (rolling mean of its last `window` non-zero reinforcements; 0 before any)
-//! is below the threshold.
+//! (rolling mean of its last `window` non-zero reinforcements; 0 before any;
+//! a module with a reinforcement program but no learning uses a window of 30)
+//! is below the threshold at the start of the action.
+//!
+//! # Entry points
+//!
+//! [`run_episode`] (the contract used by the GA and the CLI) builds a
+//! [`Controller`] and a [`Sim`] from the episode seed ([`episode_rngs`]) and
+//! runs them. [`validate`] checks a stage once; [`try_run_episode`] reports
+//! what [`run_episode`] would silently score 0. [`Controller::act`] runs one
+//! action on anything implementing [`Robot`] (the simulator, or a test's
+//! hand-driven robot).
 //!
 //! Initial weights: `Param::Gene` decoded from the genome, `Param::Fixed`,
 //! `Param::Random` drawn from the controller's RNG when it is built (module
 //! by module in declaration order: activation network, behavior network; then
 //! links). Learned weights are thrown away at the end of the episode
 //! (Darwinian) unless the stage is `Lamarckian`: then the learned activation
-//! weights that are genes are written back into [`EpisodeResult::learned`].
+//! weights that are (unfrozen) genes are written back into
+//! [`EpisodeResult::learned`].
 
+mod fast_expr;
 mod net;
 mod perf;
 pub mod script;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
 use crate::expr::{Env, Expr};
@@ -75,6 +87,7 @@ use crate::program::{
 };
 use crate::sim::{Command, Outcome, Pose, Sim};
 
+pub use fast_expr::FastExpr;
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
@@ -91,7 +104,7 @@ pub struct EpisodeOptions {
 }
 
 /// What one episode produced.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct EpisodeResult {
     /// Sum over the actions of the per-action fitness term, plus the bonuses
     /// times the event counts.
@@ -107,14 +120,14 @@ pub struct EpisodeResult {
 }
 
 /// Per-action record of an episode (for replays, plots and tests).
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Trace {
     /// Module names, in declaration order (the columns of the per-module vectors).
     pub modules: Vec<String>,
     pub rows: Vec<TraceRow>,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TraceRow {
     /// Action number, from 0.
     pub action: u32,
@@ -211,7 +224,7 @@ impl Robot for Sim {
 
 #[derive(Clone, Debug)]
 enum Gen<'s> {
-    Script(ScriptRun<'s>),
+    Script(ScriptRun),
     Neural { net: Net, decode: &'s Decode, bits: Vec<u8> },
 }
 
@@ -222,7 +235,7 @@ struct Mod<'s> {
     links: Vec<(usize, f32)>,
     gen: Gen<'s>,
     learning: Option<Learning>,
-    reinforce: Option<&'s Expr>,
+    reinforce: Option<FastExpr>,
     /// The script's `reinforce` steps deliver the reinforcement instead of `reinforce`.
     script_reinforces: bool,
     perf: Rolling,
@@ -281,6 +294,7 @@ pub struct Controller<'s> {
     slots: [f32; ACT_SLOTS],
     last_winner: Option<usize>,
     holding: bool,
+    fitness: Option<FastExpr>,
 }
 
 impl<'s> Controller<'s> {
@@ -333,7 +347,7 @@ impl<'s> Controller<'s> {
                 links: Vec::new(),
                 gen,
                 learning: m.learning.clone(),
-                reinforce: m.reinforce.as_ref(),
+                reinforce: m.reinforce.as_ref().map(FastExpr::new),
                 script_reinforces,
                 perf: Rolling::new(window),
             });
@@ -357,6 +371,7 @@ impl<'s> Controller<'s> {
             slots: [0.0; ACT_SLOTS],
             last_winner: None,
             holding: false,
+            fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
         })
     }
 
@@ -518,7 +533,7 @@ impl<'s> Controller<'s> {
             s.after_action(&env);
         }
         if !module.script_reinforces {
-            if let Some(e) = module.reinforce {
+            if let Some(e) = &module.reinforce {
                 r = script::sign(e.eval(&env));
             }
         }
@@ -531,13 +546,14 @@ impl<'s> Controller<'s> {
                     match l.target {
                         LearnTarget::Activation => {
                             let t = if r > 0.0 { 1.0 } else { 0.0 };
-                            module.activation.train(|_| t, rate);
+                            module.activation.train(&self.now, |_| t, rate);
                         }
                         LearnTarget::Behavior => {
                             if let Gen::Neural { net, bits, .. } = &mut module.gen {
                                 let bits = &*bits;
                                 let reward = r > 0.0;
                                 net.train(
+                                    &self.now,
                                     |o| {
                                         let b = bits[o] as f32;
                                         if reward {
@@ -554,7 +570,7 @@ impl<'s> Controller<'s> {
                 }
             }
         }
-        let fitness = self.stage.fitness.per_action.as_ref().map_or(0.0, |e| e.eval(&env));
+        let fitness = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
         self.before = self.now;
         self.now = self.next;
         ActionReport { winner, command: cmd, outcome, reinforcement: r, fitness }
@@ -617,13 +633,17 @@ impl<'s> Controller<'s> {
     }
 
     /// The genome with the learned activation weights that are genes written
-    /// back (nearest encodable value).
+    /// back (nearest encodable value). Frozen genes (from earlier stages) are
+    /// left as they are: a later stage never changes what an earlier one froze.
     pub fn write_back(&self, genome: &Genome) -> Genome {
         let mut g = genome.clone();
         for (m, module) in self.stage.modules.iter().enumerate() {
             for (p, &w) in module.activation.params.iter().zip(&self.mods[m].activation.w) {
                 if let Param::Gene(i) = *p {
-                    g.encode(&self.stage.layout.genes[i as usize], w);
+                    let gene = &self.stage.layout.genes[i as usize];
+                    if !gene.frozen {
+                        g.encode(gene, w);
+                    }
                 }
             }
         }

@@ -22,8 +22,9 @@
 //! - `wait` stops the wheels (with `charge`, asks the charger to recharge);
 //!   `arm`/`claw` steps stop the wheels and move the gripper.
 
+use super::fast_expr::FastExpr;
 use crate::catalog::{channel_bearing, CHANNELS};
-use crate::expr::{Env, Expr};
+use crate::expr::Env;
 use crate::program::{Action, Script, StepEnd};
 use crate::sim::Command;
 
@@ -32,7 +33,7 @@ pub const TOWARD_DEAD_ZONE_DEG: f32 = 20.0;
 
 /// One step with its precomputed data.
 #[derive(Clone, Debug)]
-enum Op<'s> {
+enum Op {
     Wheels([f32; 2]),
     /// Channels with the unit vector of their bearing.
     Toward {
@@ -44,27 +45,27 @@ enum Op<'s> {
     Wait {
         charge: bool,
     },
-    Reinforce(&'s Expr),
+    Reinforce(FastExpr),
 }
 
 #[derive(Clone, Debug)]
-enum End<'s> {
+enum End {
     Actions(u32),
-    Until { cond: &'s Expr, within: u32 },
+    Until { cond: FastExpr, within: u32 },
 }
 
 /// A script ready to run, with its position.
 #[derive(Clone, Debug)]
-pub struct ScriptRun<'s> {
-    steps: Vec<(Op<'s>, End<'s>)>,
+pub struct ScriptRun {
+    steps: Vec<(Op, End)>,
     /// Current step.
     pos: usize,
     /// Actions spent in the current step.
     spent: u32,
 }
 
-impl<'s> ScriptRun<'s> {
-    pub fn new(script: &'s Script) -> ScriptRun<'s> {
+impl ScriptRun {
+    pub fn new(script: &Script) -> ScriptRun {
         let steps = script
             .steps
             .iter()
@@ -81,11 +82,13 @@ impl<'s> ScriptRun<'s> {
                     Action::Arm(d) => Op::Arm(*d),
                     Action::Claw(c) => Op::Claw(*c),
                     Action::Wait { charge } => Op::Wait { charge: *charge },
-                    Action::Reinforce(e) => Op::Reinforce(e),
+                    Action::Reinforce(e) => Op::Reinforce(FastExpr::new(e)),
                 };
                 let end = match &s.end {
                     StepEnd::Actions(n) => End::Actions(*n),
-                    StepEnd::Until { cond, within } => End::Until { cond, within: *within },
+                    StepEnd::Until { cond, within } => {
+                        End::Until { cond: FastExpr::new(cond), within: *within }
+                    }
                 };
                 (op, end)
             })
