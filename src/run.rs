@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use shaping_runtime::controller::{episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace};
+use shaping_runtime::controller::{
+    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace,
+};
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Program, Stage, StageRun};
