@@ -5,22 +5,15 @@
 //! reinforcement and fitness programs. Equivalence with [`Expr::eval`] is
 //! tested on random programs.
 
-use crate::expr::{Env, Expr, Op, MAX_STACK};
-
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Agg {
-    Max,
-    Min,
-    Sum,
-    Mean,
-}
+use crate::expr::{aggregate, apply, Env, Expr, Op, MAX_STACK};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum FOp {
     Op(Op),
     /// Pushes the aggregate of channels `start..start + n` of `now` (or `prev`).
     Run {
-        agg: Agg,
+        /// The aggregate op (`Max`, `Min`, `Sum` or `Mean`).
+        agg: Op,
         prev: bool,
         start: u16,
         n: u16,
@@ -59,55 +52,10 @@ impl FastExpr {
             match *op {
                 FOp::Run { agg, prev, start, n } => {
                     let src = if prev { env.prev } else { env.now };
-                    let vals = &src[start as usize..start as usize + n as usize];
-                    stack[sp] = aggregate(agg, vals);
+                    stack[sp] = aggregate(agg, &src[start as usize..start as usize + n as usize]);
                     sp += 1;
                 }
-                FOp::Op(op) => match op {
-                    Op::Const(v) => {
-                        stack[sp] = v;
-                        sp += 1;
-                    }
-                    Op::Chan(c) => {
-                        stack[sp] = env.now[c as usize];
-                        sp += 1;
-                    }
-                    Op::Prev(c) => {
-                        stack[sp] = env.prev[c as usize];
-                        sp += 1;
-                    }
-                    Op::Act(a) => {
-                        stack[sp] = env.act[a as usize];
-                        sp += 1;
-                    }
-                    Op::Neg => stack[sp - 1] = -stack[sp - 1],
-                    Op::Not => stack[sp - 1] = truth(stack[sp - 1] == 0.0),
-                    Op::Abs => stack[sp - 1] = stack[sp - 1].abs(),
-                    Op::Sign => stack[sp - 1] = sign(stack[sp - 1]),
-                    Op::Select => {
-                        let (c, t, e) = (stack[sp - 3], stack[sp - 2], stack[sp - 1]);
-                        sp -= 2;
-                        stack[sp - 1] = if c != 0.0 { t } else { e };
-                    }
-                    Op::Max(n) | Op::Min(n) | Op::Sum(n) | Op::Mean(n) => {
-                        let n = n as usize;
-                        let agg = match op {
-                            Op::Max(_) => Agg::Max,
-                            Op::Min(_) => Agg::Min,
-                            Op::Sum(_) => Agg::Sum,
-                            _ => Agg::Mean,
-                        };
-                        let v = aggregate(agg, &stack[sp - n..sp]);
-                        sp -= n;
-                        stack[sp] = v;
-                        sp += 1;
-                    }
-                    bin => {
-                        let (a, b) = (stack[sp - 2], stack[sp - 1]);
-                        sp -= 1;
-                        stack[sp - 1] = binary(bin, a, b);
-                    }
-                },
+                FOp::Op(op) => sp = apply(op, &mut stack, sp, env),
             }
         }
         stack[0]
@@ -130,70 +78,11 @@ fn fuse(ops: &[Op]) -> Option<(FOp, usize)> {
             _ => break,
         }
     }
-    let agg = match ops.get(n)? {
-        Op::Max(k) if *k as usize == n => Agg::Max,
-        Op::Min(k) if *k as usize == n => Agg::Min,
-        Op::Sum(k) if *k as usize == n => Agg::Sum,
-        Op::Mean(k) if *k as usize == n => Agg::Mean,
+    let agg = match *ops.get(n)? {
+        agg @ (Op::Max(k) | Op::Min(k) | Op::Sum(k) | Op::Mean(k)) if k as usize == n => agg,
         _ => return None,
     };
     Some((FOp::Run { agg, prev, start, n: n as u16 }, n + 1))
-}
-
-#[inline]
-fn aggregate(agg: Agg, vals: &[f32]) -> f32 {
-    match agg {
-        Agg::Max => vals.iter().copied().fold(f32::NEG_INFINITY, f32::max),
-        Agg::Min => vals.iter().copied().fold(f32::INFINITY, f32::min),
-        Agg::Sum => vals.iter().sum(),
-        Agg::Mean => vals.iter().sum::<f32>() / vals.len() as f32,
-    }
-}
-
-#[inline]
-fn truth(b: bool) -> f32 {
-    if b {
-        1.0
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-fn sign(v: f32) -> f32 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-fn binary(op: Op, a: f32, b: f32) -> f32 {
-    match op {
-        Op::Add => a + b,
-        Op::Sub => a - b,
-        Op::Mul => a * b,
-        Op::Div => {
-            if b == 0.0 {
-                0.0
-            } else {
-                a / b
-            }
-        }
-        Op::Lt => truth(a < b),
-        Op::Le => truth(a <= b),
-        Op::Gt => truth(a > b),
-        Op::Ge => truth(a >= b),
-        Op::Eq => truth(a == b),
-        Op::Ne => truth(a != b),
-        Op::And => truth(a != 0.0 && b != 0.0),
-        Op::Or => truth(a != 0.0 || b != 0.0),
-        // Only binary operators reach here (see `eval`).
-        _ => 0.0,
-    }
 }
 
 #[cfg(test)]

@@ -534,7 +534,7 @@ impl<'s> Controller<'s> {
         }
         if !module.script_reinforces {
             if let Some(e) = &module.reinforce {
-                r = script::sign(e.eval(&env));
+                r = crate::expr::sign(e.eval(&env));
             }
         }
         if r != 0.0 {

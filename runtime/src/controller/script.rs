@@ -127,7 +127,7 @@ impl ScriptRun {
             let op = &self.steps[self.pos].0;
             let cmd = match op {
                 Op::Reinforce(e) => {
-                    *reinforcement = sign(e.eval(env));
+                    *reinforcement = crate::expr::sign(e.eval(env));
                     self.advance();
                     continue;
                 }
@@ -160,18 +160,6 @@ impl ScriptRun {
         if done {
             self.advance();
         }
-    }
-}
-
-/// The sign of a reinforcement value: +1, -1 or 0.
-#[inline]
-pub fn sign(v: f32) -> f32 {
-    if v > 0.0 {
-        1.0
-    } else if v < 0.0 {
-        -1.0
-    } else {
-        0.0
     }
 }
 
