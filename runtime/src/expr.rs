@@ -121,87 +121,100 @@ impl Expr {
     pub fn eval(&self, env: &Env) -> f32 {
         let mut stack = [0.0f32; MAX_STACK];
         let mut sp = 0usize;
-        for op in &self.ops {
-            match *op {
-                Op::Const(v) => {
-                    stack[sp] = v;
-                    sp += 1;
-                }
-                Op::Chan(c) => {
-                    stack[sp] = env.now[c as usize];
-                    sp += 1;
-                }
-                Op::Prev(c) => {
-                    stack[sp] = env.prev[c as usize];
-                    sp += 1;
-                }
-                Op::Act(a) => {
-                    stack[sp] = env.act[a as usize];
-                    sp += 1;
-                }
-                Op::Neg => stack[sp - 1] = -stack[sp - 1],
-                Op::Not => stack[sp - 1] = truth(stack[sp - 1] == 0.0),
-                Op::Abs => stack[sp - 1] = stack[sp - 1].abs(),
-                Op::Sign => {
-                    let v = stack[sp - 1];
-                    stack[sp - 1] = if v > 0.0 {
-                        1.0
-                    } else if v < 0.0 {
-                        -1.0
-                    } else {
-                        0.0
-                    };
-                }
-                Op::Select => {
-                    let e = stack[sp - 1];
-                    let t = stack[sp - 2];
-                    let c = stack[sp - 3];
-                    sp -= 2;
-                    stack[sp - 1] = if c != 0.0 { t } else { e };
-                }
-                Op::Max(n) | Op::Min(n) | Op::Sum(n) | Op::Mean(n) => {
-                    let n = n as usize;
-                    let vals = &stack[sp - n..sp];
-                    let v = match *op {
-                        Op::Max(_) => vals.iter().copied().fold(f32::NEG_INFINITY, f32::max),
-                        Op::Min(_) => vals.iter().copied().fold(f32::INFINITY, f32::min),
-                        Op::Sum(_) => vals.iter().sum(),
-                        _ => vals.iter().sum::<f32>() / n as f32,
-                    };
-                    sp -= n;
-                    stack[sp] = v;
-                    sp += 1;
-                }
-                bin => {
-                    let b = stack[sp - 1];
-                    let a = stack[sp - 2];
-                    sp -= 1;
-                    stack[sp - 1] = match bin {
-                        Op::Add => a + b,
-                        Op::Sub => a - b,
-                        Op::Mul => a * b,
-                        Op::Div => {
-                            if b == 0.0 {
-                                0.0
-                            } else {
-                                a / b
-                            }
-                        }
-                        Op::Lt => truth(a < b),
-                        Op::Le => truth(a <= b),
-                        Op::Gt => truth(a > b),
-                        Op::Ge => truth(a >= b),
-                        Op::Eq => truth(a == b),
-                        Op::Ne => truth(a != b),
-                        Op::And => truth(a != 0.0 && b != 0.0),
-                        Op::Or => truth(a != 0.0 || b != 0.0),
-                        _ => unreachable!("unary and n-ary ops are handled above"),
-                    };
-                }
-            }
+        for &op in &self.ops {
+            sp = apply(op, &mut stack, sp, env);
         }
         stack[0]
     }
+}
+
+/// `-1`, `0` or `1`.
+#[inline]
+pub fn sign(v: f32) -> f32 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// The value of an aggregate op (`Max`, `Min`, `Sum`, `Mean`) over `vals`.
+#[inline]
+pub fn aggregate(op: Op, vals: &[f32]) -> f32 {
+    match op {
+        Op::Max(_) => vals.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+        Op::Min(_) => vals.iter().copied().fold(f32::INFINITY, f32::min),
+        Op::Sum(_) => vals.iter().sum(),
+        _ => vals.iter().sum::<f32>() / vals.len() as f32,
+    }
+}
+
+/// Executes one op on the stack (`sp` values on it) and returns the new
+/// stack pointer. The code must be valid ([`Expr::is_valid`]).
+#[inline(always)]
+pub fn apply(op: Op, stack: &mut [f32; MAX_STACK], mut sp: usize, env: &Env) -> usize {
+    match op {
+        Op::Const(v) => {
+            stack[sp] = v;
+            sp += 1;
+        }
+        Op::Chan(c) => {
+            stack[sp] = env.now[c as usize];
+            sp += 1;
+        }
+        Op::Prev(c) => {
+            stack[sp] = env.prev[c as usize];
+            sp += 1;
+        }
+        Op::Act(a) => {
+            stack[sp] = env.act[a as usize];
+            sp += 1;
+        }
+        Op::Neg => stack[sp - 1] = -stack[sp - 1],
+        Op::Not => stack[sp - 1] = truth(stack[sp - 1] == 0.0),
+        Op::Abs => stack[sp - 1] = stack[sp - 1].abs(),
+        Op::Sign => stack[sp - 1] = sign(stack[sp - 1]),
+        Op::Select => {
+            let (c, t, e) = (stack[sp - 3], stack[sp - 2], stack[sp - 1]);
+            sp -= 2;
+            stack[sp - 1] = if c != 0.0 { t } else { e };
+        }
+        Op::Max(n) | Op::Min(n) | Op::Sum(n) | Op::Mean(n) => {
+            let n = n as usize;
+            let v = aggregate(op, &stack[sp - n..sp]);
+            sp -= n;
+            stack[sp] = v;
+            sp += 1;
+        }
+        bin => {
+            let (a, b) = (stack[sp - 2], stack[sp - 1]);
+            sp -= 1;
+            stack[sp - 1] = match bin {
+                Op::Add => a + b,
+                Op::Sub => a - b,
+                Op::Mul => a * b,
+                Op::Div => {
+                    if b == 0.0 {
+                        0.0
+                    } else {
+                        a / b
+                    }
+                }
+                Op::Lt => truth(a < b),
+                Op::Le => truth(a <= b),
+                Op::Gt => truth(a > b),
+                Op::Ge => truth(a >= b),
+                Op::Eq => truth(a == b),
+                Op::Ne => truth(a != b),
+                Op::And => truth(a != 0.0 && b != 0.0),
+                Op::Or => truth(a != 0.0 || b != 0.0),
+                _ => unreachable!("unary and n-ary ops are matched above"),
+            };
+        }
+    }
+    sp
 }
 
 #[cfg(test)]

@@ -17,3 +17,4 @@ pub mod expr;
 pub mod genome;
 pub mod program;
 pub mod sim;
+pub mod testkit;

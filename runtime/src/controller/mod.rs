@@ -1,2 +1,809 @@
-//! The controller: modules, winner-take-all, behaviors, CRBP and the episode
-//! runner (placeholder until the controller issue lands).
+//! The controller: modules, winner-take-all arbitration, behavior generators,
+//! CRBP and the episode runner.
+//!
+//! # One action
+//!
+//! 1. The percept `now` is the one sensed after the previous action (at the
+//!    first action: sensed at the start of the episode).
+//! 2. Every module's activation network runs on its input channels of `now`;
+//!    the sum over its incoming links of `weight * activation of the source
+//!    module at the previous action` is added to the output neuron's net
+//!    input (all activations are 0 before the first action).
+//! 3. Winner take all: the highest activation wins; ties go to the module
+//!    declared first.
+//! 4. The winner's behavior generator gives the motor command: a script (see
+//!    [`script`] for its semantics: it keeps its position while its module
+//!    keeps winning and restarts when another module has won in between) or a
+//!    neural network whose outputs are read as bits (sampled with probability
+//!    = output while the module learns, else `output > 0.5`) and decoded.
+//! 5. The command is executed (`Sim::step`) and the percept after the action
+//!    is sensed.
+//! 6. Expressions evaluated after the action (reinforcement programs, `until`
+//!    conditions, the per-action fitness) read `now` = the percept after the
+//!    action, `prev` = the percept before it (the one the decision used), and
+//!    the actuator slots = the command executed in this action (left and right
+//!    wheel speeds, arm 1 = down, claw 1 = closed; an arm or claw the command
+//!    leaves alone keeps its previous state). So `sign(max(prev ir) - max(ir))`
+//!    compares before and after the move, and
+//!    `abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir))` scores the commanded
+//!    speeds with the IR after the move.
+//! 7. The winner's reinforcement (its reinforcement program after the action,
+//!    or a `reinforce` step its script ran during this action) is pushed to its
+//!    performance indicator and, if the module was learning at the start of
+//!    the action, trains the network by CRBP (see [`Learning`]).
+//!
+//! The episode ends after `EpisodeOptions::actions` actions or as soon as the
+//! simulated battery is empty (`!Sim::alive()`, checked before each action).
+//!
+//! # CRBP
+//!
+//! Complementary reinforcement back-propagation (Ackley & Littman 1990): on a
+//! reward, one delta-rule step (rate `rate_reward`) moves the outputs of the
+//! last forward pass toward the bits that were acted on; on a punishment, one
+//! step (rate `rate_punish`) toward their complement.
+//! - On a neural behavior the bits are the sampled output bits.
+//! - On an activation network the "bit" is "this module won and acted" (1):
+//!   a reward pushes the activation up for the input pattern of the action in
+//!   which the reinforcement was delivered, a punishment pushes it down. The
+//!   link term stays part of the net input but link weights are not learned.
+//!
+//! Learning is on when `EpisodeOptions::learning` is set, the module declares
+//! a [`Learning`], and either it learns `Always` or its performance indicator
+//! (rolling mean of its last `window` non-zero reinforcements; 0 before any;
+//! a module with a reinforcement program but no learning uses a window of 30)
+//! is below the threshold at the start of the action.
+//!
+//! # Entry points
+//!
+//! [`run_episode`] (the contract used by the GA and the CLI) builds a
+//! [`Controller`] and a [`Sim`] from the episode seed ([`episode_rngs`]) and
+//! runs them. [`validate`] checks a stage once; [`try_run_episode`] reports
+//! what [`run_episode`] would silently score 0. [`Controller::act`] runs one
+//! action on anything implementing [`Robot`] (the simulator, or a test's
+//! hand-driven robot).
+//!
+//! Initial weights: `Param::Gene` decoded from the genome, `Param::Fixed`,
+//! `Param::Random` drawn from the controller's RNG when it is built (module
+//! by module in declaration order: activation network, behavior network; then
+//! links). Learned weights are thrown away at the end of the episode
+//! (Darwinian) unless the stage is `Lamarckian`: then the learned activation
+//! weights that are (unfrozen) genes are written back into
+//! [`EpisodeResult::learned`].
+
+mod fast_expr;
+mod net;
+mod perf;
+pub mod script;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
+use crate::expr::{Env, Expr};
+use crate::genome::Genome;
+use crate::program::{
+    Behavior, Decode, Event, Inheritance, LearnTarget, LearnWhen, Learning, Network, Param, Stage,
+};
+use crate::sim::{Command, Outcome, Pose, Sim};
+
+pub use fast_expr::FastExpr;
+pub use net::{sigmoid, Net};
+pub use perf::Rolling;
+pub use script::ScriptRun;
+
+/// How to run one episode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EpisodeOptions {
+    /// Most actions the episode lasts (it ends earlier when the battery dies).
+    pub actions: u32,
+    /// Enables local learning (CRBP) where the modules declare it.
+    pub learning: bool,
+    /// Seeds the simulator and the controller's RNG.
+    pub seed: u64,
+}
+
+/// What one episode produced.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct EpisodeResult {
+    /// Sum over the actions of the per-action fitness term, plus the bonuses
+    /// times the event counts.
+    pub fitness: f32,
+    /// Actions executed.
+    pub actions: u32,
+    pub grips: u32,
+    pub releases_outside: u32,
+    pub recharges: u32,
+    pub collisions: u32,
+    /// Lamarckian: the genome with learned activation weights written back
+    pub learned: Option<Genome>,
+}
+
+/// Per-action record of an episode (for replays, plots and tests).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Trace {
+    /// Module names, in declaration order (the columns of the per-module vectors).
+    pub modules: Vec<String>,
+    pub rows: Vec<TraceRow>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TraceRow {
+    /// Action number, from 0.
+    pub action: u32,
+    /// Every module's activation level at this action.
+    pub activations: Vec<f32>,
+    /// The module that drove this action.
+    pub winner: u16,
+    /// Battery level after the action.
+    pub battery: f32,
+    /// An object is held after the action.
+    pub holding: bool,
+    /// Reinforcement each module received at this action (0 = none).
+    pub reinforcement: Vec<f32>,
+    /// Each module's performance indicator after this action.
+    pub performance: Vec<f32>,
+    /// Pose after the action.
+    pub pose: Pose,
+    /// Objects gripped so far in the episode.
+    pub grips: u32,
+    /// Objects released outside so far in the episode.
+    pub releases_outside: u32,
+    /// The battery was refilled during this action.
+    pub recharged: bool,
+    /// The move of this action was undone by a collision.
+    pub collided: bool,
+}
+
+/// A stage or genome the controller cannot run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ControllerError {
+    #[error("the genome has {have} bits but the layout needs {need}")]
+    GenomeTooShort { have: usize, need: usize },
+    #[error("gene {gene} is out of the genome or has {bits} bits (1..=32 allowed)")]
+    BadGene { gene: usize, bits: u8 },
+    #[error("module `{module}`: {what}")]
+    BadModule { module: String, what: String },
+    #[error("link {index}: {what}")]
+    BadLink { index: usize, what: String },
+    #[error("the fitness expression is malformed")]
+    BadFitness,
+}
+
+// ------------------------------------------------------------------ robot
+
+/// What the controller needs from the world: the simulator implements it;
+/// tests implement it with hand-set percepts.
+pub trait Robot {
+    /// Fills the percept channels for the current state.
+    fn sense(&mut self, out: &mut [f32; CHANNELS]);
+    /// Executes one action.
+    fn step(&mut self, cmd: &Command) -> Outcome;
+    /// False once the robot can no longer act (battery empty).
+    fn alive(&self) -> bool {
+        true
+    }
+    /// Battery level 0..1.
+    fn battery(&self) -> f32 {
+        1.0
+    }
+    fn pose(&self) -> Pose {
+        Pose::default()
+    }
+    /// Whether an object is held, if the robot knows (`None`: the controller
+    /// tracks it from grips and claw openings).
+    fn holding(&self) -> Option<bool> {
+        None
+    }
+}
+
+impl Robot for Sim {
+    #[inline]
+    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
+        Sim::sense(self, out)
+    }
+    #[inline]
+    fn step(&mut self, cmd: &Command) -> Outcome {
+        Sim::step(self, cmd)
+    }
+    fn alive(&self) -> bool {
+        Sim::alive(self)
+    }
+    fn battery(&self) -> f32 {
+        Sim::battery(self)
+    }
+    fn pose(&self) -> Pose {
+        Sim::pose(self)
+    }
+    fn holding(&self) -> Option<bool> {
+        Some(Sim::holding(self))
+    }
+}
+
+// ------------------------------------------------------------------ modules
+
+#[derive(Clone, Debug)]
+enum Gen<'s> {
+    Script(ScriptRun),
+    Neural { net: Net, decode: &'s Decode, bits: Vec<u8> },
+}
+
+#[derive(Clone, Debug)]
+struct Mod<'s> {
+    activation: Net,
+    /// Incoming links: (source module, weight).
+    links: Vec<(usize, f32)>,
+    gen: Gen<'s>,
+    learning: Option<Learning>,
+    reinforce: Option<FastExpr>,
+    /// The script's `reinforce` steps deliver the reinforcement instead of `reinforce`.
+    script_reinforces: bool,
+    perf: Rolling,
+}
+
+impl Mod<'_> {
+    fn learning_on(&self) -> bool {
+        match &self.learning {
+            None => false,
+            Some(l) => match l.when {
+                LearnWhen::Always => true,
+                LearnWhen::Below { threshold } => self.perf.mean() < threshold,
+            },
+        }
+    }
+
+    fn reset_script(&mut self) {
+        if let Gen::Script(s) = &mut self.gen {
+            s.reset();
+        }
+    }
+}
+
+/// What one action did (returned by [`Controller::act`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ActionReport {
+    pub winner: usize,
+    pub command: Command,
+    pub outcome: Outcome,
+    /// The winner's reinforcement at this action (0 = none).
+    pub reinforcement: f32,
+    /// The per-action fitness term (0 without one).
+    pub fitness: f32,
+}
+
+/// The controller of one individual for one episode: decoded networks,
+/// scripts, links, learning state and the per-action buffers, allocated once
+/// in [`Controller::new`]; [`Controller::act`] allocates nothing.
+#[derive(Clone, Debug)]
+pub struct Controller<'s> {
+    stage: &'s Stage,
+    mods: Vec<Mod<'s>>,
+    /// Activations of the current action and of the previous one.
+    act: Vec<f32>,
+    prev_act: Vec<f32>,
+    /// Reinforcement per module at the last action.
+    reinf: Vec<f32>,
+    rng: ChaCha8Rng,
+    learning: bool,
+    /// Percept before the last action (`prev`), the current one (`now`) and
+    /// the scratch for the next.
+    before: [f32; CHANNELS],
+    now: [f32; CHANNELS],
+    next: [f32; CHANNELS],
+    /// Actuator slots of the last executed command.
+    slots: [f32; ACT_SLOTS],
+    last_winner: Option<usize>,
+    holding: bool,
+    fitness: Option<FastExpr>,
+}
+
+impl<'s> Controller<'s> {
+    /// Decodes `genome` through `stage.layout` and builds the modules. Random
+    /// initial weights are drawn from `rng`, which then drives CRBP sampling.
+    pub fn new(
+        stage: &'s Stage,
+        genome: &Genome,
+        mut rng: ChaCha8Rng,
+    ) -> Result<Controller<'s>, ControllerError> {
+        validate(stage, genome)?;
+        let genes = genome.decode_all(&stage.layout);
+        let mut value = |p: &Param| match *p {
+            Param::Gene(i) => genes[i as usize],
+            Param::Fixed(v) => v,
+            Param::Random { lo, hi } => {
+                if hi > lo {
+                    rng.random_range(lo..hi)
+                } else {
+                    lo
+                }
+            }
+        };
+        let mut mods = Vec::with_capacity(stage.modules.len());
+        for m in &stage.modules {
+            let a = &m.activation;
+            let activation = Net::new(
+                m.inputs.clone(),
+                a.hidden as usize,
+                a.outputs as usize,
+                a.params.iter().map(&mut value).collect(),
+            );
+            let gen = match &m.behavior {
+                Behavior::Script(s) => Gen::Script(ScriptRun::new(s)),
+                Behavior::Neural(nb) => Gen::Neural {
+                    net: Net::new(
+                        nb.inputs.clone(),
+                        nb.net.hidden as usize,
+                        nb.net.outputs as usize,
+                        nb.net.params.iter().map(&mut value).collect(),
+                    ),
+                    decode: &nb.decode,
+                    bits: vec![0; nb.net.outputs as usize],
+                },
+            };
+            let script_reinforces = matches!(&gen, Gen::Script(s) if s.delivers_reinforcement());
+            let window = m.learning.as_ref().map_or(30, |l| l.window as usize);
+            mods.push(Mod {
+                activation,
+                links: Vec::new(),
+                gen,
+                learning: m.learning.clone(),
+                reinforce: m.reinforce.as_ref().map(FastExpr::new),
+                script_reinforces,
+                perf: Rolling::new(window),
+            });
+        }
+        for l in &stage.links {
+            let w = value(&l.weight);
+            mods[l.to as usize].links.push((l.from as usize, w));
+        }
+        let n = mods.len();
+        Ok(Controller {
+            stage,
+            mods,
+            act: vec![0.0; n],
+            prev_act: vec![0.0; n],
+            reinf: vec![0.0; n],
+            rng,
+            learning: true,
+            before: [0.0; CHANNELS],
+            now: [0.0; CHANNELS],
+            next: [0.0; CHANNELS],
+            slots: [0.0; ACT_SLOTS],
+            last_winner: None,
+            holding: false,
+            fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
+        })
+    }
+
+    /// Turns local learning on or off (on after `new`).
+    pub fn set_learning(&mut self, on: bool) {
+        self.learning = on;
+    }
+
+    /// Senses the initial percept; call once before the first [`Controller::act`].
+    pub fn start<R: Robot>(&mut self, sim: &mut R) {
+        sim.sense(&mut self.now);
+        self.before = self.now;
+    }
+
+    /// Activation levels of the last action.
+    pub fn activations(&self) -> &[f32] {
+        &self.act
+    }
+
+    /// Reinforcement per module at the last action (0 = none).
+    pub fn reinforcements(&self) -> &[f32] {
+        &self.reinf
+    }
+
+    /// The performance indicator of module `m` (rolling mean of its non-zero
+    /// reinforcements).
+    pub fn performance(&self, m: usize) -> f32 {
+        self.mods[m].perf.mean()
+    }
+
+    /// The current percept (after the last action).
+    pub fn percept(&self) -> &[f32; CHANNELS] {
+        &self.now
+    }
+
+    /// The current step of module `m`'s script (`None` for a neural behavior).
+    pub fn script_position(&self, m: usize) -> Option<usize> {
+        match &self.mods[m].gen {
+            Gen::Script(s) => Some(s.position()),
+            Gen::Neural { .. } => None,
+        }
+    }
+
+    /// Module `m`'s activation network evaluated on `percept` with no link
+    /// input, using its current (possibly learned) weights. Does not disturb
+    /// the stored forward pass used by learning.
+    pub fn probe_activation(&self, m: usize, percept: &[f32; CHANNELS]) -> f32 {
+        let mut net = self.mods[m].activation.clone();
+        net.forward(percept, 0.0)[0]
+    }
+
+    /// Module `m`'s behavior network outputs on `percept` (empty for a script).
+    pub fn probe_behavior(&self, m: usize, percept: &[f32; CHANNELS]) -> Vec<f32> {
+        match &self.mods[m].gen {
+            Gen::Neural { net, .. } => net.clone().forward(percept, 0.0).to_vec(),
+            Gen::Script(_) => Vec::new(),
+        }
+    }
+
+    /// Current weights of module `m`'s activation network (`Network::params` order).
+    pub fn activation_weights(&self, m: usize) -> &[f32] {
+        &self.mods[m].activation.w
+    }
+
+    /// Current weights of module `m`'s behavior network (empty for a script).
+    pub fn behavior_weights(&self, m: usize) -> &[f32] {
+        match &self.mods[m].gen {
+            Gen::Neural { net, .. } => &net.w,
+            Gen::Script(_) => &[],
+        }
+    }
+
+    /// An object is held (as far as the controller knows: gripped and not
+    /// released since).
+    pub fn holding(&self) -> bool {
+        self.holding
+    }
+
+    /// Runs one action (see the module documentation).
+    pub fn act<R: Robot>(&mut self, sim: &mut R) -> ActionReport {
+        // 1-3: activations and arbitration.
+        std::mem::swap(&mut self.act, &mut self.prev_act);
+        let mut winner = 0usize;
+        for m in 0..self.mods.len() {
+            let module = &mut self.mods[m];
+            let link: f32 = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
+            let a = module.activation.forward(&self.now, link)[0];
+            self.act[m] = a;
+            if a > self.act[winner] {
+                winner = m;
+            }
+        }
+        self.reinf.fill(0.0);
+        if self.mods.is_empty() {
+            let outcome = sim.step(&Command::default());
+            sim.sense(&mut self.next);
+            self.before = self.now;
+            self.now = self.next;
+            return ActionReport {
+                winner: 0,
+                command: Command::default(),
+                outcome,
+                reinforcement: 0.0,
+                fitness: 0.0,
+            };
+        }
+        if self.last_winner != Some(winner) {
+            if let Some(l) = self.last_winner {
+                self.mods[l].reset_script();
+            }
+            self.mods[winner].reset_script();
+            self.last_winner = Some(winner);
+        }
+        let learn = self.learning && self.mods[winner].learning_on();
+
+        // 4: the winner's behavior.
+        let mut r = 0.0f32;
+        let module = &mut self.mods[winner];
+        let cmd = match &mut module.gen {
+            Gen::Script(s) => {
+                let env = Env { now: &self.now, prev: &self.before, act: &self.slots };
+                s.command(&env, &mut r)
+            }
+            Gen::Neural { net, decode, bits } => {
+                let y = net.forward(&self.now, 0.0);
+                for (b, &p) in bits.iter_mut().zip(y) {
+                    let on = if learn { self.rng.random::<f32>() < p } else { p > 0.5 };
+                    *b = on as u8;
+                }
+                Command { wheels: decode_wheels(decode, bits, y, learn), ..Command::default() }
+            }
+        };
+
+        // 5: act and sense.
+        let outcome = sim.step(&cmd);
+        self.slots[ACT_LEFT] = cmd.wheels[0];
+        self.slots[ACT_RIGHT] = cmd.wheels[1];
+        if let Some(d) = cmd.arm {
+            self.slots[ACT_ARM] = if d { 1.0 } else { 0.0 };
+        }
+        if let Some(c) = cmd.claw {
+            self.slots[ACT_CLAW] = if c { 1.0 } else { 0.0 };
+            if !c {
+                self.holding = false;
+            }
+        }
+        if outcome.grips > 0 {
+            self.holding = true;
+        }
+        if let Some(h) = sim.holding() {
+            self.holding = h;
+        }
+        sim.sense(&mut self.next);
+
+        // 6-7: after-action expressions, reinforcement and learning.
+        let env = Env { now: &self.next, prev: &self.now, act: &self.slots };
+        let module = &mut self.mods[winner];
+        if let Gen::Script(s) = &mut module.gen {
+            s.after_action(&env);
+        }
+        if !module.script_reinforces {
+            if let Some(e) = &module.reinforce {
+                r = crate::expr::sign(e.eval(&env));
+            }
+        }
+        if r != 0.0 {
+            self.reinf[winner] = r;
+            module.perf.push(r);
+            if learn {
+                if let Some(l) = &module.learning {
+                    let rate = if r > 0.0 { l.rate_reward } else { l.rate_punish };
+                    match l.target {
+                        LearnTarget::Activation => {
+                            let t = if r > 0.0 { 1.0 } else { 0.0 };
+                            module.activation.train(&self.now, |_| t, rate);
+                        }
+                        LearnTarget::Behavior => {
+                            if let Gen::Neural { net, bits, .. } = &mut module.gen {
+                                let bits = &*bits;
+                                let reward = r > 0.0;
+                                net.train(
+                                    &self.now,
+                                    |o| {
+                                        let b = bits[o] as f32;
+                                        if reward {
+                                            b
+                                        } else {
+                                            1.0 - b
+                                        }
+                                    },
+                                    rate,
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let fitness = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
+        self.before = self.now;
+        self.now = self.next;
+        ActionReport { winner, command: cmd, outcome, reinforcement: r, fitness }
+    }
+
+    /// Runs a whole episode on `sim` (which must be fresh) and returns its result.
+    pub fn run<R: Robot>(
+        &mut self,
+        sim: &mut R,
+        opts: &EpisodeOptions,
+        mut trace: Option<&mut Trace>,
+    ) -> EpisodeResult {
+        self.set_learning(opts.learning);
+        if let Some(t) = trace.as_deref_mut() {
+            t.modules = self.stage.modules.iter().map(|m| m.name.clone()).collect();
+            t.rows.clear();
+        }
+        self.start(sim);
+        let mut res = EpisodeResult::default();
+        let mut fitness = 0.0f64;
+        for a in 0..opts.actions {
+            if !sim.alive() {
+                break;
+            }
+            let rep = self.act(sim);
+            fitness += rep.fitness as f64;
+            res.actions += 1;
+            res.grips += rep.outcome.grips;
+            res.releases_outside += rep.outcome.releases_outside;
+            res.recharges += rep.outcome.recharged as u32;
+            res.collisions += rep.outcome.collided as u32;
+            if let Some(t) = trace.as_deref_mut() {
+                t.rows.push(TraceRow {
+                    action: a,
+                    activations: self.act.clone(),
+                    winner: rep.winner as u16,
+                    battery: sim.battery(),
+                    holding: self.holding,
+                    reinforcement: self.reinf.clone(),
+                    performance: self.mods.iter().map(|m| m.perf.mean()).collect(),
+                    pose: sim.pose(),
+                    grips: res.grips,
+                    releases_outside: res.releases_outside,
+                    recharged: rep.outcome.recharged,
+                    collided: rep.outcome.collided,
+                });
+            }
+        }
+        for b in &self.stage.fitness.bonuses {
+            let n = match b.event {
+                Event::Grip => res.grips,
+                Event::ReleaseOutside => res.releases_outside,
+                Event::Recharge => res.recharges,
+                Event::Collision => res.collisions,
+            };
+            fitness += (b.points * n as f32) as f64;
+        }
+        res.fitness = fitness as f32;
+        res
+    }
+
+    /// The genome with the learned activation weights that are genes written
+    /// back (nearest encodable value). Frozen genes (from earlier stages) are
+    /// left as they are: a later stage never changes what an earlier one froze.
+    pub fn write_back(&self, genome: &Genome) -> Genome {
+        let mut g = genome.clone();
+        for (m, module) in self.stage.modules.iter().enumerate() {
+            for (p, &w) in module.activation.params.iter().zip(&self.mods[m].activation.w) {
+                if let Param::Gene(i) = *p {
+                    let gene = &self.stage.layout.genes[i as usize];
+                    if !gene.frozen {
+                        g.encode(gene, w);
+                    }
+                }
+            }
+        }
+        g
+    }
+}
+
+/// Wheel speeds of a neural behavior's outputs.
+fn decode_wheels(decode: &Decode, bits: &[u8], y: &[f32], sampled: bool) -> [f32; 2] {
+    match decode {
+        Decode::Table(table) => {
+            let idx = bits.iter().fold(0usize, |acc, &b| (acc << 1) | b as usize);
+            table.get(idx).copied().unwrap_or([0.0, 0.0])
+        }
+        Decode::Linear { scale } => {
+            // While learning, the sampled bits drive the wheels (full speed
+            // forward or back) so that CRBP reinforces what was done.
+            let v = |o: usize| {
+                let u = if sampled { bits[o] as f32 } else { y[o] };
+                (2.0 * u - 1.0) * scale
+            };
+            [v(0), v(1)]
+        }
+    }
+}
+
+/// Derives the simulator's seed and the controller's RNG from an episode seed
+/// (separate ChaCha8 streams so the two never share random numbers).
+pub fn episode_rngs(seed: u64) -> (u64, ChaCha8Rng) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(1);
+    (seed, rng)
+}
+
+/// Runs one episode of `genome` on `stage`. An invalid stage or genome (see
+/// [`validate`]; the compiler's output always passes) gives an empty result
+/// with fitness 0; use [`try_run_episode`] to get the error.
+pub fn run_episode(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    trace: Option<&mut Trace>,
+) -> EpisodeResult {
+    try_run_episode(stage, genome, opts, trace).unwrap_or_default()
+}
+
+/// [`run_episode`], reporting an invalid stage or genome.
+pub fn try_run_episode(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    trace: Option<&mut Trace>,
+) -> Result<EpisodeResult, ControllerError> {
+    let (sim_seed, rng) = episode_rngs(opts.seed);
+    let mut ctl = Controller::new(stage, genome, rng)?;
+    let mut sim = Sim::new(&stage.world, sim_seed);
+    let mut res = ctl.run(&mut sim, opts, trace);
+    if stage.inheritance == Inheritance::Lamarckian {
+        res.learned = Some(ctl.write_back(genome));
+    }
+    Ok(res)
+}
+
+/// Checks that the controller can run `stage` with `genome`: gene indices,
+/// network shapes, channels, links, expressions and decode tables.
+pub fn validate(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
+    let layout = &stage.layout;
+    if genome.bits.len() < layout.bits as usize {
+        return Err(ControllerError::GenomeTooShort { have: genome.bits.len(), need: layout.bits as usize });
+    }
+    for (i, g) in layout.genes.iter().enumerate() {
+        if g.bits == 0 || g.bits > 32 || g.offset as usize + g.bits as usize > genome.bits.len() {
+            return Err(ControllerError::BadGene { gene: i, bits: g.bits });
+        }
+    }
+    let n_genes = layout.genes.len();
+    let param_ok = |p: &Param| match *p {
+        Param::Gene(i) => (i as usize) < n_genes,
+        Param::Fixed(v) => v.is_finite(),
+        Param::Random { lo, hi } => lo.is_finite() && hi.is_finite() && lo <= hi,
+    };
+    let chans_ok = |c: &[u16]| c.iter().all(|&c| (c as usize) < CHANNELS);
+    let net_ok = |net: &Network, inputs: &[u16]| -> Result<(), String> {
+        if net.inputs as usize != inputs.len() || !chans_ok(inputs) {
+            return Err("network inputs do not match its channels".into());
+        }
+        if net.params.len() != Network::param_count(inputs.len(), net.hidden as usize, net.outputs as usize) {
+            return Err(format!("network has {} parameters for its shape", net.params.len()));
+        }
+        if !net.params.iter().all(param_ok) {
+            return Err("a network parameter refers to a missing gene or is not finite".into());
+        }
+        Ok(())
+    };
+    let expr_ok = |e: &Expr| e.is_valid();
+    for m in &stage.modules {
+        let bad = |what: String| ControllerError::BadModule { module: m.name.clone(), what };
+        net_ok(&m.activation, &m.inputs).map_err(|w| bad(format!("activation: {w}")))?;
+        if m.activation.outputs != 1 {
+            return Err(bad("the activation network must have one output".into()));
+        }
+        match &m.behavior {
+            Behavior::Neural(nb) => {
+                net_ok(&nb.net, &nb.inputs).map_err(|w| bad(format!("behavior: {w}")))?;
+                match &nb.decode {
+                    Decode::Table(t) => {
+                        if nb.net.outputs > 16 || t.len() != 1usize << nb.net.outputs {
+                            return Err(bad("the decode table needs 2^outputs rows".into()));
+                        }
+                    }
+                    Decode::Linear { .. } => {
+                        if nb.net.outputs != 2 {
+                            return Err(bad("linear decoding needs two outputs".into()));
+                        }
+                    }
+                }
+            }
+            Behavior::Script(s) => {
+                for st in &s.steps {
+                    let ok = match &st.action {
+                        crate::program::Action::Toward { channels, .. } => chans_ok(channels),
+                        crate::program::Action::Reinforce(e) => expr_ok(e),
+                        _ => true,
+                    } && match &st.end {
+                        crate::program::StepEnd::Until { cond, .. } => expr_ok(cond),
+                        crate::program::StepEnd::Actions(_) => true,
+                    };
+                    if !ok {
+                        return Err(bad("a script step has a bad channel or expression".into()));
+                    }
+                }
+            }
+        }
+        if let Some(e) = &m.reinforce {
+            if !expr_ok(e) {
+                return Err(bad("the reinforcement program is malformed".into()));
+            }
+        }
+        if let Some(l) = &m.learning {
+            if l.window == 0 {
+                return Err(bad("the performance window must be at least 1".into()));
+            }
+            if l.target == LearnTarget::Behavior && !matches!(m.behavior, Behavior::Neural(_)) {
+                return Err(bad("only a neural behavior can learn".into()));
+            }
+        }
+    }
+    for (i, l) in stage.links.iter().enumerate() {
+        let n = stage.modules.len();
+        if l.from as usize >= n || l.to as usize >= n {
+            return Err(ControllerError::BadLink { index: i, what: "refers to a missing module".into() });
+        }
+        if !param_ok(&l.weight) {
+            return Err(ControllerError::BadLink { index: i, what: "bad weight".into() });
+        }
+    }
+    if let Some(e) = &stage.fitness.per_action {
+        if !expr_ok(e) {
+            return Err(ControllerError::BadFitness);
+        }
+    }
+    Ok(())
+}

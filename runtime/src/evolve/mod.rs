@@ -1,1 +1,531 @@
-//! The incremental GA over stages (placeholder until the evolution issue lands).
+//! The incremental GA over stages, with checkpoints as plain data.
+//!
+//! A run goes stage by stage. An evolved stage starts with [`start_stage`]
+//! (the first stage from random genomes; a later one from the final
+//! population of the stage it extends, its new genes random), then
+//! [`step_generation`] is called until [`is_finished`]. A test stage runs the
+//! parent's best individual once through [`test_best`]. The episode itself is
+//! injected as an [`Evaluate`] function, so this module knows nothing of the
+//! simulator or the controller.
+//!
+//! **Generation semantics.** Generation `g` of a stage (0-based,
+//! `Checkpoint::generation` counts the generations done) is: for `g > 0`,
+//! breed a new population from the evaluated population of `g - 1` (see
+//! [`ga::next_generation`]); then evaluate every individual (in parallel);
+//! then record its [`GenStats`] and update the stage's best. A checkpoint thus
+//! always holds an evaluated population with its fitness (except right after
+//! [`start_stage`], when `fitness` is empty), and the final checkpoint of a
+//! stage holds the evaluated final population. `Checkpoint::best` is the best
+//! evaluated individual of the stage (the genome as evaluated, before any
+//! Lamarckian write-back): the one a test stage and `replay` use.
+//!
+//! **Masks.** Bits of genes marked `frozen` in the stage's layout never
+//! change: crossover cuts only among evolvable bits and each child keeps its
+//! first parent's frozen bits; mutation flips only evolvable bits; a
+//! Lamarckian write-back only copies evolvable bits.
+//!
+//! **Determinism.** No RNG state is carried from one generation to the next:
+//! generation `g`'s breeding RNG is seeded from `(run seed, stage, g)`, each
+//! episode from `(run seed, stage, g, individual, episode)` (see [`seed`]).
+//! Evaluations run on rayon's current thread pool and are collected in index
+//! order, so any thread count gives bit-identical results, and a run resumed
+//! from a checkpoint equals the same run done straight.
+
+pub mod error;
+pub mod fingerprint;
+pub mod ga;
+pub mod glue;
+pub mod seed;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+pub use error::EvolveError;
+pub use fingerprint::stage_fingerprint;
+pub use ga::{frozen_mask, next_generation, ranking};
+pub use glue::{evaluate_with_controller, EvalOptions};
+
+use crate::genome::Genome;
+use crate::program::{Evolution, Inheritance, Program, Selection, Stage, StageRun};
+
+/// Version of the [`Checkpoint`] format.
+pub const CHECKPOINT_FORMAT: u32 = 1;
+
+/// Runs one episode of a genome with the given episode seed.
+pub type Evaluate<'a> = &'a (dyn Fn(&Genome, u64) -> Evaluation + Sync);
+
+/// The result of one episode.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Evaluation {
+    pub fitness: f32,
+    /// The genome with learned values re-encoded. In a stage with
+    /// `inheritance: lamarckian` its evolvable bits replace the individual's
+    /// in the population; otherwise it is ignored.
+    pub learned: Option<Genome>,
+}
+
+/// Statistics of one evaluated generation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GenStats {
+    pub stage: String,
+    /// Global number (0-based) continuing across the chain of stages, as in
+    /// the paper's figure 9.
+    pub generation: u32,
+    /// Number within the stage (0-based).
+    pub stage_generation: u32,
+    pub best: f32,
+    pub mean: f32,
+    pub worst: f32,
+    /// Index of the best individual in the evaluated population.
+    pub best_index: u32,
+}
+
+/// Everything needed to continue a run: plain data, serde (JSON) friendly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// [`CHECKPOINT_FORMAT`].
+    pub format: u32,
+    /// [`stage_fingerprint`] of every stage of the program up to and
+    /// including `stage`.
+    pub fingerprint: Vec<u64>,
+    /// Index of the stage in `Program::stages`.
+    pub stage: usize,
+    /// Generations done in this stage.
+    pub generation: u32,
+    /// The run seed.
+    pub seed: u64,
+    pub population: Vec<Genome>,
+    /// Fitness of `population` (empty before the first generation).
+    pub fitness: Vec<f32>,
+    /// Statistics of every generation of this stage and of the stages it
+    /// extends, oldest first.
+    pub history: Vec<GenStats>,
+    /// Best evaluated individual of this stage and its fitness.
+    pub best: Option<(Genome, f32)>,
+}
+
+/// The evolution parameters of an evolved stage.
+pub fn evolution(stage: &Stage) -> Result<&Evolution, EvolveError> {
+    match &stage.run {
+        StageRun::Evolve(evo) => Ok(evo),
+        StageRun::Test { .. } => Err(EvolveError::NotEvolved { stage: stage.name.clone() }),
+    }
+}
+
+/// Starts evolved stage `stage` of `program` with run seed `seed`.
+///
+/// `parent` must be the final checkpoint of the nearest evolved ancestor
+/// (`stage.parent`, skipping test stages) when the stage extends one, and
+/// `None` otherwise. The new population has this stage's size: individual `i`
+/// takes the bits of the parent's layout from the parent's individual of rank
+/// `i mod parent size` (best first), and random bits for the rest. The
+/// history continues the parent's.
+pub fn start_stage(
+    program: &Program,
+    stage: usize,
+    seed: u64,
+    parent: Option<&Checkpoint>,
+) -> Result<Checkpoint, EvolveError> {
+    let st = get_stage(program, stage)?;
+    let evo = evolution(st)?;
+    validate_evolution(st, evo)?;
+    validate_layout(st)?;
+    let bits = st.layout.bits as usize;
+    let mut rng = seed::rng(seed::init_seed(seed, stage));
+    let random_bits = |rng: &mut rand_chacha::ChaCha8Rng, out: &mut Vec<u8>, n: usize| {
+        use rand::Rng;
+        out.extend((0..n).map(|_| u8::from(rng.random::<bool>())));
+    };
+
+    let ancestor = evolved_ancestor(program, stage)?;
+    let (population, history) = match (ancestor, parent) {
+        (None, None) => {
+            if let Some(gene) = st.layout.genes.iter().position(|g| g.frozen) {
+                return Err(EvolveError::FrozenWithoutParent { stage: st.name.clone(), gene });
+            }
+            let population = (0..evo.population)
+                .map(|_| {
+                    let mut b = Vec::with_capacity(bits);
+                    random_bits(&mut rng, &mut b, bits);
+                    Genome { bits: b }
+                })
+                .collect();
+            (population, Vec::new())
+        }
+        (None, Some(_)) => return Err(EvolveError::UnexpectedParent { stage: st.name.clone() }),
+        (Some(p), None) => {
+            return Err(EvolveError::MissingParent {
+                stage: st.name.clone(),
+                parent: program.stages[p].name.clone(),
+            })
+        }
+        (Some(p), Some(cp)) => {
+            let pst = &program.stages[p];
+            if cp.stage != p {
+                let found =
+                    program.stages.get(cp.stage).map_or_else(|| format!("#{}", cp.stage), |s| s.name.clone());
+                return Err(EvolveError::WrongParent {
+                    stage: st.name.clone(),
+                    expected: pst.name.clone(),
+                    found,
+                });
+            }
+            check_resume(program, cp)?;
+            check_extension(st, pst)?;
+            if cp.population.is_empty() || cp.fitness.len() != cp.population.len() {
+                return Err(EvolveError::ParentNotEvaluated { stage: pst.name.clone() });
+            }
+            let kept = pst.layout.bits as usize;
+            let ranked = ranking(&cp.fitness);
+            let population = (0..evo.population as usize)
+                .map(|i| {
+                    let mut b = Vec::with_capacity(bits);
+                    b.extend_from_slice(&cp.population[ranked[i % ranked.len()]].bits[..kept]);
+                    random_bits(&mut rng, &mut b, bits - kept);
+                    Genome { bits: b }
+                })
+                .collect();
+            (population, cp.history.clone())
+        }
+    };
+    Ok(Checkpoint {
+        format: CHECKPOINT_FORMAT,
+        fingerprint: program.stages[..=stage].iter().map(stage_fingerprint).collect(),
+        stage,
+        generation: 0,
+        seed,
+        population,
+        fitness: Vec::new(),
+        history,
+        best: None,
+    })
+}
+
+/// Runs one generation of the checkpoint's stage (see the module doc for the
+/// order: breed if `generation > 0`, evaluate, record) and returns its stats.
+///
+/// With `evaluations > 1` an individual's fitness is the mean over its
+/// episodes (summed in f64), and a Lamarckian write-back uses the last
+/// episode's learned genome. The caller decides when to stop
+/// ([`is_finished`]); stepping further extends the stage.
+pub fn step_generation(
+    program: &Program,
+    cp: &mut Checkpoint,
+    evaluate: Evaluate,
+) -> Result<GenStats, EvolveError> {
+    let st = get_stage(program, cp.stage)?;
+    let evo = evolution(st)?;
+    validate_evolution(st, evo)?;
+    check_population(st, cp)?;
+    let mask = frozen_mask(&st.layout);
+    let g = cp.generation;
+    // The checkpoint is only modified once the generation succeeded, so an
+    // error leaves it as it was.
+    let mut population = if g > 0 {
+        let mut rng = seed::rng(seed::breed_seed(cp.seed, cp.stage, g));
+        next_generation(evo, &mask, &cp.population, &cp.fitness, &mut rng)
+    } else {
+        cp.population.clone()
+    };
+
+    let (run_seed, stage) = (cp.seed, cp.stage);
+    let episodes = evo.evaluations.max(1);
+    let results: Vec<(f32, Option<Genome>)> = population
+        .par_iter()
+        .enumerate()
+        .map(|(i, genome)| {
+            let mut sum = 0.0f64;
+            let mut learned = None;
+            for e in 0..episodes {
+                let ev = evaluate(genome, seed::episode_seed(run_seed, stage, g, i, e));
+                sum += ev.fitness as f64;
+                learned = ev.learned;
+            }
+            ((sum / episodes as f64) as f32, learned)
+        })
+        .collect();
+
+    let mut fitness = Vec::with_capacity(results.len());
+    let mut learned_all = Vec::with_capacity(results.len());
+    for (i, (f, learned)) in results.into_iter().enumerate() {
+        if !f.is_finite() {
+            return Err(EvolveError::NonFiniteFitness {
+                stage: st.name.clone(),
+                generation: g,
+                index: i,
+                value: f,
+            });
+        }
+        if let Some(l) = &learned {
+            if l.bits.len() != st.layout.bits as usize {
+                return Err(EvolveError::LearnedLength {
+                    stage: st.name.clone(),
+                    generation: g,
+                    index: i,
+                    expected: st.layout.bits as usize,
+                    found: l.bits.len(),
+                });
+            }
+        }
+        fitness.push(f);
+        learned_all.push(learned);
+    }
+
+    let ranked = ranking(&fitness);
+    let (best_index, worst_index) = (ranked[0], ranked[ranked.len() - 1]);
+    let best = fitness[best_index];
+    if cp.best.as_ref().is_none_or(|(_, f)| best > *f) {
+        cp.best = Some((population[best_index].clone(), best));
+    }
+    if st.inheritance == Inheritance::Lamarckian {
+        for (genome, learned) in population.iter_mut().zip(&learned_all) {
+            if let Some(l) = learned {
+                for (bit, (&frozen, &v)) in genome.bits.iter_mut().zip(mask.iter().zip(&l.bits)) {
+                    if !frozen {
+                        *bit = u8::from(v != 0);
+                    }
+                }
+            }
+        }
+    }
+
+    let stats = GenStats {
+        stage: st.name.clone(),
+        generation: cp.history.len() as u32,
+        stage_generation: g,
+        best,
+        mean: (fitness.iter().map(|&f| f as f64).sum::<f64>() / fitness.len() as f64) as f32,
+        worst: fitness[worst_index],
+        best_index: best_index as u32,
+    };
+    cp.population = population;
+    cp.fitness = fitness;
+    cp.generation = g + 1;
+    cp.history.push(stats.clone());
+    Ok(stats)
+}
+
+/// True when the checkpoint's stage has run all its declared generations (and
+/// for a test stage or a stage the program does not have).
+pub fn is_finished(program: &Program, cp: &Checkpoint) -> bool {
+    match program.stages.get(cp.stage).map(|s| &s.run) {
+        Some(StageRun::Evolve(evo)) => cp.generation >= evo.generations,
+        _ => true,
+    }
+}
+
+/// Checks that a checkpoint can continue with this program: same format, and
+/// every stage up to the checkpoint's has the fingerprint it had when the
+/// checkpoint was made (stages appended after it are fine), and the
+/// population fits the stage.
+pub fn check_resume(program: &Program, cp: &Checkpoint) -> Result<(), EvolveError> {
+    if cp.format != CHECKPOINT_FORMAT {
+        return Err(EvolveError::CheckpointFormat { found: cp.format, expected: CHECKPOINT_FORMAT });
+    }
+    if cp.fingerprint.len() != cp.stage + 1 {
+        return Err(EvolveError::Inconsistent {
+            stage: format!("#{}", cp.stage),
+            what: format!("{} fingerprints for stage index {}", cp.fingerprint.len(), cp.stage),
+        });
+    }
+    if program.stages.len() < cp.fingerprint.len() {
+        return Err(EvolveError::StageMissing {
+            expected: cp.fingerprint.len(),
+            count: program.stages.len(),
+        });
+    }
+    for (index, (stage, &fp)) in program.stages.iter().zip(&cp.fingerprint).enumerate() {
+        if stage_fingerprint(stage) != fp {
+            return Err(EvolveError::StageChanged { stage: stage.name.clone(), index });
+        }
+    }
+    check_population(&program.stages[cp.stage], cp)
+}
+
+/// The result of a test stage.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TestOutcome {
+    /// The genome that was run (the parent stage's best).
+    pub genome: Genome,
+    /// Its fitness in the parent stage.
+    pub parent_fitness: f32,
+    /// The episode seed used.
+    pub seed: u64,
+    pub evaluation: Evaluation,
+}
+
+/// Runs test stage `stage`: one episode of the best individual of `parent`
+/// (the final checkpoint of the nearest evolved ancestor), with episode seed
+/// [`seed::test_seed`]`(seed, stage, 0)`. Whether learning is on and how long
+/// the episode lasts is read by the evaluation from `StageRun::Test`.
+pub fn test_best(
+    program: &Program,
+    stage: usize,
+    seed: u64,
+    parent: &Checkpoint,
+    evaluate: Evaluate,
+) -> Result<TestOutcome, EvolveError> {
+    let st = get_stage(program, stage)?;
+    if let StageRun::Evolve(_) = st.run {
+        return Err(EvolveError::NotTest { stage: st.name.clone() });
+    }
+    let Some(p) = evolved_ancestor(program, stage)? else {
+        return Err(EvolveError::MissingParent { stage: st.name.clone(), parent: "(none)".into() });
+    };
+    let pst = &program.stages[p];
+    if parent.stage != p {
+        let found =
+            program.stages.get(parent.stage).map_or_else(|| format!("#{}", parent.stage), |s| s.name.clone());
+        return Err(EvolveError::WrongParent { stage: st.name.clone(), expected: pst.name.clone(), found });
+    }
+    check_resume(program, parent)?;
+    let Some((genome, parent_fitness)) = best_of(parent) else {
+        return Err(EvolveError::ParentNotEvaluated { stage: pst.name.clone() });
+    };
+    if genome.bits.len() != st.layout.bits as usize {
+        return Err(EvolveError::NotAnExtension {
+            stage: st.name.clone(),
+            parent: pst.name.clone(),
+            what: format!(
+                "the test stage's genome has {} bits, the parent's {}",
+                st.layout.bits,
+                genome.bits.len()
+            ),
+        });
+    }
+    let episode = seed::test_seed(seed, stage, 0);
+    let evaluation = evaluate(&genome, episode);
+    Ok(TestOutcome { genome, parent_fitness, seed: episode, evaluation })
+}
+
+/// The best individual of a checkpoint's stage: `best`, or else the best of
+/// the evaluated population.
+pub fn best_of(cp: &Checkpoint) -> Option<(Genome, f32)> {
+    if let Some(best) = &cp.best {
+        return Some(best.clone());
+    }
+    if cp.population.is_empty() || cp.fitness.len() != cp.population.len() {
+        return None;
+    }
+    let i = ranking(&cp.fitness)[0];
+    Some((cp.population[i].clone(), cp.fitness[i]))
+}
+
+// ---------------------------------------------------------------- checks
+
+fn get_stage(program: &Program, index: usize) -> Result<&Stage, EvolveError> {
+    program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })
+}
+
+/// The nearest evolved stage among `stage`'s ancestors (test stages skipped).
+fn evolved_ancestor(program: &Program, stage: usize) -> Result<Option<usize>, EvolveError> {
+    let mut child = stage;
+    let mut current = get_stage(program, stage)?.parent;
+    while let Some(p) = current {
+        let pst = get_stage(program, p)?;
+        if p >= child {
+            return Err(EvolveError::ParentOrder {
+                stage: program.stages[child].name.clone(),
+                parent: pst.name.clone(),
+            });
+        }
+        if let StageRun::Evolve(_) = pst.run {
+            return Ok(Some(p));
+        }
+        child = p;
+        current = pst.parent;
+    }
+    Ok(None)
+}
+
+fn validate_evolution(st: &Stage, evo: &Evolution) -> Result<(), EvolveError> {
+    let bad = |what: String| Err(EvolveError::InvalidParameter { stage: st.name.clone(), what });
+    if evo.population == 0 {
+        return bad("population must be at least 1".into());
+    }
+    if let Selection::Truncation { keep } = evo.selection {
+        if keep == 0 || keep > evo.population {
+            return bad(format!(
+                "truncation keeps {keep}, must be 1 to the population size {}",
+                evo.population
+            ));
+        }
+    }
+    for (name, p) in [("crossover", evo.crossover), ("mutation", evo.mutation)] {
+        if !(0.0..=1.0).contains(&p) {
+            return bad(format!("{name} probability {p} is not in 0..1"));
+        }
+    }
+    if evo.elitism > evo.population {
+        return bad(format!("elitism {} exceeds the population size {}", evo.elitism, evo.population));
+    }
+    if evo.evaluations == 0 {
+        return bad("evaluations must be at least 1".into());
+    }
+    Ok(())
+}
+
+fn validate_layout(st: &Stage) -> Result<(), EvolveError> {
+    for (i, g) in st.layout.genes.iter().enumerate() {
+        if g.bits == 0 || g.bits > 32 {
+            return Err(EvolveError::InvalidLayout {
+                stage: st.name.clone(),
+                gene: i,
+                what: format!("has {} bits, must be 1 to 32", g.bits),
+            });
+        }
+        if g.offset as u64 + g.bits as u64 > st.layout.bits as u64 {
+            return Err(EvolveError::InvalidLayout {
+                stage: st.name.clone(),
+                gene: i,
+                what: format!("ends after the genome's {} bits", st.layout.bits),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The child's layout must start with the parent's genes (same place, size and
+/// range) and may freeze only genes of that prefix.
+fn check_extension(st: &Stage, pst: &Stage) -> Result<(), EvolveError> {
+    let err =
+        |what: String| EvolveError::NotAnExtension { stage: st.name.clone(), parent: pst.name.clone(), what };
+    let (child, parent) = (&st.layout, &pst.layout);
+    if child.bits < parent.bits || child.genes.len() < parent.genes.len() {
+        return Err(err(format!(
+            "it has {} genes in {} bits, the parent {} genes in {} bits",
+            child.genes.len(),
+            child.bits,
+            parent.genes.len(),
+            parent.bits
+        )));
+    }
+    for (i, (c, p)) in child.genes.iter().zip(&parent.genes).enumerate() {
+        if (c.offset, c.bits, c.lo, c.hi) != (p.offset, p.bits, p.lo, p.hi) {
+            return Err(err(format!("gene {i} differs in position, size or range")));
+        }
+    }
+    if let Some(gene) = child.genes.iter().position(|g| g.frozen && g.offset + g.bits as u32 > parent.bits) {
+        return Err(EvolveError::FrozenNewGene { stage: st.name.clone(), parent: pst.name.clone(), gene });
+    }
+    Ok(())
+}
+
+fn check_population(st: &Stage, cp: &Checkpoint) -> Result<(), EvolveError> {
+    let bad = |what: String| Err(EvolveError::Inconsistent { stage: st.name.clone(), what });
+    let evo = evolution(st)?;
+    if cp.population.len() != evo.population as usize {
+        return bad(format!("{} individuals, the stage declares {}", cp.population.len(), evo.population));
+    }
+    if let Some(i) = cp.population.iter().position(|g| g.bits.len() != st.layout.bits as usize) {
+        return bad(format!(
+            "individual {i} has {} bits, the layout {}",
+            cp.population[i].bits.len(),
+            st.layout.bits
+        ));
+    }
+    if cp.generation > 0 && cp.fitness.len() != cp.population.len() {
+        return bad(format!("{} fitness values for {} individuals", cp.fitness.len(), cp.population.len()));
+    }
+    Ok(())
+}

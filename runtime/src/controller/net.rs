@@ -1,0 +1,200 @@
+//! Decoded feed-forward sigmoid networks, their forward pass and one CRBP
+//! (generalised delta rule) training step.
+
+use crate::catalog::CHANNELS;
+
+/// The logistic function.
+#[inline]
+pub fn sigmoid(x: f32) -> f32 {
+    1.0 / (1.0 + (-x).exp())
+}
+
+/// A decoded network (weights in the order of [`crate::program::Network`])
+/// with the state of its last forward pass, so that a training step after the
+/// action uses the outputs that produced it. The inputs are read from the
+/// percept given to [`Net::forward`], which [`Net::train`] must be given again.
+#[derive(Clone, Debug)]
+pub struct Net {
+    /// Percept channels feeding the inputs, in order.
+    chans: Vec<u16>,
+    /// First channel when `chans` is a run of consecutive channels (the
+    /// inputs are then read straight from the percept).
+    run: Option<usize>,
+    hidden: usize,
+    outputs: usize,
+    /// Weights, `Network::params` order: per unit, bias first.
+    pub(crate) w: Vec<f32>,
+    /// Scratch: gathered inputs when the channels are not consecutive.
+    x: Vec<f32>,
+    /// Hidden activations of the last forward pass.
+    h: Vec<f32>,
+    /// Outputs of the last forward pass.
+    y: Vec<f32>,
+    /// Scratch: output deltas.
+    dy: Vec<f32>,
+}
+
+/// The network's inputs on `percept`: a slice of it for a run of consecutive
+/// channels, else gathered into `scratch`.
+#[inline]
+fn inputs<'a>(
+    chans: &[u16],
+    run: Option<usize>,
+    scratch: &'a mut [f32],
+    percept: &'a [f32; CHANNELS],
+) -> &'a [f32] {
+    match run {
+        Some(s) => &percept[s..s + chans.len()],
+        None => {
+            for (x, &c) in scratch.iter_mut().zip(chans) {
+                *x = percept[c as usize];
+            }
+            scratch
+        }
+    }
+}
+
+impl Net {
+    /// A network over the given channels; `w` must hold
+    /// `Network::param_count(chans.len(), hidden, outputs)` weights.
+    pub fn new(chans: Vec<u16>, hidden: usize, outputs: usize, w: Vec<f32>) -> Net {
+        let n = chans.len();
+        debug_assert_eq!(w.len(), crate::program::Network::param_count(n, hidden, outputs));
+        let run = match chans.first() {
+            Some(&c0) if chans.iter().enumerate().all(|(i, &c)| c as usize == c0 as usize + i) => {
+                Some(c0 as usize)
+            }
+            Some(_) => None,
+            None => Some(0),
+        };
+        Net {
+            chans,
+            run,
+            hidden,
+            outputs,
+            w,
+            x: vec![0.0; n],
+            h: vec![0.0; hidden],
+            y: vec![0.0; outputs],
+            dy: vec![0.0; outputs],
+        }
+    }
+
+    pub fn outputs(&self) -> &[f32] {
+        &self.y
+    }
+
+    /// Forward pass on a percept; `extra` is added to every output neuron's net
+    /// input (the link term of an activation network).
+    #[inline]
+    pub fn forward(&mut self, percept: &[f32; CHANNELS], extra: f32) -> &[f32] {
+        let Net { chans, run, hidden, w, x, h, y, .. } = self;
+        let x = inputs(chans, *run, x, percept);
+        let n = x.len();
+        if *hidden == 0 {
+            for (o, y) in y.iter_mut().enumerate() {
+                let row = &w[o * (n + 1)..(o + 1) * (n + 1)];
+                *y = sigmoid(row[0] + dot(&row[1..], x) + extra);
+            }
+        } else {
+            for (j, h) in h.iter_mut().enumerate() {
+                let row = &w[j * (n + 1)..(j + 1) * (n + 1)];
+                *h = sigmoid(row[0] + dot(&row[1..], x));
+            }
+            let base = *hidden * (n + 1);
+            let m = *hidden + 1;
+            for (o, y) in y.iter_mut().enumerate() {
+                let row = &w[base + o * m..base + (o + 1) * m];
+                *y = sigmoid(row[0] + dot(&row[1..], h) + extra);
+            }
+        }
+        &self.y
+    }
+
+    /// One step of the generalised delta rule on the last forward pass (whose
+    /// percept must be given again) toward the targets `target(o)` (squared
+    /// error, sigmoid units, biases as weights on a constant 1):
+    /// `delta = (t - y) y (1 - y)`, `dw = rate * delta * input`.
+    pub fn train(&mut self, percept: &[f32; CHANNELS], target: impl Fn(usize) -> f32, rate: f32) {
+        let Net { chans, run, hidden, outputs, w, x, h, y, dy } = self;
+        let x = inputs(chans, *run, x, percept);
+        let n = x.len();
+        for (o, (d, &y)) in dy.iter_mut().zip(y.iter()).enumerate() {
+            *d = (target(o) - y) * y * (1.0 - y);
+        }
+        if *hidden == 0 {
+            for o in 0..*outputs {
+                let g = rate * dy[o];
+                let row = &mut w[o * (n + 1)..(o + 1) * (n + 1)];
+                row[0] += g;
+                for (w, &x) in row[1..].iter_mut().zip(x) {
+                    *w += g * x;
+                }
+            }
+            return;
+        }
+        let base = *hidden * (n + 1);
+        let m = *hidden + 1;
+        // Hidden deltas from the weights before this update.
+        for j in 0..*hidden {
+            let back: f32 = (0..*outputs).map(|o| w[base + o * m + 1 + j] * dy[o]).sum();
+            let hj = h[j];
+            let g = rate * back * hj * (1.0 - hj);
+            let row = &mut w[j * (n + 1)..(j + 1) * (n + 1)];
+            row[0] += g;
+            for (w, &x) in row[1..].iter_mut().zip(x) {
+                *w += g * x;
+            }
+        }
+        for o in 0..*outputs {
+            let g = rate * dy[o];
+            let row = &mut w[base + o * m..base + (o + 1) * m];
+            row[0] += g;
+            for (w, &h) in row[1..].iter_mut().zip(h.iter()) {
+                *w += g * h;
+            }
+        }
+    }
+}
+
+#[inline]
+fn dot(a: &[f32], b: &[f32]) -> f32 {
+    a.iter().zip(b).map(|(a, b)| a * b).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forward_matches_hand_computation() {
+        // 2 inputs, no hidden, 1 output: bias 0.5, w = [1, -2].
+        let mut net = Net::new(vec![0, 1], 0, 1, vec![0.5, 1.0, -2.0]);
+        let mut p = [0.0; CHANNELS];
+        p[0] = 0.3;
+        p[1] = 0.4;
+        let y = net.forward(&p, 0.25)[0];
+        assert!((y - sigmoid(0.5 + 0.3 - 0.8 + 0.25)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn training_moves_outputs_toward_targets_with_a_hidden_layer() {
+        let w: Vec<f32> =
+            (0..Network::param_count(3, 2, 2)).map(|i| ((i * 7 % 5) as f32 - 2.0) * 0.3).collect();
+        // Channels 2, 0, 1: not a run, so the inputs are gathered.
+        let mut net = Net::new(vec![2, 0, 1], 2, 2, w);
+        let mut p = [0.0; CHANNELS];
+        p[2] = 1.0;
+        p[1] = 0.5;
+        let before = net.forward(&p, 0.0).to_vec();
+        for _ in 0..50 {
+            net.forward(&p, 0.0);
+            net.train(&p, |o| if o == 0 { 1.0 } else { 0.0 }, 0.5);
+        }
+        let after = net.forward(&p, 0.0).to_vec();
+        assert!(after[0] > before[0] + 0.05, "{before:?} -> {after:?}");
+        assert!(after[1] < before[1] - 0.05, "{before:?} -> {after:?}");
+    }
+
+    use crate::program::Network;
+}

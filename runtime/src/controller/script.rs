@@ -1,0 +1,218 @@
+//! Execution of scripted behaviors ([`crate::program::Script`]).
+//!
+//! Semantics (the runtime side of the language's `script { ... }`):
+//! - A script's position (current step and the actions spent in it) is kept
+//!   across actions **while its module keeps winning** the arbitration. When
+//!   another module wins, the script is reset to its first step, so a script
+//!   always starts from the beginning when its module regains control.
+//! - After the last step the script wraps around to the first one.
+//! - Every action the winning module runs its script up to the first step that
+//!   moves something: `reinforce` steps take no time (they are executed and
+//!   skipped in the same action) and read `now` = the current percept (the one
+//!   the arbitration of this action used), `prev` = the one before, and the
+//!   actuator slots of the previous action.
+//! - After the action, the current step's end is checked: `Actions(n)` ends
+//!   after `n` actions; `Until { cond, within }` ends when `cond` holds on the
+//!   percept after the action (`now` = after, `prev` = before the action,
+//!   actuators = this action's command) or after `within` actions.
+//! - `toward(channels, speed)` steers to the vector sum of the channel
+//!   readings along their sensors' bearings: it turns in place when that
+//!   direction is more than 20 degrees off the heading, else drives forward at
+//!   `speed`; with nothing sensed it drives forward.
+//! - `wait` stops the wheels (with `charge`, asks the charger to recharge);
+//!   `arm`/`claw` steps stop the wheels and move the gripper.
+
+use super::fast_expr::FastExpr;
+use crate::catalog::{channel_bearing, CHANNELS};
+use crate::expr::Env;
+use crate::program::{Action, Script, StepEnd};
+use crate::sim::Command;
+
+/// Angle beyond which `toward` turns in place instead of driving forward.
+pub const TOWARD_DEAD_ZONE_DEG: f32 = 20.0;
+
+/// One step with its precomputed data.
+#[derive(Clone, Debug)]
+enum Op {
+    Wheels([f32; 2]),
+    /// Channels with the unit vector of their bearing.
+    Toward {
+        dirs: Vec<(u16, f32, f32)>,
+        speed: f32,
+    },
+    Arm(bool),
+    Claw(bool),
+    Wait {
+        charge: bool,
+    },
+    Reinforce(FastExpr),
+}
+
+#[derive(Clone, Debug)]
+enum End {
+    Actions(u32),
+    Until { cond: FastExpr, within: u32 },
+}
+
+/// A script ready to run, with its position.
+#[derive(Clone, Debug)]
+pub struct ScriptRun {
+    steps: Vec<(Op, End)>,
+    /// Current step.
+    pos: usize,
+    /// Actions spent in the current step.
+    spent: u32,
+}
+
+impl ScriptRun {
+    pub fn new(script: &Script) -> ScriptRun {
+        let steps = script
+            .steps
+            .iter()
+            .map(|s| {
+                let op = match &s.action {
+                    Action::Wheels { left, right } => Op::Wheels([*left, *right]),
+                    Action::Toward { channels, speed } => Op::Toward {
+                        dirs: channels
+                            .iter()
+                            .filter_map(|&c| channel_bearing(c as usize).map(|b| (c, b.cos(), b.sin())))
+                            .collect(),
+                        speed: *speed,
+                    },
+                    Action::Arm(d) => Op::Arm(*d),
+                    Action::Claw(c) => Op::Claw(*c),
+                    Action::Wait { charge } => Op::Wait { charge: *charge },
+                    Action::Reinforce(e) => Op::Reinforce(FastExpr::new(e)),
+                };
+                let end = match &s.end {
+                    StepEnd::Actions(n) => End::Actions(*n),
+                    StepEnd::Until { cond, within } => {
+                        End::Until { cond: FastExpr::new(cond), within: *within }
+                    }
+                };
+                (op, end)
+            })
+            .collect();
+        ScriptRun { steps, pos: 0, spent: 0 }
+    }
+
+    /// True when the script contains `reinforce` steps (then they, not the
+    /// module's reinforcement program after each action, deliver reinforcement).
+    pub fn delivers_reinforcement(&self) -> bool {
+        self.steps.iter().any(|(op, _)| matches!(op, Op::Reinforce(_)))
+    }
+
+    /// Back to the first step.
+    pub fn reset(&mut self) {
+        self.pos = 0;
+        self.spent = 0;
+    }
+
+    /// The current step index (for tests and traces).
+    pub fn position(&self) -> usize {
+        self.pos
+    }
+
+    fn advance(&mut self) {
+        self.pos = if self.pos + 1 >= self.steps.len() { 0 } else { self.pos + 1 };
+        self.spent = 0;
+    }
+
+    /// Runs the script up to its next moving step and returns the command.
+    /// `reinforcement` receives the sign of the last `reinforce` step run (0 if none).
+    pub fn command(&mut self, env: &Env, reinforcement: &mut f32) -> Command {
+        // Each step at most once per action, so a script made only of
+        // `reinforce` steps cannot loop forever.
+        for _ in 0..self.steps.len() {
+            let op = &self.steps[self.pos].0;
+            let cmd = match op {
+                Op::Reinforce(e) => {
+                    *reinforcement = crate::expr::sign(e.eval(env));
+                    self.advance();
+                    continue;
+                }
+                Op::Wheels(w) => Command { wheels: *w, ..Command::default() },
+                Op::Toward { dirs, speed } => {
+                    Command { wheels: toward(dirs, *speed, env.now), ..Command::default() }
+                }
+                Op::Arm(d) => Command { arm: Some(*d), ..Command::default() },
+                Op::Claw(c) => Command { claw: Some(*c), ..Command::default() },
+                Op::Wait { charge } => Command { charge: *charge, ..Command::default() },
+            };
+            return cmd;
+        }
+        Command::default()
+    }
+
+    /// Called after the action the script drove: counts it and moves to the
+    /// next step when the current one has ended.
+    pub fn after_action(&mut self, env: &Env) {
+        let Some((op, end)) = self.steps.get(self.pos) else { return };
+        if matches!(op, Op::Reinforce(_)) {
+            // Only reinforce steps were left this action (nothing moved).
+            return;
+        }
+        self.spent += 1;
+        let done = match end {
+            End::Actions(n) => self.spent >= *n,
+            End::Until { cond, within } => cond.eval(env) != 0.0 || self.spent >= *within,
+        };
+        if done {
+            self.advance();
+        }
+    }
+}
+
+/// Wheel speeds steering toward the vector sum of the channel readings.
+fn toward(dirs: &[(u16, f32, f32)], speed: f32, now: &[f32; CHANNELS]) -> [f32; 2] {
+    let (mut x, mut y) = (0.0f32, 0.0f32);
+    for &(c, cx, cy) in dirs {
+        let v = now[c as usize];
+        x += v * cx;
+        y += v * cy;
+    }
+    if x * x + y * y < 1e-8 {
+        return [speed, speed];
+    }
+    let angle = y.atan2(x);
+    if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
+        [speed, speed]
+    } else if angle > 0.0 {
+        // Target on the left (counter-clockwise): turn left in place.
+        [-speed, speed]
+    } else {
+        [speed, -speed]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalog::{CH_IR, CH_LIGHT};
+
+    fn dirs(chans: std::ops::Range<usize>) -> Vec<(u16, f32, f32)> {
+        chans
+            .map(|c| (c as u16, channel_bearing(c).unwrap().cos(), channel_bearing(c).unwrap().sin()))
+            .collect()
+    }
+
+    #[test]
+    fn toward_turns_to_the_stronger_side_and_goes_forward_when_ahead() {
+        let d = dirs(CH_LIGHT..CH_LIGHT + 8);
+        let mut p = [0.0; CHANNELS];
+        assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5], "nothing sensed: forward");
+        p[CH_LIGHT] = 1.0; // left 90 degrees
+        assert_eq!(toward(&d, 0.5, &p), [-0.5, 0.5]);
+        p[CH_LIGHT] = 0.0;
+        p[CH_LIGHT + 5] = 1.0; // right 90 degrees
+        assert_eq!(toward(&d, 0.5, &p), [0.5, -0.5]);
+        p[CH_LIGHT + 5] = 0.0;
+        p[CH_LIGHT + 2] = 1.0;
+        p[CH_LIGHT + 3] = 0.8; // front pair: straight ahead
+        assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5]);
+        let d = dirs(CH_IR..CH_IR + 8);
+        let mut p = [0.0; CHANNELS];
+        p[CH_IR + 6] = 1.0; // back right
+        assert_eq!(toward(&d, 1.0, &p), [1.0, -1.0]);
+    }
+}

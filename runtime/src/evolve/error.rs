@@ -1,0 +1,66 @@
+//! Errors of the GA driver: every message says what went wrong and where
+//! (stage name, generation, individual).
+
+use thiserror::Error;
+
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum EvolveError {
+    #[error("stage index {index} is out of range: the program has {count} stages")]
+    StageIndex { index: usize, count: usize },
+
+    #[error("stage `{stage}` extends `{parent}`, which is not an earlier stage")]
+    ParentOrder { stage: String, parent: String },
+
+    #[error("stage `{stage}` is a test stage, it is not evolved")]
+    NotEvolved { stage: String },
+
+    #[error("stage `{stage}` is evolved, not a test stage")]
+    NotTest { stage: String },
+
+    #[error("stage `{stage}`: invalid evolution parameter: {what}")]
+    InvalidParameter { stage: String, what: String },
+
+    #[error("stage `{stage}`: gene {gene} {what}")]
+    InvalidLayout { stage: String, gene: usize, what: String },
+
+    #[error("stage `{stage}` extends no stage but its gene {gene} is frozen")]
+    FrozenWithoutParent { stage: String, gene: usize },
+
+    #[error("stage `{stage}`: gene {gene} is frozen but was not introduced by `{parent}`")]
+    FrozenNewGene { stage: String, parent: String, gene: usize },
+
+    #[error("stage `{stage}` does not extend the layout of `{parent}`: {what}")]
+    NotAnExtension { stage: String, parent: String, what: String },
+
+    #[error(
+        "stage `{stage}` starts from the final population of `{parent}`, but no checkpoint of it was given"
+    )]
+    MissingParent { stage: String, parent: String },
+
+    #[error("stage `{stage}` extends no stage, but a parent checkpoint was given")]
+    UnexpectedParent { stage: String },
+
+    #[error("stage `{stage}` starts from `{expected}`, but the given checkpoint is of stage `{found}`")]
+    WrongParent { stage: String, expected: String, found: String },
+
+    #[error("the checkpoint of stage `{stage}` holds no evaluated population")]
+    ParentNotEvaluated { stage: String },
+
+    #[error("stage `{stage}`, generation {generation}, individual {index}: fitness is {value}, not a finite number")]
+    NonFiniteFitness { stage: String, generation: u32, index: usize, value: f32 },
+
+    #[error("stage `{stage}`, generation {generation}, individual {index}: the learned genome has {found} bits, expected {expected}")]
+    LearnedLength { stage: String, generation: u32, index: usize, expected: usize, found: usize },
+
+    #[error("checkpoint format {found} is not supported (expected {expected})")]
+    CheckpointFormat { found: u32, expected: u32 },
+
+    #[error("the checkpoint was made with a different stage `{stage}` (stage {index}): its layout or evolution parameters changed since")]
+    StageChanged { stage: String, index: usize },
+
+    #[error("the checkpoint covers {expected} stages but the program has only {count}")]
+    StageMissing { expected: usize, count: usize },
+
+    #[error("inconsistent checkpoint of stage `{stage}`: {what}")]
+    Inconsistent { stage: String, what: String },
+}

@@ -1,0 +1,45 @@
+//! The evaluation of a stage's episodes by the controller and simulator: the
+//! [`super::Evaluate`] function the CLI passes to the GA.
+
+use crate::controller::{self, ControllerError, EpisodeOptions};
+use crate::genome::Genome;
+use crate::program::{Stage, StageRun};
+
+use super::Evaluation;
+
+/// How episodes of a stage run: its life length in actions, and whether local
+/// learning is on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EvalOptions {
+    pub actions: u32,
+    pub learning: bool,
+}
+
+impl EvalOptions {
+    /// What the stage declares: an evolved stage lives `Evolution::actions`
+    /// actions with learning on (modules without `learning` never learn); a
+    /// test stage as declared in `StageRun::Test`.
+    pub fn of(stage: &Stage) -> EvalOptions {
+        match &stage.run {
+            StageRun::Evolve(evo) => EvalOptions { actions: evo.actions, learning: true },
+            StageRun::Test { actions, learning } => EvalOptions { actions: *actions, learning: *learning },
+        }
+    }
+}
+
+/// An evaluation function running one controller episode of `stage` per call,
+/// seeded with the episode seed. The stage is checked once here (with a zero
+/// genome of its layout's length), so the episodes of genomes of that length,
+/// which the GA always makes, cannot fail. With `inheritance: lamarckian`
+/// the learned genome is returned for write-back.
+pub fn evaluate_with_controller(
+    stage: &Stage,
+    opts: EvalOptions,
+) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + '_, ControllerError> {
+    controller::validate(stage, &Genome::zeros(stage.layout.bits as usize))?;
+    Ok(move |genome: &Genome, seed: u64| {
+        let episode = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed };
+        let result = controller::run_episode(stage, genome, &episode, None);
+        Evaluation { fitness: result.fitness, learned: result.learned }
+    })
+}

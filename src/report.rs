@@ -1,0 +1,208 @@
+//! Turning runtime results into files: CSV tables and pictures.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use shaping_runtime::controller::Trace;
+use shaping_runtime::evolve::GenStats;
+use shaping_runtime::program::{LearnTarget, Stage};
+use shaping_runtime::sim::{ObjectState, Scene};
+
+use crate::load::{write_atomic, CliError};
+use crate::plot;
+
+/// Window of the reinforcement rolling means drawn in the pictures (the paper's).
+pub const REINFORCEMENT_WINDOW: usize = 30;
+
+/// `generations.csv`: one row per generation of the stage and its ancestors.
+pub fn generations_csv(history: &[GenStats]) -> String {
+    let mut s = String::from("stage,generation,stage_generation,best,mean,worst,best_index\n");
+    for h in history {
+        let _ = writeln!(
+            s,
+            "{},{},{},{:.6},{:.6},{:.6},{}",
+            h.stage, h.generation, h.stage_generation, h.best, h.mean, h.worst, h.best_index
+        );
+    }
+    s
+}
+
+/// Points for the fitness pictures, and where each stage starts.
+pub fn fitness_points(history: &[GenStats]) -> (Vec<plot::GenPoint>, Vec<(u32, String)>) {
+    let points = history
+        .iter()
+        .map(|h| plot::GenPoint { generation: h.generation, best: h.best, mean: h.mean })
+        .collect();
+    let mut starts: Vec<(u32, String)> = Vec::new();
+    for h in history {
+        if starts.last().is_none_or(|(_, name)| *name != h.stage) {
+            starts.push((h.generation, h.stage.clone()));
+        }
+    }
+    (points, starts)
+}
+
+/// Draws `fitness.{svg,png}` into `dir`.
+pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(), CliError> {
+    if history.is_empty() {
+        return Ok(());
+    }
+    let (points, starts) = fitness_points(history);
+    plot::fitness_curves(&dir.join("fitness"), title, &points, &starts, false)
+        .map_err(|e| CliError::io(format!("error: {e}")))
+}
+
+/// `trace.csv`: one row per action.
+pub fn trace_csv(trace: &Trace) -> String {
+    let mut s =
+        String::from("action,winner,battery,holding,grips,releases_outside,recharged,collided,x,y,theta");
+    for m in &trace.modules {
+        let _ = write!(s, ",act_{m}");
+    }
+    for m in &trace.modules {
+        let _ = write!(s, ",reinf_{m}");
+    }
+    for m in &trace.modules {
+        let _ = write!(s, ",perf_{m}");
+    }
+    s.push('\n');
+    for r in &trace.rows {
+        let winner = trace.modules.get(r.winner as usize).map_or("", |m| m.as_str());
+        let _ = write!(
+            s,
+            "{},{},{:.4},{},{},{},{},{},{:.2},{:.2},{:.4}",
+            r.action,
+            winner,
+            r.battery,
+            r.holding as u8,
+            r.grips,
+            r.releases_outside,
+            r.recharged as u8,
+            r.collided as u8,
+            r.pose.x,
+            r.pose.y,
+            r.pose.theta
+        );
+        for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
+            let _ = write!(s, ",{v:.4}");
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Writes `trace.csv` and the pictures of one episode into `dir`:
+/// `activations` (figure 11), `reinforcement` (figures 5, 10, 13) for every
+/// learning module, and `trajectory`.
+pub fn episode_files(
+    dir: &Path,
+    title: &str,
+    stage: &Stage,
+    trace: &Trace,
+    scene: &Scene,
+    marks: &[(u32, String)],
+) -> Result<(), CliError> {
+    let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
+    write_atomic(&dir.join("trace.csv"), trace_csv(trace).as_bytes())?;
+    if trace.rows.is_empty() {
+        return Ok(());
+    }
+    let act = plot::ActivationTrace {
+        modules: trace.modules.clone(),
+        activations: trace.rows.iter().map(|r| r.activations.clone()).collect(),
+        winner: trace.rows.iter().map(|r| r.winner).collect(),
+        battery: trace.rows.iter().map(|r| r.battery).collect(),
+        holding: trace.rows.iter().map(|r| r.holding).collect(),
+    };
+    plot::activation_trace(&dir.join("activations"), &format!("{title}: module activations"), &act)
+        .map_err(to_err)?;
+
+    let series: Vec<(String, Vec<f32>)> = learning_modules(stage)
+        .into_iter()
+        .map(|(i, name)| (name, reinforcement_signals(trace, i)))
+        .filter(|(_, v)| v.iter().any(|x| x.is_finite()))
+        .collect();
+    if !series.is_empty() {
+        plot::rolling_reinforcement(
+            &dir.join("reinforcement"),
+            &format!("{title}: reinforcement (rolling mean, window {REINFORCEMENT_WINDOW})"),
+            &series,
+            REINFORCEMENT_WINDOW,
+            marks,
+        )
+        .map_err(to_err)?;
+    }
+
+    let scene = trajectory_scene(scene, trace);
+    plot::trajectory(&dir.join("trajectory"), &format!("{title}: trajectory"), &scene).map_err(to_err)
+}
+
+/// Modules that learn (or at least receive reinforcement), with their index.
+pub fn learning_modules(stage: &Stage) -> Vec<(usize, String)> {
+    stage
+        .modules
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| m.learning.is_some() || m.reinforce.is_some())
+        .map(|(i, m)| {
+            let on = match m.learning.as_ref().map(|l| l.target) {
+                Some(LearnTarget::Activation) => " (activation)",
+                Some(LearnTarget::Behavior) => " (behavior)",
+                None => "",
+            };
+            (i, format!("{}{on}", m.name))
+        })
+        .collect()
+}
+
+/// A module's reinforcement signals, one per action: the signal where one was
+/// delivered, NaN where none was (so rolling means skip the gaps).
+pub fn reinforcement_signals(trace: &Trace, module: usize) -> Vec<f32> {
+    trace
+        .rows
+        .iter()
+        .map(|r| match r.reinforcement.get(module) {
+            Some(&v) if v != 0.0 => v,
+            _ => f32::NAN,
+        })
+        .collect()
+}
+
+fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
+    let mut marks = Vec::new();
+    let (mut grips, mut releases) = (0, 0);
+    for (i, r) in trace.rows.iter().enumerate() {
+        if r.grips > grips {
+            marks.push((i, "grip".to_string()));
+        }
+        if r.releases_outside > releases {
+            marks.push((i, "release".to_string()));
+        }
+        if r.recharged {
+            marks.push((i, "recharged".to_string()));
+        }
+        grips = r.grips;
+        releases = r.releases_outside;
+    }
+    plot::TrajectoryScene {
+        arena: scene.arena,
+        bar: scene.bar.map(|[a, b]| (a, b)),
+        lamp: scene.lamp,
+        objects: scene
+            .objects
+            .iter()
+            .map(|o| plot::SceneObject {
+                x: o.x,
+                y: o.y,
+                radius: o.radius,
+                virtual_: o.virtual_,
+                collected: o.state != ObjectState::Floor,
+            })
+            .collect(),
+        path: trace.rows.iter().map(|r| [r.pose.x, r.pose.y, r.pose.theta]).collect(),
+        body_radius: scene.body_radius,
+        marks,
+        path_modules: Some(trace.rows.iter().map(|r| r.winner).collect()),
+        module_names: trace.modules.clone(),
+    }
+}

@@ -1,0 +1,368 @@
+//! `shaping run`: evolves the stages in order, with checkpoints, statistics,
+//! a progress bar and pictures.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use shaping_runtime::controller::{
+    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace,
+};
+use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Program, Stage, StageRun};
+use shaping_runtime::sim::{Scene, Sim};
+
+use crate::load::{self, create_dir, write_atomic, CliError};
+use crate::report;
+
+pub struct RunArgs {
+    pub file: PathBuf,
+    pub stage: Option<String>,
+    pub seed: Option<u64>,
+    pub out: Option<PathBuf>,
+    pub jobs: Option<usize>,
+    pub quiet: bool,
+    pub json: bool,
+    pub fresh: bool,
+    pub error_format: crate::diag::ErrorFormat,
+}
+
+/// The directory a run of `file` writes to by default: `runs/<file stem>`.
+pub fn default_out(file: &Path) -> PathBuf {
+    let stem = file.file_stem().map_or_else(|| "program".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from("runs").join(stem)
+}
+
+/// The run seed: `--seed`, else the first evolved stage's declared seed.
+pub fn run_seed(program: &Program, seed: Option<u64>) -> u64 {
+    seed.unwrap_or_else(|| {
+        program
+            .stages
+            .iter()
+            .find_map(|s| match &s.run {
+                StageRun::Evolve(e) => Some(e.seed),
+                StageRun::Test { .. } => None,
+            })
+            .unwrap_or(1)
+    })
+}
+
+/// The stages to run for a target stage: it and its ancestors, in order.
+pub fn chain(program: &Program, target: usize) -> Vec<usize> {
+    let mut chain = vec![target];
+    let mut cur = program.stages[target].parent;
+    while let Some(p) = cur {
+        chain.push(p);
+        cur = program.stages[p].parent;
+    }
+    chain.reverse();
+    chain
+}
+
+/// Evaluation of one genome in an evolved stage: one episode with local learning on.
+pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evaluation + Sync + '_ {
+    move |genome: &Genome, seed: u64| {
+        let r = run_episode(stage, genome, &EpisodeOptions { actions, learning: true, seed }, None);
+        Evaluation { fitness: r.fitness, learned: r.learned }
+    }
+}
+
+fn ckpt_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint.json")
+}
+
+fn read_checkpoint(path: &Path) -> Result<Option<Checkpoint>, CliError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bytes = load::read_bytes(path)?;
+    serde_json::from_slice(&bytes).map(Some).map_err(|e| {
+        CliError::io(format!(
+            "error: the checkpoint `{}` is corrupt ({e}); move it away or pass `--fresh` to start the stage again",
+            path.display()
+        ))
+    })
+}
+
+fn to_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
+    serde_json::to_string_pretty(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
+}
+
+pub fn run(args: RunArgs) -> Result<(), CliError> {
+    let program = load::load_program(&args.file, args.error_format)?;
+    let target = match args.stage.as_deref() {
+        Some(_) => load::stage_index(&program, args.stage.as_deref())?,
+        None => program.stages.len().saturating_sub(1),
+    };
+    if program.stages.is_empty() {
+        return Err(CliError::io("error: the program has no stages"));
+    }
+    let stages =
+        if args.stage.is_some() { chain(&program, target) } else { (0..program.stages.len()).collect() };
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.file));
+    let seed = run_seed(&program, args.seed);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build()
+        .map_err(|e| CliError::io(format!("error: cannot start worker threads: {e}")))?;
+    create_dir(&out)?;
+    let started = Instant::now();
+    let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
+    for &index in &stages {
+        let stage = &program.stages[index];
+        let dir = out.join(&stage.name);
+        create_dir(&dir)?;
+        match &stage.run {
+            StageRun::Evolve(_) => {
+                let parent = evolved_parent(&program, index, &finals)?;
+                let cp = pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args))?;
+                finals[index] = Some(cp);
+            }
+            StageRun::Test { actions, learning } => {
+                let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
+                    CliError::io(format!("error: test stage `{}` extends no evolved stage", stage.name))
+                })?;
+                test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+            }
+        }
+    }
+    if !args.quiet && !args.json {
+        eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), out.display());
+    }
+    Ok(())
+}
+
+/// The final checkpoint of the nearest evolved ancestor of `index`.
+fn evolved_parent<'a>(
+    program: &Program,
+    index: usize,
+    finals: &'a [Option<Checkpoint>],
+) -> Result<Option<&'a Checkpoint>, CliError> {
+    let mut cur = program.stages[index].parent;
+    while let Some(p) = cur {
+        if let StageRun::Evolve(_) = program.stages[p].run {
+            return finals[p].as_ref().map(Some).ok_or_else(|| {
+                CliError::io(format!("error: stage `{}` has not been run", program.stages[p].name))
+            });
+        }
+        cur = program.stages[p].parent;
+    }
+    Ok(None)
+}
+
+fn evolve_stage(
+    program: &Program,
+    index: usize,
+    seed: u64,
+    parent: Option<&Checkpoint>,
+    dir: &Path,
+    args: &RunArgs,
+) -> Result<Checkpoint, CliError> {
+    let stage = &program.stages[index];
+    let StageRun::Evolve(evo) = &stage.run else { unreachable!("evolve_stage is called for evolved stages") };
+    let path = ckpt_path(dir);
+    let existing = if args.fresh { None } else { read_checkpoint(&path)? };
+    let mut cp = match existing {
+        Some(cp) => {
+            evolve::check_resume(program, &cp).map_err(|e| {
+                CliError::io(format!(
+                    "error: cannot resume from `{}`: {e}; pass `--fresh` (or another `--out`) to start again",
+                    path.display()
+                ))
+            })?;
+            if cp.stage != index || cp.seed != seed {
+                return Err(CliError::io(format!(
+                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it or `--fresh` to start again",
+                    path.display(),
+                    cp.seed,
+                    cp.seed
+                )));
+            }
+            cp
+        }
+        None => evolve::start_stage(program, index, seed, parent)
+            .map_err(|e| CliError::io(format!("error: {e}")))?,
+    };
+    let bar = progress_bar(args, stage, evo.generations, cp.generation);
+    let eval = evaluator(stage, evo.actions);
+    while !evolve::is_finished(program, &cp) {
+        let stats = evolve::step_generation(program, &mut cp, &eval)
+            .map_err(|e| CliError::io(format!("error: {e}")))?;
+        write_atomic(&path, to_json(&cp)?.as_bytes())?;
+        write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+        report_generation(args, &bar, &stats);
+    }
+    bar.finish_and_clear();
+    let (genome, fitness) = evolve::best_of(&cp)
+        .ok_or_else(|| CliError::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
+    write_atomic(&dir.join("best.genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+    report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
+    if !args.quiet && !args.json {
+        let last = cp.history.last();
+        eprintln!(
+            "stage {:<12} {} generations  best {:.3} (best ever {:.3})  mean {:.3}  -> {}",
+            stage.name,
+            cp.generation,
+            last.map_or(0.0, |h| h.best),
+            fitness,
+            last.map_or(0.0, |h| h.mean),
+            dir.display()
+        );
+    }
+    Ok(cp)
+}
+
+/// One life of a test stage's individual: `actions` in the world of the stage
+/// it extends ("before"), then `actions` in the stage's own world ("after"),
+/// with one controller, so what local learning acquired before the change
+/// carries over (the paper's section 4.9).
+pub struct BeforeAfter {
+    pub trace: Trace,
+    /// Index of the first action in the changed world.
+    pub switch: u32,
+    pub before: EpisodeResult,
+    pub after: EpisodeResult,
+    /// The changed world at its start, for the trajectory picture.
+    pub scene: Scene,
+}
+
+pub fn before_after(
+    parent: &Stage,
+    stage: &Stage,
+    genome: &Genome,
+    actions: u32,
+    learning: bool,
+    seed: u64,
+) -> Result<BeforeAfter, CliError> {
+    let (sim_seed, rng) = episode_rngs(seed);
+    let mut ctl = Controller::new(stage, genome, rng)
+        .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
+    let opts = EpisodeOptions { actions, learning, seed };
+    let mut first = Trace::default();
+    let before = ctl.run(&mut Sim::new(&parent.world, sim_seed), &opts, Some(&mut first));
+    let mut second = Trace::default();
+    let after_seed = sim_seed ^ 0x9e37_79b9_7f4a_7c15;
+    let mut sim = Sim::new(&stage.world, after_seed);
+    let scene = sim.scene();
+    let after = ctl.run(&mut sim, &opts, Some(&mut second));
+    let switch = first.rows.len() as u32;
+    let mut trace = first;
+    trace.rows.extend(second.rows.into_iter().map(|mut r| {
+        r.action += switch;
+        r
+    }));
+    Ok(BeforeAfter { trace, switch, before, after, scene })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn test_stage(
+    program: &Program,
+    index: usize,
+    seed: u64,
+    parent: &Checkpoint,
+    actions: u32,
+    learning: bool,
+    dir: &Path,
+    args: &RunArgs,
+) -> Result<(), CliError> {
+    let stage = &program.stages[index];
+    let eval = |genome: &Genome, episode: u64| {
+        let r = run_episode(stage, genome, &EpisodeOptions { actions, learning, seed: episode }, None);
+        Evaluation { fitness: r.fitness, learned: r.learned }
+    };
+    // Checks that the parent fits and picks its best individual and the episode seed.
+    let outcome = evolve::test_best(program, index, seed, parent, &eval)
+        .map_err(|e| CliError::io(format!("error: {e}")))?;
+    let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
+    let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
+    let mark = [(ba.switch, format!("world of `{}`", stage.name))];
+    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.scene, &mark)?;
+    write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
+    let perf = |r: &EpisodeResult| {
+        serde_json::json!({
+            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
+            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
+        })
+    };
+    let (b, a) = (&ba.before, &ba.after);
+    let summary = serde_json::json!({
+        "stage": stage.name, "learning": learning, "seed": outcome.seed,
+        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
+        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
+        "before": perf(b), "after": perf(a),
+        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
+    });
+    write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
+    if args.json {
+        println!("{summary}");
+    } else if !args.quiet {
+        eprintln!(
+            "stage {:<12} test of the best, {} actions before and {} after the change: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
+            stage.name,
+            b.actions,
+            a.actions,
+            b.fitness,
+            a.fitness,
+            b.grips,
+            a.grips,
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Mean reinforcement of each learning module over the life before the world
+/// changed, the first 100 actions after it, and the rest after it.
+fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json::Value {
+    let mean = |v: &[f32]| {
+        let xs: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+        if xs.is_empty() {
+            serde_json::Value::Null
+        } else {
+            serde_json::json!(xs.iter().sum::<f32>() / xs.len() as f32)
+        }
+    };
+    let mut out = serde_json::Map::new();
+    for (i, name) in report::learning_modules(stage) {
+        let sig = report::reinforcement_signals(trace, i);
+        let s = (switch as usize).min(sig.len());
+        let early = (s + 100).min(sig.len());
+        out.insert(
+            name,
+            serde_json::json!({
+                "before": mean(&sig[..s]), "after_first_100": mean(&sig[s..early]), "after_rest": mean(&sig[early..]),
+            }),
+        );
+    }
+    serde_json::Value::Object(out)
+}
+
+fn progress_bar(args: &RunArgs, stage: &Stage, generations: u32, done: u32) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(
+        Some(generations as u64),
+        if args.quiet || args.json { ProgressDrawTarget::hidden() } else { ProgressDrawTarget::stderr() },
+    );
+    let style = ProgressStyle::with_template(
+        "{prefix:>12} [{bar:30}] gen {pos:>3}/{len}  {msg}  {elapsed_precise} eta {eta}",
+    )
+    .unwrap_or_else(|_| ProgressStyle::default_bar())
+    .progress_chars("=> ");
+    bar.set_style(style);
+    bar.set_prefix(stage.name.clone());
+    bar.set_position(done as u64);
+    bar
+}
+
+fn report_generation(args: &RunArgs, bar: &ProgressBar, stats: &GenStats) {
+    bar.set_message(format!("best {:.3} mean {:.3}", stats.best, stats.mean));
+    bar.inc(1);
+    if args.json {
+        if let Ok(line) = serde_json::to_string(stats) {
+            let mut out = std::io::stdout().lock();
+            let _ = writeln!(out, "{line}");
+        }
+    }
+}

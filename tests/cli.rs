@@ -1,0 +1,279 @@
+//! The `shaping` binary, run as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn shaping() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shaping"))
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tiny() -> PathBuf {
+    root().join("tests/cli/tiny.bat")
+}
+
+/// A fresh, empty scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shaping-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn run(cmd: &mut Command) -> Output {
+    cmd.output().expect("the binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn run_tiny(out: &Path, extra: &[&str]) -> Output {
+    run(shaping().arg("run").arg(tiny()).arg("--out").arg(out).arg("--quiet").args(extra))
+}
+
+#[test]
+fn check_accepts_every_example() {
+    let examples: Vec<PathBuf> = std::fs::read_dir(root().join("examples"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "bat"))
+        .collect();
+    assert!(examples.len() >= 3);
+    let out = run(shaping().arg("check").args(&examples));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("khepera.bat: ok"));
+}
+
+#[test]
+fn check_reports_diagnostics_with_exit_1() {
+    let dir = scratch("diag");
+    let bad = dir.join("bad.bat");
+    std::fs::write(
+        &bad,
+        "robot r { sensor ir[8] proximty }\nstage s { module m { sense ir  behavior forward(1) } }\n",
+    )
+    .unwrap();
+    let out = run(shaping().arg("check").arg(&bad).arg("--error-format").arg("plain"));
+    assert_eq!(out.status.code(), Some(1));
+    let err = text(&out.stderr);
+    assert!(err.contains("proximty"), "{err}");
+    assert!(err.contains("proximity"), "a did-you-mean help is expected: {err}");
+
+    let json = run(shaping().arg("check").arg(&bad).arg("--error-format").arg("json"));
+    assert_eq!(json.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_str(text(&json.stdout).lines().next().unwrap()).unwrap();
+    assert!(v.get("message").is_some(), "{v}");
+}
+
+#[test]
+fn bad_inputs_give_an_error_never_a_panic() {
+    let dir = scratch("bad-inputs");
+    let cases: Vec<(&str, Vec<u8>)> = vec![
+        ("empty.bat", Vec::new()),
+        ("garbage.bat", b"\x01\x02 }{ ;; stage stage {{{".to_vec()),
+        ("binary.bat", vec![0x66, 0x6f, 0xff, 0xfe, 0x00, 0x80]),
+        (
+            "nested.bat",
+            format!("stage s {{ fitness per action {}1{} }}", "(".repeat(5000), ")".repeat(5000))
+                .into_bytes(),
+        ),
+        ("huge.bat", "module m { sense ir }\n".repeat(20000).into_bytes()),
+    ];
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let out = run(shaping().arg("check").arg(&path));
+        assert_eq!(out.status.code(), Some(1), "{name}: {}", text(&out.stderr));
+        let err = text(&out.stderr);
+        assert!(!err.contains("panicked"), "{name}: {err}");
+        assert!(!err.trim().is_empty(), "{name} printed no diagnostic");
+    }
+    let missing = run(shaping().arg("check").arg(dir.join("nope.bat")));
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(text(&missing.stderr).contains("nope.bat"));
+}
+
+#[test]
+fn layout_shows_frozen_and_evolvable_genes() {
+    let out =
+        run(shaping().arg("layout").arg(root().join("examples/khepera.bat")).args(["--stage", "collect"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let table = text(&out.stdout);
+    let nav = table.lines().find(|l| l.contains(" navigation ")).expect("a navigation gene");
+    assert!(nav.contains("frozen"), "{nav}");
+    let new = table.lines().find(|l| l.contains(" collect ")).expect("a collect gene");
+    assert!(new.contains("evolvable"), "{new}");
+    assert!(table.contains("frozen:") && table.contains("evolvable:"), "totals missing");
+
+    let bad = run(shaping().arg("layout").arg(root().join("examples/khepera.bat")).args(["--stage", "nope"]));
+    assert_eq!(bad.status.code(), Some(2));
+    let err = text(&bad.stderr);
+    assert!(err.contains("no stage `nope`") && err.contains("navigation"), "{err}");
+}
+
+#[test]
+fn graph_is_dot() {
+    let out = run(shaping().arg("graph").arg(root().join("examples/khepera.bat")));
+    assert!(out.status.success());
+    let dot = text(&out.stdout);
+    assert!(dot.starts_with("digraph") && dot.contains("avoid"), "{dot}");
+}
+
+#[test]
+fn build_then_run_the_built_program() {
+    let dir = scratch("build");
+    let program = dir.join("tiny.json");
+    let out = run(shaping().arg("build").arg(tiny()).arg("-o").arg(&program));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = run(shaping().arg("run").arg(&program).arg("--out").arg(dir.join("run")).arg("--quiet"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(dir.join("run/second/best.genome").exists());
+
+    std::fs::write(&program, b"{\"format\": 1, \"name\": 3}").unwrap();
+    let out = run(shaping().arg("run").arg(&program).arg("--out").arg(dir.join("run2")));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("tiny.json"));
+}
+
+#[test]
+fn run_writes_statistics_genomes_and_plots_and_is_deterministic() {
+    let a = scratch("det-a");
+    let b = scratch("det-b");
+    assert!(run_tiny(&a, &["--jobs", "1"]).status.success());
+    let out = run(shaping().arg("run").arg(tiny()).arg("--out").arg(&b).args(["--jobs", "2", "--json"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // One JSON line per generation: 6 + 4.
+    let lines: Vec<serde_json::Value> =
+        text(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 10);
+    assert_eq!(lines[9]["generation"], 9);
+    for stage in ["first", "second"] {
+        for f in ["generations.csv", "best.genome", "checkpoint.json", "fitness.svg", "fitness.png"] {
+            assert!(a.join(stage).join(f).exists(), "{stage}/{f}");
+        }
+        let ca = std::fs::read(a.join(stage).join("checkpoint.json")).unwrap();
+        let cb = std::fs::read(b.join(stage).join("checkpoint.json")).unwrap();
+        assert!(ca == cb, "stage {stage}: 1 and 2 threads differ");
+    }
+    let csv = std::fs::read_to_string(a.join("second/generations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 10, "{csv}");
+}
+
+#[test]
+fn killed_run_resumes_to_the_same_result() {
+    let straight = scratch("straight");
+    assert!(run_tiny(&straight, &[]).status.success());
+
+    let killed = scratch("killed");
+    let mut child = shaping()
+        .arg("run")
+        .arg(tiny())
+        .arg("--out")
+        .arg(&killed)
+        .arg("--quiet")
+        .args(["--jobs", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill as soon as the first checkpoint of the first stage exists.
+    let start = Instant::now();
+    while !killed.join("first/checkpoint.json").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let out = run_tiny(&killed, &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for stage in ["first", "second"] {
+        let a = std::fs::read(straight.join(stage).join("checkpoint.json")).unwrap();
+        let b = std::fs::read(killed.join(stage).join("checkpoint.json")).unwrap();
+        assert!(a == b, "stage {stage}: resumed run differs from the straight run");
+    }
+}
+
+#[test]
+fn corrupt_checkpoint_is_reported_and_kept() {
+    let dir = scratch("corrupt");
+    assert!(run_tiny(&dir, &[]).status.success());
+    let ckpt = dir.join("first/checkpoint.json");
+    std::fs::write(&ckpt, b"{ not json").unwrap();
+    let out = run_tiny(&dir, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(err.contains("checkpoint.json") && err.contains("corrupt"), "{err}");
+    assert_eq!(std::fs::read(&ckpt).unwrap(), b"{ not json", "the checkpoint must be left as it was");
+    assert!(run_tiny(&dir, &["--fresh"]).status.success());
+}
+
+#[test]
+fn resuming_with_changed_earlier_stage_fails_but_appended_stage_runs() {
+    let dir = scratch("changed");
+    assert!(run_tiny(&dir, &[]).status.success());
+    let source = std::fs::read_to_string(tiny()).unwrap();
+
+    let appended = dir.join("appended.bat");
+    std::fs::write(
+        &appended,
+        format!("{source}\nstage third extends second {{\n  evolve {{ generations 2 }}\n  module back {{ sense ir[6..7]  behavior back(0.5) }}\n  links all evolvable\n}}\n"),
+    )
+    .unwrap();
+    let out = run(shaping().arg("run").arg(&appended).arg("--out").arg(&dir).arg("--quiet"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(dir.join("third/best.genome").exists());
+
+    let changed = dir.join("changed.bat");
+    std::fs::write(&changed, source.replace("module wander { sense ir ", "module wander { sense ir[0..5] "))
+        .unwrap();
+    let out = run(shaping().arg("run").arg(&changed).arg("--out").arg(&dir).arg("--quiet"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(err.contains("first") && err.contains("--fresh"), "{err}");
+}
+
+#[test]
+fn run_rejects_unknown_stage_and_replay_writes_pictures() {
+    let dir = scratch("replay");
+    let out = run(shaping().arg("run").arg(tiny()).args(["--stage", "fifth"]).arg("--out").arg(&dir));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("no stage `fifth`"));
+
+    let missing = run(shaping().arg("replay").arg(tiny()).arg("--run").arg(&dir));
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(text(&missing.stderr).contains("shaping run"), "{}", text(&missing.stderr));
+
+    assert!(run_tiny(&dir, &[]).status.success());
+    let pics = dir.join("pics");
+    let out = run(shaping()
+        .arg("replay")
+        .arg(tiny())
+        .args(["--stage", "second", "--actions", "80"])
+        .arg("--run")
+        .arg(&dir)
+        .arg("--out")
+        .arg(&pics));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for f in ["trace.csv", "activations.png", "activations.svg", "trajectory.png", "trajectory.svg"] {
+        assert!(pics.join(f).exists(), "{f}");
+    }
+    let trace = std::fs::read_to_string(pics.join("trace.csv")).unwrap();
+    assert!(trace.lines().count() > 1 && trace.lines().count() <= 81);
+
+    let short = run(shaping().arg("replay").arg(tiny()).args(["--stage", "second", "--genome", "0101"]));
+    assert_eq!(short.status.code(), Some(2));
+    assert!(text(&short.stderr).contains("bits"));
+}
+
+#[test]
+fn bench_prints_one_json_line() {
+    let out = run(shaping().arg("bench").arg(tiny()).args(["--runs", "1"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
+    assert!(v["sim_steps_per_sec"].as_f64().unwrap() > 0.0);
+    assert!(v["controller_actions_per_sec"].as_f64().unwrap() > 0.0);
+}
