@@ -21,7 +21,8 @@ fn language_reference_examples() {
         }
         let name = format!("language.md:{}", i + 1);
         match (shaping_compiler::compile(&src, &name), fails) {
-            (Ok(_), false) | (Err(_), true) => {}
+            (Ok(p), false) => assert_eq!(p.validate(), Ok(()), "{name}"),
+            (Err(_), true) => {}
             (Ok(_), true) => panic!("{name}: the block is marked `fails` but compiles"),
             (Err(d), false) => panic!("{name} does not compile:\n{}", crate::render(&d)),
         }

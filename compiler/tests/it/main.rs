@@ -30,7 +30,13 @@ pub fn render(d: &dyn miette::Diagnostic) -> String {
 /// Compiles a file of the repository, panicking with the rendered diagnostics.
 pub fn compile_ok(src: &str, name: &str) -> shaping_compiler::Program {
     match shaping_compiler::compile(src, name) {
-        Ok(p) => p,
+        Ok(p) => {
+            // What the compiler emits is always a program the runtime accepts.
+            if let Err(e) = p.validate() {
+                panic!("{name} compiles to an invalid program: {e}");
+            }
+            p
+        }
         Err(e) => panic!("{name} does not compile:\n{}", render(&e)),
     }
 }

@@ -126,7 +126,11 @@ proptest! {
     #[test]
     fn any_token_soup_compiles_or_gives_a_diagnostic(tokens in prop::collection::vec(prop::sample::select(TOKENS), 0..120)) {
         let src = tokens.join(" ");
-        if let Err(d) = compile(&src, "soup.bat") {
+        let result = compile(&src, "soup.bat");
+        if let Ok(p) = &result {
+            prop_assert_eq!(p.validate(), Ok(()));
+        }
+        if let Err(d) = result {
             prop_assert!(!d.is_empty());
             // Rendering never panics either.
             let _ = crate::render(&d);
@@ -141,8 +145,9 @@ proptest! {
         if src.is_char_boundary(at) && src.is_char_boundary(end) {
             src.replace_range(at..end, insert);
         }
-        if let Err(d) = compile(&src, "mutated.bat") {
-            prop_assert!(!d.is_empty());
+        match compile(&src, "mutated.bat") {
+            Ok(p) => prop_assert_eq!(p.validate(), Ok(())),
+            Err(d) => prop_assert!(!d.is_empty()),
         }
     }
 
@@ -183,6 +188,7 @@ proptest! {
         }
         prop_assert_eq!(offset, new.layout.bits);
         prop_assert!(serde_roundtrip(&grown));
+        prop_assert_eq!(grown.validate(), Ok(()));
     }
 }
 
