@@ -247,8 +247,12 @@ impl<'a> Lower<'a> {
                 return None;
             }
         }
-        if q.value.fract() != 0.0 || q.value < 0.0 || !q.value.is_finite() || q.value > u32::MAX as f64 {
+        if q.value.fract() != 0.0 || q.value < 0.0 || !q.value.is_finite() {
             self.value_error(q.span, format!("{what} must be a whole number"), "not a whole number", None);
+            return None;
+        }
+        if q.value > u32::MAX as f64 {
+            self.value_error(q.span, format!("{what} must be at most {}", u32::MAX), "too large", None);
             return None;
         }
         let v = q.value as u64;
