@@ -126,6 +126,9 @@ struct StageSt {
     world: WorldSt,
     genome: GenomeSt,
     evolution: Evolution,
+    /// No `selection truncation keep N` written here or in an ancestor: the
+    /// truncation keeps a fifth of the population (20 of the paper's 100).
+    keep_default: bool,
     inheritance: Inheritance,
     run: StageRun,
     fitness: Fitness,
@@ -526,6 +529,7 @@ impl<'a> Lower<'a> {
             },
             genome: GenomeSt { links: spec, weights: spec, biases: spec },
             evolution: default_evolution(),
+            keep_default: true,
             inheritance: Inheritance::Darwinian,
             run: StageRun::Evolve(default_evolution()),
             fitness: Fitness { per_action: None, bonuses: Vec::new() },

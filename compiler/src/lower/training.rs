@@ -155,6 +155,13 @@ impl Lower<'_> {
                 }),
             }
         }
+        if keep_span.is_some() || ev.selection == Selection::Roulette {
+            st.keep_default = false;
+        }
+        let ev = &mut st.evolution;
+        if st.keep_default {
+            ev.selection = Selection::Truncation { keep: (ev.population / 5).max(1) };
+        }
         if let (Selection::Truncation { keep }, Some(sp)) = (ev.selection, keep_span) {
             if keep > ev.population {
                 let pop = ev.population;

@@ -39,3 +39,23 @@ fn rendering_a_missing_stage_says_so() {
     assert!(shaping_compiler::render_layout(&p, 9).starts_with("no stage 9"));
     assert!(shaping_compiler::render_graph(&p, 9).starts_with("digraph"));
 }
+
+#[test]
+fn truncation_keeps_a_fifth_of_the_population_unless_told() {
+    use shaping_runtime::program::{Selection, StageRun};
+    let keep = |src: &str, stage: usize| match &compile_ok(src, "keep.bat").stages[stage].run {
+        StageRun::Evolve(e) => e.selection,
+        StageRun::Test { .. } => panic!("an evolved stage"),
+    };
+    let head = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n";
+    let body = "fitness per action wheels[0]  module m { sense ir  behavior forward }";
+    let small = format!("{head}stage s {{ evolve {{ population 12 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} }}");
+    assert_eq!(keep(&small, 0), Selection::Truncation { keep: 2 });
+    assert_eq!(keep(&small, 1), Selection::Truncation { keep: 6 });
+    let told = format!(
+        "{head}stage s {{ evolve {{ population 12  selection truncation keep 3 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} }}"
+    );
+    assert_eq!(keep(&told, 0), Selection::Truncation { keep: 3 });
+    assert_eq!(keep(&told, 1), Selection::Truncation { keep: 3 }, "an explicit keep is inherited");
+    assert_eq!(keep(&format!("{head}stage s {{ {body} }}"), 0), Selection::Truncation { keep: 20 });
+}
