@@ -11,9 +11,6 @@ use shaping_runtime::sim::{ObjectState, Scene};
 use crate::load::{write_atomic, CliError};
 use crate::plot;
 
-/// Window of the reinforcement rolling means drawn in the pictures (the paper's).
-pub const REINFORCEMENT_WINDOW: usize = 30;
-
 /// `generations.csv`: one row per generation of the stage and its ancestors.
 pub fn generations_csv(history: &[GenStats]) -> String {
     let mut s = String::from("stage,generation,stage_generation,best,mean,worst,best_index\n");
@@ -117,17 +114,21 @@ pub fn episode_files(
     plot::activation_trace(&dir.join("activations"), &format!("{title}: module activations"), &act)
         .map_err(to_err)?;
 
+    // The performance indicator the controller keeps: the rolling mean of the
+    // module's last `window` reinforcement signals (the paper's figures 5, 10
+    // and 13 average over signals, not over actions).
     let series: Vec<(String, Vec<f32>)> = learning_modules(stage)
         .into_iter()
-        .map(|(i, name)| (name, reinforcement_signals(trace, i)))
+        .map(|(i, name)| (name, performance_curve(trace, i)))
         .filter(|(_, v)| v.iter().any(|x| x.is_finite()))
         .collect();
     if !series.is_empty() {
+        let window = stage.modules.iter().find_map(|m| m.learning.as_ref().map(|l| l.window)).unwrap_or(30);
         plot::rolling_reinforcement(
             &dir.join("reinforcement"),
-            &format!("{title}: reinforcement (rolling mean, window {REINFORCEMENT_WINDOW})"),
+            &format!("{title}: performance (rolling mean of the last {window} reinforcements)"),
             &series,
-            REINFORCEMENT_WINDOW,
+            1,
             marks,
         )
         .map_err(to_err)?;
@@ -151,6 +152,23 @@ pub fn learning_modules(stage: &Stage) -> Vec<(usize, String)> {
                 None => "",
             };
             (i, format!("{}{on}", m.name))
+        })
+        .collect()
+}
+
+/// A module's performance indicator per action, NaN until its first
+/// reinforcement signal.
+pub fn performance_curve(trace: &Trace, module: usize) -> Vec<f32> {
+    let mut seen = false;
+    trace
+        .rows
+        .iter()
+        .map(|r| {
+            seen |= r.reinforcement.get(module).is_some_and(|&v| v != 0.0);
+            match r.performance.get(module) {
+                Some(&p) if seen => p,
+                _ => f32::NAN,
+            }
         })
         .collect()
 }
