@@ -184,7 +184,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;
             match format {
-                LayoutFormat::Text => print!("{}", shaping_compiler::render_layout(&program, index)),
+                LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index)),
                 LayoutFormat::Json => {
                     let json = serde_json::to_string_pretty(&program.stages[index].layout)
                         .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
@@ -196,7 +196,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
         Command::Graph { file, stage, error_format } => {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;
-            print!("{}", shaping_compiler::render_graph(&program, index));
+            print_text(&shaping_compiler::render_graph(&program, index));
             Ok(())
         }
         Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, error_format } => {
@@ -238,6 +238,15 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
             Ok(())
         }
+    }
+}
+
+/// Prints text to stdout, ending it with a newline.
+fn print_text(text: &str) {
+    if text.ends_with('\n') {
+        print!("{text}");
+    } else {
+        println!("{text}");
     }
 }
 
