@@ -93,6 +93,15 @@ fn winner_take_all_picks_the_highest_activation_and_breaks_ties_by_declaration_o
     let mut c = controller(&s, 1);
     c.start(&mut robot);
     assert_eq!(c.act(&mut robot).winner, 1);
+
+    // Saturated activations (both exactly 1.0 in f32) are still ordered by
+    // their net input, not by declaration.
+    let s = stage_of(vec![constant_module("a", 30.0, 0.1), constant_module("b", 40.0, 0.2)], vec![]);
+    let mut c = controller(&s, 1);
+    c.start(&mut robot);
+    let rep = c.act(&mut robot);
+    assert_eq!(c.activations(), &[1.0, 1.0], "both sigmoids saturate");
+    assert_eq!(rep.winner, 1);
 }
 
 #[test]

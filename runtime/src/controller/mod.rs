@@ -9,8 +9,9 @@
 //!    the sum over its incoming links of `weight * activation of the source
 //!    module at the previous action` is added to the output neuron's net
 //!    input (all activations are 0 before the first action).
-//! 3. Winner take all: the highest activation wins; ties go to the module
-//!    declared first.
+//! 3. Winner take all: the highest activation wins (compared on the net
+//!    input, so modules whose sigmoid saturates at 1.0 still differ); ties go
+//!    to the module declared first.
 //! 4. The winner's behavior generator gives the motor command: a script (see
 //!    [`script`] for its semantics: it keeps its position while its module
 //!    keeps winning and restarts when another module has won in between) or a
@@ -454,13 +455,19 @@ impl<'s> Controller<'s> {
     pub fn act<R: Robot>(&mut self, sim: &mut R) -> ActionReport {
         // 1-3: activations and arbitration.
         std::mem::swap(&mut self.act, &mut self.prev_act);
+        // The winner is compared on the net input of the activation unit:
+        // the same order as the activation, but f32 sigmoids saturate to
+        // exactly 1.0 above a net input of about 17, and saturated modules
+        // would otherwise tie and fall back to declaration order.
         let mut winner = 0usize;
+        let mut best = f32::NEG_INFINITY;
         for m in 0..self.mods.len() {
             let module = &mut self.mods[m];
             let link: f32 = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
-            let a = module.activation.forward(&self.now, link)[0];
-            self.act[m] = a;
-            if a > self.act[winner] {
+            self.act[m] = module.activation.forward(&self.now, link)[0];
+            let z = module.activation.net_inputs()[0];
+            if z > best {
+                best = z;
                 winner = m;
             }
         }

@@ -30,6 +30,9 @@ pub struct Net {
     h: Vec<f32>,
     /// Outputs of the last forward pass.
     y: Vec<f32>,
+    /// Net inputs of the output units in the last forward pass (what the
+    /// sigmoid was applied to: ordered like the outputs, never saturated).
+    z: Vec<f32>,
     /// Scratch: output deltas.
     dy: Vec<f32>,
 }
@@ -76,6 +79,7 @@ impl Net {
             x: vec![0.0; n],
             h: vec![0.0; hidden],
             y: vec![0.0; outputs],
+            z: vec![0.0; outputs],
             dy: vec![0.0; outputs],
         }
     }
@@ -84,17 +88,23 @@ impl Net {
         &self.y
     }
 
+    /// Net inputs of the output units in the last forward pass.
+    pub fn net_inputs(&self) -> &[f32] {
+        &self.z
+    }
+
     /// Forward pass on a percept; `extra` is added to every output neuron's net
     /// input (the link term of an activation network).
     #[inline]
     pub fn forward(&mut self, percept: &[f32; CHANNELS], extra: f32) -> &[f32] {
-        let Net { chans, run, hidden, w, x, h, y, .. } = self;
+        let Net { chans, run, hidden, w, x, h, y, z, .. } = self;
         let x = inputs(chans, *run, x, percept);
         let n = x.len();
         if *hidden == 0 {
-            for (o, y) in y.iter_mut().enumerate() {
+            for (o, (y, z)) in y.iter_mut().zip(z.iter_mut()).enumerate() {
                 let row = &w[o * (n + 1)..(o + 1) * (n + 1)];
-                *y = sigmoid(row[0] + dot(&row[1..], x) + extra);
+                *z = row[0] + dot(&row[1..], x) + extra;
+                *y = sigmoid(*z);
             }
         } else {
             for (j, h) in h.iter_mut().enumerate() {
@@ -103,9 +113,10 @@ impl Net {
             }
             let base = *hidden * (n + 1);
             let m = *hidden + 1;
-            for (o, y) in y.iter_mut().enumerate() {
+            for (o, (y, z)) in y.iter_mut().zip(z.iter_mut()).enumerate() {
                 let row = &w[base + o * m..base + (o + 1) * m];
-                *y = sigmoid(row[0] + dot(&row[1..], h) + extra);
+                *z = row[0] + dot(&row[1..], h) + extra;
+                *y = sigmoid(*z);
             }
         }
         &self.y
@@ -116,7 +127,7 @@ impl Net {
     /// error, sigmoid units, biases as weights on a constant 1):
     /// `delta = (t - y) y (1 - y)`, `dw = rate * delta * input`.
     pub fn train(&mut self, percept: &[f32; CHANNELS], target: impl Fn(usize) -> f32, rate: f32) {
-        let Net { chans, run, hidden, outputs, w, x, h, y, dy } = self;
+        let Net { chans, run, hidden, outputs, w, x, h, y, dy, .. } = self;
         let x = inputs(chans, *run, x, percept);
         let n = x.len();
         for (o, (d, &y)) in dy.iter_mut().zip(y.iter()).enumerate() {

@@ -31,6 +31,10 @@ use crate::sim::Command;
 /// Angle beyond which `toward` turns in place instead of driving forward.
 pub const TOWARD_DEAD_ZONE_DEG: f32 = 20.0;
 
+/// Shortest summed sensor vector `toward` steers by; shorter is noise (the
+/// simulator's sensor noise is 0.01 per channel) and counts as nothing sensed.
+pub const TOWARD_MIN_LENGTH: f32 = 0.03;
+
 /// One step with its precomputed data.
 #[derive(Clone, Debug)]
 enum Op {
@@ -171,7 +175,9 @@ fn toward(dirs: &[(u16, f32, f32)], speed: f32, now: &[f32; CHANNELS]) -> [f32; 
         x += v * cx;
         y += v * cy;
     }
-    if x * x + y * y < 1e-8 {
+    // A vector shorter than TOWARD_MIN_LENGTH is sensor noise: nothing is
+    // sensed, drive forward instead of spinning on noise.
+    if x * x + y * y < TOWARD_MIN_LENGTH * TOWARD_MIN_LENGTH {
         return [speed, speed];
     }
     let angle = y.atan2(x);
@@ -201,6 +207,8 @@ mod tests {
         let d = dirs(CH_LIGHT..CH_LIGHT + 8);
         let mut p = [0.0; CHANNELS];
         assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5], "nothing sensed: forward");
+        p[CH_LIGHT] = 0.02; // noise-level reading on the left: still nothing
+        assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5], "noise is not a direction");
         p[CH_LIGHT] = 1.0; // left 90 degrees
         assert_eq!(toward(&d, 0.5, &p), [-0.5, 0.5]);
         p[CH_LIGHT] = 0.0;
