@@ -229,9 +229,13 @@ pub enum Decode {
 /// (a step with a duration spans several actions). While the module keeps
 /// winning, the script continues where it was; after its last step it starts
 /// again. When another module wins, the script is reset to its first step.
+/// A `commit` script, once its module has won, keeps control of the robot
+/// until its last step has ended (every step is bounded, so it always ends).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Script {
     pub steps: Vec<Step>,
+    #[serde(default)]
+    pub commit: bool,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -92,7 +92,7 @@ pub fn module(name: &str, stage: u16, inputs: Vec<u16>, behavior: Behavior) -> M
 
 /// A one-step script.
 pub fn script(action: Action) -> Behavior {
-    Behavior::Script(Script { steps: vec![Step { action, end: StepEnd::Actions(1) }] })
+    Behavior::Script(Script { steps: vec![Step { action, end: StepEnd::Actions(1) }], commit: false })
 }
 
 /// The paper's obstacle-avoidance behavior: a neural network from the 8 IR
@@ -284,6 +284,7 @@ pub fn navigation_with(spec: GeneSpec) -> Stage {
                 action: Action::Wait { charge: true },
                 end: StepEnd::Until { cond: full, within: 40 },
             }],
+            commit: false,
         }),
     );
     s.modules = vec![wander, avoid, follow, recharge];
@@ -322,6 +323,7 @@ pub fn grip_script() -> Script {
             step(Action::Claw(true), StepEnd::Actions(1)),
             step(Action::Arm(false), StepEnd::Actions(1)),
         ],
+        commit: false,
     }
 }
 
@@ -348,6 +350,7 @@ pub fn release_script() -> Script {
             step(Action::Reinforce(reinforce), StepEnd::Actions(1)),
             step(Action::Claw(false), StepEnd::Actions(1)),
         ],
+        commit: false,
     }
 }
 

@@ -142,7 +142,10 @@ fn script_stage() -> Stage {
         stage: 0,
         inputs: vec![],
         activation: bias_only(0.0),
-        behavior: Behavior::Script(Script { steps: vec![step(1.0, 1), step(2.0, 2), step(3.0, 1)] }),
+        behavior: Behavior::Script(Script {
+            steps: vec![step(1.0, 1), step(2.0, 2), step(3.0, 1)],
+            commit: false,
+        }),
         learning: None,
         reinforce: None,
     };
@@ -201,6 +204,7 @@ fn until_steps_end_on_their_condition_or_bound_and_reinforce_steps_take_no_time(
                 Step { action: Action::Reinforce(r), end: StepEnd::Actions(1) },
                 Step { action: Action::Wheels { left: 2.0, right: 2.0 }, end: StepEnd::Actions(1) },
             ],
+            commit: false,
         }),
         learning: None,
         reinforce: Some(expr(vec![Op::Const(5.0)])), // ignored: the script delivers reinforcement
@@ -242,7 +246,7 @@ fn toward_wait_arm_and_claw_steps_give_their_commands() {
         stage: 0,
         inputs: vec![],
         activation: bias_only(0.0),
-        behavior: Behavior::Script(Script { steps }),
+        behavior: Behavior::Script(Script { steps, commit: false }),
         learning: None,
         reinforce: None,
     };
@@ -553,6 +557,7 @@ fn follow_light_then_recharge_keeps_the_robot_alive() {
             Step { action: Action::Wheels { left: 0.3, right: 0.3 }, end: StepEnd::Actions(2) },
             Step { action: Action::Wait { charge: true }, end: StepEnd::Until { cond: full, within: 40 } },
         ],
+        commit: false,
     });
     s.links.clear();
     let mut recharged = 0;
@@ -611,4 +616,35 @@ fn decode_tables_must_have_a_row_per_bit_pattern() {
     let g = Genome::zeros(0);
     let err = Controller::new(&s, &g, ChaCha8Rng::seed_from_u64(1)).err();
     assert!(matches!(err, Some(ControllerError::BadModule { .. })), "{err:?}");
+}
+
+#[test]
+fn a_committed_script_keeps_control_until_its_last_step() {
+    // `a` wins the first action (no link input yet); from the second action
+    // the excitatory link a -> b makes `b`'s activation the highest. A plain
+    // script gives way at once; a committed one finishes its three steps.
+    let step =
+        |id: f32, n: u32| Step { action: Action::Wheels { left: id, right: id }, end: StepEnd::Actions(n) };
+    for commit in [false, true] {
+        let a = Module {
+            name: "a".into(),
+            stage: 0,
+            inputs: vec![],
+            activation: bias_only(1.0),
+            behavior: Behavior::Script(Script { steps: vec![step(1.0, 1), step(2.0, 2)], commit }),
+            learning: None,
+            reinforce: None,
+        };
+        let links = vec![Link { from: 0, to: 1, weight: Param::Fixed(10.0) }];
+        let s = stage_of(vec![a, constant_module("b", 0.0, 9.0)], links);
+        let mut c = controller(&s, 1);
+        let mut robot = Puppet::default();
+        c.start(&mut robot);
+        let winners: Vec<usize> = (0..5).map(|_| c.act(&mut robot).winner).collect();
+        if commit {
+            assert_eq!(winners, [0, 0, 0, 1, 1], "the committed script runs its 3 actions, then b wins");
+        } else {
+            assert_eq!(winners, [0, 1, 1, 1, 1]);
+        }
+    }
 }

@@ -242,6 +242,7 @@ fn grip_trial_script() -> Script {
             step(Action::Arm(false), StepEnd::Actions(1)),
             step(Action::Claw(false), StepEnd::Actions(1)),
         ],
+        commit: false,
     }
 }
 

@@ -8,7 +8,7 @@ stage s {
   fitness per action 0
   module m {
     sense ir[2], ir[4..5], battery, barrier
-    behavior script {
+    behavior script commit {
       forward; forward(0.5) for 3 actions
       back(0.2) until barrier within 4 actions
       turn left; turn right(0.3); stop

@@ -822,7 +822,7 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
                 outputs: 1,
                 params: m.act_params.clone(),
             },
-            behavior: m.behavior.clone().unwrap_or(Behavior::Script(Script { steps: vec![] })),
+            behavior: m.behavior.clone().unwrap_or(Behavior::Script(Script { steps: vec![], commit: false })),
             learning: m.learning.clone(),
             reinforce: m.reinforce.clone(),
         })

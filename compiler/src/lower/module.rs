@@ -114,13 +114,13 @@ impl Lower<'_> {
                     st.behavior_genes = None;
                     st.script_reinforces = false;
                     st.behavior = match b {
-                        ast::BehaviorDecl::Script(steps, _) => {
+                        ast::BehaviorDecl::Script(steps, commit, _) => {
                             let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
                             let lowered: Vec<Step> =
                                 steps.iter().filter_map(|x| self.step(hw, x, &scope)).collect();
                             st.script_reinforces =
                                 steps.iter().any(|x| matches!(x.action, ast::ActionDecl::Reinforce(..)));
-                            Some(Behavior::Script(Script { steps: lowered }))
+                            Some(Behavior::Script(Script { steps: lowered, commit: *commit }))
                         }
                         ast::BehaviorDecl::Neural(n) => {
                             let (nb, genes) = self.neural(hw, n, &inputs);

@@ -258,14 +258,15 @@ pub struct ActivationDecl {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum BehaviorDecl {
-    Script(Vec<StepDecl>, Span),
+    /// The steps, and whether the script commits (runs to its end once started).
+    Script(Vec<StepDecl>, bool, Span),
     Neural(NeuralDecl),
 }
 
 impl BehaviorDecl {
     pub fn span(&self) -> Span {
         match self {
-            BehaviorDecl::Script(_, s) => *s,
+            BehaviorDecl::Script(_, _, s) => *s,
             BehaviorDecl::Neural(n) => n.span,
         }
     }

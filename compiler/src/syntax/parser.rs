@@ -184,6 +184,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::hidden | Rule::k_hidden => "`hidden`",
         Rule::behavior => "`behavior`",
         Rule::script => "`{`",
+        Rule::commit => "`commit`",
         Rule::step => "a step",
         Rule::for_end => "`for`",
         Rule::until_end => "`until`",
@@ -552,9 +553,18 @@ impl Builder {
                         let decl = match b.as_rule() {
                             Rule::neural => BehaviorDecl::Neural(self.neural(b)),
                             Rule::script => {
-                                BehaviorDecl::Script(b.into_inner().map(|s| self.step(s)).collect(), bsp)
+                                let mut commit = false;
+                                let mut steps = Vec::new();
+                                for s in b.into_inner() {
+                                    if s.as_rule() == Rule::commit {
+                                        commit = true;
+                                    } else {
+                                        steps.push(self.step(s));
+                                    }
+                                }
+                                BehaviorDecl::Script(steps, commit, bsp)
                             }
-                            _ => BehaviorDecl::Script(vec![self.step(b)], bsp),
+                            _ => BehaviorDecl::Script(vec![self.step(b)], false, bsp),
                         };
                         items.push(ModuleItem::Behavior(decl));
                     }

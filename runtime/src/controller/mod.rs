@@ -11,7 +11,8 @@
 //!    input (all activations are 0 before the first action).
 //! 3. Winner take all: the highest activation wins (compared on the net
 //!    input, so modules whose sigmoid saturates at 1.0 still differ); ties go
-//!    to the module declared first.
+//!    to the module declared first. Exception: a `commit` script that has
+//!    started keeps its module in control until its last step has ended.
 //! 4. The winner's behavior generator gives the motor command: a script (see
 //!    [`script`] for its semantics: it keeps its position while its module
 //!    keeps winning and restarts when another module has won in between) or a
@@ -484,6 +485,12 @@ impl<'s> Controller<'s> {
                 reinforcement: 0.0,
                 fitness: 0.0,
             };
+        }
+        // A committed script that has started keeps control until it ends.
+        if let Some(l) = self.last_winner {
+            if matches!(&self.mods[l].gen, Gen::Script(s) if s.holds_control()) {
+                winner = l;
+            }
         }
         if self.last_winner != Some(winner) {
             if let Some(l) = self.last_winner {

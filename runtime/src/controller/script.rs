@@ -62,6 +62,8 @@ enum End {
 #[derive(Clone, Debug)]
 pub struct ScriptRun {
     steps: Vec<(Op, End)>,
+    /// Once started, keeps its module in control until its last step ends.
+    commit: bool,
     /// Current step.
     pos: usize,
     /// Actions spent in the current step.
@@ -97,7 +99,7 @@ impl ScriptRun {
                 (op, end)
             })
             .collect();
-        ScriptRun { steps, pos: 0, spent: 0 }
+        ScriptRun { steps, commit: script.commit, pos: 0, spent: 0 }
     }
 
     /// True when the script contains `reinforce` steps (then they, not the
@@ -110,6 +112,12 @@ impl ScriptRun {
     pub fn reset(&mut self) {
         self.pos = 0;
         self.spent = 0;
+    }
+
+    /// A committed script between its first action and the end of its last
+    /// step: its module keeps control whatever the activations.
+    pub fn holds_control(&self) -> bool {
+        self.commit && (self.pos > 0 || self.spent > 0)
     }
 
     /// The current step index (for tests and traces).
