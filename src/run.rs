@@ -195,6 +195,19 @@ fn evolve_stage(
         report_generation(args, &bar, &stats);
     }
     bar.finish_and_clear();
+    if !cp.validated {
+        // Pick the stage's best by its mean over fresh episodes, not by its
+        // luckiest single evaluation.
+        evolve::validate_best(
+            program,
+            &mut cp,
+            &eval,
+            evolve::VALIDATE_CANDIDATES,
+            evolve::VALIDATE_EPISODES,
+        )
+        .map_err(|e| CliError::io(format!("error: {e}")))?;
+        write_atomic(&path, to_json(&cp)?.as_bytes())?;
+    }
     let (genome, fitness) = evolve::best_of(&cp)
         .ok_or_else(|| CliError::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
@@ -203,12 +216,13 @@ fn evolve_stage(
     if !args.quiet && !args.json {
         let last = cp.history.last();
         eprintln!(
-            "stage {:<12} {} generations  best {:.3} (best ever {:.3})  mean {:.3}  -> {}",
+            "stage {:<12} {} generations  last best {:.3}  mean {:.3}  chosen best {:.3} (mean of {} fresh episodes)  -> {}",
             stage.name,
             cp.generation,
             last.map_or(0.0, |h| h.best),
-            fitness,
             last.map_or(0.0, |h| h.mean),
+            fitness,
+            evolve::VALIDATE_EPISODES,
             dir.display()
         );
     }

@@ -477,3 +477,41 @@ fn bad_input_is_an_error_not_a_panic() {
         Err(EvolveError::Inconsistent { .. })
     ));
 }
+
+#[test]
+fn validate_best_prefers_the_best_mean_over_a_lucky_evaluation() {
+    // A "lucky" evaluation: during evolution an all-zeros genome is scored
+    // by a noisy evaluation that once gave it 10; on fresh episodes it is
+    // worth 0, while an all-ones genome of the final population is worth 1.
+    let program = one_stage(10, 2);
+    let mut cp = start_stage(&program, 0, 3, None).unwrap();
+    let bits = cp.population[0].bits.len();
+    cp.population = (0..10).map(|i| Genome { bits: vec![u8::from(i == 4); bits] }).collect();
+    cp.fitness = (0..10).map(|i| if i == 4 { 0.9 } else { 0.1 }).collect();
+    cp.best = Some((Genome { bits: vec![0; bits] }, 10.0));
+    let fresh = |g: &Genome, _e: u64| ones(g, 0);
+    let (g, f) = evolve::validate_best(&program, &mut cp, &fresh, 4, 3).unwrap();
+    assert_eq!(g.bits, vec![1; bits], "the all-ones genome wins on fresh episodes");
+    assert_eq!(f, 1.0);
+    assert!(cp.validated);
+    assert_eq!(best_of(&cp), Some((g.clone(), 1.0)));
+
+    // Idempotent: a second call (e.g. after resuming a finished run) keeps it.
+    let never = |_: &Genome, _: u64| -> Evaluation { panic!("not evaluated again") };
+    assert_eq!(evolve::validate_best(&program, &mut cp, &never, 4, 3).unwrap(), (g, 1.0));
+
+    // Every candidate sees the same episode seeds, and they are distinct.
+    let seen = std::sync::Mutex::new(Vec::new());
+    let record = |g: &Genome, e: u64| {
+        seen.lock().unwrap().push((g.bits[0], e));
+        ones(g, e)
+    };
+    let mut cp2 = start_stage(&program, 0, 3, None).unwrap();
+    cp2.fitness = vec![0.5; 10];
+    evolve::validate_best(&program, &mut cp2, &record, 2, 3).unwrap();
+    let mut seeds: Vec<u64> = seen.lock().unwrap().iter().map(|&(_, e)| e).collect();
+    assert_eq!(seeds.len(), 6, "2 candidates x 3 episodes");
+    seeds.sort_unstable();
+    seeds.dedup();
+    assert_eq!(seeds.len(), 3, "the candidates share the 3 episode seeds");
+}

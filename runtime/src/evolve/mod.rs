@@ -17,7 +17,9 @@
 //! [`start_stage`], when `fitness` is empty), and the final checkpoint of a
 //! stage holds the evaluated final population. `Checkpoint::best` is the best
 //! evaluated individual of the stage (the genome as evaluated, before any
-//! Lamarckian write-back): the one a test stage and `replay` use.
+//! Lamarckian write-back) until [`validate_best`] replaces it, at the end of
+//! the stage, by the candidate with the best mean over fresh episodes: the
+//! one a test stage and `replay` use.
 //!
 //! **Masks.** Bits of genes marked `frozen` in the stage's layout never
 //! change: crossover cuts only among evolvable bits and each child keeps its
@@ -100,8 +102,13 @@ pub struct Checkpoint {
     /// Statistics of every generation of this stage and of the stages it
     /// extends, oldest first.
     pub history: Vec<GenStats>,
-    /// Best evaluated individual of this stage and its fitness.
+    /// Best evaluated individual of this stage and its fitness: during the
+    /// stage, the best single evaluation; once [`validate_best`] has run,
+    /// the candidate with the best mean over fresh episodes.
     pub best: Option<(Genome, f32)>,
+    /// [`validate_best`] has chosen `best`.
+    #[serde(default)]
+    pub validated: bool,
 }
 
 /// The evolution parameters of an evolved stage.
@@ -198,6 +205,7 @@ pub fn start_stage(
         fitness: Vec::new(),
         history,
         best: None,
+        validated: false,
     })
 }
 
@@ -340,6 +348,77 @@ pub fn check_resume(program: &Program, cp: &Checkpoint) -> Result<(), EvolveErro
         }
     }
     check_population(&program.stages[cp.stage], cp)
+}
+
+/// How many candidates [`validate_best`] re-evaluates, and on how many episodes.
+pub const VALIDATE_CANDIDATES: usize = 10;
+pub const VALIDATE_EPISODES: u32 = 5;
+
+/// Chooses the stage's best individual once its generations are done: the
+/// best single evaluation of the stage is often a lucky episode, so the
+/// candidates (that individual, then the final population by fitness, without
+/// duplicates, `candidates` in all) are re-evaluated on the same `episodes`
+/// fresh episodes ([`seed::validate_seed`]) and the best mean wins (ties to
+/// the earlier candidate). Sets `best` and `validated`; calling it again
+/// changes nothing. Deterministic for any thread count.
+pub fn validate_best(
+    program: &Program,
+    cp: &mut Checkpoint,
+    evaluate: Evaluate,
+    candidates: usize,
+    episodes: u32,
+) -> Result<(Genome, f32), EvolveError> {
+    if cp.validated {
+        if let Some(best) = &cp.best {
+            return Ok(best.clone());
+        }
+    }
+    let mut pool: Vec<&Genome> = Vec::with_capacity(candidates);
+    if let Some((g, _)) = &cp.best {
+        pool.push(g);
+    }
+    if cp.fitness.len() == cp.population.len() {
+        for i in ranking(&cp.fitness) {
+            if pool.len() >= candidates.max(1) {
+                break;
+            }
+            let g = &cp.population[i];
+            if !pool.contains(&g) {
+                pool.push(g);
+            }
+        }
+    }
+    let name = get_stage(program, cp.stage)?.name.clone();
+    if pool.is_empty() {
+        return Err(EvolveError::ParentNotEvaluated { stage: name });
+    }
+    let episodes = episodes.max(1);
+    let (run_seed, stage) = (cp.seed, cp.stage);
+    let jobs: Vec<(usize, u32)> = (0..pool.len()).flat_map(|c| (0..episodes).map(move |e| (c, e))).collect();
+    let scores: Vec<f32> = jobs
+        .par_iter()
+        .map(|&(c, e)| evaluate(pool[c], seed::validate_seed(run_seed, stage, e)).fitness)
+        .collect();
+    let mut best = (0usize, f64::NEG_INFINITY);
+    for c in 0..pool.len() {
+        let per = &scores[c * episodes as usize..(c + 1) * episodes as usize];
+        if let Some(bad) = per.iter().find(|f| !f.is_finite()) {
+            return Err(EvolveError::NonFiniteFitness {
+                stage: name,
+                generation: cp.generation,
+                index: c,
+                value: *bad,
+            });
+        }
+        let mean = per.iter().map(|&f| f as f64).sum::<f64>() / episodes as f64;
+        if mean > best.1 {
+            best = (c, mean);
+        }
+    }
+    let chosen = (pool[best.0].clone(), best.1 as f32);
+    cp.best = Some(chosen.clone());
+    cp.validated = true;
+    Ok(chosen)
 }
 
 /// The result of a test stage.

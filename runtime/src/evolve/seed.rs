@@ -16,6 +16,7 @@ const DOMAIN_INIT: u64 = 0x494e_4954; // "INIT"
 const DOMAIN_BREED: u64 = 0x0042_5245_4544; // "BREED"
 const DOMAIN_EVAL: u64 = 0x4556_414c; // "EVAL"
 const DOMAIN_TEST: u64 = 0x5445_5354; // "TEST"
+const DOMAIN_VALIDATE: u64 = 0x5641_4c49_4441_5445; // "VALIDATE"
 
 /// One SplitMix64 step: a bijective 64-bit mixer.
 pub fn splitmix64(x: u64) -> u64 {
@@ -51,6 +52,11 @@ pub fn init_seed(run_seed: u64, stage: usize) -> u64 {
 /// Seed of episode `episode` of a test stage.
 pub fn test_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
     mix(run_seed, &[DOMAIN_TEST, stage as u64, episode as u64])
+}
+
+/// Seed of episode `episode` of the re-evaluation that picks a stage's best.
+pub fn validate_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
+    mix(run_seed, &[DOMAIN_VALIDATE, stage as u64, episode as u64])
 }
 
 pub(crate) fn rng(seed: u64) -> ChaCha8Rng {
