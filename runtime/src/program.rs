@@ -419,7 +419,8 @@ pub enum Selection {
 pub enum Inheritance {
     /// Learned weights are not written back to the genome.
     Darwinian,
-    /// Learned activation weights are written back (re-encoded) to the genome.
+    /// Learned weights that are genes (activation networks, evolvable neural
+    /// behaviors) are written back (re-encoded) to the genome.
     Lamarckian,
 }
 

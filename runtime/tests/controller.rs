@@ -648,3 +648,38 @@ fn a_committed_script_keeps_control_until_its_last_step() {
         }
     }
 }
+
+#[test]
+fn lamarckian_inheritance_writes_learned_behavior_genes_back() {
+    // The neural behavior's 6 weights are genes (4 bits, -4..4), starting
+    // at 0 (integer 7.5 is not encodable: 8 decodes to +0.27). Rewarding the
+    // first output's 1s with input 0 on raises that output's bias and w0.
+    let learn = Some(testkit::crbp(LearnTarget::Behavior, 0.5, 0.5, 30));
+    let mut s = neural_stage(when_left_forward(1.0), learn, (0..6).map(Param::Gene).collect());
+    s.layout.genes = (0..6)
+        .map(|i| Gene {
+            offset: 4 * i,
+            bits: 4,
+            lo: -4.0,
+            hi: 4.0,
+            stage: 0,
+            module: 0,
+            role: GeneRole::Bias,
+            frozen: false,
+        })
+        .collect();
+    s.layout.bits = 24;
+    let mut genome = Genome::zeros(24);
+    for g in &s.layout.genes {
+        genome.set_gene_int(g, 8);
+    }
+    let mut c = Controller::new(&s, &genome, ChaCha8Rng::seed_from_u64(3)).unwrap();
+    let mut robot = Puppet::default();
+    robot.percept[0] = 1.0;
+    c.run(&mut robot, &EpisodeOptions { actions: 200, learning: true, seed: 3 }, None);
+    let learned = c.write_back(&genome);
+    // Output 0's parameters are genes 0 (bias), 1 (w from input 0), 2 (w from input 1).
+    assert!(learned.gene_int(&s.layout.genes[0]) > 8, "{}", learned.to_bitstring());
+    assert!(learned.gene_int(&s.layout.genes[1]) > 8, "{}", learned.to_bitstring());
+    assert_eq!(learned.gene_int(&s.layout.genes[2]), 8, "input 1 was 0: its weight is unchanged");
+}

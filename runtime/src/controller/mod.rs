@@ -646,19 +646,27 @@ impl<'s> Controller<'s> {
         res
     }
 
-    /// The genome with the learned activation weights that are genes written
-    /// back (nearest encodable value). Frozen genes (from earlier stages) are
+    /// The genome with the learned weights that are genes (activation networks
+    /// and evolvable neural behaviors) written back (nearest encodable value).
+    /// Frozen genes (from earlier stages) are
     /// left as they are: a later stage never changes what an earlier one froze.
     pub fn write_back(&self, genome: &Genome) -> Genome {
         let mut g = genome.clone();
-        for (m, module) in self.stage.modules.iter().enumerate() {
-            for (p, &w) in module.activation.params.iter().zip(&self.mods[m].activation.w) {
+        let mut put = |params: &[Param], learned: &[f32]| {
+            for (p, &w) in params.iter().zip(learned) {
                 if let Param::Gene(i) = *p {
                     let gene = &self.stage.layout.genes[i as usize];
                     if !gene.frozen {
                         g.encode(gene, w);
                     }
                 }
+            }
+        };
+        for (m, module) in self.stage.modules.iter().enumerate() {
+            put(&module.activation.params, &self.mods[m].activation.w);
+            // Evolvable weights of a neural behavior generator learn too.
+            if let (Behavior::Neural(nb), Gen::Neural { net, .. }) = (&module.behavior, &self.mods[m].gen) {
+                put(&nb.net.params, &net.w);
             }
         }
         g
