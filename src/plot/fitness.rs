@@ -114,23 +114,10 @@ impl Figure for Single<'_> {
                     .label("population mean")
                     .legend(dash_dot_glyph!(mean_colour()));
             }
-            legend(&mut chart)?;
+            render::series_legend(&mut chart)?;
         }
         Ok(())
     }
-}
-
-fn legend<'a, DB: DrawingBackend + 'a>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
-) -> DrawResult<DB> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .margin(12)
-        .label_font(render::label_style(15.0))
-        .background_style(WHITE.mix(0.9))
-        .border_style(render::GRID_BOLD)
-        .draw()
 }
 
 /// Per generation: (median, min, max) of best and of mean over the runs that have it.
@@ -204,7 +191,7 @@ impl Figure for Multi<'_> {
                 .draw_series(LineSeries::new(std::iter::empty(), mean_colour()))?
                 .label("population mean: median")
                 .legend(dash_dot_glyph!(mean_colour()));
-            legend(&mut chart)?;
+            render::series_legend(&mut chart)?;
         }
         Ok(())
     }

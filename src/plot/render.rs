@@ -6,6 +6,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -316,4 +317,18 @@ pub(super) fn span(values: impl IntoIterator<Item = f64>, pad: f64, fallback: (f
         return (lo - w, hi + w);
     }
     (lo - d * pad, hi + d * pad)
+}
+
+/// The legend of a line chart, in its lower right corner.
+pub fn series_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+) -> DrawResult<DB> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .margin(12)
+        .label_font(label_style(15.0))
+        .background_style(WHITE.mix(0.9))
+        .border_style(GRID_BOLD)
+        .draw()
 }

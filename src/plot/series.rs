@@ -192,14 +192,7 @@ impl Figure for Reinforcement<'_> {
             }
         }
         if text && self.series.iter().any(|s| !s.0.is_empty()) {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerRight)
-                .margin(12)
-                .label_font(render::label_style(15.0))
-                .background_style(WHITE.mix(0.9))
-                .border_style(render::GRID_BOLD)
-                .draw()?;
+            render::series_legend(&mut chart)?;
         }
         Ok(())
     }
