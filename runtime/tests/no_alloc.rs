@@ -1,0 +1,68 @@
+//! The per-action loop never allocates: the simulator's `sense` + `step`, and
+//! whole episodes whose allocation count does not grow with their length.
+//!
+//! `allocation_counter::measure` counts the allocations of the current
+//! thread only, so tests running in parallel do not disturb each other.
+
+use allocation_counter::measure;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use shaping_runtime::catalog::CHANNELS;
+use shaping_runtime::controller::{run_episode, EpisodeOptions};
+use shaping_runtime::program::Stage;
+use shaping_runtime::sim::{Command, Sim};
+use shaping_runtime::testkit;
+
+#[test]
+fn the_simulator_step_never_allocates() {
+    for stage in [testkit::navigation(), testkit::collect()] {
+        let mut world = stage.world.clone();
+        world.battery = None;
+        let mut sim = Sim::new(&world, 5);
+        let mut p = [0.0f32; CHANNELS];
+        let info = measure(|| {
+            for i in 0..5_000u32 {
+                sim.sense(&mut p);
+                let turn = if i % 40 < 5 { 0.8 } else { 0.0 };
+                let cmd = Command {
+                    wheels: [1.0 - turn, 1.0 + turn],
+                    arm: (i % 97 == 0).then_some(i % 2 == 0),
+                    claw: (i % 89 == 0).then_some(i % 3 == 0),
+                    charge: i % 7 == 0,
+                };
+                sim.step(&cmd);
+            }
+        });
+        assert_eq!(info.count_total, 0, "stage `{}`: sense + step allocated", stage.name);
+    }
+}
+
+/// Allocations of one untraced episode of `actions` actions.
+fn episode_allocations(stage: &Stage, actions: u32) -> (u64, u32) {
+    let genome = testkit::random_genome(stage, &mut ChaCha8Rng::seed_from_u64(9));
+    let opts = EpisodeOptions { actions, learning: true, seed: 3 };
+    let mut actions = 0;
+    let info = measure(|| actions = run_episode(stage, &genome, &opts, None).actions);
+    (info.count_total, actions)
+}
+
+#[test]
+fn an_episode_allocates_the_same_whatever_its_length() {
+    // Navigation (CRBP on a behavior network) and collect (scripts, gripper,
+    // CRBP on activation networks), without a battery so every episode
+    // lasts as long as asked.
+    for mut stage in [testkit::navigation(), testkit::collect()] {
+        stage.world.battery = None;
+        let (short, n_short) = episode_allocations(&stage, 10);
+        let (long, n_long) = episode_allocations(&stage, 3_000);
+        assert_eq!((n_short, n_long), (10, 3_000));
+        assert!(short > 0, "the episode's set-up allocates, so the counter works");
+        assert_eq!(
+            short,
+            long,
+            "stage `{}`: 2990 more actions made {} more allocations",
+            stage.name,
+            long - short
+        );
+    }
+}
