@@ -13,8 +13,13 @@ robot khepera {
   actuator wheels[2] speed      // -1..1 of v_max
 }
 
-// Every evolved value is a 4-bit gene decoded into -1..1 (paper, fig. 2).
-genome { bits 4  range -1..1 }
+// Every evolved value is a 4-bit gene (paper, fig. 2), normalised to 0..1
+// and decoded into -4..4 (spec section 7: W_max = 4). With -1..1 a link,
+// whose source activation is at most 1, adds at most 1 to a net input that
+// six saturated proximity sensors can push to 6: the follow -> recharge
+// link, the only way the recharge module can tell the charger from any
+// other wall, could never matter, and recharging did not evolve.
+genome { bits 4  range -4..4 }
 
 stage navigation {
   world {
@@ -49,9 +54,16 @@ stage navigation {
     behavior toward(light)
   }
 
+  // The bar charges only within 3 mm of the body, but the proximity
+  // sensors saturate from about 15 mm: dock first, then freeze the motors
+  // until the battery is full (or stops filling: not the charger). Committed,
+  // so the docking is not cut short by the other modules.
   module recharge {
     sense ir[0..5], battery
-    behavior wait until battery >= 1 within 40 actions uses charger
+    behavior script commit {
+      forward(0.6) for 2 actions
+      wait until battery >= 1 or battery <= prev battery within 25 actions uses charger
+    }
   }
 
   links all evolvable
