@@ -207,8 +207,8 @@ impl Figure for Arena<'_> {
                 line.push(pts[i]);
                 i += 1;
             }
-            chart
-                .draw_series(std::iter::once(PathElement::new(line, self.key_colour(key).stroke_width(2))))?;
+            let style = self.key_colour(key).stroke_width(2);
+            chart.draw_series(unmitered(&line).into_iter().map(|l| PathElement::new(l, style)))?;
         }
         for (i, label) in &s.marks {
             let dot = EmptyElement::at(pts[*i]) + Circle::new((0, 0), 4, INK.filled());
@@ -241,6 +241,34 @@ impl Figure for Arena<'_> {
 }
 
 /// The lamp: a yellow disc with rays, in pixels around `at`.
+/// Splits a polyline into pieces that a wide stroke can join safely:
+/// repeated points are dropped and the line is cut wherever it turns by more
+/// than 90 degrees (a blocked robot backing off), because the bitmap backend
+/// miters such a join into a long spike.
+pub(super) fn unmitered(line: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+    let mut pieces = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    for &p in line {
+        match cur.as_slice() {
+            [.., last] if *last == p => continue,
+            [.., a, b] if (b.0 - a.0) * (p.0 - b.0) + (b.1 - a.1) * (p.1 - b.1) < 0.0 => {
+                let b = *b;
+                pieces.push(std::mem::replace(&mut cur, vec![b]));
+            }
+            _ => {}
+        }
+        cur.push(p);
+    }
+    if cur.len() == 1 && pieces.is_empty() {
+        // A single point (e.g. a robot that never moved) is still drawn.
+        cur.push(cur[0]);
+    }
+    if cur.len() > 1 {
+        pieces.push(cur);
+    }
+    pieces
+}
+
 fn draw_lamp<DB: DrawingBackend, CT: CoordTranslate>(
     area: &DrawingArea<DB, CT>,
     at: CT::From,

@@ -383,3 +383,74 @@ fn dashes_cover_the_on_part_of_the_pattern() {
     assert_eq!(dash(&line, &[]), vec![line.to_vec()]);
     assert_eq!(dash(&line, &[0.0, 1.0]), vec![line.to_vec()]);
 }
+
+/// A path that runs into the east wall and bounces off it, repeating points
+/// as a blocked robot does, never draws beyond the wall (repeated points once
+/// drew long spikes in the PNG).
+#[test]
+fn a_bouncing_path_with_repeated_points_stays_inside_the_arena() {
+    use super::arena::Arena;
+    use super::render::Figure;
+    use plotters::prelude::*;
+    // A robot pushed into the east wall, backing off and pushing again:
+    // near-reversals at many angles.
+    let mut path = vec![[300.0f32, 300.0, 0.0]];
+    for k in 0..40 {
+        let a = 0.05 * k as f32;
+        let y = 300.0 + 0.3 * k as f32;
+        path.push([372.0, y, 0.0]);
+        path.push([372.0 - 18.0 * a.cos().abs(), y + 18.0 * a.sin(), 0.0]);
+    }
+    let n = path.len();
+    let sc = TrajectoryScene {
+        arena: [400.0, 600.0],
+        bar: None,
+        lamp: None,
+        objects: vec![],
+        path,
+        body_radius: 27.5,
+        marks: vec![],
+        path_modules: Some(vec![0; n]),
+        module_names: vec!["a".into()],
+    };
+    let fig = Arena::new("", &sc);
+    let (w, h) = fig.size(false);
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        fig.draw(&root, false).unwrap();
+        root.present().unwrap();
+    }
+    let px = |x: u32, y: u32| {
+        let i = ((y * w + x) * 3) as usize;
+        [buf[i], buf[i + 1], buf[i + 2]]
+    };
+    // The east wall: the right-most column with the wall's ink in the row of the path.
+    let row = (0..h).find(|&r| (0..w).any(|c| px(c, r) != [255, 255, 255])).unwrap() + h / 2;
+    let wall = (0..w).rev().find(|&c| px(c, row) == [0x28, 0x28, 0x28]).expect("the east wall is drawn");
+    for r in 0..h {
+        for c in wall + 1..w {
+            assert_eq!(
+                px(c, r),
+                [255, 255, 255],
+                "pixel ({c}, {r}) east of the wall (column {wall}) is drawn"
+            );
+        }
+    }
+}
+
+#[test]
+fn polylines_are_cut_at_reversals_and_repeated_points_dropped() {
+    use super::arena::unmitered;
+    let l = [(0.0, 0.0), (1.0, 0.0), (1.0, 0.0), (2.0, 0.0), (1.5, 0.5), (1.0, 1.0), (1.5, 1.0)];
+    assert_eq!(
+        unmitered(&l),
+        vec![
+            vec![(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)],
+            vec![(2.0, 0.0), (1.5, 0.5), (1.0, 1.0)],
+            vec![(1.0, 1.0), (1.5, 1.0)]
+        ]
+    );
+    assert_eq!(unmitered(&[(3.0, 4.0)]), vec![vec![(3.0, 4.0), (3.0, 4.0)]]);
+    assert_eq!(unmitered(&[(3.0, 4.0), (3.0, 4.0)]), vec![vec![(3.0, 4.0), (3.0, 4.0)]]);
+}
