@@ -21,10 +21,20 @@ pub enum Error {
     },
 
     #[error("the file is too complex to parse: {reason}")]
+    #[diagnostic(help("architecture files are a few kilobytes; split this one or simplify it"))]
     TooComplex {
         #[label("parsing gave up here")]
         span: SourceSpan,
         reason: String,
+    },
+
+    #[error("line {line} is longer than {limit} bytes")]
+    #[diagnostic(help("break it into shorter lines"))]
+    LineTooLong {
+        #[label("this line")]
+        span: SourceSpan,
+        line: usize,
+        limit: usize,
     },
 
     #[error("{what} deeper than {limit} levels")]
@@ -216,9 +226,17 @@ fn count(n: usize) -> String {
 
 impl Diagnostics {
     pub fn new(file_name: &str, source: &str, errors: Vec<Error>) -> Diagnostics {
+        // A line too long is reported alone, at its start: show its beginning only.
+        let mut shown = source.len();
+        if let [Error::LineTooLong { span, .. }] = &errors[..] {
+            shown = (span.offset() + 100).min(source.len());
+            while !source.is_char_boundary(shown) {
+                shown -= 1;
+            }
+        }
         Diagnostics {
             name: file_name.to_string(),
-            source_code: NamedSource::new(file_name, source.to_string()),
+            source_code: NamedSource::new(file_name, source[..shown].to_string()),
             errors,
         }
     }

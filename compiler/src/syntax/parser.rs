@@ -49,6 +49,9 @@ const RESERVED: [&str; 29] = [
 const MAX_NESTING: usize = 48;
 /// Most grammar nodes in one expression (bounds every recursion over it).
 const MAX_EXPR_NODES: usize = 256;
+/// Longest line accepted, in bytes. Diagnostics show the line with its
+/// labels, and renderers (miette) cannot pad a label past 65535 columns.
+const MAX_LINE: usize = 4096;
 /// Budget of pest rule calls for one file.
 const CALL_LIMIT: usize = 20_000_000;
 
@@ -59,7 +62,7 @@ pub fn parse(src: &str) -> Result<File, Vec<Error>> {
 }
 
 fn parse_with_limit(src: &str, call_limit: usize) -> Result<File, Vec<Error>> {
-    if let Some(err) = check_nesting(src) {
+    if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
         return Err(vec![err]);
     }
     pest::set_call_limit(std::num::NonZeroUsize::new(call_limit));
@@ -92,6 +95,23 @@ fn pratt() -> PrattParser<Rule> {
         .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
         .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
         .op(Op::prefix(Rule::neg) | Op::prefix(Rule::prev))
+}
+
+/// Rejects the first line longer than [`MAX_LINE`], labelled at its start.
+fn check_lines(src: &str) -> Option<Error> {
+    let mut start = 0;
+    for (n, line) in src.split('\n').enumerate() {
+        if line.len() > MAX_LINE {
+            let first = line.chars().next().map_or(1, char::len_utf8);
+            return Some(Error::LineTooLong {
+                span: Span::new(start, start + first).into(),
+                line: n + 1,
+                limit: MAX_LINE,
+            });
+        }
+        start += line.len() + 1;
+    }
+    None
 }
 
 /// Rejects nesting deep enough to exhaust the stack of a recursive parser.
@@ -134,6 +154,8 @@ fn check_nesting(src: &str) -> Option<Error> {
 fn describe(rule: Rule) -> Option<&'static str> {
     Some(match rule {
         Rule::EOI => "end of file",
+        // pest reports the whole rule when the first item fails at the start.
+        Rule::file => "`genome`, `robot` or `stage`",
         Rule::ident => "a name",
         Rule::integer => "a whole number",
         Rule::number | Rule::quantity => "a number",
@@ -914,6 +936,15 @@ mod tests {
         assert!(matches!(&errors[..], [Error::TooComplex { .. }]), "{errors:?}");
         assert!(errors[0].to_string().starts_with("the file is too complex to parse"));
         assert!(parse_with_limit(src, CALL_LIMIT).is_ok());
+    }
+
+    #[test]
+    fn long_lines_are_rejected_before_parsing() {
+        let ok = format!("{}\n{}", "x".repeat(MAX_LINE), "y".repeat(MAX_LINE));
+        assert!(check_lines(&ok).is_none());
+        let src = format!("// one\n{}]", " ".repeat(70_000));
+        let Some(Error::LineTooLong { span, line: 2, .. }) = check_lines(&src) else { panic!() };
+        assert_eq!((span.offset(), span.len()), (7, 1));
     }
 
     #[test]
