@@ -1,5 +1,8 @@
 //! Bad inputs: every file of `tests/ui/` must fail; the snapshot is the
 //! source followed by the rendered diagnostics (no colour, 80 columns).
+//! Inputs too big for a file are generated, and only their diagnostics kept.
+
+use shaping_compiler::Error;
 
 use crate::render;
 
@@ -16,4 +19,87 @@ fn ui() {
             }
         }
     });
+}
+
+/// Megabytes of modules: the parser's call limit gives up.
+fn too_complex() -> String {
+    let mut src = String::from(
+        "robot r { sensor ir[8] proximity actuator wheels[2] speed }\nstage s {\n fitness per action 1\n",
+    );
+    src.push_str(&" module m { sense ir behavior forward }\n".repeat(200_000));
+    src.push_str("}\n");
+    src
+}
+
+#[test]
+fn ui_generated() {
+    let d = shaping_compiler::compile(&too_complex(), "too_complex.bat").unwrap_err();
+    insta::assert_snapshot!("too_complex", render(&d));
+}
+
+/// The kind of an error, by an exhaustive match: a new variant fails to
+/// compile here until it is added to [`KINDS`] and given a ui test.
+fn kind(e: &Error) -> &'static str {
+    match e {
+        Error::Syntax { .. } => "Syntax",
+        Error::TooComplex { .. } => "TooComplex",
+        Error::LineTooLong { .. } => "LineTooLong",
+        Error::TooDeep { .. } => "TooDeep",
+        Error::TooLarge { .. } => "TooLarge",
+        Error::Unknown { .. } => "Unknown",
+        Error::Duplicate { .. } => "Duplicate",
+        Error::IndexOutOfRange { .. } => "IndexOutOfRange",
+        Error::BadRange { .. } => "BadRange",
+        Error::Type { .. } => "Type",
+        Error::Bits { .. } => "Bits",
+        Error::Cycle { .. } => "Cycle",
+        Error::NotSensed { .. } => "NotSensed",
+        Error::UnboundedUntil { .. } => "UnboundedUntil",
+        Error::MissingHardware { .. } => "MissingHardware",
+        Error::Frozen { .. } => "Frozen",
+        Error::Unit { .. } => "Unit",
+        Error::Value { .. } => "Value",
+        Error::StackTooDeep { .. } => "StackTooDeep",
+        Error::Conflict { .. } => "Conflict",
+    }
+}
+
+const KINDS: [&str; 20] = [
+    "Syntax",
+    "TooComplex",
+    "LineTooLong",
+    "TooDeep",
+    "TooLarge",
+    "Unknown",
+    "Duplicate",
+    "IndexOutOfRange",
+    "BadRange",
+    "Type",
+    "Bits",
+    "Cycle",
+    "NotSensed",
+    "UnboundedUntil",
+    "MissingHardware",
+    "Frozen",
+    "Unit",
+    "Value",
+    "StackTooDeep",
+    "Conflict",
+];
+
+#[test]
+fn every_error_kind_has_a_ui_test() {
+    let mut seen = std::collections::BTreeSet::new();
+    let mut files = 0;
+    for entry in std::fs::read_dir(crate::root().join("tests/ui")).unwrap() {
+        let path = entry.unwrap().path();
+        let src = std::fs::read_to_string(&path).unwrap();
+        let d = shaping_compiler::compile(&src, "ui.bat").unwrap_err();
+        seen.extend(d.errors().iter().map(kind));
+        files += 1;
+    }
+    seen.extend(shaping_compiler::compile(&too_complex(), "ui.bat").unwrap_err().errors().iter().map(kind));
+    assert!(files >= 25, "{files} ui files, at least 25 expected");
+    let missing: Vec<_> = KINDS.iter().filter(|k| !seen.contains(*k)).collect();
+    assert!(missing.is_empty(), "error kinds without a ui test: {missing:?}");
 }
