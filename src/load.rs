@@ -42,7 +42,10 @@ impl fmt::Display for CliError {
 /// at the first invalid byte.
 #[derive(Debug)]
 struct NotUtf8 {
-    src: NamedSource<String>,
+    /// None when the invalid byte is too far into its line to be shown
+    /// (miette cannot pad a label past 65535 columns).
+    src: Option<NamedSource<String>>,
+    name: String,
     at: SourceSpan,
 }
 
@@ -50,7 +53,10 @@ impl std::error::Error for NotUtf8 {}
 
 impl fmt::Display for NotUtf8 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "the file is not valid UTF-8")
+        match self.src {
+            Some(_) => write!(f, "the file is not valid UTF-8"),
+            None => write!(f, "`{}` is not valid UTF-8 (byte {})", self.name, self.at.offset()),
+        }
     }
 }
 
@@ -60,10 +66,11 @@ impl Diagnostic for NotUtf8 {
     }
 
     fn source_code(&self) -> Option<&dyn miette::SourceCode> {
-        Some(&self.src)
+        self.src.as_ref().map(|s| s as &dyn miette::SourceCode)
     }
 
     fn labels(&self) -> Option<Box<dyn Iterator<Item = miette::LabeledSpan> + '_>> {
+        self.src.as_ref()?;
         Some(Box::new(std::iter::once(miette::LabeledSpan::new_with_span(
             Some("invalid byte here".into()),
             self.at,
@@ -87,9 +94,17 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliErro
         Ok(s) => s,
         Err(e) => {
             let at = e.utf8_error().valid_up_to();
-            let lossy = String::from_utf8_lossy(e.as_bytes()).into_owned();
+            let mut lossy = String::from_utf8_lossy(e.as_bytes()).into_owned();
             // Offsets shift in the lossy copy only after the first invalid byte.
-            let report = NotUtf8 { src: NamedSource::new(name, lossy), at: (at, 1).into() };
+            // Show the text up to the end of that byte's line, at most 80 bytes more.
+            let mut end = lossy[at..].find('\n').map_or(lossy.len(), |i| at + i).min(at + 80);
+            while !lossy.is_char_boundary(end) {
+                end += 1;
+            }
+            lossy.truncate(end);
+            let column = at - lossy[..at].rfind('\n').map_or(0, |i| i + 1);
+            let src = (column <= 1000).then(|| NamedSource::new(&name, lossy));
+            let report = NotUtf8 { src, name, at: (at, 1).into() };
             return Err(CliError::Diagnostics(diag::render(&report, format)));
         }
     };

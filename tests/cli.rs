@@ -83,6 +83,14 @@ fn bad_inputs_give_an_error_never_a_panic() {
                 .into_bytes(),
         ),
         ("huge.bat", "module m { sense ir }\n".repeat(20000).into_bytes()),
+        ("deeper.bat", "(".repeat(100_000).into_bytes()),
+        (
+            "megabytes.bat",
+            "stage s {\n module m { sense ir behavior forward }\n".repeat(200_000).into_bytes(),
+        ),
+        // Errors far to the right of a long line (miette cannot pad past 65535 columns).
+        ("long_line.bat", format!("{}]", " ".repeat(70_000)).into_bytes()),
+        ("long_binary.bat", [" ".repeat(70_000).as_bytes(), b"\xff"].concat()),
     ];
     for (name, bytes) in cases {
         let path = dir.join(name);
@@ -96,6 +104,9 @@ fn bad_inputs_give_an_error_never_a_panic() {
     let missing = run(shaping().arg("check").arg(dir.join("nope.bat")));
     assert_eq!(missing.status.code(), Some(2));
     assert!(text(&missing.stderr).contains("nope.bat"));
+    let directory = run(shaping().arg("check").arg(&dir));
+    assert_eq!(directory.status.code(), Some(2));
+    assert!(text(&directory.stderr).contains("cannot read"), "{}", text(&directory.stderr));
 }
 
 #[test]
