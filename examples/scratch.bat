@@ -7,6 +7,8 @@
 // Compared with the `navigation` stage of khepera.bat, the obstacle-
 // avoidance module's behavior network is evolved (its 18 weights are genes)
 // instead of learned by CRBP from random weights, and evolution runs longer.
+// Everything else (world, fitness, genes, the docking recharge script) is
+// the same.
 
 robot khepera {
   sensor ir[8]      proximity
@@ -15,7 +17,8 @@ robot khepera {
   actuator wheels[2] speed
 }
 
-genome { bits 4  range -1..1 }
+// The same genes as khepera.bat: 4 bits decoded into -4..4.
+genome { bits 4  range -4..4 }
 
 stage scratch {
   world {
@@ -37,7 +40,10 @@ stage scratch {
   module follow { sense light, battery  behavior toward(light) }
   module recharge {
     sense ir[0..5], battery
-    behavior wait until battery >= 1 within 40 actions uses charger
+    behavior script commit {
+      forward(0.6) for 2 actions
+      wait until battery >= 1 or battery <= prev battery within 25 actions uses charger
+    }
   }
 
   links all evolvable
