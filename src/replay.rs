@@ -59,6 +59,8 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let genome = match &args.genome {
         Some(g) => parse_genome(g)?,
+        // Nothing is evolved: the empty genome is the only individual.
+        None if stage.layout.bits == 0 && args.run.is_none() => Genome::zeros(0),
         None => {
             let source = &program.stages[evolved_source(&program, index)];
             let path = run_dir.join(&source.name).join("best.genome");

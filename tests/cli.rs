@@ -288,3 +288,23 @@ fn bench_prints_one_json_line() {
     assert!(v["sim_steps_per_sec"].as_f64().unwrap() > 0.0);
     assert!(v["controller_actions_per_sec"].as_f64().unwrap() > 0.0);
 }
+
+/// A stage with nothing evolved replays without a genome, and its avoid
+/// module's performance indicator rises (figure 5 from the command line).
+#[test]
+fn replay_of_a_stage_without_genes_needs_no_genome() {
+    let dir = scratch("avoid");
+    let out = run(shaping().arg("replay").arg(root().join("examples/avoid.bat")).arg("--out").arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("avoid: 5000 actions"), "{}", text(&out.stdout));
+    assert!(dir.join("reinforcement.png").exists());
+    let trace = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "perf_avoid").expect("a performance column");
+    let perf: Vec<f32> =
+        trace.lines().skip(1).map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
+    let mean = |s: &[f32]| s.iter().sum::<f32>() / s.len() as f32;
+    let (first, last) = (mean(&perf[..300]), mean(&perf[4000..]));
+    assert!(last > first + 0.1 && last > 0.15, "performance {first} -> {last}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
