@@ -79,14 +79,17 @@ stage collect extends navigation {
   evolve { generations 40 }
   fitness adds 0.5 per grip, 1.0 per release outside
 
-  // Approach, lower the arm and look between the arms: an object (barrier
-  // on) is rewarded, a wall punished; then grip and lift.
+  // Approach, lower the arm with the claw open and back until the object
+  // is between the arms: an object there (the barrier on with the claw
+  // open) is rewarded, a wall punished; then grip and lift. Committed: cut
+  // short, the sequence leaves the arm down or the claw closed on nothing.
   module grip {
     sense ir, barrier
-    behavior script {
-      toward(ir)
+    behavior script commit {
+      toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
       arm down
-      back until barrier within 5 actions
+      claw open
+      back(0.5) until barrier within 6 actions
       reinforce barrier ? 1 : -1
       claw closed
       arm up
@@ -94,15 +97,18 @@ stage collect extends navigation {
     learn crbp(0.1, 0.01) on activation always
   }
 
-  // Drop the object outside: turn to the closest obstacle and open the
-  // claw. Releasing while both front sensors see a wall puts the object
-  // outside the arena, and is rewarded; releasing elsewhere is punished.
+  // Drop the object outside: approach the obstacle, lower the arm, open
+  // the claw. Rewarded when an object held before opening (the barrier on)
+  // is gone after (thrown over the wall), punished when it falls in front
+  // (not a wall) or when nothing was held: the reverse of the grip
+  // module's discrimination.
   module release {
     sense ir, barrier
-    behavior script {
-      toward(ir)
-      reinforce ir[2] > 0.5 and ir[3] > 0.5 ? 1 : -1
+    behavior script commit {
+      toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
+      arm down
       claw open
+      reinforce prev barrier and not barrier ? 1 : -1
       arm up
     }
     learn crbp(0.1, 0.01) on activation always
