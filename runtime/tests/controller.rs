@@ -135,8 +135,11 @@ fn an_inhibitory_link_suppresses_its_target_at_the_next_action() {
 /// two actions), activation 0.5. Module 1: drives `[9, 9]`, activation
 /// `sigmoid(20 * battery - 10)`: it wins when the test sets battery to 1.
 fn script_stage() -> Stage {
-    let step =
-        |v: f32, n: u32| Step { action: Action::Wheels { left: v, right: v }, end: StepEnd::Actions(n) };
+    let step = |v: f32, n: u32| Step {
+        action: Action::Wheels { left: v, right: v },
+        end: StepEnd::Actions(n),
+        when: None,
+    };
     let scripted = Module {
         name: "scripted".into(),
         stage: 0,
@@ -200,9 +203,14 @@ fn until_steps_end_on_their_condition_or_bound_and_reinforce_steps_take_no_time(
                 Step {
                     action: Action::Wheels { left: 1.0, right: 1.0 },
                     end: StepEnd::Until { cond, within: 3 },
+                    when: None,
                 },
-                Step { action: Action::Reinforce(r), end: StepEnd::Actions(1) },
-                Step { action: Action::Wheels { left: 2.0, right: 2.0 }, end: StepEnd::Actions(1) },
+                Step { action: Action::Reinforce(r), end: StepEnd::Actions(1), when: None },
+                Step {
+                    action: Action::Wheels { left: 2.0, right: 2.0 },
+                    end: StepEnd::Actions(1),
+                    when: None,
+                },
             ],
             commit: false,
         }),
@@ -236,10 +244,11 @@ fn toward_wait_arm_and_claw_steps_give_their_commands() {
         Step {
             action: Action::Toward { channels: testkit::chans(CH_IR, 8), speed: 0.5 },
             end: StepEnd::Actions(1),
+            when: None,
         },
-        Step { action: Action::Arm(true), end: StepEnd::Actions(1) },
-        Step { action: Action::Claw(true), end: StepEnd::Actions(1) },
-        Step { action: Action::Wait { charge: true }, end: StepEnd::Actions(1) },
+        Step { action: Action::Arm(true), end: StepEnd::Actions(1), when: None },
+        Step { action: Action::Claw(true), end: StepEnd::Actions(1), when: None },
+        Step { action: Action::Wait { charge: true }, end: StepEnd::Actions(1), when: None },
     ];
     let m = Module {
         name: "m".into(),
@@ -404,6 +413,38 @@ fn crbp_on_an_activation_network_pushes_it_up_on_reward_and_down_on_punishment()
 }
 
 #[test]
+fn a_reinforce_step_late_in_a_script_trains_the_pattern_the_script_started_on() {
+    // Drive one action, then reward: the percept changes in between.
+    let steps = vec![
+        Step { action: Action::Wheels { left: 1.0, right: 1.0 }, end: StepEnd::Actions(1), when: None },
+        Step { action: Action::Reinforce(expr(vec![Op::Const(1.0)])), end: StepEnd::Actions(1), when: None },
+    ];
+    let m = Module {
+        name: "grip".into(),
+        stage: 0,
+        inputs: vec![0, 1],
+        activation: Network { inputs: 2, hidden: 0, outputs: 1, params: vec![Param::Fixed(0.0); 3] },
+        behavior: Behavior::Script(Script { steps, commit: true }),
+        learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
+        reinforce: Some(expr(vec![Op::Const(1.0)])),
+    };
+    let s = stage_of(vec![m], vec![]);
+    let mut c = controller(&s, 1);
+    let mut robot = Puppet::default();
+    robot.percept[0] = 1.0; // the decision: ir[0]
+    c.start(&mut robot);
+    robot.percept = [0.0; CHANNELS];
+    robot.percept[1] = 1.0; // after the move: ir[1]
+    c.act(&mut robot); // decides on ir[0] and drives
+    assert_eq!(c.activation_weights(0), &[0.0, 0.0, 0.0][..], "no reinforcement yet");
+    let rep = c.act(&mut robot); // the reinforce step, on ir[1]
+    assert_eq!(rep.reinforcement, 1.0);
+    let w = c.activation_weights(0);
+    assert!(w[0] > 0.0 && w[1] > 0.0, "the decision's pattern is rewarded: {w:?}");
+    assert_eq!(w[2], 0.0, "not the pattern at the reinforce step: {w:?}");
+}
+
+#[test]
 fn fitness_sums_the_per_action_term_and_adds_bonuses_per_event() {
     let mut s = stage_of(vec![constant_module("fwd", 0.0, 1.0)], vec![]);
     s.fitness.per_action = Some(testkit::straight_and_far(300.0));
@@ -554,8 +595,12 @@ fn follow_light_then_recharge_keeps_the_robot_alive() {
     let full = expr(vec![Op::Chan(CH_BATTERY as u16), Op::Const(1.0), Op::Ge]);
     s.modules[3].behavior = Behavior::Script(Script {
         steps: vec![
-            Step { action: Action::Wheels { left: 0.3, right: 0.3 }, end: StepEnd::Actions(2) },
-            Step { action: Action::Wait { charge: true }, end: StepEnd::Until { cond: full, within: 40 } },
+            Step { action: Action::Wheels { left: 0.3, right: 0.3 }, end: StepEnd::Actions(2), when: None },
+            Step {
+                action: Action::Wait { charge: true },
+                end: StepEnd::Until { cond: full, within: 40 },
+                when: None,
+            },
         ],
         commit: false,
     });
@@ -623,8 +668,11 @@ fn a_committed_script_keeps_control_until_its_last_step() {
     // `a` wins the first action (no link input yet); from the second action
     // the excitatory link a -> b makes `b`'s activation the highest. A plain
     // script gives way at once; a committed one finishes its three steps.
-    let step =
-        |id: f32, n: u32| Step { action: Action::Wheels { left: id, right: id }, end: StepEnd::Actions(n) };
+    let step = |id: f32, n: u32| Step {
+        action: Action::Wheels { left: id, right: id },
+        end: StepEnd::Actions(n),
+        when: None,
+    };
     for commit in [false, true] {
         let a = Module {
             name: "a".into(),
