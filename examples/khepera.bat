@@ -79,18 +79,20 @@ stage collect extends navigation {
   evolve { generations 40 }
   fitness adds 0.5 per grip, 1.0 per release outside
 
-  // Approach, lower the arm with the claw open and back until the object
-  // is between the arms: an object there (the barrier on with the claw
-  // open) is rewarded, a wall punished; then grip and lift. Committed: cut
-  // short, the sequence leaves the arm down or the claw closed on nothing.
+  // Approach, lower the arm and back until the object is between the arms:
+  // an object there (the barrier on, the claw open) is rewarded; a wall, or
+  // an object already held (the barrier on, the claw closed), is punished;
+  // then grip and lift. A claw a failed grip left closed on nothing opens
+  // again; a held object stays in the claw. Committed: cut short, the
+  // sequence would leave the arm down.
   module grip {
     sense ir, barrier
     behavior script commit {
       toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
       arm down
-      claw open
+      claw open if not barrier
       back(0.5) until barrier within 6 actions
-      reinforce barrier ? 1 : -1
+      reinforce barrier and not claw ? 1 : -1
       claw closed
       arm up
     }
