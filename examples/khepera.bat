@@ -79,30 +79,38 @@ stage collect extends navigation {
   evolve { generations 40 }
   fitness adds 0.5 per grip, 1.0 per release outside
 
-  // Approach, lower the arm and look between the arms: an object (barrier
-  // on) is rewarded, a wall punished; then grip and lift.
+  // Approach, lower the arm and back until the object is between the arms:
+  // an object there (the barrier on, the claw open) is rewarded; a wall, or
+  // an object already held (the barrier on, the claw closed), is punished;
+  // then grip and lift. A claw a failed grip left closed on nothing opens
+  // again; a held object stays in the claw. Committed: cut short, the
+  // sequence would leave the arm down.
   module grip {
     sense ir, barrier
-    behavior script {
-      toward(ir)
+    behavior script commit {
+      toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
       arm down
-      back until barrier within 5 actions
-      reinforce barrier ? 1 : -1
+      claw open if not barrier
+      back(0.5) until barrier within 6 actions
+      reinforce barrier and not claw ? 1 : -1
       claw closed
       arm up
     }
     learn crbp(0.1, 0.01) on activation always
   }
 
-  // Drop the object outside: turn to the closest obstacle and open the
-  // claw. Releasing while both front sensors see a wall puts the object
-  // outside the arena, and is rewarded; releasing elsewhere is punished.
+  // Drop the object outside: approach the obstacle, lower the arm, open
+  // the claw. Rewarded when an object held before opening (the barrier on)
+  // is gone after (thrown over the wall), punished when it falls in front
+  // (not a wall) or when nothing was held: the reverse of the grip
+  // module's discrimination.
   module release {
     sense ir, barrier
-    behavior script {
-      toward(ir)
-      reinforce ir[2] > 0.5 and ir[3] > 0.5 ? 1 : -1
+    behavior script commit {
+      toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
+      arm down
       claw open
+      reinforce prev barrier and not barrier ? 1 : -1
       arm up
     }
     learn crbp(0.1, 0.01) on activation always

@@ -242,6 +242,11 @@ pub struct Script {
 pub struct Step {
     pub action: Action,
     pub end: StepEnd,
+    /// `if COND`: the step runs only when this holds as it is reached
+    /// (evaluated like a `reinforce` step); otherwise it is skipped and
+    /// takes no time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub when: Option<Expr>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -15,6 +15,7 @@ stage s {
       wheels(0.1, -0.1)
       toward(ir); turn toward(ir[0..5], 0.4)
       arm down; claw closed; arm up; claw open
+      claw open if not barrier; back(0.5) until barrier within 2 actions if arm == 1
       wait for 2 actions; recharge
       wait until battery >= 1 within 9 actions uses charger
       reinforce barrier ? 1 : -1

@@ -439,7 +439,11 @@ impl Lower<'_> {
                 StepEnd::Until { cond: cond?, within }
             }
         };
-        Some(Step { action, end })
+        let when = match &x.cond {
+            Some(c) => Some(self.expr(hw, c, &Scope { only: None })?),
+            None => None,
+        };
+        Some(Step { action, end, when })
     }
 
     /// A neural behavior; also gives the gene range when its weights evolve.

@@ -277,6 +277,8 @@ pub struct StepDecl {
     pub action: ActionDecl,
     pub end: Option<EndDecl>,
     pub uses_charger: Option<Span>,
+    /// `if COND`: run the step only when the condition holds.
+    pub cond: Option<Expr>,
     pub span: Span,
 }
 

@@ -212,6 +212,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::until_end => "`until`",
         Rule::within => "`within`",
         Rule::uses_charger => "`uses charger`",
+        Rule::step_if => "`if`",
         Rule::forward | Rule::k_forward => "`forward`",
         Rule::back | Rule::k_back => "`back`",
         Rule::turn | Rule::k_turn => "`turn`",
@@ -677,6 +678,7 @@ impl Builder {
         };
         let mut end = None;
         let mut uses_charger = None;
+        let mut cond = None;
         for c in it {
             match c.as_rule() {
                 Rule::for_end => {
@@ -693,10 +695,17 @@ impl Builder {
                     end = Some(EndDecl::Until { cond, within, span: usp });
                 }
                 Rule::uses_charger => uses_charger = Some(span(&c)),
+                Rule::step_if => {
+                    let isp = span(&c);
+                    cond = Some(match c.into_inner().next() {
+                        Some(e) => self.expr(e),
+                        None => Expr { kind: ExprKind::Number(0.0, None), span: isp },
+                    });
+                }
                 _ => {}
             }
         }
-        StepDecl { action, end, uses_charger, span: sp }
+        StepDecl { action, end, uses_charger, cond, span: sp }
     }
 
     fn action(&mut self, p: Pair<Rule>) -> ActionDecl {

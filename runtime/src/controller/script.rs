@@ -21,6 +21,9 @@
 //!   `speed`; with nothing sensed it drives forward.
 //! - `wait` stops the wheels (with `charge`, asks the charger to recharge);
 //!   `arm`/`claw` steps stop the wheels and move the gripper.
+//! - A step with `if COND` is checked as it is reached, like a `reinforce`
+//!   step (same `now`, `prev` and actuators): when COND is false it is
+//!   skipped and takes no time.
 
 use super::fast_expr::FastExpr;
 use crate::catalog::{channel_bearing, CHANNELS};
@@ -62,6 +65,11 @@ enum End {
 #[derive(Clone, Debug)]
 pub struct ScriptRun {
     steps: Vec<(Op, End)>,
+    /// The `if` condition of each step (`None`: always runs).
+    when: Vec<Option<FastExpr>>,
+    /// The last [`ScriptRun::command`] ran a moving step (not only skipped or
+    /// `reinforce` steps).
+    acted: bool,
     /// Once started, keeps its module in control until its last step ends.
     commit: bool,
     /// Current step.
@@ -99,7 +107,8 @@ impl ScriptRun {
                 (op, end)
             })
             .collect();
-        ScriptRun { steps, commit: script.commit, pos: 0, spent: 0 }
+        let when = script.steps.iter().map(|s| s.when.as_ref().map(FastExpr::new)).collect();
+        ScriptRun { steps, when, acted: false, commit: script.commit, pos: 0, spent: 0 }
     }
 
     /// True when the script contains `reinforce` steps (then they, not the
@@ -135,7 +144,12 @@ impl ScriptRun {
     pub fn command(&mut self, env: &Env, reinforcement: &mut f32) -> Command {
         // Each step at most once per action, so a script made only of
         // `reinforce` steps cannot loop forever.
+        self.acted = false;
         for _ in 0..self.steps.len() {
+            if self.when[self.pos].as_ref().is_some_and(|w| w.eval(env) == 0.0) {
+                self.advance();
+                continue;
+            }
             let op = &self.steps[self.pos].0;
             let cmd = match op {
                 Op::Reinforce(e) => {
@@ -151,6 +165,7 @@ impl ScriptRun {
                 Op::Claw(c) => Command { claw: Some(*c), ..Command::default() },
                 Op::Wait { charge } => Command { charge: *charge, ..Command::default() },
             };
+            self.acted = true;
             return cmd;
         }
         Command::default()
@@ -159,11 +174,11 @@ impl ScriptRun {
     /// Called after the action the script drove: counts it and moves to the
     /// next step when the current one has ended.
     pub fn after_action(&mut self, env: &Env) {
-        let Some((op, end)) = self.steps.get(self.pos) else { return };
-        if matches!(op, Op::Reinforce(_)) {
-            // Only reinforce steps were left this action (nothing moved).
+        if !self.acted {
+            // Only reinforce or skipped steps were left this action (nothing moved).
             return;
         }
+        let Some((_, end)) = self.steps.get(self.pos) else { return };
         self.spent += 1;
         let done = match end {
             End::Actions(n) => self.spent >= *n,
@@ -208,6 +223,54 @@ mod tests {
         chans
             .map(|c| (c as u16, channel_bearing(c).unwrap().cos(), channel_bearing(c).unwrap().sin()))
             .collect()
+    }
+
+    #[test]
+    fn a_step_whose_if_condition_is_false_is_skipped_and_takes_no_time() {
+        use crate::catalog::{ACT_SLOTS, CH_BARRIER};
+        use crate::expr::{Expr, Op};
+        use crate::program::Step;
+        let not_barrier = Expr { ops: vec![Op::Chan(CH_BARRIER as u16), Op::Not], depth: 1 };
+        let step = |action, when| Step { action, end: StepEnd::Actions(1), when };
+        let script = Script {
+            steps: vec![
+                step(Action::Arm(true), None),
+                step(Action::Claw(false), Some(not_barrier)),
+                step(Action::Wheels { left: -0.5, right: -0.5 }, None),
+            ],
+            commit: true,
+        };
+        let act = [0.0; ACT_SLOTS];
+        let mut r = 0.0;
+        for barrier in [0.0, 1.0] {
+            let mut p = [0.0; CHANNELS];
+            p[CH_BARRIER] = barrier;
+            let env = Env { now: &p, prev: &p, act: &act };
+            let mut s = ScriptRun::new(&script);
+            assert_eq!(s.command(&env, &mut r).arm, Some(true));
+            s.after_action(&env);
+            let cmd = s.command(&env, &mut r);
+            if barrier == 0.0 {
+                assert_eq!(cmd.claw, Some(false), "the condition holds: the claw opens");
+                s.after_action(&env);
+                assert_eq!(s.command(&env, &mut r).wheels, [-0.5, -0.5]);
+            } else {
+                assert_eq!(cmd.claw, None, "skipped: the next step runs in the same action");
+                assert_eq!(cmd.wheels, [-0.5, -0.5]);
+            }
+            s.after_action(&env);
+            assert_eq!(s.position(), 0, "the script ended and wrapped around");
+            assert!(!s.holds_control());
+        }
+        // Every step skipped: nothing moves and nothing is counted.
+        let never = Expr { ops: vec![Op::Const(0.0)], depth: 1 };
+        let script = Script { steps: vec![step(Action::Arm(true), Some(never))], commit: false };
+        let mut s = ScriptRun::new(&script);
+        let p = [0.0; CHANNELS];
+        let env = Env { now: &p, prev: &p, act: &act };
+        assert_eq!(s.command(&env, &mut r), Command::default());
+        s.after_action(&env);
+        assert_eq!((s.position(), s.holds_control()), (0, false));
     }
 
     #[test]
