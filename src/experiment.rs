@@ -86,7 +86,10 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
             error_format: args.error_format,
         })?;
     }
-    let summary = summarise(&program, &out, &seeds, &criteria)?;
+    // Titled by the file: several files may share a robot (and so a program name).
+    let title =
+        args.file.file_stem().map_or_else(|| program.name.clone(), |s| s.to_string_lossy().into_owned());
+    let summary = summarise(&program, &title, &out, &seeds, &criteria)?;
     write_atomic(&out.join("summary.md"), summary.as_bytes())?;
     print!("{summary}");
     Ok(())
@@ -101,12 +104,13 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, CliError>
 /// Builds the Markdown summary and the multi-seed fitness picture.
 fn summarise(
     program: &Program,
+    title: &str,
     out: &Path,
     seeds: &[u64],
     criteria: &[(String, f32)],
 ) -> Result<String, CliError> {
     let mut md = String::new();
-    let _ = writeln!(md, "# {} over {} seeds ({:?})\n", program.name, seeds.len(), seeds);
+    let _ = writeln!(md, "# {title} over {} seeds ({:?})\n", seeds.len(), seeds);
     let _ = writeln!(md, "Median (min .. max) over seeds.\n");
     let _ = writeln!(
         md,
@@ -192,7 +196,7 @@ fn summarise(
         let starts = report::fitness_points(first).1;
         plot::multi_seed_fitness(
             &out.join("fitness-seeds"),
-            &format!("{}: fitness over {} seeds (median, min-max)", program.name, seeds.len()),
+            &format!("{title}: fitness over {} seeds (median, min-max)", seeds.len()),
             &runs,
             &starts,
         )
