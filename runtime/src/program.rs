@@ -503,7 +503,7 @@ impl Program {
                             } && match &step.end {
                                 StepEnd::Until { cond, .. } => cond.is_valid(),
                                 StepEnd::Actions(_) => true,
-                            };
+                            } && step.when.as_ref().is_none_or(Expr::is_valid);
                             if !expr_ok {
                                 return Err(at("malformed script step"));
                             }

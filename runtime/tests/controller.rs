@@ -519,6 +519,18 @@ fn invalid_stages_are_errors_not_panics() {
     let mut bad = s.clone();
     bad.links[0].to = 42;
     assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadLink { .. })));
+
+    // A script step's `if` condition reading a channel that does not exist,
+    // as a hand-edited program.json could hold.
+    let mut bad = testkit::collect();
+    let g = Genome::zeros(bad.layout.bits as usize);
+    let m = bad.modules.iter().position(|m| matches!(m.behavior, Behavior::Script(_))).unwrap();
+    let Behavior::Script(script) = &mut bad.modules[m].behavior else { unreachable!() };
+    script.steps[0].when = Some(Expr { ops: vec![Op::Chan(99)], depth: 1 });
+    assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadModule { .. })));
+    let program = Program { format: 1, name: "bad".into(), stages: vec![testkit::navigation(), bad] };
+    let e = program.validate().unwrap_err();
+    assert!(e.contains("malformed script step"), "{e}");
 }
 
 #[test]

@@ -792,7 +792,7 @@ pub fn validate(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
                     } && match &st.end {
                         crate::program::StepEnd::Until { cond, .. } => expr_ok(cond),
                         crate::program::StepEnd::Actions(_) => true,
-                    };
+                    } && st.when.as_ref().is_none_or(expr_ok);
                     if !ok {
                         return Err(bad("a script step has a bad channel or expression".into()));
                     }
