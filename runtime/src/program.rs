@@ -249,6 +249,13 @@ pub struct Step {
     pub when: Option<Expr>,
 }
 
+impl Step {
+    /// A step that always runs (no `if` condition).
+    pub fn new(action: Action, end: StepEnd) -> Step {
+        Step { action, end, when: None }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Action {
     /// Set both wheel speeds (-1..1): `forward(v)`, `back(v)`, `turn left`, `stop`, ...

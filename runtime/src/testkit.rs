@@ -92,10 +92,7 @@ pub fn module(name: &str, stage: u16, inputs: Vec<u16>, behavior: Behavior) -> M
 
 /// A one-step script.
 pub fn script(action: Action) -> Behavior {
-    Behavior::Script(Script {
-        steps: vec![Step { action, end: StepEnd::Actions(1), when: None }],
-        commit: false,
-    })
+    Behavior::Script(Script { steps: vec![Step::new(action, StepEnd::Actions(1))], commit: false })
 }
 
 /// The paper's obstacle-avoidance behavior: a neural network from the 8 IR
@@ -283,11 +280,7 @@ pub fn navigation_with(spec: GeneSpec) -> Stage {
         0,
         rech_in,
         Behavior::Script(Script {
-            steps: vec![Step {
-                action: Action::Wait { charge: true },
-                end: StepEnd::Until { cond: full, within: 40 },
-                when: None,
-            }],
+            steps: vec![Step::new(Action::Wait { charge: true }, StepEnd::Until { cond: full, within: 40 })],
             commit: false,
         }),
     );
@@ -313,7 +306,7 @@ pub fn barrier_select(hit: f32, miss: f32) -> Expr {
 /// (at most 4 actions; the approach usually ends too close for the catch
 /// zone), reinforce `barrier ? 1 : -1`, close the claw, lift the arm.
 pub fn grip_script() -> Script {
-    let step = |action, end| Step { action, end, when: None };
+    let step = Step::new;
     let barrier = expr(vec![Op::Chan(CH_BARRIER as u16)]);
     Script {
         steps: vec![
@@ -341,7 +334,7 @@ pub fn wall_ahead(level: f32) -> Expr {
 /// high: a wall, where an object is thrown out; the simulator's barrier stays
 /// on while an object is held, so it cannot tell walls here), open the claw.
 pub fn release_script() -> Script {
-    let step = |action, end| Step { action, end, when: None };
+    let step = Step::new;
     let wall = wall_ahead(0.5);
     let reinforce =
         expr(wall.ops.iter().copied().chain([Op::Const(1.0), Op::Const(-1.0), Op::Select]).collect());

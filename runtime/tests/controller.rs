@@ -135,11 +135,7 @@ fn an_inhibitory_link_suppresses_its_target_at_the_next_action() {
 /// two actions), activation 0.5. Module 1: drives `[9, 9]`, activation
 /// `sigmoid(20 * battery - 10)`: it wins when the test sets battery to 1.
 fn script_stage() -> Stage {
-    let step = |v: f32, n: u32| Step {
-        action: Action::Wheels { left: v, right: v },
-        end: StepEnd::Actions(n),
-        when: None,
-    };
+    let step = |v: f32, n: u32| Step::new(Action::Wheels { left: v, right: v }, StepEnd::Actions(n));
     let scripted = Module {
         name: "scripted".into(),
         stage: 0,
@@ -200,17 +196,9 @@ fn until_steps_end_on_their_condition_or_bound_and_reinforce_steps_take_no_time(
         activation: bias_only(0.0),
         behavior: Behavior::Script(Script {
             steps: vec![
-                Step {
-                    action: Action::Wheels { left: 1.0, right: 1.0 },
-                    end: StepEnd::Until { cond, within: 3 },
-                    when: None,
-                },
-                Step { action: Action::Reinforce(r), end: StepEnd::Actions(1), when: None },
-                Step {
-                    action: Action::Wheels { left: 2.0, right: 2.0 },
-                    end: StepEnd::Actions(1),
-                    when: None,
-                },
+                Step::new(Action::Wheels { left: 1.0, right: 1.0 }, StepEnd::Until { cond, within: 3 }),
+                Step::new(Action::Reinforce(r), StepEnd::Actions(1)),
+                Step::new(Action::Wheels { left: 2.0, right: 2.0 }, StepEnd::Actions(1)),
             ],
             commit: false,
         }),
@@ -241,14 +229,10 @@ fn until_steps_end_on_their_condition_or_bound_and_reinforce_steps_take_no_time(
 #[test]
 fn toward_wait_arm_and_claw_steps_give_their_commands() {
     let steps = vec![
-        Step {
-            action: Action::Toward { channels: testkit::chans(CH_IR, 8), speed: 0.5 },
-            end: StepEnd::Actions(1),
-            when: None,
-        },
-        Step { action: Action::Arm(true), end: StepEnd::Actions(1), when: None },
-        Step { action: Action::Claw(true), end: StepEnd::Actions(1), when: None },
-        Step { action: Action::Wait { charge: true }, end: StepEnd::Actions(1), when: None },
+        Step::new(Action::Toward { channels: testkit::chans(CH_IR, 8), speed: 0.5 }, StepEnd::Actions(1)),
+        Step::new(Action::Arm(true), StepEnd::Actions(1)),
+        Step::new(Action::Claw(true), StepEnd::Actions(1)),
+        Step::new(Action::Wait { charge: true }, StepEnd::Actions(1)),
     ];
     let m = Module {
         name: "m".into(),
@@ -528,7 +512,8 @@ fn invalid_stages_are_errors_not_panics() {
     let Behavior::Script(script) = &mut bad.modules[m].behavior else { unreachable!() };
     script.steps[0].when = Some(Expr { ops: vec![Op::Chan(99)], depth: 1 });
     assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadModule { .. })));
-    let program = Program { format: 1, name: "bad".into(), stages: vec![testkit::navigation(), bad] };
+    let program =
+        Program { format: FORMAT_VERSION, name: "bad".into(), stages: vec![testkit::navigation(), bad] };
     let e = program.validate().unwrap_err();
     assert!(e.contains("malformed script step"), "{e}");
 }
@@ -575,12 +560,8 @@ fn follow_light_then_recharge_keeps_the_robot_alive() {
     let full = expr(vec![Op::Chan(CH_BATTERY as u16), Op::Const(1.0), Op::Ge]);
     s.modules[3].behavior = Behavior::Script(Script {
         steps: vec![
-            Step { action: Action::Wheels { left: 0.3, right: 0.3 }, end: StepEnd::Actions(2), when: None },
-            Step {
-                action: Action::Wait { charge: true },
-                end: StepEnd::Until { cond: full, within: 40 },
-                when: None,
-            },
+            Step::new(Action::Wheels { left: 0.3, right: 0.3 }, StepEnd::Actions(2)),
+            Step::new(Action::Wait { charge: true }, StepEnd::Until { cond: full, within: 40 }),
         ],
         commit: false,
     });
@@ -648,11 +629,7 @@ fn a_committed_script_keeps_control_until_its_last_step() {
     // `a` wins the first action (no link input yet); from the second action
     // the excitatory link a -> b makes `b`'s activation the highest. A plain
     // script gives way at once; a committed one finishes its three steps.
-    let step = |id: f32, n: u32| Step {
-        action: Action::Wheels { left: id, right: id },
-        end: StepEnd::Actions(n),
-        when: None,
-    };
+    let step = |id: f32, n: u32| Step::new(Action::Wheels { left: id, right: id }, StepEnd::Actions(n));
     for commit in [false, true] {
         let a = Module {
             name: "a".into(),

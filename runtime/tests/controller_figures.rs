@@ -227,7 +227,7 @@ fn trial_stage(rate_reward: f32, rate_punish: f32, init: (f32, f32, &[usize]), w
 /// actions), reinforce `barrier ? 1 : -1`, close the claw, lift the arm, open
 /// the claw.
 fn grip_trial_script() -> Script {
-    let step = |action, end| Step { action, end, when: None };
+    let step = Step::new;
     let barrier = expr(vec![Op::Chan(CH_BARRIER as u16)]);
     Script {
         steps: vec![

@@ -7,7 +7,7 @@ use shaping_runtime::evolve::{
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{
     Body, Evolution, Fitness, Gene, GeneRole, GenomeLayout, Inheritance, Program, Selection, Stage, StageRun,
-    World,
+    World, FORMAT_VERSION,
 };
 
 // ---------------------------------------------------------------- builders
@@ -70,7 +70,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, run: StageRun)
 /// Stage `first` (10 genes) evolved, then `second` extends it with 6 genes.
 fn two_stages(population: u32, generations: u32) -> Program {
     Program {
-        format: 1,
+        format: FORMAT_VERSION,
         name: "test".into(),
         stages: vec![
             stage("first", None, layout(10, 0), StageRun::Evolve(evolution(population, generations))),

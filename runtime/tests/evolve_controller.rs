@@ -3,7 +3,7 @@
 use shaping_runtime::evolve::{
     evaluate_with_controller, is_finished, start_stage, step_generation, EvalOptions,
 };
-use shaping_runtime::program::{Program, StageRun};
+use shaping_runtime::program::{Program, StageRun, FORMAT_VERSION};
 use shaping_runtime::testkit;
 
 #[test]
@@ -15,7 +15,7 @@ fn navigation_fitness_rises_over_five_generations() {
         evo.selection = shaping_runtime::program::Selection::Truncation { keep: 8 };
         evo.actions = 300;
     }
-    let program = Program { format: 1, name: "navigation".into(), stages: vec![stage] };
+    let program = Program { format: FORMAT_VERSION, name: "navigation".into(), stages: vec![stage] };
     let eval = evaluate_with_controller(&program.stages[0], EvalOptions::of(&program.stages[0])).unwrap();
     let mut cp = start_stage(&program, 0, 2024, None).unwrap();
     let mut stats = Vec::new();
@@ -39,7 +39,7 @@ fn controller_runs_are_identical_on_one_and_two_threads() {
         evo.selection = shaping_runtime::program::Selection::Truncation { keep: 4 };
         evo.actions = 100;
     }
-    let program = Program { format: 1, name: "navigation".into(), stages: vec![stage] };
+    let program = Program { format: FORMAT_VERSION, name: "navigation".into(), stages: vec![stage] };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
@@ -76,7 +76,7 @@ fn collect_stage_starts_from_navigation_and_keeps_its_genes() {
         stage
     };
     let program = Program {
-        format: 1,
+        format: FORMAT_VERSION,
         name: "shaping".into(),
         stages: vec![small(testkit::navigation()), small(testkit::collect())],
     };

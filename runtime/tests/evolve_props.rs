@@ -7,7 +7,7 @@ use shaping_runtime::evolve::{frozen_mask, next_generation, start_stage, step_ge
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{
     Body, Evolution, Fitness, Gene, GeneRole, GenomeLayout, Inheritance, Program, Selection, Stage, StageRun,
-    World,
+    World, FORMAT_VERSION,
 };
 
 fn selection() -> impl Strategy<Value = Selection> {
@@ -154,7 +154,7 @@ proptest! {
         let second: Vec<(u8, bool)> =
             old.iter().map(|&b| (b, true)).chain(new.iter().map(|&b| (b, false))).collect();
         let program = Program {
-            format: 1,
+            format: FORMAT_VERSION,
             name: "prop".into(),
             stages: vec![
                 stage("a", None, layout(&first), evolution(12, sel, crossover, mutation, 1)),
