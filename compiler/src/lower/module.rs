@@ -426,6 +426,8 @@ impl Lower<'_> {
                 help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
             });
         }
+        // Lowered first, so its errors are reported even when `end` fails.
+        let when = x.cond.as_ref().map(|c| self.expr(hw, c, &Scope { only: None }));
         let end = match &x.end {
             None => StepEnd::Actions(1),
             Some(EndDecl::For(q)) => StepEnd::Actions(self.count(q, "a step's duration", 1)? as u32),
@@ -439,8 +441,8 @@ impl Lower<'_> {
                 StepEnd::Until { cond: cond?, within }
             }
         };
-        let when = match &x.cond {
-            Some(c) => Some(self.expr(hw, c, &Scope { only: None })?),
+        let when = match when {
+            Some(c) => Some(c?),
             None => None,
         };
         Some(Step { action, end, when })
