@@ -1,6 +1,9 @@
 // khepera.bat: the experiment of "Incremental Robot Shaping" (Urzelai,
-// Floreano, Dorigo, Colombetti 1998), in three stages.
+// Floreano, Dorigo, Colombetti 1998): a training stage, then three stages.
 //
+//   avoidance   the obstacle-avoidance module learns alone, before evolution
+//               (the paper: modules "can be separately trained before
+//               evolution and/or during evolution")
 //   navigation  wander, avoid obstacles, follow the light, recharge
 //   collect     + a gripper: pick objects up and drop them outside the arena
 //   bigger      the objects grow from 10 to 25 mm: no evolution, the
@@ -21,6 +24,32 @@ robot khepera {
 // other wall, could never matter, and recharging did not evolve.
 genome { bits 4  range -4..4 }
 
+// The avoidance module learns by CRBP from random weights, with the paper's
+// reinforcement program, for one life of 1000 actions. A wander module
+// drives in free space and hands over to it near obstacles (as the evolved
+// arbitration does in the paper's figure 5, the best individual of the first
+// generation): alone, it would be punished for every approach to a wall that
+// driving forward in free space makes, whatever it learned.
+stage avoidance {
+  world { arena 400mm x 600mm }
+  train for 1000 actions
+  module wander {
+    sense ir
+    activation fixed 0
+    behavior forward(1.0)
+  }
+  module avoid {
+    sense ir
+    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]   // wins when sum(ir) > 0.3
+    behavior neural {
+      outputs sign(2) -> forward | right | left | back
+      weights random -0.5..0.5
+    }
+    learn crbp(0.5, 0.1) on behavior always over 30 actions
+    reinforce sign(max(prev ir) - max(ir))
+  }
+}
+
 stage navigation {
   world {
     arena 400mm x 600mm
@@ -37,15 +66,17 @@ stage navigation {
     behavior forward(1.0)
   }
 
-  // Learns to avoid obstacles from random weights: rewarded when the
-  // closest obstacle gets farther, punished when it gets closer.
+  // Starts every life from the weights it learned in stage `avoidance` and
+  // keeps learning (the paper: "local learning in the obstacle avoidance
+  // module was always active"): rewarded when the closest obstacle gets
+  // farther, punished when it gets closer.
   module avoid {
     sense ir
     behavior neural {
       outputs sign(2) -> forward | right | left | back
-      weights random -0.5..0.5
+      weights trained avoidance
     }
-    learn crbp(0.1, 0.01) on behavior always over 30 actions
+    learn crbp(0.5, 0.1) on behavior always over 30 actions
     reinforce sign(max(prev ir) - max(ir))
   }
 
@@ -96,7 +127,7 @@ stage collect extends navigation {
       claw closed
       arm up
     }
-    learn crbp(0.1, 0.01) on activation always
+    learn crbp(0.5, 0.1) on activation always
   }
 
   // Drop the object outside: approach the obstacle, lower the arm, open
@@ -113,7 +144,7 @@ stage collect extends navigation {
       reinforce prev barrier and not barrier ? 1 : -1
       arm up
     }
-    learn crbp(0.1, 0.01) on activation always
+    learn crbp(0.5, 0.1) on activation always
   }
 
   links all evolvable

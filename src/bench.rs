@@ -27,8 +27,10 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 pub fn bench(args: BenchArgs) -> Result<(), CliError> {
-    let program = load::load_program(&args.file, args.error_format)?;
+    let mut program = load::load_program(&args.file, args.error_format)?;
     let index = load::stage_index(&program, args.stage.as_deref())?;
+    let seed = crate::run::run_seed(&program, None);
+    crate::run::bind_training(&mut program, None, seed)?;
     let stage = &program.stages[index];
     let runs = args.runs.max(1);
     let mut rng = ChaCha8Rng::seed_from_u64(7);

@@ -168,6 +168,22 @@ fn summarise(
                     reach_text
                 );
             }
+            StageRun::Train { actions } => {
+                let mut perf = Vec::new();
+                for &seed in seeds {
+                    let t: shaping_runtime::evolve::Trained =
+                        read_json(&out.join(format!("seed-{seed}")).join(&stage.name).join("trained.json"))?;
+                    let learners =
+                        stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
+                    perf.extend(learners.map(|(_, p)| *p as f64));
+                }
+                let _ = writeln!(
+                    md,
+                    "| {} | training, {actions} actions | performance at the end {} | - | - | - |",
+                    stage.name,
+                    fmt_spread(spread(&perf), 2),
+                );
+            }
             StageRun::Test { actions, learning } => {
                 let mut fit = Vec::new();
                 let mut grips = Vec::new();

@@ -53,10 +53,12 @@ fn evolved_source(program: &Program, index: usize) -> usize {
 }
 
 pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
-    let program = load::load_program(&args.file, args.error_format)?;
+    let mut program = load::load_program(&args.file, args.error_format)?;
     let index = load::stage_index(&program, args.stage.as_deref())?;
-    let stage = &program.stages[index];
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let train_seed = run::run_seed(&program, None);
+    run::bind_training(&mut program, Some(&run_dir), train_seed)?;
+    let stage = &program.stages[index];
     let genome = match &args.genome {
         Some(g) => parse_genome(g)?,
         // Nothing is evolved: the empty genome is the only individual.
@@ -85,6 +87,7 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let (actions, learning) = match &stage.run {
         StageRun::Evolve(e) => (e.actions, true),
         StageRun::Test { actions, learning } => (*actions, *learning),
+        StageRun::Train { actions } => (*actions, true),
     };
     let actions = args.actions.unwrap_or(actions);
     let learning = learning && !args.no_learning;

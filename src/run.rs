@@ -43,7 +43,7 @@ pub fn run_seed(program: &Program, seed: Option<u64>) -> u64 {
             .iter()
             .find_map(|s| match &s.run {
                 StageRun::Evolve(e) => Some(e.seed),
-                StageRun::Test { .. } => None,
+                StageRun::Test { .. } | StageRun::Train { .. } => None,
             })
             .unwrap_or(1)
     })
@@ -91,7 +91,7 @@ fn to_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
 }
 
 pub fn run(args: RunArgs) -> Result<(), CliError> {
-    let program = load::load_program(&args.file, args.error_format)?;
+    let mut program = load::load_program(&args.file, args.error_format)?;
     let target = match args.stage.as_deref() {
         Some(_) => load::stage_index(&program, args.stage.as_deref())?,
         None => program.stages.len().saturating_sub(1),
@@ -111,6 +111,14 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
     let started = Instant::now();
     let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
     for &index in &stages {
+        if let StageRun::Train { .. } = program.stages[index].run {
+            let dir = out.join(&program.stages[index].name);
+            create_dir(&dir)?;
+            let trained = train_step(&program, index, seed, &dir, &args)?;
+            evolve::train::bind(&mut program, index, &trained)
+                .map_err(|e| CliError::io(format!("error: {e}")))?;
+            continue;
+        }
         let stage = &program.stages[index];
         let dir = out.join(&stage.name);
         create_dir(&dir)?;
@@ -126,6 +134,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
                 })?;
                 test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
             }
+            StageRun::Train { .. } => unreachable!("training stages run above"),
         }
     }
     if !args.quiet && !args.json {
@@ -379,4 +388,95 @@ fn report_generation(args: &RunArgs, bar: &ProgressBar, stats: &GenStats) {
             let _ = writeln!(out, "{line}");
         }
     }
+}
+
+/// Runs training stage `index` (or reuses the `trained.json` a previous run
+/// of the same stage and seed left in `dir`) and writes its files: the
+/// learned weights, the trace of the training life and its pictures.
+fn train_step(
+    program: &Program,
+    index: usize,
+    seed: u64,
+    dir: &Path,
+    args: &RunArgs,
+) -> Result<evolve::Trained, CliError> {
+    let stage = &program.stages[index];
+    let path = dir.join("trained.json");
+    if !args.fresh {
+        if let Some(t) = read_trained(&path)? {
+            if t.fingerprint == evolve::train::training_fingerprint(stage) && t.run_seed == seed {
+                if !args.quiet && !args.json {
+                    eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
+                }
+                return Ok(t);
+            }
+        }
+    }
+    let mut trace = Trace::default();
+    let trained = evolve::train_stage(program, index, seed, Some(&mut trace))
+        .map_err(|e| CliError::io(format!("error: {e}")))?;
+    let scene = Sim::new(&stage.world, 0).scene();
+    report::episode_files(dir, &stage.name, stage, &trace, &scene, &[])?;
+    write_atomic(&path, to_json(&trained)?.as_bytes())?;
+    if args.json {
+        println!(
+            "{}",
+            serde_json::json!({"stage": stage.name, "trained": trained.result.actions, "performance": trained.performance})
+        );
+    } else if !args.quiet {
+        let perf: Vec<String> = stage
+            .modules
+            .iter()
+            .zip(&trained.performance)
+            .filter(|(m, _)| m.learning.is_some())
+            .map(|(m, p)| format!("{} {p:+.2}", m.name))
+            .collect();
+        eprintln!(
+            "stage {:<12} trained for {} actions, performance {}  -> {}",
+            stage.name,
+            trained.result.actions,
+            perf.join(", "),
+            dir.display()
+        );
+    }
+    Ok(trained)
+}
+
+/// A `trained.json`, if there is one (a corrupt one is an error).
+fn read_trained(path: &Path) -> Result<Option<evolve::Trained>, CliError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bytes = std::fs::read(path)
+        .map_err(|e| CliError::io(format!("error: cannot read `{}`: {e}", path.display())))?;
+    serde_json::from_slice(&bytes).map(Some).map_err(|e| {
+        CliError::io(format!(
+            "error: `{}` is not a trained-weights file ({e}); delete it or pass `--fresh`",
+            path.display()
+        ))
+    })
+}
+
+/// Binds the weights of every training stage into `program`: from the
+/// `trained.json` files of run directory `run_dir` where they exist and fit,
+/// else by training again from `seed` (training is deterministic by seed).
+pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -> Result<(), CliError> {
+    for i in 0..program.stages.len() {
+        if !matches!(program.stages[i].run, StageRun::Train { .. }) {
+            continue;
+        }
+        let stage = &program.stages[i];
+        let saved = match run_dir {
+            Some(d) => read_trained(&d.join(&stage.name).join("trained.json"))?
+                .filter(|t| t.fingerprint == evolve::train::training_fingerprint(stage)),
+            None => None,
+        };
+        let trained = match saved {
+            Some(t) => t,
+            None => evolve::train_stage(program, i, seed, None)
+                .map_err(|e| CliError::io(format!("error: {e}")))?,
+        };
+        evolve::train::bind(program, i, &trained).map_err(|e| CliError::io(format!("error: {e}")))?;
+    }
+    Ok(())
 }

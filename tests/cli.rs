@@ -290,13 +290,14 @@ fn bench_prints_one_json_line() {
 }
 
 /// A stage with nothing evolved replays without a genome, and its avoid
-/// module's performance indicator rises (figure 5 from the command line).
+/// module's performance indicator is high by action 300 (figure 5 from the
+/// command line).
 #[test]
 fn replay_of_a_stage_without_genes_needs_no_genome() {
     let dir = scratch("avoid");
     let out = run(shaping().arg("replay").arg(root().join("examples/avoid.bat")).arg("--out").arg(&dir));
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("avoid: 5000 actions"), "{}", text(&out.stdout));
+    assert!(text(&out.stdout).contains("avoid: 1000 actions"), "{}", text(&out.stdout));
     assert!(dir.join("reinforcement.png").exists());
     let trace = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
     let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
@@ -304,7 +305,37 @@ fn replay_of_a_stage_without_genes_needs_no_genome() {
     let perf: Vec<f32> =
         trace.lines().skip(1).map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
     let mean = |s: &[f32]| s.iter().sum::<f32>() / s.len() as f32;
-    let (first, last) = (mean(&perf[..300]), mean(&perf[4000..]));
-    assert!(last > first + 0.1 && last > 0.15, "performance {first} -> {last}");
+    let (first, at300) = (mean(&perf[..100]), perf[299]);
+    assert!(
+        at300 >= 0.5 && at300 > first + 0.2,
+        "performance {first} in the first 100 actions, {at300} at 300"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `run` trains a training stage as a step of its own (its directory, its
+/// weights, its pictures), reuses the weights when run again, and `layout`
+/// shows the trained weights of the stage that uses them as parameters, not
+/// genes.
+#[test]
+fn training_stage_runs_as_a_step_and_its_weights_reach_the_next_stage() {
+    let dir = scratch("pretrained");
+    let file = root().join("examples/pretrained.bat");
+    let first = run(shaping().arg("run").arg(&file).args(["--stage", "avoidance", "--out"]).arg(&dir));
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    assert!(text(&first.stderr).contains("trained for 1000 actions"), "{}", text(&first.stderr));
+    let trained = std::fs::read_to_string(dir.join("avoidance/trained.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&trained).unwrap();
+    assert_eq!(v["weights"][1].as_array().map(|w| w.len()), Some(18), "the avoid module's 18 weights");
+    assert!(dir.join("avoidance/reinforcement.png").exists());
+    let again = run(shaping().arg("run").arg(&file).args(["--stage", "avoidance", "--out"]).arg(&dir));
+    assert!(text(&again.stderr).contains("trained before, reused"), "{}", text(&again.stderr));
+    assert_eq!(std::fs::read_to_string(dir.join("avoidance/trained.json")).unwrap(), trained);
+    let layout = run(shaping().arg("layout").arg(&file).args(["--stage", "navigation"]));
+    assert!(
+        text(&layout.stdout).contains("trained: `avoid` behavior, 18 weights, learned by stage `avoidance`"),
+        "{}",
+        text(&layout.stdout)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use shaping_runtime::program::{Behavior, GeneRole, Param, Program, Stage};
+use shaping_runtime::program::{Behavior, GeneRole, Param, Program, Stage, StageRun};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
 fn channel_name(stage: &Stage, c: u16) -> String {
@@ -125,6 +125,25 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         n - frozen.len(),
         st.layout.bits - fbits
     );
+    // Parameters that are not genes: what training stages learned.
+    for m in &st.modules {
+        let Behavior::Neural(nb) = &m.behavior else { continue };
+        let Some(Param::Trained { stage: t, .. }) = nb.net.params.first() else { continue };
+        let by = program.stages.get(*t as usize).map(|s| s.name.as_str()).unwrap_or("?");
+        let actions = match program.stages.get(*t as usize).map(|s| &s.run) {
+            Some(StageRun::Train { actions }) => format!(" for {actions} actions"),
+            _ => String::new(),
+        };
+        let _ = writeln!(
+            out,
+            "trained: `{}` behavior, {} weights, learned by stage `{by}`{actions} (not genes)",
+            m.name,
+            nb.net.params.len()
+        );
+    }
+    if let StageRun::Train { actions } = st.run {
+        let _ = writeln!(out, "training stage: its modules learn for {actions} actions; nothing is evolved");
+    }
     out
 }
 
@@ -182,6 +201,7 @@ pub fn render_graph(program: &Program, stage: usize) -> String {
             Param::Gene(g) => format!("gene {g}"),
             Param::Fixed(w) => format!("{w:.2}"),
             Param::Random { lo, hi } => format!("random {lo:.2}..{hi:.2}"),
+            Param::Trained { .. } => "trained".into(),
         };
         let frozen =
             matches!(l.weight, Param::Gene(g) if st.layout.genes.get(g as usize).is_some_and(|x| x.frozen));

@@ -197,6 +197,10 @@ pub enum Param {
     /// Drawn uniformly in `lo..hi` at the start of each episode from the
     /// individual's RNG (e.g. a behavior network that learns from random weights).
     Random { lo: f32, hi: f32 },
+    /// Weight `index` of the behavior network that module `module` of the
+    /// training stage `stage` learned. Bound to `Fixed` by [`bind_trained`]
+    /// once that stage has run; a controller refuses an unbound one.
+    Trained { stage: u16, module: u16, index: u32 },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -293,6 +297,23 @@ pub struct Learning {
     pub when: LearnWhen,
     /// Window (in reinforcement signals) of the performance indicator.
     pub window: u32,
+    /// The error the delta rule back-propagates.
+    #[serde(default)]
+    pub error: CrbpError,
+}
+
+/// The output error CRBP back-propagates toward the target bits `t`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CrbpError {
+    /// `t - y`: the discrepancy itself, as the paper describes CRBP
+    /// ("back-propagating the discrepancy (O - S)"); the gradient of the
+    /// cross-entropy of sigmoid outputs, so a saturated output still learns.
+    #[default]
+    Difference,
+    /// `(t - y) y (1 - y)`: the gradient of the squared error through the
+    /// sigmoid; steps vanish where an output saturates.
+    Squared,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -399,6 +420,12 @@ pub enum StageRun {
         actions: u32,
         learning: bool,
     },
+    /// No evolution and no genes: the stage's modules live one life of
+    /// `actions` actions in its world with learning on, and later stages
+    /// start from the behavior weights they learned (`Param::Trained`).
+    Train {
+        actions: u32,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -477,6 +504,9 @@ impl Program {
                 Param::Gene(i) => (i as usize) < genes,
                 Param::Fixed(v) => v.is_finite(),
                 Param::Random { lo, hi } => lo.is_finite() && hi.is_finite() && lo <= hi,
+                Param::Trained { stage: t, .. } => {
+                    (t as usize) < si && matches!(self.stages[t as usize].run, StageRun::Train { .. })
+                }
             };
             let net_ok = |n: &Network, inputs: usize| {
                 n.inputs as usize == inputs
@@ -535,4 +565,28 @@ impl Program {
         }
         Ok(())
     }
+}
+
+/// Replaces every `Param::Trained` that refers to training stage `stage`
+/// with the weight its module learned: `weights[m]` are the behavior
+/// weights of that stage's module `m` (`Network::params` order). Returns how
+/// many parameters were bound.
+pub fn bind_trained(program: &mut Program, stage: usize, weights: &[Vec<f32>]) -> usize {
+    let mut bound = 0;
+    for st in &mut program.stages {
+        for m in &mut st.modules {
+            let Behavior::Neural(nb) = &mut m.behavior else { continue };
+            for p in &mut nb.net.params {
+                if let Param::Trained { stage: s, module, index } = *p {
+                    if s as usize == stage {
+                        if let Some(&w) = weights.get(module as usize).and_then(|w| w.get(index as usize)) {
+                            *p = Param::Fixed(w);
+                            bound += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    bound
 }

@@ -110,7 +110,14 @@ pub fn avoid_behavior(init: f32, speed: f32) -> Behavior {
 
 /// CRBP learning settings.
 pub fn crbp(target: LearnTarget, rate_reward: f32, rate_punish: f32, window: u32) -> Learning {
-    Learning { target, rate_reward, rate_punish, when: LearnWhen::Always, window }
+    Learning {
+        target,
+        rate_reward,
+        rate_punish,
+        when: LearnWhen::Always,
+        window,
+        error: CrbpError::default(),
+    }
 }
 
 /// Links between every ordered pair of distinct modules, evolvable.

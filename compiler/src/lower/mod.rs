@@ -152,7 +152,14 @@ pub(crate) struct Lower<'a> {
     stage_names: Vec<String>,
     /// Hardware whose declaration failed: not reported again where used.
     poisoned: std::collections::HashSet<String>,
+    /// Training stages lowered so far, by name: their program index and, per
+    /// module, its name and behavior network shape (inputs, hidden, outputs).
+    trained: HashMap<String, (u16, Vec<TrainedModule>)>,
 }
+
+/// A module of a training stage: its name and its behavior network's shape
+/// (inputs, hidden, outputs), `None` for a script.
+pub(crate) type TrainedModule = (String, Option<(u16, u16, u16)>);
 
 const DEFAULT_BITS: u8 = 4;
 /// Most modules in a stage (module indices are `u16`, and `links all`
@@ -163,7 +170,7 @@ const MAX_STAGES: usize = 64;
 const DEFAULT_WINDOW: u32 = 30;
 const DEFAULT_LAMP_HEIGHT: f32 = 150.0;
 const DEFAULT_RECHARGE: u32 = 20;
-const DEFAULT_RATES: (f32, f32) = (0.1, 0.01);
+const DEFAULT_RATES: (f32, f32) = (0.5, 0.1);
 
 fn default_evolution() -> Evolution {
     Evolution {
@@ -188,6 +195,7 @@ pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
         module_origin: HashMap::new(),
         stage_names: Vec::new(),
         poisoned: Default::default(),
+        trained: HashMap::new(),
     };
     let program = lw.program(file_name);
     if lw.errors.is_empty() {
@@ -489,7 +497,7 @@ impl<'a> Lower<'a> {
             }
         }
         let mut states: Vec<StageSt> = Vec::new();
-        let mut stages = Vec::new();
+        let mut stages: Vec<Stage> = Vec::new();
         for &i in &order {
             let decl = &file.stages[i];
             let s = stages.len() as u16;
@@ -505,6 +513,49 @@ impl<'a> Lower<'a> {
             let (state, stage) = self.stage(decl, s, parent_index, base);
             if orphan[i] {
                 self.errors.truncate(saved);
+            }
+            if let Some(p) = parent_index {
+                if let (StageRun::Train { .. }, Some(e)) = (&stages[p].run, &decl.extends) {
+                    self.value_error(
+                        e.span,
+                        format!("stage `{}` extends training stage `{}`", decl.name.text, stages[p].name),
+                        "a training stage",
+                        Some(format!(
+                            "use what it learned with `weights trained {}` in a neural behavior",
+                            stages[p].name
+                        )),
+                    );
+                }
+            }
+            let trains = decl.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }));
+            if let (StageRun::Train { .. }, true) = (&stage.run, trains) {
+                if !stage.layout.genes.is_empty() {
+                    self.value_error(
+                        decl.name.span,
+                        format!(
+                            "training stage `{}` evolves nothing, but declares {} genes",
+                            decl.name.text,
+                            stage.layout.genes.len()
+                        ),
+                        "has genes",
+                        Some(
+                            "declare its activation weights, behavior weights and links `fixed` or `random`"
+                                .into(),
+                        ),
+                    );
+                }
+                let shapes = stage
+                    .modules
+                    .iter()
+                    .map(|m| {
+                        let shape = match &m.behavior {
+                            Behavior::Neural(nb) => Some((nb.net.inputs, nb.net.hidden, nb.net.outputs)),
+                            Behavior::Script(_) => None,
+                        };
+                        (m.name.clone(), shape)
+                    })
+                    .collect();
+                self.trained.insert(decl.name.text.clone(), (s, shapes));
             }
             states.push(state);
             stages.push(stage);

@@ -123,7 +123,7 @@ impl Lower<'_> {
                             Some(Behavior::Script(Script { steps: lowered, commit: *commit }))
                         }
                         ast::BehaviorDecl::Neural(n) => {
-                            let (nb, genes) = self.neural(hw, n, &inputs);
+                            let (nb, genes) = self.neural(hw, n, &inputs, &m.name.text);
                             st.behavior_genes = genes;
                             nb.map(Behavior::Neural)
                         }
@@ -220,6 +220,15 @@ impl Lower<'_> {
             Some(ast::WeightSource::Random(r, _)) => {
                 let (lo, hi) = self.range(r)?;
                 Source::Random(lo, hi)
+            }
+            Some(ast::WeightSource::Trained(_, sp)) => {
+                self.value_error(
+                    *sp,
+                    "activation networks are not trained by training stages".into(),
+                    "not here",
+                    Some("`weights trained STAGE` is for neural behaviors; an activation network is `evolvable`, `fixed` or `random`".into()),
+                );
+                return None;
             }
         };
         if range.is_some() && !matches!(source, Source::Evolvable(_)) {
@@ -454,6 +463,7 @@ impl Lower<'_> {
         hw: &Hw,
         n: &ast::NeuralDecl,
         module_inputs: &[u16],
+        module: &str,
     ) -> (Option<NeuralBehavior>, Option<Option<(f32, f32)>>) {
         let inputs = match &n.sense {
             Some((refs, _)) => match self.sensor_refs(hw, refs) {
@@ -536,9 +546,67 @@ impl Lower<'_> {
                 (self.fixed_params(&vals, count, *sp), None)
             }
             Some(ast::WeightSource::Evolvable(_)) => (Vec::new(), Some(None)),
+            Some(ast::WeightSource::Trained(by, sp)) => {
+                let shape = (inputs.len() as u16, hidden, outputs);
+                match self.trained_params(by, *sp, module, shape) {
+                    Some(p) => (p, None),
+                    None => return (None, None),
+                }
+            }
         };
         let net = Network { inputs: inputs.len() as u16, hidden, outputs, params };
         (Some(NeuralBehavior { inputs, net, decode }), genes)
+    }
+
+    /// `weights trained STAGE`: the behavior weights module `module` of the
+    /// training stage `STAGE` learned, for a network of the same shape.
+    fn trained_params(
+        &mut self,
+        by: &ast::Name,
+        span: Span,
+        module: &str,
+        shape: (u16, u16, u16),
+    ) -> Option<Vec<Param>> {
+        let Some((stage, modules)) = self.trained.get(&by.text) else {
+            let help = did_you_mean(&by.text, self.trained.keys().map(String::as_str)).or_else(|| {
+                Some("name a training stage (`train for N actions`) declared before this one".into())
+            });
+            self.errors.push(Error::Unknown {
+                span: by.span.into(),
+                what: "training stage",
+                name: by.text.clone(),
+                help,
+            });
+            return None;
+        };
+        let stage = *stage;
+        let Some((m, (_, found))) = modules.iter().enumerate().find(|(_, (n, _))| n == module) else {
+            self.value_error(
+                by.span,
+                format!("training stage `{}` has no module `{module}`", by.text),
+                "no such module there",
+                Some("weights are trained by the module of the same name".into()),
+            );
+            return None;
+        };
+        if *found != Some(shape) {
+            let what = match found {
+                Some((i, h, o)) => format!("{i} inputs, {h} hidden and {o} outputs"),
+                None => "a scripted behavior".into(),
+            };
+            self.value_error(
+                span,
+                format!(
+                    "module `{module}` of `{}` has {what}, but this network has {} inputs, {} hidden and {} outputs",
+                    by.text, shape.0, shape.1, shape.2
+                ),
+                "another shape",
+                Some("sense the same inputs and declare the same `hidden` and `outputs`".into()),
+            );
+            return None;
+        }
+        let count = Network::param_count(shape.0 as usize, shape.1 as usize, shape.2 as usize) as u32;
+        Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
     }
 
     fn learn(&mut self, l: &ast::LearnDecl) -> Option<Learning> {
@@ -564,6 +632,21 @@ impl Lower<'_> {
             }
             None => DEFAULT_RATES,
         };
+        let error = match l.error.as_ref().map(|e| e.text.as_str()) {
+            None | Some("difference") => CrbpError::Difference,
+            Some("squared") => CrbpError::Squared,
+            Some(other) => {
+                let e = l.error.as_ref().expect("matched Some");
+                self.errors.push(Error::Unknown {
+                    span: e.span.into(),
+                    what: "CRBP error",
+                    name: other.into(),
+                    help: did_you_mean(other, ["difference", "squared"])
+                        .or_else(|| Some("the error is `difference` (the paper's) or `squared`".into())),
+                });
+                return None;
+            }
+        };
         let when = match l.below {
             None => LearnWhen::Always,
             Some(t) => LearnWhen::Below {
@@ -574,6 +657,6 @@ impl Lower<'_> {
             Some(q) => self.count(q, "the performance window", 1)? as u32,
             None => DEFAULT_WINDOW,
         };
-        Some(Learning { target, rate_reward, rate_punish, when, window })
+        Some(Learning { target, rate_reward, rate_punish, when, window, error })
     }
 }

@@ -16,6 +16,23 @@ impl Lower<'_> {
         let mut test_span: Option<Span> = None;
         for item in &decl.items {
             match item {
+                I::Train { actions, span } => {
+                    if let Some(e) = evolve_span.or(test_span) {
+                        self.conflict_run(*span, e);
+                    }
+                    test_span = Some(*span);
+                    if has_parent {
+                        self.value_error(
+                            *span,
+                            format!("training stage `{}` extends another stage", decl.name.text),
+                            "trains from scratch",
+                            Some("a training stage stands alone; later stages use what it learned with `weights trained STAGE`".into()),
+                        );
+                    }
+                    if let Some(n) = self.count(actions, "the training length", 1) {
+                        st.run = StageRun::Train { actions: n as u32 };
+                    }
+                }
                 I::Evolve(settings, sp) => {
                     if let Some(t) = test_span {
                         self.conflict_run(*sp, t);
@@ -60,7 +77,7 @@ impl Lower<'_> {
         self.errors.push(Error::Conflict {
             span: span.into(),
             other: other.into(),
-            message: "a stage either evolves or tests, not both".into(),
+            message: "a stage either evolves, tests or trains: one of them".into(),
             label: "this".into(),
             other_label: "conflicts with this".into(),
         });

@@ -105,6 +105,7 @@ pub enum StageItem {
     World(WorldBlock),
     Evolve(Vec<Setting>, Span),
     Test { actions: Quantity, learning: bool, span: Span },
+    Train { actions: Quantity, span: Span },
     Fitness(FitnessDecl),
     Module(ModuleDecl),
     LinksAll(LinkKind, Span),
@@ -238,12 +239,18 @@ pub enum WeightSource {
     Evolvable(Span),
     Fixed(Vec<f64>, Span),
     Random(Range, Span),
+    /// `trained STAGE`: the weights a training stage's module of the same
+    /// name learned.
+    Trained(Name, Span),
 }
 
 impl WeightSource {
     pub fn span(&self) -> Span {
         match self {
-            WeightSource::Evolvable(s) | WeightSource::Fixed(_, s) | WeightSource::Random(_, s) => *s,
+            WeightSource::Evolvable(s)
+            | WeightSource::Fixed(_, s)
+            | WeightSource::Random(_, s)
+            | WeightSource::Trained(_, s) => *s,
         }
     }
 }
@@ -350,6 +357,8 @@ pub enum OutputsDecl {
 #[derive(Clone, Debug, PartialEq)]
 pub struct LearnDecl {
     pub rates: Option<(f64, f64, Span)>,
+    /// `error difference|squared` in the parentheses.
+    pub error: Option<Name>,
     pub target: Name,
     /// `None` for `always`, else the threshold.
     pub below: Option<f64>,

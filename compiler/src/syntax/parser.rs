@@ -187,6 +187,8 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::evolve => "`evolve`",
         Rule::selection => "`selection`",
         Rule::test_run => "`test`",
+        Rule::train_run => "`train`",
+        Rule::k_trained => "`trained`",
         Rule::test_learning => "`with learning` or `without learning`",
         Rule::fitness => "`fitness`",
         Rule::fitness_mode => "`adds`",
@@ -198,7 +200,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::sensor_ref => "a sensor",
         Rule::index => "`[`",
         Rule::activation => "`activation`",
-        Rule::weights_source => "`evolvable`, `fixed` or `random`",
+        Rule::weights_source => "`evolvable`, `fixed`, `random` or `trained`",
         Rule::k_evolvable => "`evolvable`",
         Rule::k_fixed => "`fixed`",
         Rule::k_random => "`random`",
@@ -234,6 +236,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::learn => "`learn`",
         Rule::rates => "`(`",
         Rule::learn_target => "`behavior` or `activation`",
+        Rule::learn_error => "`difference` or `squared`",
         Rule::learn_when | Rule::k_always => "`always` or `when`",
         Rule::window => "`over`",
         Rule::links_all => "`links`",
@@ -440,6 +443,10 @@ fn weight_source(p: Pair<Rule>) -> WeightSource {
             let r = it.next().map(range).unwrap_or(Range { lo: -1.0, hi: 1.0, span: sp });
             WeightSource::Random(r, sp)
         }
+        Some(Rule::k_trained) => match it.next() {
+            Some(n) => WeightSource::Trained(name(n), sp),
+            None => WeightSource::Trained(Name { text: String::new(), span: sp }, sp),
+        },
         _ => WeightSource::Evolvable(sp),
     }
 }
@@ -487,6 +494,14 @@ impl Builder {
                 Rule::genome => items.push(StageItem::Genome(genome(c))),
                 Rule::world => items.push(StageItem::World(world(c))),
                 Rule::evolve => items.push(StageItem::Evolve(c.into_inner().map(setting).collect(), csp)),
+                Rule::train_run => {
+                    let actions = c.into_inner().next().map(quantity).unwrap_or(Quantity {
+                        value: 0.0,
+                        unit: None,
+                        span: csp,
+                    });
+                    items.push(StageItem::Train { actions, span: csp });
+                }
                 Rule::test_run => {
                     let mut ti = c.into_inner();
                     let actions =
@@ -595,6 +610,7 @@ impl Builder {
                 Rule::learn => {
                     let mut l = LearnDecl {
                         rates: None,
+                        error: None,
                         target: Name { text: String::new(), span: csp },
                         below: None,
                         window: None,
@@ -604,7 +620,13 @@ impl Builder {
                         match o.as_rule() {
                             Rule::rates => {
                                 let rs = span(&o);
-                                let v: Vec<f64> = o.into_inner().map(|n| num(&n)).collect();
+                                let mut v: Vec<f64> = Vec::new();
+                                for n in o.into_inner() {
+                                    match n.as_rule() {
+                                        Rule::learn_error => l.error = Some(name(n)),
+                                        _ => v.push(num(&n)),
+                                    }
+                                }
                                 if v.len() == 2 {
                                     l.rates = Some((v[0], v[1], rs));
                                 }

@@ -18,16 +18,18 @@ fn every_example_compiles() {
 }
 
 #[test]
-fn khepera_has_the_papers_three_stages() {
+fn khepera_has_a_training_stage_and_the_papers_three_stages() {
     use shaping_compiler::Program;
     use shaping_runtime::program::{Behavior, Decode, StageRun};
     let src = std::fs::read_to_string(root().join("examples/khepera.bat")).unwrap();
     let p: Program = compile_ok(&src, "khepera.bat");
     let names: Vec<&str> = p.stages.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["navigation", "collect", "bigger"]);
-    assert_eq!(p.stages[1].parent, Some(0));
+    assert_eq!(names, ["avoidance", "navigation", "collect", "bigger"]);
+    assert_eq!(p.stages[0].run, StageRun::Train { actions: 1000 });
+    assert!(p.stages[0].layout.genes.is_empty(), "a training stage has no genes");
     assert_eq!(p.stages[2].parent, Some(1));
-    let nav = &p.stages[0];
+    assert_eq!(p.stages[3].parent, Some(2));
+    let nav = &p.stages[1];
     // 4 modules, all interconnected: 12 links.
     assert_eq!(nav.modules.len(), 4);
     assert_eq!(nav.links.len(), 12);
@@ -36,18 +38,22 @@ fn khepera_has_the_papers_three_stages() {
     // avoid: neural, 2 sign outputs; bits 11 = forward, 00 = back.
     let Behavior::Neural(nb) = &nav.modules[1].behavior else { panic!("avoid is neural") };
     assert_eq!(nb.net.outputs, 2);
+    // Its weights are what the training stage's avoid module (module 1) learns.
+    assert!(nb.net.params.iter().enumerate().all(
+        |(i, w)| *w == shaping_runtime::program::Param::Trained { stage: 0, module: 1, index: i as u32 }
+    ));
     assert_eq!(nb.decode, Decode::Table(vec![[-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0], [1.0, 1.0]]));
     // collect keeps navigation's genes as a frozen prefix.
-    let col = &p.stages[1];
+    let col = &p.stages[2];
     assert_eq!(
         &col.layout.genes[..nav.layout.genes.len()].iter().map(|g| g.offset).collect::<Vec<_>>(),
         &nav.layout.genes.iter().map(|g| g.offset).collect::<Vec<_>>()
     );
     assert!(col.layout.genes[..nav.layout.genes.len()].iter().all(|g| g.frozen));
-    assert!(col.layout.genes[nav.layout.genes.len()..].iter().all(|g| !g.frozen && g.stage == 1));
+    assert!(col.layout.genes[nav.layout.genes.len()..].iter().all(|g| !g.frozen && g.stage == 2));
     assert_eq!(col.links.len(), 30);
     assert_eq!(col.world.objects.as_ref().map(|o| o.diameter), Some(10.0));
-    assert_eq!(p.stages[2].world.objects.as_ref().map(|o| o.diameter), Some(25.0));
-    assert_eq!(p.stages[2].run, StageRun::Test { actions: 300, learning: true });
+    assert_eq!(p.stages[3].world.objects.as_ref().map(|o| o.diameter), Some(25.0));
+    assert_eq!(p.stages[3].run, StageRun::Test { actions: 300, learning: true });
     assert_eq!(col.fitness.bonuses.len(), 2);
 }

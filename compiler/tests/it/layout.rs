@@ -45,7 +45,7 @@ fn truncation_keeps_a_fifth_of_the_population_unless_told() {
     use shaping_runtime::program::{Selection, StageRun};
     let keep = |src: &str, stage: usize| match &compile_ok(src, "keep.bat").stages[stage].run {
         StageRun::Evolve(e) => e.selection,
-        StageRun::Test { .. } => panic!("an evolved stage"),
+        StageRun::Test { .. } | StageRun::Train { .. } => panic!("an evolved stage"),
     };
     let head = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n";
     let body = "fitness per action wheels[0]  module m { sense ir  behavior forward }";

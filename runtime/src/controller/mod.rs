@@ -319,6 +319,7 @@ impl<'s> Controller<'s> {
                     lo
                 }
             }
+            Param::Trained { .. } => unreachable!("validate refuses unbound trained weights"),
         };
         let mut mods = Vec::with_capacity(stage.modules.len());
         for m in &stage.modules {
@@ -560,7 +561,7 @@ impl<'s> Controller<'s> {
                     match l.target {
                         LearnTarget::Activation => {
                             let t = if r > 0.0 { 1.0 } else { 0.0 };
-                            module.activation.train(&self.now, |_| t, rate);
+                            module.activation.train(&self.now, |_| t, rate, l.error);
                         }
                         LearnTarget::Behavior => {
                             if let Gen::Neural { net, bits, .. } = &mut module.gen {
@@ -577,6 +578,7 @@ impl<'s> Controller<'s> {
                                         }
                                     },
                                     rate,
+                                    l.error,
                                 );
                             }
                         }
@@ -746,6 +748,7 @@ pub fn validate(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
         Param::Gene(i) => (i as usize) < n_genes,
         Param::Fixed(v) => v.is_finite(),
         Param::Random { lo, hi } => lo.is_finite() && hi.is_finite() && lo <= hi,
+        Param::Trained { .. } => false,
     };
     let chans_ok = |c: &[u16]| c.iter().all(|&c| (c as usize) < CHANNELS);
     let net_ok = |net: &Network, inputs: &[u16]| -> Result<(), String> {
@@ -756,7 +759,11 @@ pub fn validate(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
             return Err(format!("network has {} parameters for its shape", net.params.len()));
         }
         if !net.params.iter().all(param_ok) {
-            return Err("a network parameter refers to a missing gene or is not finite".into());
+            return Err(if net.params.iter().any(|p| matches!(p, Param::Trained { .. })) {
+                "its weights come from a training stage that has not run".into()
+            } else {
+                "a network parameter refers to a missing gene or is not finite".into()
+            });
         }
         Ok(())
     };

@@ -2,6 +2,7 @@
 //! (generalised delta rule) training step.
 
 use crate::catalog::CHANNELS;
+use crate::program::CrbpError;
 
 /// The logistic function.
 #[inline]
@@ -123,15 +124,26 @@ impl Net {
     }
 
     /// One step of the generalised delta rule on the last forward pass (whose
-    /// percept must be given again) toward the targets `target(o)` (squared
-    /// error, sigmoid units, biases as weights on a constant 1):
-    /// `delta = (t - y) y (1 - y)`, `dw = rate * delta * input`.
-    pub fn train(&mut self, percept: &[f32; CHANNELS], target: impl Fn(usize) -> f32, rate: f32) {
+    /// percept must be given again) toward the targets `target(o)` (sigmoid
+    /// units, biases as weights on a constant 1): the output delta is
+    /// `t - y` ([`CrbpError::Difference`]) or `(t - y) y (1 - y)`
+    /// ([`CrbpError::Squared`]), `dw = rate * delta * input`, and hidden
+    /// units back-propagate it through the sigmoid's derivative.
+    pub fn train(
+        &mut self,
+        percept: &[f32; CHANNELS],
+        target: impl Fn(usize) -> f32,
+        rate: f32,
+        error: CrbpError,
+    ) {
         let Net { chans, run, hidden, outputs, w, x, h, y, dy, .. } = self;
         let x = inputs(chans, *run, x, percept);
         let n = x.len();
         for (o, (d, &y)) in dy.iter_mut().zip(y.iter()).enumerate() {
-            *d = (target(o) - y) * y * (1.0 - y);
+            *d = match error {
+                CrbpError::Difference => target(o) - y,
+                CrbpError::Squared => (target(o) - y) * y * (1.0 - y),
+            };
         }
         if *hidden == 0 {
             for o in 0..*outputs {
@@ -200,7 +212,7 @@ mod tests {
         let before = net.forward(&p, 0.0).to_vec();
         for _ in 0..50 {
             net.forward(&p, 0.0);
-            net.train(&p, |o| if o == 0 { 1.0 } else { 0.0 }, 0.5);
+            net.train(&p, |o| if o == 0 { 1.0 } else { 0.0 }, 0.5, CrbpError::Squared);
         }
         let after = net.forward(&p, 0.0).to_vec();
         assert!(after[0] > before[0] + 0.05, "{before:?} -> {after:?}");

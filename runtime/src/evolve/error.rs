@@ -11,11 +11,14 @@ pub enum EvolveError {
     #[error("stage `{stage}` extends `{parent}`, which is not an earlier stage")]
     ParentOrder { stage: String, parent: String },
 
-    #[error("stage `{stage}` is a test stage, it is not evolved")]
+    #[error("stage `{stage}` is a test or training stage, it is not evolved")]
     NotEvolved { stage: String },
 
     #[error("stage `{stage}` is evolved, not a test stage")]
     NotTest { stage: String },
+
+    #[error("stage `{stage}` is not a training stage")]
+    NotTrained { stage: String },
 
     #[error("stage `{stage}`: invalid evolution parameter: {what}")]
     InvalidParameter { stage: String, what: String },

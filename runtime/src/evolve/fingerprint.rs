@@ -25,6 +25,9 @@ struct StageKey<'a> {
 
 #[derive(Serialize)]
 enum RunKey {
+    Train {
+        actions: u32,
+    },
     Evolve {
         population: u32,
         actions: u32,
@@ -67,6 +70,7 @@ pub fn stage_fingerprint(stage: &Stage) -> u64 {
             evaluations: *evaluations,
         },
         StageRun::Test { .. } => RunKey::Test,
+        StageRun::Train { actions } => RunKey::Train { actions: *actions },
     };
     let key = StageKey {
         name: &stage.name,

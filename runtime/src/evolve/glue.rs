@@ -23,6 +23,7 @@ impl EvalOptions {
         match &stage.run {
             StageRun::Evolve(evo) => EvalOptions { actions: evo.actions, learning: true },
             StageRun::Test { actions, learning } => EvalOptions { actions: *actions, learning: *learning },
+            StageRun::Train { actions } => EvalOptions { actions: *actions, learning: true },
         }
     }
 }

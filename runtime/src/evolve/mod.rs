@@ -38,6 +38,7 @@ pub mod fingerprint;
 pub mod ga;
 pub mod glue;
 pub mod seed;
+pub mod train;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -46,6 +47,7 @@ pub use error::EvolveError;
 pub use fingerprint::stage_fingerprint;
 pub use ga::{frozen_mask, next_generation, ranking};
 pub use glue::{evaluate_with_controller, EvalOptions};
+pub use train::{train_all, train_stage, Trained};
 
 use crate::genome::Genome;
 use crate::program::{Evolution, Inheritance, Program, Selection, Stage, StageRun};
@@ -115,7 +117,9 @@ pub struct Checkpoint {
 pub fn evolution(stage: &Stage) -> Result<&Evolution, EvolveError> {
     match &stage.run {
         StageRun::Evolve(evo) => Ok(evo),
-        StageRun::Test { .. } => Err(EvolveError::NotEvolved { stage: stage.name.clone() }),
+        StageRun::Test { .. } | StageRun::Train { .. } => {
+            Err(EvolveError::NotEvolved { stage: stage.name.clone() })
+        }
     }
 }
 

@@ -1,0 +1,161 @@
+//! Training stages: modules that learn for one life before evolution uses
+//! them (the paper: "individual modules with learning abilities can be
+//! separately trained before evolution and/or during evolution").
+
+use serde::{Deserialize, Serialize};
+
+use super::{fingerprint::fnv1a, seed, EvolveError};
+use crate::controller::{episode_rngs, Controller, EpisodeOptions, EpisodeResult, Trace};
+use crate::genome::Genome;
+use crate::program::{bind_trained, Program, StageRun};
+use crate::sim::Sim;
+
+/// What one training stage learned, as written to `trained.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Trained {
+    pub stage: String,
+    /// [`training_fingerprint`] of the training stage: a `trained.json` made
+    /// by another version of the stage is not reused.
+    pub fingerprint: u64,
+    /// The run seed the life was derived from.
+    pub run_seed: u64,
+    /// Behavior weights per module of the stage, in declaration order
+    /// (`Network::params` order; empty for a scripted module).
+    pub weights: Vec<Vec<f32>>,
+    /// Performance indicator of each module at the end of the life.
+    pub performance: Vec<f32>,
+    pub result: EpisodeResult,
+}
+
+/// A stable hash of everything a training stage's result depends on: the
+/// whole stage (world, modules, learning, reinforcement, length), as compact
+/// JSON hashed with 64-bit FNV-1a.
+pub fn training_fingerprint(stage: &crate::program::Stage) -> u64 {
+    fnv1a(&serde_json::to_vec(stage).unwrap_or_default())
+}
+
+/// Runs training stage `index` for one life of its declared length, with
+/// learning on, from an episode seed derived from `run_seed` and the stage.
+pub fn train_stage(
+    program: &Program,
+    index: usize,
+    run_seed: u64,
+    trace: Option<&mut Trace>,
+) -> Result<Trained, EvolveError> {
+    let stage =
+        program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })?;
+    let StageRun::Train { actions } = stage.run else {
+        return Err(EvolveError::NotTrained { stage: stage.name.clone() });
+    };
+    let episode = seed::episode_seed(run_seed, index, 0, 0, 0);
+    let (sim_seed, rng) = episode_rngs(episode);
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let mut ctl = Controller::new(stage, &genome, rng)
+        .map_err(|e| EvolveError::InvalidParameter { stage: stage.name.clone(), what: e.to_string() })?;
+    let mut sim = Sim::new(&stage.world, sim_seed);
+    let result = ctl.run(&mut sim, &EpisodeOptions { actions, learning: true, seed: episode }, trace);
+    let n = stage.modules.len();
+    Ok(Trained {
+        stage: stage.name.clone(),
+        fingerprint: training_fingerprint(stage),
+        run_seed,
+        weights: (0..n).map(|m| ctl.behavior_weights(m).to_vec()).collect(),
+        performance: (0..n).map(|m| ctl.performance(m)).collect(),
+        result,
+    })
+}
+
+/// Binds what training stage `index` learned into the stages that use it
+/// (`weights trained STAGE`). Refuses a `trained` record of another stage or
+/// of another version of it.
+pub fn bind(program: &mut Program, index: usize, trained: &Trained) -> Result<usize, EvolveError> {
+    let stage =
+        program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })?;
+    if trained.stage != stage.name || trained.fingerprint != training_fingerprint(stage) {
+        return Err(EvolveError::InvalidParameter {
+            stage: stage.name.clone(),
+            what: format!(
+                "the trained weights were made by another stage or another version of `{}`",
+                stage.name
+            ),
+        });
+    }
+    Ok(bind_trained(program, index, &trained.weights))
+}
+
+/// Trains every training stage of `program` in order (each life derived from
+/// `run_seed`) and binds the weights into the stages that use them.
+pub fn train_all(program: &mut Program, run_seed: u64) -> Result<Vec<(usize, Trained)>, EvolveError> {
+    let mut out = Vec::new();
+    for i in 0..program.stages.len() {
+        if let StageRun::Train { .. } = program.stages[i].run {
+            let t = train_stage(program, i, run_seed, None)?;
+            bind(program, i, &t)?;
+            out.push((i, t));
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::catalog::CH_IR;
+    use crate::program::{Action, Behavior, LearnTarget, Network, Param, FORMAT_VERSION};
+    use crate::testkit;
+
+    /// A training stage (wander + a learning avoid module) and a stage whose
+    /// avoid behavior starts from what it learned.
+    fn program() -> Program {
+        let mut train = testkit::bare_stage("avoidance", testkit::arena_world());
+        train.world.battery = None;
+        train.run = StageRun::Train { actions: 300 };
+        let mut wander =
+            testkit::module("wander", 0, vec![], testkit::script(Action::Wheels { left: 1.0, right: 1.0 }));
+        wander.activation.params = vec![Param::Fixed(0.0)];
+        let mut avoid =
+            testkit::module("avoid", 0, testkit::chans(CH_IR, 8), testkit::avoid_behavior(0.5, 1.0));
+        let mut act = vec![Param::Fixed(1.0); 9];
+        act[0] = Param::Fixed(-0.3);
+        avoid.activation = Network { inputs: 8, hidden: 0, outputs: 1, params: act };
+        avoid.learning = Some(testkit::crbp(LearnTarget::Behavior, 0.5, 0.1, 30));
+        avoid.reinforce = Some(testkit::ir_decrease());
+        train.modules = vec![wander, avoid.clone()];
+        let mut user = testkit::bare_stage("user", testkit::arena_world());
+        let mut uses = avoid;
+        let Behavior::Neural(nb) = &mut uses.behavior else { unreachable!() };
+        nb.net.params = (0..18).map(|index| Param::Trained { stage: 0, module: 1, index }).collect();
+        uses.activation.params = vec![Param::Fixed(0.0); 9];
+        user.modules = vec![uses];
+        Program { format: FORMAT_VERSION, name: "t".into(), stages: vec![train, user] }
+    }
+
+    #[test]
+    fn trained_weights_reach_the_stage_that_uses_them() {
+        let mut p = program();
+        assert!(Controller::new(&p.stages[1], &Genome::zeros(0), episode_rngs(1).1).is_err(), "unbound");
+        let t = train_stage(&p, 0, 7, None).unwrap();
+        assert_eq!(t.weights[0].len(), 0, "a scripted module learns no weights");
+        assert_eq!(t.weights[1].len(), 18);
+        assert!(t.performance[1] > 0.3, "the avoid module learned: {}", t.performance[1]);
+        assert_eq!(bind(&mut p, 0, &t).unwrap(), 18);
+        let Behavior::Neural(nb) = &p.stages[1].modules[0].behavior else { unreachable!() };
+        let bound: Vec<f32> =
+            nb.net.params.iter().map(|x| if let Param::Fixed(w) = x { *w } else { f32::NAN }).collect();
+        assert_eq!(bound, t.weights[1]);
+        let ctl = Controller::new(&p.stages[1], &Genome::zeros(0), episode_rngs(1).1).unwrap();
+        assert_eq!(ctl.behavior_weights(0), &t.weights[1][..]);
+        // The same seed trains the same weights; another does not.
+        assert_eq!(train_stage(&program(), 0, 7, None).unwrap(), t);
+        assert_ne!(train_stage(&program(), 0, 8, None).unwrap().weights, t.weights);
+    }
+
+    #[test]
+    fn weights_of_another_version_of_the_stage_are_refused() {
+        let mut p = program();
+        let t = train_stage(&p, 0, 7, None).unwrap();
+        p.stages[0].run = StageRun::Train { actions: 500 };
+        assert!(bind(&mut p, 0, &t).is_err());
+        assert!(train_stage(&p, 1, 7, None).is_err(), "stage 1 is not a training stage");
+    }
+}
