@@ -57,7 +57,7 @@ stage navigation {
     charger 200mm on north wall with lamp
     battery 200 actions, recharge 20 actions
   }
-  evolve { population 100  generations 40  actions 300  seed 1 }
+  evolve { population 100  generations 40  actions 300  seed 1  mutation 0.02 }
   // Straight, fast motion away from obstacles (Floreano & Mondada 1994),
   // scaled so that a perfect life of 300 actions scores 1.
   fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) / 300

@@ -25,7 +25,7 @@ stage full {
     battery 200 actions, recharge 20 actions
     objects 8 diameter 10mm virtual
   }
-  evolve { population 100  generations 80  actions 300  seed 1 }
+  evolve { population 100  generations 80  actions 300  seed 1  mutation 0.02 }
   fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) / 300
   fitness adds 0.5 per grip, 1.0 per release outside
 

@@ -11,7 +11,7 @@ use shaping_runtime::controller::{
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Program, Stage, StageRun};
+use shaping_runtime::program::{Behavior, Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
 use crate::load::{self, create_dir, write_atomic, CliError};
@@ -49,16 +49,27 @@ pub fn run_seed(program: &Program, seed: Option<u64>) -> u64 {
     })
 }
 
-/// The stages to run for a target stage: it and its ancestors, in order.
+/// The stages to run for a target stage: it, its ancestors and the training
+/// stages whose weights they use, in program order.
 pub fn chain(program: &Program, target: usize) -> Vec<usize> {
-    let mut chain = vec![target];
-    let mut cur = program.stages[target].parent;
-    while let Some(p) = cur {
-        chain.push(p);
-        cur = program.stages[p].parent;
+    let mut need = vec![false; program.stages.len()];
+    let mut cur = Some(target);
+    while let Some(i) = cur {
+        need[i] = true;
+        for m in &program.stages[i].modules {
+            if let Behavior::Neural(nb) = &m.behavior {
+                for p in &nb.net.params {
+                    if let Param::Trained { stage, .. } = *p {
+                        if let Some(n) = need.get_mut(stage as usize) {
+                            *n = true;
+                        }
+                    }
+                }
+            }
+        }
+        cur = program.stages[i].parent;
     }
-    chain.reverse();
-    chain
+    (0..program.stages.len()).filter(|&i| need[i]).collect()
 }
 
 /// Evaluation of one genome in an evolved stage: one episode with local learning on.
@@ -194,6 +205,11 @@ fn evolve_stage(
         None => evolve::start_stage(program, index, seed, parent)
             .map_err(|e| CliError::io(format!("error: {e}")))?,
     };
+    // Every individual would silently score 0 on a stage the controller
+    // cannot run (e.g. weights of a training stage that was not bound).
+    let probe = Genome::zeros(stage.layout.bits as usize);
+    shaping_runtime::controller::validate(stage, &probe)
+        .map_err(|e| CliError::io(format!("error: stage `{}` cannot run: {e}", stage.name)))?;
     let bar = progress_bar(args, stage, evo.generations, cp.generation);
     let eval = evaluator(stage, evo.actions);
     while !evolve::is_finished(program, &cp) {
@@ -479,4 +495,21 @@ pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -
         evolve::train::bind(program, i, &trained).map_err(|e| CliError::io(format!("error: {e}")))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Running a stage runs its ancestors and the training stages whose
+    /// weights it uses, whatever their place in the file.
+    #[test]
+    fn the_chain_of_a_stage_includes_the_training_stages_it_uses() {
+        let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/khepera.bat")).unwrap();
+        let program = shaping_compiler::compile(&src, "khepera.bat").unwrap();
+        let names = |c: Vec<usize>| c.into_iter().map(|i| program.stages[i].name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(chain(&program, 1)), ["avoidance", "navigation"]);
+        assert_eq!(names(chain(&program, 3)), ["avoidance", "navigation", "collect", "bigger"]);
+        assert_eq!(names(chain(&program, 0)), ["avoidance"]);
+    }
 }

@@ -1,49 +1,59 @@
 #!/usr/bin/env bash
 # Regenerates every number and picture of EXPERIMENTS.md (a few minutes on
 # two cores). Results go to runs/experiments/; the pictures EXPERIMENTS.md
-# shows are copied next to this script.
+# shows are copied next to this script; the numbers are printed.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet
 B=target/release/shaping
 R=runs/experiments
 D=docs/experiments
+SEEDS=10
 mkdir -p "$R"
 
-# Figures 4 and 9 (and the test stage of figure 13), five seeds.
-$B experiment examples/khepera.bat --seeds 5 --out $R/khepera --fresh --criterion navigation=0.5
-# The from-scratch baselines, same seeds, same criterion.
-$B experiment examples/scratch.bat --seeds 5 --out $R/scratch --fresh --criterion scratch=0.5
-$B experiment examples/monolithic.bat --seeds 5 --out $R/monolithic --fresh --criterion mono=0.5
+# Figures 4, 9 and 13: every stage of khepera.bat over seeds 1..10.
+$B experiment examples/khepera.bat --seeds $SEEDS --out $R/khepera --fresh \
+  --criterion navigation=0.7 --criterion collect=3 > /dev/null
+# The other choice for learning during evolution (navigation only).
+$B experiment examples/pretrained.bat --seeds $SEEDS --out $R/pretrained --fresh --criterion navigation=0.7 > /dev/null
+# The paper's fitness against one that counts forward motion only.
+sed 's#fitness per action abs(wheels\[0\] + wheels\[1\]) / 2#fitness per action max(wheels[0] + wheels[1], 0) / 2#' \
+  examples/pretrained.bat > $R/forward-only.bat
+grep -q 'max(wheels\[0\] + wheels\[1\], 0)' $R/forward-only.bat
+$B experiment $R/forward-only.bat --seeds $SEEDS --out $R/forward-only --fresh --criterion navigation=0.7 > /dev/null
+# Shaping against evolution from scratch on the whole task.
+$B experiment examples/scratch-full.bat --seeds $SEEDS --out $R/scratch-full --fresh --criterion full=3 > /dev/null
 
-# The evolved bests at work: three fresh episodes each.
-for stage in navigation collect; do
-  for s in 1 2 3 4 5; do
-    for r in 101 102 103; do
-      echo -n "$stage seed $s episode $r: "
-      $B replay examples/khepera.bat --stage $stage --run $R/khepera/seed-$s --seed $r \
-        --out $R/replay-$stage-$s-$r | sed 's/ -> .*//'
+# The chosen bests at work: three fresh episodes each (seeds 101..103),
+# with learning and, for collect, without it (how much grip decisions owe
+# to learning within the life).
+: > $R/replays.txt
+for s in $(seq 1 $SEEDS); do
+  for r in 101 102 103; do
+    for spec in "khepera navigation" "khepera collect" "pretrained navigation" "forward-only navigation" "scratch-full full"; do
+      set -- $spec
+      file=examples/$1.bat; [ -f "$file" ] || file=$R/$1.bat
+      echo "$1 $2 $s $r learning $($B replay $file --stage $2 --run $R/$1/seed-$s --seed $r --out $R/replay-$1-$2-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
     done
+    echo "khepera collect $s $r nolearning $($B replay examples/khepera.bat --stage collect --run $R/khepera/seed-$s --seed $r --no-learning --out $R/replay-khepera-collect-nl-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
   done
 done
 
-# Figure 5: the avoid module alone, learning for 5000 actions, five seeds.
-# Printed: the mean performance per block of 500 actions.
-for s in 1 2 3 4 5; do
-  $B replay examples/avoid.bat --seed $s --out $R/avoid-$s > /dev/null
-  awk -F, -v s=$s 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "perf_avoid") c = i; next }
-    { sum += $c; n++; if (n == 500) { line = line sprintf(" %5.2f", sum / n); sum = 0; n = 0 } }
-    END { print "avoid seed " s ":" line }' $R/avoid-$s/trace.csv
+# Figure 5: avoid.bat over seeds 1..10 (one training life of 1000 actions each).
+for s in $(seq 1 $SEEDS); do
+  $B run examples/avoid.bat --seed $s --out $R/avoid-$s --fresh --quiet
 done
 
 # Figure 11: the collect best of seed 1 over 225 actions.
-$B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11
+$B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 > /dev/null
 
-for f in khepera/fitness-seeds scratch/fitness-seeds monolithic/fitness-seeds avoid-1/reinforcement \
+for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement \
   figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
-for f in khepera scratch monolithic; do
+
+for f in khepera pretrained forward-only scratch-full; do
   echo "== $f"
   cat $R/$f/summary.md
 done
+python3 docs/experiments/analyse.py "$R" "$SEEDS"

@@ -1,0 +1,162 @@
+"""Prints the figures of EXPERIMENTS.md from the files docs/experiments/run.sh wrote.
+
+Usage: python3 docs/experiments/analyse.py RUNS_DIR SEEDS
+"""
+
+import csv
+import json
+import re
+import statistics
+import sys
+
+R, N = sys.argv[1], int(sys.argv[2])
+SEEDS = range(1, N + 1)
+
+
+def spread(v, digits=2):
+    v = [x for x in v if x is not None]
+    if not v:
+        return "-"
+    f = f"{{:.{digits}f}}"
+    return f"{f.format(statistics.median(v))} ({f.format(min(v))}..{f.format(max(v))})"
+
+
+def rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def history(run, seed, stage):
+    return [float(r["best"]) for r in rows(f"{R}/{run}/seed-{seed}/{stage}/generations.csv") if r["stage"] == stage]
+
+
+def roll3(b):
+    return [sum(b[max(0, i - 2): i + 1]) / len(b[max(0, i - 2): i + 1]) for i in range(len(b))]
+
+
+def first_reach(v, level):
+    return next((i + 1 for i, x in enumerate(v) if x >= level), None)
+
+
+# ---------------------------------------------------------------- replays
+REPLAY = re.compile(
+    r"^(\S+) (\S+) (\d+) (\d+) (\S+) \S+: (\d+) actions, fitness ([-\d.]+), (\d+) grips, (\d+) released outside, (\d+) recharges"
+)
+replays = []
+with open(f"{R}/replays.txt") as f:
+    for line in f:
+        m = REPLAY.match(line)
+        if m:
+            run, stage, seed, ep, mode, actions, fit, grips, out, rech = m.groups()
+            replays.append(dict(run=run, stage=stage, seed=int(seed), ep=int(ep), mode=mode, actions=int(actions),
+                                fitness=float(fit), grips=int(grips), out=int(out), recharges=int(rech)))
+
+
+def sel(run, stage, mode="learning"):
+    return [r for r in replays if r["run"] == run and r["stage"] == stage and r["mode"] == mode]
+
+
+def recharge_share(run, stage):
+    v = sel(run, stage)
+    return sum(1 for r in v if r["recharges"] > 0), len(v)
+
+
+print("\n== figure 5: avoid.bat, performance indicator at action 300 (and 100, 1000)")
+at = {100: [], 300: [], 1000: []}
+for s in SEEDS:
+    perf = [float(r["perf_avoid"]) for r in rows(f"{R}/avoid-{s}/avoid/trace.csv")]
+    for k in at:
+        at[k].append(perf[k - 1] if len(perf) >= k else None)
+    print(f"  seed {s}: " + " ".join(f"{perf[k - 1]:+.2f}" for k in (50, 100, 200, 300, 500, 1000) if len(perf) >= k))
+for k, v in at.items():
+    print(f"  at action {k}: {spread(v)}")
+
+for run in ("khepera", "pretrained", "forward-only"):
+    print(f"\n== figure 4: {run}, navigation")
+    r25, r40, reach, ever = [], [], [], []
+    for s in SEEDS:
+        b = history(run, s, "navigation")
+        r = roll3(b)
+        r25.append(r[24])
+        r40.append(r[-1])
+        reach.append(first_reach(r, 0.70))
+        ever.append(max(b))
+    print(f"  best, 3-generation rolling mean, at generation 25: {spread(r25, 3)}; at 40: {spread(r40, 3)}")
+    print(f"  best ever: {spread(ever, 3)}; generation where the rolling best reaches 0.70: {reach}")
+    ok, tot = recharge_share(run, "navigation")
+    fits = [r["fitness"] for r in sel(run, "navigation")]
+    print(f"  chosen best, replays: recharges in {ok} of {tot} ({100 * ok / max(tot, 1):.0f}%); fitness {spread(fits, 3)}")
+
+print("\n== figures 9 and 11: khepera collect, chosen best replays (300 actions)")
+for mode in ("learning", "nolearning"):
+    v = sel("khepera", "collect", mode)
+    print(f"  {mode}: released outside per replay {spread([r['out'] for r in v], 1)} (mean {statistics.mean([r['out'] for r in v]):.2f}); "
+          f"grips {spread([r['grips'] for r in v], 1)}; fitness {spread([r['fitness'] for r in v], 3)}; "
+          f"recharge in {sum(1 for r in v if r['recharges'] > 0)} of {len(v)}")
+
+
+def grip_signals(path):
+    t = rows(path)
+    if not t or "reinf_grip" not in t[0]:
+        return []
+    return [(int(r["action"]), float(r["reinf_grip"])) for r in t if float(r["reinf_grip"]) != 0.0]
+
+
+print("\n== grip attempts at walls inside the architecture (punished grip attempts / all grip attempts)")
+for mode, tag in (("learning", ""), ("nolearning", "nl-")):
+    pun = tot = early_p = early_t = late_p = late_t = 0
+    for s in SEEDS:
+        for ep in (101, 102, 103):
+            for a, r in grip_signals(f"{R}/replay-khepera-collect-{tag}{s}-{ep}/trace.csv"):
+                tot += 1
+                pun += r < 0
+                if a < 150:
+                    early_t += 1
+                    early_p += r < 0
+                else:
+                    late_t += 1
+                    late_p += r < 0
+    share = lambda p, t: f"{p}/{t} = {p / t:.2f}" if t else "-"
+    print(f"  {mode}: all {share(pun, tot)}; actions 0-149 {share(early_p, early_t)}; 150-299 {share(late_p, late_t)}")
+
+print("\n== figure 13: khepera bigger (test of the collect best; objects 10 -> 25 mm, learning only)")
+drops = recov = 0
+for s in SEEDS:
+    t = rows(f"{R}/khepera/seed-{s}/bigger/trace.csv")
+    with open(f"{R}/khepera/seed-{s}/bigger/summary.json") as f:
+        switch = json.load(f)["before"]["actions"]
+    perf = [float(r["perf_grip"]) for r in t]
+    sig = [float(r["reinf_grip"]) for r in t]
+    n_before = sum(1 for x in sig[:switch] if x)
+    n_after = sum(1 for x in sig[switch:] if x)
+    before = perf[switch - 1] if switch > 0 else 0.0
+    after50 = perf[switch: switch + 50]
+    low = min(after50) if after50 else before
+    end = perf[-1]
+    d = before - low >= 0.2
+    rcv = d and abs(end - before) <= 0.1
+    drops += d
+    recov += rcv
+    print(f"  seed {s}: grip signals {n_before} before, {n_after} after; performance before {before:+.2f}, lowest in the first 50 after {low:+.2f}, at the end {end:+.2f}; drop {d}, recovery {rcv}")
+print(f"  seeds with a drop of 0.2 or more: {drops} of {N}; with recovery within 0.1: {recov} of {N}")
+
+print("\n== shaping vs evolution from scratch, whole task (criterion: best of a generation >= 3.0)")
+sh, sc = [], []
+for s in SEEDS:
+    col = history("khepera", s, "collect")
+    g = first_reach(col, 3.0)
+    # navigation's 40 generations, then collect's; the training life is 1000 actions, about 3 evaluations.
+    sh.append(None if g is None else 100 * (40 + g) + 1000 / 300)
+    full = history("scratch-full", s, "full")
+    g2 = first_reach(full, 3.0)
+    sc.append(None if g2 is None else 100 * g2)
+print(f"  evaluations, shaping (khepera.bat): {spread(sh, 0)}; from scratch (scratch-full.bat): {spread(sc, 0)}")
+ms, mc = statistics.median([x for x in sh if x]), statistics.median([x for x in sc if x])
+print(f"  ratio of medians shaping / scratch: {ms / mc:.2f}")
+for run, stage in (("khepera", "collect"), ("scratch-full", "full")):
+    v = sel(run, stage)
+    print(f"  chosen best of {run}: fitness {spread([r['fitness'] for r in v], 3)}, released outside per replay "
+          f"{spread([r['out'] for r in v], 1)} (mean {statistics.mean([r['out'] for r in v]):.2f}), recharge in "
+          f"{sum(1 for r in v if r['recharges'] > 0)} of {len(v)}")
+    fin = [history(run, s, stage)[-1] for s in SEEDS]
+    print(f"  final best of {run}: {spread(fin, 3)}")
