@@ -127,7 +127,7 @@ stage collect extends navigation {
       claw closed
       arm up
     }
-    learn crbp(0.5, 0.1) on activation always
+    learn crbp(1, 0.5) on activation always
   }
 
   // Drop the object outside: approach the obstacle, lower the arm, open
@@ -144,7 +144,7 @@ stage collect extends navigation {
       reinforce prev barrier and not barrier ? 1 : -1
       arm up
     }
-    learn crbp(0.5, 0.1) on activation always
+    learn crbp(1, 0.5) on activation always
   }
 
   links all evolvable

@@ -80,7 +80,7 @@ stage full {
       claw closed
       arm up
     }
-    learn crbp(0.5, 0.1) on activation always
+    learn crbp(1, 0.5) on activation always
   }
 
   // Drop the object outside: approach the obstacle, lower the arm, open
@@ -97,7 +97,7 @@ stage full {
       reinforce prev barrier and not barrier ? 1 : -1
       arm up
     }
-    learn crbp(0.5, 0.1) on activation always
+    learn crbp(1, 0.5) on activation always
   }
 
   links all evolvable

@@ -397,6 +397,38 @@ fn crbp_on_an_activation_network_pushes_it_up_on_reward_and_down_on_punishment()
 }
 
 #[test]
+fn a_reinforce_step_late_in_a_script_trains_the_pattern_the_script_started_on() {
+    // Drive one action, then reward: the percept changes in between.
+    let steps = vec![
+        Step { action: Action::Wheels { left: 1.0, right: 1.0 }, end: StepEnd::Actions(1), when: None },
+        Step { action: Action::Reinforce(expr(vec![Op::Const(1.0)])), end: StepEnd::Actions(1), when: None },
+    ];
+    let m = Module {
+        name: "grip".into(),
+        stage: 0,
+        inputs: vec![0, 1],
+        activation: Network { inputs: 2, hidden: 0, outputs: 1, params: vec![Param::Fixed(0.0); 3] },
+        behavior: Behavior::Script(Script { steps, commit: true }),
+        learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
+        reinforce: Some(expr(vec![Op::Const(1.0)])),
+    };
+    let s = stage_of(vec![m], vec![]);
+    let mut c = controller(&s, 1);
+    let mut robot = Puppet::default();
+    robot.percept[0] = 1.0; // the decision: ir[0]
+    c.start(&mut robot);
+    robot.percept = [0.0; CHANNELS];
+    robot.percept[1] = 1.0; // after the move: ir[1]
+    c.act(&mut robot); // decides on ir[0] and drives
+    assert_eq!(c.activation_weights(0), &[0.0, 0.0, 0.0][..], "no reinforcement yet");
+    let rep = c.act(&mut robot); // the reinforce step, on ir[1]
+    assert_eq!(rep.reinforcement, 1.0);
+    let w = c.activation_weights(0);
+    assert!(w[0] > 0.0 && w[1] > 0.0, "the decision's pattern is rewarded: {w:?}");
+    assert_eq!(w[2], 0.0, "not the pattern at the reinforce step: {w:?}");
+}
+
+#[test]
 fn fitness_sums_the_per_action_term_and_adds_bonuses_per_event() {
     let mut s = stage_of(vec![constant_module("fwd", 0.0, 1.0)], vec![]);
     s.fitness.per_action = Some(testkit::straight_and_far(300.0));

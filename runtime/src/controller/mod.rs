@@ -45,9 +45,14 @@
 //! step (rate `rate_punish`) toward their complement.
 //! - On a neural behavior the bits are the sampled output bits.
 //! - On an activation network the "bit" is "this module won and acted" (1):
-//!   a reward pushes the activation up for the input pattern of the action in
-//!   which the reinforcement was delivered, a punishment pushes it down. The
-//!   link term stays part of the net input but link weights are not learned.
+//!   a reward pushes the activation up for the input pattern of the decision
+//!   it judges, a punishment pushes it down. With a scripted behavior that
+//!   decision is the action whose arbitration started the current run of the
+//!   script (its first step): a `reinforce` step late in a script, after the
+//!   robot has moved and lowered its arm, still trains the pattern the module
+//!   chose to act on. Otherwise it is the action in which the reinforcement
+//!   was delivered. The link term (of that action) stays part of the net
+//!   input but link weights are not learned.
 //!
 //! Learning is on when `EpisodeOptions::learning` is set, the module declares
 //! a [`Learning`], and either it learns `Always` or its performance indicator
@@ -241,6 +246,10 @@ struct Mod<'s> {
     /// The script's `reinforce` steps deliver the reinforcement instead of `reinforce`.
     script_reinforces: bool,
     perf: Rolling,
+    /// A script's decision: the percept and link input on which the module
+    /// won the arbitration that started the current run of its script.
+    decided: [f32; CHANNELS],
+    decided_link: f32,
 }
 
 impl Mod<'_> {
@@ -352,6 +361,8 @@ impl<'s> Controller<'s> {
                 learning: m.learning.clone(),
                 reinforce: m.reinforce.as_ref().map(FastExpr::new),
                 script_reinforces,
+                decided: [0.0; CHANNELS],
+                decided_link: 0.0,
                 perf: Rolling::new(window),
             });
         }
@@ -501,6 +512,13 @@ impl<'s> Controller<'s> {
             self.last_winner = Some(winner);
         }
         let learn = self.learning && self.mods[winner].learning_on();
+        {
+            let module = &mut self.mods[winner];
+            if matches!(&module.gen, Gen::Script(s) if s.at_start()) {
+                module.decided = self.now;
+                module.decided_link = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
+            }
+        }
 
         // 4: the winner's behavior.
         let mut r = 0.0f32;
@@ -561,7 +579,16 @@ impl<'s> Controller<'s> {
                     match l.target {
                         LearnTarget::Activation => {
                             let t = if r > 0.0 { 1.0 } else { 0.0 };
-                            module.activation.train(&self.now, |_| t, rate, l.error);
+                            if let Gen::Script(_) = module.gen {
+                                // The reinforcement judges the decision that
+                                // started the script, not the percept where a
+                                // later `reinforce` step delivered it.
+                                let (p, link) = (module.decided, module.decided_link);
+                                module.activation.forward(&p, link);
+                                module.activation.train(&p, |_| t, rate, l.error);
+                            } else {
+                                module.activation.train(&self.now, |_| t, rate, l.error);
+                            }
                         }
                         LearnTarget::Behavior => {
                             if let Gen::Neural { net, bits, .. } = &mut module.gen {

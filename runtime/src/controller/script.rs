@@ -129,6 +129,12 @@ impl ScriptRun {
         self.commit && (self.pos > 0 || self.spent > 0)
     }
 
+    /// At the first step with no action spent: the next action starts a run
+    /// of the script.
+    pub fn at_start(&self) -> bool {
+        self.pos == 0 && self.spent == 0
+    }
+
     /// The current step index (for tests and traces).
     pub fn position(&self) -> usize {
         self.pos
