@@ -520,6 +520,7 @@ proptest! {
 
 #[test]
 fn the_lookup_tables_agree_with_the_exact_model() {
+    use nalgebra::{Point2, Vector2};
     use shaping_runtime::sim::ir::KHEPERA;
     let mut sim = Sim::new(&with_objects(1, 10.0, true), 15);
     assert!(sim.set_object(0, 100.0, 500.0));
@@ -531,7 +532,7 @@ fn the_lookup_tables_agree_with_the_exact_model() {
         assert!(sim.set_pose(Pose { x: 27.5 + d, y: 300.0, theta }));
         let p = percept(&mut sim);
         // The west wall's outward normal (-1, 0) in the robot frame.
-        let normal = [-theta.cos(), theta.sin()];
+        let normal = Vector2::new(-theta.cos(), theta.sin());
         for s in 0..8 {
             let exact = KHEPERA.wall_reading(s, 27.5, 27.5 + d, normal).min(1.0);
             assert!((p[CH_IR + s] - exact).abs() < 2e-3, "wall d={d} s={s}: {} vs {exact}", p[CH_IR + s]);
@@ -541,10 +542,10 @@ fn the_lookup_tables_agree_with_the_exact_model() {
         let (bx, by) = (200.0 + (27.5 + d + 5.0) * 0.3f32.cos(), 300.0 + (27.5 + d + 5.0) * 0.3f32.sin());
         assert!(sim.set_object(0, bx, by));
         let p = percept(&mut sim);
-        let rel = [
+        let rel = Point2::new(
             (bx - 200.0) * theta.cos() + (by - 300.0) * theta.sin(),
             -(bx - 200.0) * theta.sin() + (by - 300.0) * theta.cos(),
-        ];
+        );
         for s in 0..8 {
             let exact = KHEPERA.cylinder_reading(s, 27.5, rel, 5.0).min(1.0);
             if d >= 5.0 {
