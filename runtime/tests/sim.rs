@@ -81,6 +81,44 @@ fn turning_in_place_keeps_the_position() {
 }
 
 #[test]
+fn a_pose_is_an_isometry_of_the_body_frame() {
+    use nalgebra::{Isometry2, Point2};
+    for theta in [-3.0f32, -1.0, 0.0, 0.5, 3.1] {
+        let pose = Pose { x: 120.0, y: 80.0, theta };
+        let iso = Isometry2::from(pose);
+        // The body frame's x axis is the heading, its y axis the left side.
+        let ahead = iso * Point2::new(10.0, 0.0);
+        let left = iso * Point2::new(0.0, 10.0);
+        assert!((ahead - Point2::new(120.0 + 10.0 * theta.cos(), 80.0 + 10.0 * theta.sin())).norm() < 1e-4);
+        assert!((left - Point2::new(120.0 - 10.0 * theta.sin(), 80.0 + 10.0 * theta.cos())).norm() < 1e-4);
+        let back = Pose::from(iso);
+        assert_eq!((back.x, back.y), (120.0, 80.0));
+        assert!((back.theta - theta).abs() < 1e-6, "{theta}: {back:?}");
+    }
+    // The heading comes back in -pi..=pi.
+    let back = Pose::from(Isometry2::from(Pose { x: 0.0, y: 0.0, theta: 7.0 }));
+    assert!((back.theta - (7.0 - std::f32::consts::TAU)).abs() < 1e-5, "{back:?}");
+}
+
+#[test]
+fn the_heading_stays_a_rotation_over_many_turns() {
+    // Thousands of composed rotations: rounding must not shrink or stretch
+    // the heading, or straight moves would stop covering 20 mm.
+    let mut sim = Sim::new(&World { battery: None, ..world() }, 2);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    for _ in 0..20_000 {
+        sim.step(&wheels(-0.37, 0.37));
+    }
+    let before = sim.pose();
+    assert!(dist(before, Pose { x: 200.0, y: 300.0, theta: 0.0 }) < 1e-3, "{before:?}");
+    sim.step(&wheels(1.0, 1.0));
+    let after = sim.pose();
+    assert!((dist(before, after) - 20.0).abs() < 1e-3, "{before:?} -> {after:?}");
+    let dir = ((after.y - before.y).atan2(after.x - before.x) - before.theta).sin();
+    assert!(dir.abs() < 1e-4, "moved along the reported heading: {before:?} -> {after:?}");
+}
+
+#[test]
 fn an_arc_follows_the_exact_update() {
     let mut sim = Sim::new(&world(), 3);
     assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
