@@ -159,7 +159,13 @@ pub struct Geometry {
 
 impl Geometry {
     pub fn new(model: &IrModel, body: f32) -> Geometry {
-        let turn = |deg: f32| UnitComplex::new(deg.to_radians());
+        // sin and cos in f64, rounded once: the correctly rounded values,
+        // the same whether or not the compiler folds the model's constants
+        // (an f32 `sin_cos` at run time can be one unit in the last place off).
+        let turn = |deg: f32| {
+            let (s, c) = f64::from(deg.to_radians()).sin_cos();
+            UnitComplex::from_cos_sin_unchecked(c as f32, s as f32)
+        };
         let pos = model.position_deg.map(|deg| (turn(deg) * Point2::new(body, 0.0)).coords.transpose());
         let rays = model.axis_deg.map(|deg| (turn(deg) * Vector2::x()).transpose());
         Geometry { pos: SMatrix::from_rows(&pos), rays: SMatrix::from_rows(&rays) }
