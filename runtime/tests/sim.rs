@@ -81,6 +81,44 @@ fn turning_in_place_keeps_the_position() {
 }
 
 #[test]
+fn a_pose_is_an_isometry_of_the_body_frame() {
+    use nalgebra::{Isometry2, Point2};
+    for theta in [-3.0f32, -1.0, 0.0, 0.5, 3.1] {
+        let pose = Pose { x: 120.0, y: 80.0, theta };
+        let iso = Isometry2::from(pose);
+        // The body frame's x axis is the heading, its y axis the left side.
+        let ahead = iso * Point2::new(10.0, 0.0);
+        let left = iso * Point2::new(0.0, 10.0);
+        assert!((ahead - Point2::new(120.0 + 10.0 * theta.cos(), 80.0 + 10.0 * theta.sin())).norm() < 1e-4);
+        assert!((left - Point2::new(120.0 - 10.0 * theta.sin(), 80.0 + 10.0 * theta.cos())).norm() < 1e-4);
+        let back = Pose::from(iso);
+        assert_eq!((back.x, back.y), (120.0, 80.0));
+        assert!((back.theta - theta).abs() < 1e-6, "{theta}: {back:?}");
+    }
+    // The heading comes back in -pi..=pi.
+    let back = Pose::from(Isometry2::from(Pose { x: 0.0, y: 0.0, theta: 7.0 }));
+    assert!((back.theta - (7.0 - std::f32::consts::TAU)).abs() < 1e-5, "{back:?}");
+}
+
+#[test]
+fn the_heading_stays_a_rotation_over_many_turns() {
+    // Thousands of composed rotations: rounding must not shrink or stretch
+    // the heading, or straight moves would stop covering 20 mm.
+    let mut sim = Sim::new(&World { battery: None, ..world() }, 2);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    for _ in 0..20_000 {
+        sim.step(&wheels(-0.37, 0.37));
+    }
+    let before = sim.pose();
+    assert!(dist(before, Pose { x: 200.0, y: 300.0, theta: 0.0 }) < 1e-3, "{before:?}");
+    sim.step(&wheels(1.0, 1.0));
+    let after = sim.pose();
+    assert!((dist(before, after) - 20.0).abs() < 1e-3, "{before:?} -> {after:?}");
+    let dir = ((after.y - before.y).atan2(after.x - before.x) - before.theta).sin();
+    assert!(dir.abs() < 1e-4, "moved along the reported heading: {before:?} -> {after:?}");
+}
+
+#[test]
 fn an_arc_follows_the_exact_update() {
     let mut sim = Sim::new(&world(), 3);
     assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
@@ -520,6 +558,7 @@ proptest! {
 
 #[test]
 fn the_lookup_tables_agree_with_the_exact_model() {
+    use nalgebra::{Point2, Vector2};
     use shaping_runtime::sim::ir::KHEPERA;
     let mut sim = Sim::new(&with_objects(1, 10.0, true), 15);
     assert!(sim.set_object(0, 100.0, 500.0));
@@ -531,7 +570,7 @@ fn the_lookup_tables_agree_with_the_exact_model() {
         assert!(sim.set_pose(Pose { x: 27.5 + d, y: 300.0, theta }));
         let p = percept(&mut sim);
         // The west wall's outward normal (-1, 0) in the robot frame.
-        let normal = [-theta.cos(), theta.sin()];
+        let normal = Vector2::new(-theta.cos(), theta.sin());
         for s in 0..8 {
             let exact = KHEPERA.wall_reading(s, 27.5, 27.5 + d, normal).min(1.0);
             assert!((p[CH_IR + s] - exact).abs() < 2e-3, "wall d={d} s={s}: {} vs {exact}", p[CH_IR + s]);
@@ -541,10 +580,10 @@ fn the_lookup_tables_agree_with_the_exact_model() {
         let (bx, by) = (200.0 + (27.5 + d + 5.0) * 0.3f32.cos(), 300.0 + (27.5 + d + 5.0) * 0.3f32.sin());
         assert!(sim.set_object(0, bx, by));
         let p = percept(&mut sim);
-        let rel = [
+        let rel = Point2::new(
             (bx - 200.0) * theta.cos() + (by - 300.0) * theta.sin(),
             -(bx - 200.0) * theta.sin() + (by - 300.0) * theta.cos(),
-        ];
+        );
         for s in 0..8 {
             let exact = KHEPERA.cylinder_reading(s, 27.5, rel, 5.0).min(1.0);
             if d >= 5.0 {

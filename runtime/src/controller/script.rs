@@ -25,6 +25,8 @@
 //!   step (same `now`, `prev` and actuators): when COND is false it is
 //!   skipped and takes no time.
 
+use nalgebra::Vector2;
+
 use super::fast_expr::FastExpr;
 use crate::catalog::{channel_bearing, CHANNELS};
 use crate::expr::Env;
@@ -42,9 +44,9 @@ pub const TOWARD_MIN_LENGTH: f32 = 0.03;
 #[derive(Clone, Debug)]
 enum Op {
     Wheels([f32; 2]),
-    /// Channels with the unit vector of their bearing.
+    /// Channels with the unit vector of their bearing (body frame).
     Toward {
-        dirs: Vec<(u16, f32, f32)>,
+        dirs: Vec<(u16, Vector2<f32>)>,
         speed: f32,
     },
     Arm(bool),
@@ -89,7 +91,7 @@ impl ScriptRun {
                     Action::Toward { channels, speed } => Op::Toward {
                         dirs: channels
                             .iter()
-                            .filter_map(|&c| channel_bearing(c as usize).map(|b| (c, b.cos(), b.sin())))
+                            .filter_map(|&c| Some((c, bearing_vector(c as usize)?)))
                             .collect(),
                         speed: *speed,
                     },
@@ -196,20 +198,21 @@ impl ScriptRun {
     }
 }
 
+/// The unit vector (body frame) along a channel's bearing.
+fn bearing_vector(channel: usize) -> Option<Vector2<f32>> {
+    channel_bearing(channel).map(|b| Vector2::new(b.cos(), b.sin()))
+}
+
 /// Wheel speeds steering toward the vector sum of the channel readings.
-fn toward(dirs: &[(u16, f32, f32)], speed: f32, now: &[f32; CHANNELS]) -> [f32; 2] {
-    let (mut x, mut y) = (0.0f32, 0.0f32);
-    for &(c, cx, cy) in dirs {
-        let v = now[c as usize];
-        x += v * cx;
-        y += v * cy;
-    }
+fn toward(dirs: &[(u16, Vector2<f32>)], speed: f32, now: &[f32; CHANNELS]) -> [f32; 2] {
+    let sum = dirs.iter().fold(Vector2::zeros(), |sum, (c, dir)| sum + dir * now[*c as usize]);
     // A vector shorter than TOWARD_MIN_LENGTH is sensor noise: nothing is
     // sensed, drive forward instead of spinning on noise.
-    if x * x + y * y < TOWARD_MIN_LENGTH * TOWARD_MIN_LENGTH {
+    if sum.norm_squared() < TOWARD_MIN_LENGTH * TOWARD_MIN_LENGTH {
         return [speed, speed];
     }
-    let angle = y.atan2(x);
+    // The bearing of the sum, counter-clockwise from the heading.
+    let angle = sum.y.atan2(sum.x);
     if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
         [speed, speed]
     } else if angle > 0.0 {
@@ -225,10 +228,8 @@ mod tests {
     use super::*;
     use crate::catalog::{CH_IR, CH_LIGHT};
 
-    fn dirs(chans: std::ops::Range<usize>) -> Vec<(u16, f32, f32)> {
-        chans
-            .map(|c| (c as u16, channel_bearing(c).unwrap().cos(), channel_bearing(c).unwrap().sin()))
-            .collect()
+    fn dirs(chans: std::ops::Range<usize>) -> Vec<(u16, Vector2<f32>)> {
+        chans.map(|c| (c as u16, bearing_vector(c).unwrap())).collect()
     }
 
     #[test]

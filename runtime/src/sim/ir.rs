@@ -29,6 +29,8 @@
 
 use std::sync::OnceLock;
 
+use nalgebra::{Point2, SMatrix, UnitComplex, Vector2};
+
 /// Number of IR sensors.
 pub const SENSORS: usize = 8;
 /// Radius of the cylinder the cylinder constants were measured with, mm.
@@ -120,52 +122,63 @@ impl IrModel {
     }
 
     /// Exact (table-free) reading of sensor `s` for a wall whose outward
-    /// normal, in the robot frame, is `normal` (unit) and whose distance from
-    /// the robot centre is `dist`; `body` is the body radius.
-    pub fn wall_reading(&self, s: usize, body: f32, dist: f32, normal: [f32; 2]) -> f32 {
+    /// normal, in the body frame, is `normal` (unit) and whose distance from
+    /// the body centre is `dist`; `body` is the body radius.
+    pub fn wall_reading(&self, s: usize, body: f32, dist: f32, normal: Vector2<f32>) -> f32 {
         let g = Geometry::new(self, body);
-        let d = dist - (g.px[s] * normal[0] + g.py[s] * normal[1]);
-        let cos_a = g.ax[s] * normal[0] + g.ay[s] * normal[1];
+        let d = dist - g.position(s).coords.dot(&normal);
+        let cos_a = g.axis(s).dot(&normal);
         let r = &self.wall;
         saturate((r.reach[s] - d) / r.decay[s] + r.focus[s] * (cos_a - 1.0), r.knee)
     }
 
     /// Exact reading of sensor `s` for a cylinder of radius `radius` centred
-    /// at `centre` (robot frame, mm).
-    pub fn cylinder_reading(&self, s: usize, body: f32, centre: [f32; 2], radius: f32) -> f32 {
+    /// at `centre` (body frame, mm).
+    pub fn cylinder_reading(&self, s: usize, body: f32, centre: Point2<f32>, radius: f32) -> f32 {
         let g = Geometry::new(self, body);
-        let vx = centre[0] - g.px[s];
-        let vy = centre[1] - g.py[s];
-        let dist = (vx * vx + vy * vy).sqrt().max(1e-3);
+        let v = centre - g.position(s);
+        let dist = v.norm().max(1e-3);
         let d = dist - radius;
-        let cos_a = (g.ax[s] * vx + g.ay[s] * vy) / dist;
+        let cos_a = g.axis(s).dot(&v) / dist;
         let r = &self.cylinder;
         let reach = self.cylinder_reach(radius)[s];
         saturate((reach - d) / r.decay[s] + r.focus[s] * (cos_a - 1.0), r.knee)
     }
 }
 
-/// Precomputed sensor positions (robot frame, on the body rim) and axes.
+/// The sensors in the body frame (x ahead, y to the left; mm), precomputed
+/// for a body radius. One row per sensor, so that a product with a vector
+/// projects every sensor on it at once (`pos * n`, `rays * n`).
 #[derive(Clone, Copy, Debug)]
 pub struct Geometry {
-    pub px: [f32; SENSORS],
-    pub py: [f32; SENSORS],
-    pub ax: [f32; SENSORS],
-    pub ay: [f32; SENSORS],
+    /// Where each sensor sits, on the body rim: row `s` is sensor `s`'s (x, y).
+    pub pos: SMatrix<f32, SENSORS, 2>,
+    /// Where each sensor looks: row `s` is the unit vector of its axis.
+    pub rays: SMatrix<f32, SENSORS, 2>,
 }
 
 impl Geometry {
     pub fn new(model: &IrModel, body: f32) -> Geometry {
-        let mut g = Geometry { px: [0.0; 8], py: [0.0; 8], ax: [0.0; 8], ay: [0.0; 8] };
-        for s in 0..SENSORS {
-            let (sp, cp) = model.position_deg[s].to_radians().sin_cos();
-            let (sa, ca) = model.axis_deg[s].to_radians().sin_cos();
-            g.px[s] = body * cp;
-            g.py[s] = body * sp;
-            g.ax[s] = ca;
-            g.ay[s] = sa;
-        }
-        g
+        // sin and cos in f64, rounded once: the correctly rounded values,
+        // the same whether or not the compiler folds the model's constants
+        // (an f32 `sin_cos` at run time can be one unit in the last place off).
+        let turn = |deg: f32| {
+            let (s, c) = f64::from(deg.to_radians()).sin_cos();
+            UnitComplex::from_cos_sin_unchecked(c as f32, s as f32)
+        };
+        let pos = model.position_deg.map(|deg| (turn(deg) * Point2::new(body, 0.0)).coords.transpose());
+        let rays = model.axis_deg.map(|deg| (turn(deg) * Vector2::x()).transpose());
+        Geometry { pos: SMatrix::from_rows(&pos), rays: SMatrix::from_rows(&rays) }
+    }
+
+    /// Where sensor `s` sits.
+    pub fn position(&self, s: usize) -> Point2<f32> {
+        Point2::new(self.pos[(s, 0)], self.pos[(s, 1)])
+    }
+
+    /// The unit vector of sensor `s`'s axis.
+    pub fn axis(&self, s: usize) -> Vector2<f32> {
+        Vector2::new(self.rays[(s, 0)], self.rays[(s, 1)])
     }
 }
 

@@ -5,6 +5,15 @@
 //! Frame: origin at the arena's south-west corner, x east (`arena[0]` wide),
 //! y north (`arena[1]` deep), headings counter-clockwise from +x, mm.
 //!
+//! Geometry is written on `nalgebra`'s fixed-size `f32` types: positions are
+//! `Point2`, directions and offsets `Vector2`, the robot's pose an `Isometry2`
+//! (its translation is the body centre, its `UnitComplex` rotation the
+//! heading as `(cos, sin)`), so the body frame (x ahead, y to the left) maps
+//! to the world by the pose. Sensors are fixed in the body frame
+//! ([`ir::Geometry`]); walls, objects and the lamp are brought into the body
+//! frame by the pose's inverse, once per surface rather than once per sensor.
+//! [`Pose`] is the same pose as plain data for reports, traces and tests.
+//!
 //! One [`Sim`] is one episode. Everything random (start pose, object
 //! placement, wheel and sensor noise) comes from one `ChaCha8Rng` seeded with
 //! the `seed` given to [`Sim::new`], so the same seed and commands give the
@@ -33,6 +42,7 @@
 pub mod ir;
 mod scene;
 
+use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -63,12 +73,28 @@ pub struct Outcome {
     pub collided: bool,
 }
 
+/// A pose as plain data: the body centre and the heading. The simulator
+/// keeps it as an [`Isometry2`]; the two convert into each other.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pose {
     pub x: f32,
     pub y: f32,
     /// Heading, radians, counter-clockwise from +x.
     pub theta: f32,
+}
+
+impl From<Pose> for Isometry2<f32> {
+    fn from(p: Pose) -> Isometry2<f32> {
+        Isometry2::new(Vector2::new(p.x, p.y), p.theta)
+    }
+}
+
+impl From<Isometry2<f32>> for Pose {
+    /// The heading in `-pi..=pi`.
+    fn from(iso: Isometry2<f32>) -> Pose {
+        let t = iso.translation.vector;
+        Pose { x: t.x, y: t.y, theta: iso.rotation.angle() }
+    }
 }
 
 /// Minimum clearance between the body and the walls at the start, mm.
@@ -108,8 +134,8 @@ const PLACE_BUDGET: u32 = 20_000;
 /// One object of the world.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Obj {
-    x: f32,
-    y: f32,
+    /// Centre (where it lay last, while held or outside).
+    at: Point2<f32>,
     state: ObjectState,
     /// Gripped before: gripping it again (after a drop inside the arena) is
     /// not a new grip event, so fitness cannot be farmed on one object.
@@ -129,9 +155,9 @@ pub struct Sim {
     travel: f32,
     wheel_noise: f32,
     sensor_noise: f32,
-    bar: Option<[[f32; 2]; 2]>,
-    /// Lamp (x, y), height and the intensity constant.
-    lamp: Option<([f32; 2], f32, f32)>,
+    /// The charger bar's end points.
+    bar: Option<[Point2<f32>; 2]>,
+    lamp: Option<Lamp>,
     /// Battery capacity and recharge time in actions (`None`: no battery).
     battery_spec: Option<(u64, u64)>,
     obj_radius: f32,
@@ -142,14 +168,23 @@ pub struct Sim {
     wall_k: ir::Coeffs,
     cyl_k: ir::Coeffs,
     // state
-    pose: Pose,
-    cos_t: f32,
-    sin_t: f32,
+    /// The body frame in the world frame.
+    pose: Isometry2<f32>,
     /// Battery charge in units of `1 / (capacity * recharge)`.
     charge: u64,
     arm_down: bool,
     claw_closed: bool,
     held: Option<usize>,
+}
+
+/// The lamp above the charger.
+#[derive(Clone, Copy, Debug)]
+struct Lamp {
+    /// Where it is, seen from above.
+    at: Point2<f32>,
+    height: f32,
+    /// The intensity constant `K` of `K / (rho^2 + h^2)`.
+    k: f32,
 }
 
 /// A uniform draw in `lo..hi` that never panics (the middle if `hi <= lo`).
@@ -187,13 +222,27 @@ fn finite_or(x: f32, default: f32) -> f32 {
     }
 }
 
-fn wrap_angle(t: f32) -> f32 {
-    use std::f32::consts::{PI, TAU};
-    if (-PI..=PI).contains(&t) {
-        t
-    } else {
-        t - TAU * ((t + PI) / TAU).floor()
-    }
+/// The unit vector a rotation turns +x into: `(cos, sin)` of its angle.
+fn direction(r: &UnitComplex<f32>) -> Vector2<f32> {
+    Vector2::new(r.re, r.im)
+}
+
+/// `r` scaled back to length 1 (rounding drifts it over many products).
+/// Written out rather than `UnitComplex::renormalize`, which divides by a
+/// `hypot`: this form is cheaper and gives the simulator's historical bits.
+fn renormalized(r: UnitComplex<f32>) -> UnitComplex<f32> {
+    let c = r.into_inner();
+    let inv = 1.0 / c.norm_sqr().sqrt();
+    UnitComplex::new_unchecked(c * inv)
+}
+
+/// Squared distance from `p` to the segment `a`..`b`.
+fn segment_distance2(p: &Point2<f32>, a: &Point2<f32>, b: &Point2<f32>) -> f32 {
+    let ap = p - a;
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 { (ap.dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    (ap - ab * t).norm_squared()
 }
 
 impl Sim {
@@ -209,9 +258,8 @@ impl Sim {
         let bar = world.charger.as_ref().map(|c| bar_segment(c.wall, c.length, width, depth));
         let lamp = world.charger.as_ref().and_then(|c| {
             let h = finite_or(c.lamp_height?, 150.0).max(0.0);
-            let b = bar_segment(c.wall, c.length, width, depth);
-            let mid = [(b[0][0] + b[1][0]) / 2.0, (b[0][1] + b[1][1]) / 2.0];
-            Some((mid, h, LAMP_FULL * LAMP_FULL + h * h))
+            let [a, b] = bar_segment(c.wall, c.length, width, depth);
+            Some(Lamp { at: nalgebra::center(&a, &b), height: h, k: LAMP_FULL * LAMP_FULL + h * h })
         });
         let battery_spec =
             world.battery.as_ref().map(|b| (u64::from(b.capacity.max(1)), u64::from(b.recharge.max(1))));
@@ -242,9 +290,7 @@ impl Sim {
             geo: ir::Geometry::new(model, radius),
             wall_k: ir::Coeffs::new(&model.wall.reach, &model.wall),
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
-            pose: Pose::default(),
-            cos_t: 1.0,
-            sin_t: 0.0,
+            pose: Isometry2::identity(),
             charge: battery_spec.map_or(0, |(c, r)| c * r),
             arm_down: false,
             claw_closed: false,
@@ -253,50 +299,49 @@ impl Sim {
         // Objects first, then the robot somewhere free.
         let mut budget = PLACE_BUDGET;
         for _ in 0..count {
-            let ((x, y), used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
+            let (at, used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
             budget = budget.saturating_sub(used);
-            sim.objects.push(Obj { x, y, state: ObjectState::Floor, gripped: false });
+            sim.objects.push(Obj { at, state: ObjectState::Floor, gripped: false });
         }
         let margin = radius + START_CLEARANCE;
-        let mut pose = Pose { x: width / 2.0, y: depth / 2.0, theta: 0.0 };
+        let mut centre = Point2::new(width / 2.0, depth / 2.0);
         for _ in 0..PLACE_TRIES {
             let x = uniform(&mut rng, margin, width - margin);
             let y = uniform(&mut rng, margin, depth - margin);
-            pose = Pose { x, y, theta: 0.0 };
-            let clear = sim.objects.iter().all(|o| {
-                let d = radius + sim.obj_radius + 2.0;
-                (o.x - x).powi(2) + (o.y - y).powi(2) >= d * d
-            });
-            if clear {
+            centre = Point2::new(x, y);
+            let d = radius + sim.obj_radius + 2.0;
+            if sim.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d) {
                 break;
             }
         }
-        pose.theta = uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI);
-        sim.set_pose_unchecked(pose);
+        let theta = uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI);
+        sim.set_pose_unchecked(Pose { x: centre.x, y: centre.y, theta });
         sim.rng = rng;
         sim
     }
 
     /// A random position for an object centre, at least [`OBJECT_CLEARANCE`]
     /// from the walls and not overlapping other floor objects (nor the robot
-    /// when `robot` is given). Gives up after `tries` (at least one) and
-    /// returns the last try; also returns the number of tries used.
-    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Pose>, tries: u32) -> ((f32, f32), u32) {
+    /// when the robot's centre `robot` is given). Gives up after `tries` (at
+    /// least one) and returns the last try; also returns the number of tries
+    /// used.
+    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Point2<f32>>, tries: u32) -> (Point2<f32>, u32) {
         let r = self.obj_radius;
         let m = r + OBJECT_CLEARANCE;
-        let mut spot = (self.width / 2.0, self.depth / 2.0);
+        let mut spot = Point2::new(self.width / 2.0, self.depth / 2.0);
         let mut used = 0;
         while used < tries.max(1) {
             used += 1;
             let x = uniform(rng, m, self.width - m);
             let y = uniform(rng, m, self.depth - m);
-            spot = (x, y);
-            let clear_objects = self.objects.iter().all(|o| {
-                o.state != ObjectState::Floor || (o.x - x).powi(2) + (o.y - y).powi(2) >= 4.0 * r * r
-            });
+            spot = Point2::new(x, y);
+            let clear_objects = self
+                .objects
+                .iter()
+                .all(|o| o.state != ObjectState::Floor || (o.at - spot).norm_squared() >= 4.0 * r * r);
             let clear_robot = robot.is_none_or(|p| {
                 let d = self.radius + r + 2.0;
-                (p.x - x).powi(2) + (p.y - y).powi(2) >= d * d
+                (p - spot).norm_squared() >= d * d
             });
             if clear_objects && clear_robot {
                 break;
@@ -306,18 +351,25 @@ impl Sim {
     }
 
     fn set_pose_unchecked(&mut self, pose: Pose) {
-        let theta = wrap_angle(finite_or(pose.theta, 0.0));
-        self.pose = Pose { x: finite_or(pose.x, 0.0), y: finite_or(pose.y, 0.0), theta };
-        let (s, c) = theta.sin_cos();
-        self.sin_t = s;
-        self.cos_t = c;
+        let (x, y, theta) = (finite_or(pose.x, 0.0), finite_or(pose.y, 0.0), finite_or(pose.theta, 0.0));
+        self.pose = Pose { x, y, theta }.into();
+    }
+
+    /// The body centre.
+    fn centre(&self) -> Point2<f32> {
+        self.pose.translation.vector.into()
+    }
+
+    /// The unit vector of the heading.
+    fn heading(&self) -> Vector2<f32> {
+        direction(&self.pose.rotation)
     }
 
     /// Puts the robot at `pose` (for tests and tools). Returns false, and
     /// leaves the robot where it was, if the body would overlap a wall or a
     /// physical object.
     pub fn set_pose(&mut self, pose: Pose) -> bool {
-        if !self.free(pose.x, pose.y) {
+        if !self.free(&Point2::new(pose.x, pose.y)) {
             return false;
         }
         self.set_pose_unchecked(pose);
@@ -329,19 +381,18 @@ impl Sim {
     pub fn set_object(&mut self, index: usize, x: f32, y: f32) -> bool {
         match self.objects.get_mut(index) {
             Some(o) if o.state == ObjectState::Floor && x.is_finite() && y.is_finite() => {
-                o.x = x;
-                o.y = y;
+                o.at = Point2::new(x, y);
                 true
             }
             _ => false,
         }
     }
 
-    /// True when the body centred at `(x, y)` overlaps no wall and no
-    /// physical object on the floor.
-    fn free(&self, x: f32, y: f32) -> bool {
+    /// True when the body centred at `p` overlaps no wall and no physical
+    /// object on the floor.
+    fn free(&self, p: &Point2<f32>) -> bool {
         let r = self.radius;
-        if !(x >= r && x <= self.width - r && y >= r && y <= self.depth - r) {
+        if !(p.x >= r && p.x <= self.width - r && p.y >= r && p.y <= self.depth - r) {
             return false;
         }
         if self.obj_virtual {
@@ -349,9 +400,14 @@ impl Sim {
         }
         let d = r + self.obj_radius;
         let d2 = d * d;
-        self.objects
-            .iter()
-            .all(|o| o.state != ObjectState::Floor || (o.x - x).powi(2) + (o.y - y).powi(2) >= d2)
+        self.objects.iter().all(|o| o.state != ObjectState::Floor || (o.at - p).norm_squared() >= d2)
+    }
+
+    /// The four walls seen from `p`: distance to each and its outward unit
+    /// normal (west, east, south, north).
+    fn walls(&self, p: &Point2<f32>) -> [(f32, Vector2<f32>); 4] {
+        let (x, y) = (Vector2::x(), Vector2::y());
+        [(p.x, -x), (self.width - p.x, x), (p.y, -y), (self.depth - p.y, y)]
     }
 
     /// Fills the percept channels for the current state.
@@ -386,23 +442,22 @@ impl Sim {
             let t = ir::tables();
             (&t.0, &t.1)
         };
-        let Pose { x, y, .. } = self.pose;
-        let (c, s) = (self.cos_t, self.sin_t);
+        let centre = self.centre();
+        let rot = &self.pose.rotation;
         let g = &self.geo;
         let reach = self.radius + ir::RANGE;
-        // Walls: (distance from the centre, outward normal in the world frame).
-        let walls = [(x, -1.0, 0.0), (self.width - x, 1.0, 0.0), (y, 0.0, -1.0), (self.depth - y, 0.0, 1.0)];
-        for &(dist, wx, wy) in &walls {
+        for (dist, normal) in self.walls(&centre) {
             if dist > reach {
                 continue;
             }
-            // The normal in the robot frame.
-            let nx = wx * c + wy * s;
-            let ny = -wx * s + wy * c;
+            // With `n` the normal in the body frame, each sensor is `pos . n`
+            // nearer the wall than the centre, and its axis makes an angle
+            // of cosine `ray . n` with the normal: all eight at once.
+            let n = rot.inverse_transform_vector(&normal);
+            let nearer = g.pos * n;
+            let cos_a = g.rays * n;
             for k in 0..ir::SENSORS {
-                let d = dist - (g.px[k] * nx + g.py[k] * ny);
-                let cos_a = g.ax[k] * nx + g.ay[k] * ny;
-                out[k] += wt.get(self.wall_k.z(k, d, cos_a));
+                out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
             }
         }
         let r = self.obj_radius;
@@ -412,28 +467,25 @@ impl Sim {
             if o.state != ObjectState::Floor {
                 continue;
             }
-            let dx = o.x - x;
-            let dy = o.y - y;
-            if dx * dx + dy * dy > reach2 {
+            let offset = o.at - centre;
+            if offset.norm_squared() > reach2 {
                 continue;
             }
-            let mut rx = dx * c + dy * s;
-            let mut ry = -dx * s + dy * c;
+            // The object's centre in the body frame.
+            let mut at = Point2::from(rot.inverse_transform_vector(&offset));
             // Closer than the nearest measured distance (a virtual object under
             // the body): read it as if it were at that distance, same bearing.
             let near = self.radius + r + ir::NEAREST;
-            let d2 = rx * rx + ry * ry;
+            let d2 = at.coords.norm_squared();
             if d2 < near * near {
                 let d = d2.sqrt();
-                let (ux, uy) = if d > 1e-3 { (rx / d, ry / d) } else { (1.0, 0.0) };
-                rx = ux * near;
-                ry = uy * near;
+                let u = if d > 1e-3 { at.coords / d } else { Vector2::x() };
+                at = Point2::from(u * near);
             }
             for k in 0..ir::SENSORS {
-                let vx = rx - g.px[k];
-                let vy = ry - g.py[k];
-                let dist = (vx * vx + vy * vy).sqrt().max(1e-3);
-                let cos_a = (g.ax[k] * vx + g.ay[k] * vy) / dist;
+                let v = at - g.position(k);
+                let dist = v.norm().max(1e-3);
+                let cos_a = g.axis(k).dot(&v) / dist;
                 out[k] += ct.get(self.cyl_k.z(k, dist - r, cos_a));
             }
         }
@@ -445,22 +497,19 @@ impl Sim {
     /// times the lobe `cos(1.5 a)` for a horizontal bearing `|a| < 60` degrees
     /// off the sensor's axis (0 beyond), clamped at 1.
     fn sense_light(&self, out: &mut [f32; ir::SENSORS]) {
-        let Some(([lx, ly], h, k)) = self.lamp else {
+        let Some(lamp) = self.lamp else {
             return;
         };
-        let dx = lx - self.pose.x;
-        let dy = ly - self.pose.y;
-        let (c, s) = (self.cos_t, self.sin_t);
-        let rx = dx * c + dy * s;
-        let ry = -dx * s + dy * c;
-        let rho2 = rx * rx + ry * ry;
-        let intensity = k / (rho2 + h * h);
+        // The lamp in the body frame.
+        let rel = self.pose.inverse_transform_point(&lamp.at).coords;
+        let rho2 = rel.norm_squared();
+        let intensity = lamp.k / (rho2 + lamp.height * lamp.height);
         let rho = rho2.sqrt();
-        let g = &self.geo;
+        let along = self.geo.rays * rel;
         for i in 0..ir::SENSORS {
             // cos of the bearing off the axis; straight below the lamp every
             // sensor sees it head-on.
-            let cos_a = if rho > 1e-3 { (g.ax[i] * rx + g.ay[i] * ry) / rho } else { 1.0 };
+            let cos_a = if rho > 1e-3 { along[i] / rho } else { 1.0 };
             // cos(1.5 a) = 4 q^3 - 3 q with q = cos(a / 2).
             let q = ((1.0 + cos_a) * 0.5).max(0.0).sqrt();
             let lobe = (4.0 * q * q * q - 3.0 * q).max(0.0);
@@ -476,16 +525,15 @@ impl Sim {
 
     /// The floor object whose centre lies in the catch zone (the nearest).
     fn catchable(&self) -> Option<usize> {
-        let (c, s) = (self.cos_t, self.sin_t);
         let mut best: Option<(usize, f32)> = None;
         for (i, o) in self.objects.iter().enumerate() {
             if o.state != ObjectState::Floor {
                 continue;
             }
-            let dx = o.x - self.pose.x;
-            let dy = o.y - self.pose.y;
-            let fwd = dx * c + dy * s - self.radius;
-            let side = -dx * s + dy * c;
+            // The object's centre in the body frame: ahead, and to the side.
+            let at = self.pose.inverse_transform_point(&o.at);
+            let fwd = at.x - self.radius;
+            let side = at.y;
             if (CATCH_NEAR..=CATCH_FAR).contains(&fwd)
                 && side.abs() <= CATCH_HALF_WIDTH
                 && best.is_none_or(|(_, f)| fwd < f)
@@ -548,9 +596,9 @@ impl Sim {
             out.releases_outside += 1;
             if self.obj_virtual {
                 let mut rng = self.rng.clone();
-                let ((x, y), _) = self.free_spot(&mut rng, Some(self.pose), PLACE_TRIES);
+                let (at, _) = self.free_spot(&mut rng, Some(self.centre()), PLACE_TRIES);
                 self.rng = rng;
-                self.objects[i] = Obj { x, y, state: ObjectState::Floor, gripped: false };
+                self.objects[i] = Obj { at, state: ObjectState::Floor, gripped: false };
             } else {
                 self.objects[i].state = ObjectState::Outside;
             }
@@ -558,13 +606,15 @@ impl Sim {
         }
         let r = self.obj_radius;
         let ahead = self.radius + ((CATCH_NEAR + CATCH_FAR) / 2.0).max(r + 1.0);
-        let x = (self.pose.x + ahead * self.cos_t).clamp(r, (self.width - r).max(r));
-        let y = (self.pose.y + ahead * self.sin_t).clamp(r, (self.depth - r).max(r));
+        let centre = self.centre();
+        let front = centre + self.heading() * ahead;
+        let at =
+            Point2::new(front.x.clamp(r, (self.width - r).max(r)), front.y.clamp(r, (self.depth - r).max(r)));
         let d = self.radius + r;
-        if !self.obj_virtual && (x - self.pose.x).powi(2) + (y - self.pose.y).powi(2) < d * d {
+        if !self.obj_virtual && (at - centre).norm_squared() < d * d {
             return false;
         }
-        self.objects[i] = Obj { x, y, state: ObjectState::Floor, gripped: true };
+        self.objects[i] = Obj { at, state: ObjectState::Floor, gripped: true };
         self.held = None;
         true
     }
@@ -572,11 +622,10 @@ impl Sim {
     /// A wall within [`RELEASE_REACH`] of the body surface, within
     /// [`RELEASE_ANGLE_DEG`] of the heading.
     fn wall_ahead(&self) -> bool {
-        let Pose { x, y, .. } = self.pose;
         let reach = self.radius + RELEASE_REACH;
         let cos_max = RELEASE_ANGLE_DEG.to_radians().cos();
-        let walls = [(x, -1.0, 0.0), (self.width - x, 1.0, 0.0), (y, 0.0, -1.0), (self.depth - y, 0.0, 1.0)];
-        walls.iter().any(|&(dist, wx, wy)| dist <= reach && wx * self.cos_t + wy * self.sin_t >= cos_max)
+        let heading = self.heading();
+        self.walls(&self.centre()).iter().any(|(dist, n)| *dist <= reach && n.dot(&heading) >= cos_max)
     }
 
     /// The body surface within [`CONTACT`] of the charger bar.
@@ -584,13 +633,8 @@ impl Sim {
         let Some([a, b]) = self.bar else {
             return false;
         };
-        let (px, py) = (self.pose.x - a[0], self.pose.y - a[1]);
-        let (ux, uy) = (b[0] - a[0], b[1] - a[1]);
-        let len2 = ux * ux + uy * uy;
-        let t = if len2 > 0.0 { ((px * ux + py * uy) / len2).clamp(0.0, 1.0) } else { 0.0 };
-        let (dx, dy) = (px - t * ux, py - t * uy);
         let reach = self.radius + CONTACT;
-        dx * dx + dy * dy <= reach * reach
+        segment_distance2(&self.centre(), &a, &b) <= reach * reach
     }
 
     /// Moves the body for one action; returns true on a collision. The exact
@@ -608,31 +652,23 @@ impl Sim {
         if dl == 0.0 && dr == 0.0 {
             return false;
         }
-        let start = self.pose;
+        let start = self.centre();
+        let heading = self.pose.rotation;
         // The exact arc (spec 1.3) in chord form: the centre moves by
-        // `d * sinc(phi / 2)` along `theta + phi / 2`, and halfway by
-        // `d / 2 * sinc(phi / 4)` along `theta + phi / 4`. One `sin_cos` of
-        // `phi / 4` and the cached heading give everything by double angles.
+        // `d * sinc(phi / 2)` along the heading turned by `phi / 2`, and
+        // halfway by `d / 2 * sinc(phi / 4)` along it turned by `phi / 4`.
+        // One `sin_cos` of `phi / 4` gives the turns by `phi / 2` and `phi`
+        // as products of rotations.
         let d = (dl + dr) / 2.0;
         let phi = (dr - dl) / (2.0 * self.half_axle);
         let q = phi / 4.0;
         let (s1, c1) = q.sin_cos();
-        let (s2, c2) = (2.0 * s1 * c1, c1 * c1 - s1 * s1);
-        let (s4, c4) = (2.0 * s2 * c2, c2 * c2 - s2 * s2);
-        let (c0, s0) = (self.cos_t, self.sin_t);
-        let rot = |c: f32, s: f32| (c0 * c - s0 * s, s0 * c + c0 * s);
-        let (ce, se) = rot(c2, s2);
-        let len = d * sinc(2.0 * q, s2);
-        let (ex, ey) = (start.x + len * ce, start.y + len * se);
-        let (cm, sm) = rot(c1, s1);
-        let half = d / 2.0 * sinc(q, s1);
-        let (mx, my) = (start.x + half * cm, start.y + half * sm);
-        if self.free(ex, ey) && self.free(mx, my) {
-            let (ct, st) = rot(c4, s4);
-            let norm = 1.0 / (ct * ct + st * st).sqrt();
-            self.pose = Pose { x: ex, y: ey, theta: wrap_angle(start.theta + phi) };
-            self.cos_t = ct * norm;
-            self.sin_t = st * norm;
+        let turn4 = UnitComplex::from_cos_sin_unchecked(c1, s1);
+        let turn2 = turn4 * turn4;
+        let end = start + direction(&(heading * turn2)) * (d * sinc(2.0 * q, turn2.im));
+        let mid = start + direction(&(heading * turn4)) * (d / 2.0 * sinc(q, s1));
+        if self.free(&end) && self.free(&mid) {
+            self.pose = Isometry2::from_parts(end.into(), renormalized(heading * (turn2 * turn2)));
             return false;
         }
         // Retrace in `n` equal sub-arcs: each moves the centre by the chord
@@ -641,27 +677,25 @@ impl Sim {
         let n = ((dl.abs().max(dr.abs()) / SUBSTEP).ceil() as u32).clamp(1, 10_000);
         let sub = phi / n as f32;
         let (sh, ch) = (sub / 2.0).sin_cos();
-        let (sf, cf) = (2.0 * sh * ch, ch * ch - sh * sh);
+        let half_turn = UnitComplex::from_cos_sin_unchecked(ch, sh);
+        let turn = half_turn * half_turn;
         let len = d / n as f32 * sinc(sub / 2.0, sh);
-        let (mut x, mut y, mut c, mut s) = (start.x, start.y, c0, s0);
+        let (mut at, mut rot) = (start, heading);
         let mut k = 0;
         while k < n {
-            let (nx, ny) = (x + len * (c * ch - s * sh), y + len * (s * ch + c * sh));
-            if !self.free(nx, ny) {
+            let next = at + direction(&(rot * half_turn)) * len;
+            if !self.free(&next) {
                 break;
             }
-            (x, y, c, s) = (nx, ny, c * cf - s * sf, s * cf + c * sf);
+            (at, rot) = (next, rot * turn);
             k += 1;
         }
-        let norm = 1.0 / (c * c + s * s).sqrt();
-        self.pose = Pose { x, y, theta: wrap_angle(start.theta + sub * k as f32) };
-        self.cos_t = c * norm;
-        self.sin_t = s * norm;
+        self.pose = Isometry2::from_parts(at.into(), renormalized(rot));
         k < n
     }
 
     pub fn pose(&self) -> Pose {
-        self.pose
+        self.pose.into()
     }
 
     /// Battery level 0..1 (1 forever without a battery).
@@ -692,24 +726,30 @@ impl Sim {
 
     /// Plain data describing the current state, for pictures.
     pub fn scene(&self) -> Scene {
+        let xy = |p: Point2<f32>| [p.x, p.y];
         Scene {
             arena: [self.width, self.depth],
-            bar: self.bar,
-            lamp: self.lamp.map(|(p, _, _)| p),
+            bar: self.bar.map(|[a, b]| [xy(a), xy(b)]),
+            lamp: self.lamp.map(|l| xy(l.at)),
             objects: self
                 .objects
                 .iter()
                 .map(|o| {
-                    let (x, y) = if o.state == ObjectState::Held {
-                        let a = self.radius + (CATCH_NEAR + CATCH_FAR) / 2.0;
-                        (self.pose.x + a * self.cos_t, self.pose.y + a * self.sin_t)
+                    let at = if o.state == ObjectState::Held {
+                        self.centre() + self.heading() * (self.radius + (CATCH_NEAR + CATCH_FAR) / 2.0)
                     } else {
-                        (o.x, o.y)
+                        o.at
                     };
-                    SceneObject { x, y, radius: self.obj_radius, virtual_: self.obj_virtual, state: o.state }
+                    SceneObject {
+                        x: at.x,
+                        y: at.y,
+                        radius: self.obj_radius,
+                        virtual_: self.obj_virtual,
+                        state: o.state,
+                    }
                 })
                 .collect(),
-            pose: self.pose,
+            pose: self.pose(),
             body_radius: self.radius,
             arm_down: self.arm_down,
             claw_closed: self.claw_closed,
@@ -718,17 +758,18 @@ impl Sim {
 }
 
 /// The bar's end points: centred on `wall`, flush with it.
-fn bar_segment(wall: Wall, length: f32, width: f32, depth: f32) -> [[f32; 2]; 2] {
+fn bar_segment(wall: Wall, length: f32, width: f32, depth: f32) -> [Point2<f32>; 2] {
     let along = match wall {
         Wall::North | Wall::South => width,
         Wall::East | Wall::West => depth,
     };
     let half = finite_or(length, 0.0).clamp(0.0, along) / 2.0;
     let mid = along / 2.0;
+    let p = Point2::new;
     match wall {
-        Wall::North => [[mid - half, depth], [mid + half, depth]],
-        Wall::South => [[mid - half, 0.0], [mid + half, 0.0]],
-        Wall::East => [[width, mid - half], [width, mid + half]],
-        Wall::West => [[0.0, mid - half], [0.0, mid + half]],
+        Wall::North => [p(mid - half, depth), p(mid + half, depth)],
+        Wall::South => [p(mid - half, 0.0), p(mid + half, 0.0)],
+        Wall::East => [p(width, mid - half), p(width, mid + half)],
+        Wall::West => [p(0.0, mid - half), p(0.0, mid + half)],
     }
 }
