@@ -142,6 +142,9 @@ pub struct EpisodeColumns {
 pub struct Episode {
     pub format: u32,
     pub stage: String,
+    /// The episode seed, as a string: seeds use all 64 bits, more than a
+    /// JavaScript number holds exactly.
+    #[serde(with = "seed_string")]
     pub seed: u64,
     pub learning: bool,
     /// The robot has a gripper (arm and claw).
@@ -153,6 +156,18 @@ pub struct Episode {
     pub sensor_range: f32,
     pub worlds: Vec<EpisodeWorld>,
     pub actions: EpisodeColumns,
+}
+
+mod seed_string {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(seed: &u64, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&seed.to_string())
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+        String::deserialize(d)?.parse().map_err(serde::de::Error::custom)
+    }
 }
 
 fn round(v: f32, digits: i32) -> f32 {

@@ -109,7 +109,7 @@
   function drawArena() {
     const ep = R.ep, cv = $('arena');
     const [aw, ah] = worldBox(ep);
-    const pad = 16, top = 22, maxW = 520, maxH = 660;
+    const pad = 16, top = 22, maxW = 480, maxH = 580;
     const s = Math.min((maxW - 2 * pad) / aw, (maxH - pad - top) / ah);
     const W = Math.round(aw * s + 2 * pad), H = Math.round(ah * s + pad + top);
     const dpr = window.devicePixelRatio || 1;
