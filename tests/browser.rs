@@ -174,3 +174,80 @@ fn report_opens_without_console_messages_and_shows_the_trace_at_an_action() {
     assert!(png.starts_with(b"\x89PNG") && png.len() > 20_000, "screenshot of {} bytes", png.len());
     eprintln!("screenshot: {}", shot.display());
 }
+
+/// Drives the page's controls in the browser: keys, the scrub bar, a click
+/// on the timeline, play and pause, and a changed fragment. A script added
+/// to a copy of the report does it once the page has loaded, and leaves
+/// what the page showed after each step in an attribute of the body.
+#[test]
+fn keyboard_mouse_and_fragment_move_the_replay() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("controls");
+    let out = shaping()
+        .arg("run")
+        .arg(root().join("tests/cli/report.bat"))
+        .arg("--out")
+        .arg(&dir)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let driver = r#"<script>
+window.addEventListener('load', () => {
+  const log = [];
+  const key = (k, shift) => document.dispatchEvent(new KeyboardEvent('keydown', { key: k, shiftKey: !!shift, bubbles: true }));
+  const shown = () => document.getElementById('r-action').textContent + ' ' + document.body.dataset.stage + ' ' + location.hash;
+  key('Home'); log.push(shown());
+  key('ArrowRight'); log.push(shown());
+  key('ArrowRight', true); log.push(shown());
+  key('ArrowLeft'); log.push(shown());
+  key('End'); log.push(shown());
+  const s = document.getElementById('scrub'); s.value = '5'; s.dispatchEvent(new Event('input')); log.push(shown());
+  const tl = document.getElementById('timeline'); const r = tl.getBoundingClientRect();
+  tl.dispatchEvent(new MouseEvent('mousedown', { clientX: r.left + r.width * 0.5, clientY: r.top + 10, bubbles: true }));
+  window.dispatchEvent(new MouseEvent('mouseup', {}));
+  log.push(shown());
+  key(' ');
+  setTimeout(() => {
+    key(' '); log.push(shown());
+    location.hash = '#stage=navigation&action=7';
+    setTimeout(() => { log.push(shown()); document.body.dataset.driven = JSON.stringify(log); }, 100);
+  }, 1000);
+});
+</script>
+</body>"#;
+    let driven = dir.join("driven.html");
+    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
+    let url = format!("{}#stage=bigger&action=3", file_url(&driven));
+    let out = headless(&browser, &scratch("profile-controls"), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let log: Vec<String> = serde_json::from_str(
+        &body_attr(&dom, "data-driven")
+            .expect("the driver ran")
+            .replace("&quot;", "\"")
+            .replace("&amp;", "&"),
+    )
+    .unwrap();
+    let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
+    let last = trace.lines().count() - 2;
+    let at = |a: usize| format!("{a} bigger #stage=bigger&action={a}");
+    assert_eq!(log[0], at(0), "Home");
+    assert_eq!(log[1], at(1), "Right");
+    assert_eq!(log[2], at(11), "Shift+Right");
+    assert_eq!(log[3], at(10), "Left");
+    assert_eq!(log[4], at(last), "End");
+    assert_eq!(log[5], at(5), "the scrub bar");
+    let clicked: usize = log[6].split(' ').next().unwrap().parse().unwrap();
+    assert!(
+        last / 4 < clicked && clicked < last * 3 / 4,
+        "a click in the middle of the timeline went to {clicked} of {last}"
+    );
+    assert_eq!(log[6], at(clicked));
+    let played: usize = log[7].split(' ').next().unwrap().parse().unwrap();
+    assert!(played > clicked, "a second of play moved from {clicked} to {played}");
+    assert_eq!(log[7], at(played), "the fragment follows the replay");
+    assert_eq!(log[8], "7 navigation #stage=navigation&action=7", "a changed fragment moves the replay");
+}

@@ -67,7 +67,7 @@
   }));
 
   // ------------------------------------------------------------------ replay
-  const R = { ep: null, epIndex: 0, a: 0, playing: false, speed: 10, acc: 0, last: 0, hashTimer: 0 };
+  const R = { ep: null, epIndex: 0, a: 0, playing: false, speed: 10, acc: 0, last: 0, hashTimer: 0, timer: 0 };
 
   function prepare(ep) {
     const c = ep.actions;
@@ -393,12 +393,17 @@
     if (R.playing && R.a >= R.ep._.n - 1) R.a = 0;
     R.acc = 0; R.last = performance.now();
     readout();
-    if (R.playing) requestAnimationFrame(tick);
+    clearTimeout(R.timer);
+    if (R.playing) R.timer = setTimeout(tick, frameDelay());
     else writeHash();
   }
 
-  function tick(now) {
+  // Timers rather than animation frames: they also run in a headless browser.
+  const frameDelay = () => Math.max(16, 1000 / R.speed);
+
+  function tick() {
     if (!R.playing) return;
+    const now = performance.now();
     R.acc += (now - R.last) / 1000 * R.speed;
     R.last = now;
     if (R.acc >= 1) {
@@ -408,7 +413,7 @@
       seek(R.a + step, true);
       if (now - R.hashTimer > 300) { writeHash(); R.hashTimer = now; }
     }
-    requestAnimationFrame(tick);
+    R.timer = setTimeout(tick, frameDelay());
   }
 
   function parseHash() {
