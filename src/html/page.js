@@ -203,7 +203,7 @@
     add('battery', 30);
     if (ep._.learners.length) { add('reinf', 24); add('perf', 54); }
     add('events', 14);
-    return { rows, height: y + 14, left: 110, right: 10 };
+    return { rows, height: y + 14, left: 110, right: 22 };
   }
 
   function drawTimelineStatic() {
