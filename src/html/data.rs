@@ -32,6 +32,8 @@ pub struct ReportData {
     pub seeds: Vec<u64>,
     /// Where the episodes come from, in words (for an experiment: which seed).
     pub episodes_note: String,
+    /// An experiment's seed whose genomes, episodes and test results are shown.
+    pub shown_seed: Option<u64>,
     pub stages: Vec<StageView>,
     /// One series per evolved stage, in program order.
     pub fitness: Vec<FitnessSeries>,
@@ -626,6 +628,7 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         generator: format!("shaping {}", env!("CARGO_PKG_VERSION")),
         seeds: Vec::new(),
         episodes_note: String::new(),
+        shown_seed: None,
         stages: Vec::new(),
         fitness: Vec::new(),
         episodes: Vec::new(),
@@ -720,6 +723,7 @@ fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, CliErr
     let pick = order[(order.len() - 1) / 2].1;
     let (seed, run) = &seeds[pick];
     (data.stages, data.episodes) = run_stages(&program, run, None)?;
+    data.shown_seed = Some(*seed);
     data.episodes_note = format!(
         "seed {seed}, the median of {} seeds by the final best fitness{}; genomes and episodes of that seed",
         seeds.len(),

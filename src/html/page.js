@@ -15,6 +15,8 @@
   window.addEventListener('error', (e) => showError(String(e.message || e)));
 
   const D = JSON.parse(document.getElementById('data').textContent);
+  // An episode without a single action (a flat battery) has nothing to show.
+  D.episodes = D.episodes.filter((e) => e.actions.x.length > 0);
   const $ = (id) => document.getElementById(id);
   const PALETTE = ['#1f77b4', '#e8741c', '#2ca02c', '#d62728', '#9467bd', '#8c564b', '#e377c2', '#17becf', '#7f7f7f', '#bcbd22'];
   const SVGNS = 'http://www.w3.org/2000/svg';
@@ -141,7 +143,8 @@
     g.lineWidth = 2; g.lineCap = 'round';
     let px = w.start[0], py = w.start[1];
     for (let k = w.from; k <= a; k++) {
-      g.strokeStyle = color(c.winner[k]); g.globalAlpha = 0.55;
+      // Older parts of a long trail fade.
+      g.strokeStyle = color(c.winner[k]); g.globalAlpha = 0.15 + 0.5 * Math.max(0, 1 - (a - k) / 400);
       g.beginPath(); g.moveTo(X(px), Y(py)); g.lineTo(X(c.x[k]), Y(c.y[k])); g.stroke();
       px = c.x[k]; py = c.y[k];
     }
@@ -590,13 +593,14 @@
       let text = '';
       if (s && s.best.length) {
         const k = s.best.length - 1;
-        text = (D.kind === 'experiment' ? 'median ' : '') + 'final best ' + fmt(s.best[k], 3) + ', mean ' + fmt(s.mean[k], 3) +
-          ', highest best ' + fmt(Math.max(...s.best), 3);
+        text = D.kind === 'experiment'
+          ? 'median over seeds: final best ' + fmt(s.best[k], 3) + ', final mean ' + fmt(s.mean[k], 3) + ', final best ranges ' + fmt(s.best_min[k], 3) + '..' + fmt(s.best_max[k], 3)
+          : 'final best ' + fmt(s.best[k], 3) + ', mean ' + fmt(s.mean[k], 3) + ', highest best ' + fmt(Math.max(...s.best), 3);
       } else if (st.results) {
         const r = st.results, b = r.before || {}, a = r.after || {};
         text = 'fitness ' + fmt(b.fitness, 3) + ' → ' + fmt(a.fitness, 3) + ', grips ' + b.grips + ' → ' + a.grips +
           ', released outside ' + b.releases_outside + ' → ' + a.releases_outside + ', recharges ' + b.recharges + ' → ' + a.recharges +
-          ' (before → after the change)';
+          ' (before → after the change)' + (D.shown_seed !== null && D.shown_seed !== undefined ? ', run seed ' + D.shown_seed : '');
       }
       tb.append(el('tr', {}, el('td', { text: st.name }), el('td', { text: st.run }), el('td', { text: text || '–' })));
     }
@@ -638,7 +642,7 @@
     const svg = sv('svg', { viewBox: '0 0 ' + W + ' ' + H, role: 'img', 'aria-label': 'module graph of ' + st.name });
     const defs = sv('defs');
     for (const [id, col] of [['pos', '#2563eb'], ['neg', '#d23c3c'], ['nil', '#9aa5b1']]) {
-      defs.append(sv('marker', { id: 'arrow-' + id, viewBox: '0 0 10 10', refX: 9, refY: 5, markerWidth: 7, markerHeight: 7, orient: 'auto-start-reverse' },
+      defs.append(sv('marker', { id: 'arrow-' + id, viewBox: '0 0 10 10', refX: 9, refY: 5, markerWidth: 9, markerHeight: 9, markerUnits: 'userSpaceOnUse', orient: 'auto-start-reverse' },
         sv('path', { d: 'M0 0 L10 5 L0 10 z', fill: col })));
     }
     svg.append(defs);

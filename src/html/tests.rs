@@ -229,6 +229,7 @@ fn sample_data(title: &str) -> ReportData {
         generator: "shaping test".into(),
         seeds: Vec::new(),
         episodes_note: "a test".into(),
+        shown_seed: None,
         stages: (0..p.stages.len()).map(|i| stage_view(&p, i, None)).collect(),
         fitness: Vec::new(),
         episodes: vec![ep],
