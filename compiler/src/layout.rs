@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use shaping_runtime::program::{Behavior, GeneRole, Param, Program, Stage, StageRun};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
-pub fn channel_name(stage: &Stage, c: u16) -> String {
+fn channel_name(stage: &Stage, c: u16) -> String {
     match stage.sensors.iter().find(|s| s.channel <= c && c < s.channel + s.count) {
         Some(s) if s.count == 1 => s.name.clone(),
         Some(s) => format!("{}[{}]", s.name, c - s.channel),

@@ -462,7 +462,9 @@
     $('b-next').addEventListener('click', (e) => seek(R.a + (e.shiftKey ? 10 : 1)));
     $('b-play').addEventListener('click', () => play(!R.playing));
     $('scrub').addEventListener('input', () => seek(Number($('scrub').value)));
-    $('speed').addEventListener('change', () => setSpeed(Number($('speed').value)));
+    $('speed').addEventListener('change', () => { setSpeed(Number($('speed').value)); $('speed').blur(); });
+    // After a mouse click the keys drive the replay again, not the button.
+    document.querySelectorAll('#controls button, #ep-tabs button').forEach((b) => b.addEventListener('click', (e) => { if (e.detail > 0) b.blur(); }));
     const tl = $('timeline');
     let dragging = false;
     const fromMouse = (e) => {
@@ -477,6 +479,8 @@
       const t = e.target;
       if (t && (t.tagName === 'INPUT' && t.type !== 'range' || t.tagName === 'SELECT' || t.tagName === 'TEXTAREA')) return;
       if (e.ctrlKey || e.metaKey || e.altKey) return;
+      // A focused button (reached with Tab) takes Space and Enter itself.
+      if (t && t.tagName === 'BUTTON' && (e.key === ' ' || e.key === 'Enter')) return;
       const big = e.shiftKey ? 10 : 1;
       const speeds = [1, 2, 5, 10, 20, 50, 100, 200];
       switch (e.key) {
