@@ -120,6 +120,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             let dir = out.join(&program.stages[index].name);
             create_dir(&dir)?;
             let trained = train_step(&program, index, seed, &dir, &args)?;
+            train_episode(&program.stages[index], index, seed, &dir)?;
             evolve::train::bind(&mut program, index, &trained)
                 .map_err(|e| CliError::io(format!("error: {e}")))?;
             continue;
@@ -155,6 +156,22 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
 
 fn compact_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
     serde_json::to_string(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
+}
+
+/// `episode.json` of a training stage: its life recorded again, the same
+/// life as `evolve::train_stage`'s (the same episode seed and genome).
+fn train_episode(stage: &Stage, index: usize, seed: u64, dir: &Path) -> Result<(), CliError> {
+    let StageRun::Train { actions } = stage.run else { return Ok(()) };
+    let opts = EpisodeOptions { actions, learning: true, seed: train_episode_seed(seed, index) };
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let (_, _, ep) =
+        episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
+}
+
+/// The episode seed of training stage `index`'s life.
+pub fn train_episode_seed(run_seed: u64, index: usize) -> u64 {
+    evolve::seed::episode_seed(run_seed, index, 0, 0, 0)
 }
 
 /// `episode.json` of an evolved stage: one recorded episode of its best

@@ -297,6 +297,7 @@ fn behavior_text(stage: &Stage, b: &Behavior) -> String {
                 }
                 Some(Param::Gene(_)) => ", weights evolved".into(),
                 Some(Param::Fixed(_)) => ", weights fixed".into(),
+                Some(Param::Trained { .. }) => ", weights trained by a training stage".into(),
                 None => String::new(),
             };
             format!(
@@ -375,6 +376,9 @@ fn run_text(st: &Stage) -> String {
         StageRun::Evolve(e) => format!(
             "evolved: {} generations of {}, {} actions per life, seed {}",
             e.generations, e.population, e.actions, e.seed
+        ),
+        StageRun::Train { actions } => format!(
+            "trained: one life of {actions} actions with learning on; the stages that use it start from the behavior weights learned"
         ),
         StageRun::Test { actions, learning } => format!(
             "test of the parent's best: {actions} actions in the parent's world, then {actions} in this one, learning {}",
@@ -479,9 +483,10 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
                     let new = introduced(l.from).max(introduced(l.to)) as usize == index;
                     ("fixed", Some(w), None, false, new)
                 }
-                Param::Random { .. } => {
+                Param::Random { .. } | Param::Trained { .. } => {
                     let new = introduced(l.from).max(introduced(l.to)) as usize == index;
-                    ("random", None, None, false, new)
+                    let kind = if matches!(l.weight, Param::Random { .. }) { "random" } else { "trained" };
+                    (kind, None, None, false, new)
                 }
             };
             LinkView { from: l.from, to: l.to, kind, weight, gene, frozen, new }

@@ -302,3 +302,25 @@ fn episode_json_round_trips() {
     let back: Episode = serde_json::from_str(&text).unwrap();
     assert_eq!(back, ep);
 }
+
+#[test]
+fn a_training_stage_episode_is_the_training_life() {
+    let src = include_str!("../../examples/khepera.bat");
+    let p = shaping_compiler::compile(src, "khepera.bat").expect("the example compiles");
+    let (i, stage) = p
+        .stages
+        .iter()
+        .enumerate()
+        .find(|(_, s)| matches!(s.run, StageRun::Train { .. }))
+        .expect("khepera.bat has a training stage");
+    let StageRun::Train { actions } = stage.run else { unreachable!() };
+    let mut trace = Trace::default();
+    let trained = shaping_runtime::evolve::train_stage(&p, i, 5, Some(&mut trace)).unwrap();
+    let opts = EpisodeOptions { actions, learning: true, seed: crate::run::train_episode_seed(5, i) };
+    let (result, recorded, ep) =
+        run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts).unwrap();
+    assert_eq!(result, trained.result);
+    assert_eq!(recorded, trace);
+    assert_eq!(ep.actions.x.len(), trace.rows.len());
+    assert!(trace.rows.len() > 100);
+}
