@@ -68,6 +68,8 @@ fn headless(browser: &Path, profile: &Path, url: &str, what: &str) -> Output {
             "--headless",
             "--no-sandbox",
             "--disable-gpu",
+            // Containers often have a small /dev/shm, where the renderer crashes.
+            "--disable-dev-shm-usage",
             "--no-first-run",
             "--disable-extensions",
             "--hide-scrollbars",
