@@ -18,6 +18,8 @@ pub struct ExperimentArgs {
     pub jobs: Option<usize>,
     pub criterion: Vec<String>,
     pub fresh: bool,
+    /// Write no `report.html` at the end.
+    pub no_report: bool,
     pub error_format: crate::diag::ErrorFormat,
 }
 
@@ -83,6 +85,8 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
             quiet: false,
             json: false,
             fresh: args.fresh,
+            // One report for the whole experiment, written below.
+            no_report: true,
             error_format: args.error_format,
         })?;
     }
@@ -92,6 +96,10 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
     let summary = summarise(&program, &title, &out, &seeds, &criteria)?;
     write_atomic(&out.join("summary.md"), summary.as_bytes())?;
     print!("{summary}");
+    if !args.no_report {
+        let path = crate::html::write(&out, None)?;
+        eprintln!("report: {}", path.display());
+    }
     Ok(())
 }
 

@@ -2,7 +2,9 @@
 
 mod bench;
 mod diag;
+mod episode;
 mod experiment;
+mod html;
 mod load;
 mod plot;
 mod replay;
@@ -89,6 +91,9 @@ enum Command {
         /// Ignore existing checkpoints and start every stage again.
         #[arg(long)]
         fresh: bool,
+        /// Write no `report.html` at the end.
+        #[arg(long)]
+        no_report: bool,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -117,6 +122,9 @@ enum Command {
         /// Switch local learning off.
         #[arg(long)]
         no_learning: bool,
+        /// Also write `report.html`: the episode animated in a web page.
+        #[arg(long)]
+        report: bool,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -141,8 +149,21 @@ enum Command {
         /// Ignore existing checkpoints.
         #[arg(long)]
         fresh: bool,
+        /// Write no `report.html` at the end.
+        #[arg(long)]
+        no_report: bool,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
+    },
+    /// Write one self-contained HTML page (no network needed) for a run, stage,
+    /// experiment or replay directory: the replay animated with its module
+    /// activations, fitness, architecture and genome layout.
+    Report {
+        /// The directory a `run`, `experiment` or `replay` wrote.
+        dir: PathBuf,
+        /// Output file (default: `DIR/report.html`).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
     /// Measure simulator steps and controller actions per second (one JSON line).
     Bench {
@@ -199,33 +220,69 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             print_text(&shaping_compiler::render_graph(&program, index));
             Ok(())
         }
-        Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, error_format } => {
-            run::run(run::RunArgs { file, stage, seed, out, jobs, quiet, json, fresh, error_format })
-        }
-        Command::Replay { file, stage, genome, run, actions, out, seed, no_learning, error_format } => {
-            replay::replay(replay::ReplayArgs {
+        Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, no_report, error_format } => {
+            run::run(run::RunArgs {
                 file,
                 stage,
-                genome,
-                run,
-                actions,
-                out,
                 seed,
-                no_learning,
+                out,
+                jobs,
+                quiet,
+                json,
+                fresh,
+                no_report,
                 error_format,
             })
         }
-        Command::Experiment { file, seeds, first_seed, out, jobs, criterion, fresh, error_format } => {
-            experiment::experiment(experiment::ExperimentArgs {
-                file,
-                seeds,
-                first_seed,
-                out,
-                jobs,
-                criterion,
-                fresh,
-                error_format,
-            })
+        Command::Replay {
+            file,
+            stage,
+            genome,
+            run,
+            actions,
+            out,
+            seed,
+            no_learning,
+            report,
+            error_format,
+        } => replay::replay(replay::ReplayArgs {
+            file,
+            stage,
+            genome,
+            run,
+            actions,
+            out,
+            seed,
+            no_learning,
+            report,
+            error_format,
+        }),
+        Command::Experiment {
+            file,
+            seeds,
+            first_seed,
+            out,
+            jobs,
+            criterion,
+            fresh,
+            no_report,
+            error_format,
+        } => experiment::experiment(experiment::ExperimentArgs {
+            file,
+            seeds,
+            first_seed,
+            out,
+            jobs,
+            criterion,
+            fresh,
+            no_report,
+            error_format,
+        }),
+        Command::Report { dir, output } => {
+            let path = html::write(&dir, output.as_deref())?;
+            let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+            eprintln!("wrote {} ({} kB)", path.display(), size.div_ceil(1000));
+            Ok(())
         }
         Command::Bench { file, stage, runs, error_format } => {
             bench::bench(bench::BenchArgs { file, stage, runs, error_format })

@@ -2,13 +2,13 @@
 
 use std::path::{Path, PathBuf};
 
-use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
+use shaping_runtime::controller::EpisodeOptions;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Program, StageRun};
 use shaping_runtime::sim::Sim;
 
 use crate::load::{self, create_dir, write_atomic, CliError};
-use crate::{report, run};
+use crate::{episode, html, report, run};
 
 pub struct ReplayArgs {
     pub file: PathBuf,
@@ -19,6 +19,8 @@ pub struct ReplayArgs {
     pub out: Option<PathBuf>,
     pub seed: Option<u64>,
     pub no_learning: bool,
+    /// Also write `report.html` for the episode.
+    pub report: bool,
     pub error_format: crate::diag::ErrorFormat,
 }
 
@@ -92,12 +94,15 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let actions = args.actions.unwrap_or(actions);
     let learning = learning && !args.no_learning;
     let seed = args.seed.unwrap_or_else(|| run::run_seed(&program, None));
-    let mut trace = Trace::default();
-    let r = run_episode(stage, &genome, &EpisodeOptions { actions, learning, seed }, Some(&mut trace));
+    let (r, trace, ep) = episode::run_recorded(stage, &genome, &EpisodeOptions { actions, learning, seed })
+        .map_err(|e| CliError::io(format!("error: {e}")))?;
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     create_dir(&out)?;
     let scene = Sim::new(&stage.world, seed).scene();
     report::episode_files(&out, &stage.name, stage, &trace, &scene, &[])?;
+    let err = |e: serde_json::Error| CliError::io(format!("error: cannot serialise: {e}"));
+    write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).map_err(err)?.as_bytes())?;
+    write_atomic(&out.join("program.json"), serde_json::to_string(&program).map_err(err)?.as_bytes())?;
     println!(
         "{}: {} actions, fitness {:.3}, {} grips, {} released outside, {} recharges, {} collisions -> {}",
         stage.name,
@@ -109,5 +114,10 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
         r.collisions,
         out.display()
     );
-    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())
+    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    if args.report {
+        let path = html::write(&out, None)?;
+        println!("report: {}", path.display());
+    }
+    Ok(())
 }

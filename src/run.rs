@@ -14,8 +14,9 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Behavior, Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
+use crate::episode::{self, Part, Recorder};
 use crate::load::{self, create_dir, write_atomic, CliError};
-use crate::report;
+use crate::{html, report};
 
 pub struct RunArgs {
     pub file: PathBuf,
@@ -26,6 +27,8 @@ pub struct RunArgs {
     pub quiet: bool,
     pub json: bool,
     pub fresh: bool,
+    /// Write no `report.html` at the end.
+    pub no_report: bool,
     pub error_format: crate::diag::ErrorFormat,
 }
 
@@ -119,6 +122,8 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::io(format!("error: cannot start worker threads: {e}")))?;
     create_dir(&out)?;
+    // The compiled program, for `shaping report` (and `shaping run program.json`).
+    write_atomic(&out.join("program.json"), compact_json(&program)?.as_bytes())?;
     let started = Instant::now();
     let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
     for &index in &stages {
@@ -126,6 +131,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             let dir = out.join(&program.stages[index].name);
             create_dir(&dir)?;
             let trained = train_step(&program, index, seed, &dir, &args)?;
+            train_episode(&program.stages[index], index, seed, &dir)?;
             evolve::train::bind(&mut program, index, &trained)
                 .map_err(|e| CliError::io(format!("error: {e}")))?;
             continue;
@@ -137,6 +143,7 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             StageRun::Evolve(_) => {
                 let parent = evolved_parent(&program, index, &finals)?;
                 let cp = pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args))?;
+                best_episode(stage, &cp, seed, &dir)?;
                 finals[index] = Some(cp);
             }
             StageRun::Test { actions, learning } => {
@@ -148,10 +155,46 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
             StageRun::Train { .. } => unreachable!("training stages run above"),
         }
     }
+    let report = if args.no_report { None } else { Some(html::write(&out, None)?) };
     if !args.quiet && !args.json {
         eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), out.display());
+        if let Some(path) = report {
+            eprintln!("report: {}", path.display());
+        }
     }
     Ok(())
+}
+
+fn compact_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
+    serde_json::to_string(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
+}
+
+/// `episode.json` of a training stage: its life recorded again, the same
+/// life as `evolve::train_stage`'s (the same episode seed and genome).
+fn train_episode(stage: &Stage, index: usize, seed: u64, dir: &Path) -> Result<(), CliError> {
+    let StageRun::Train { actions } = stage.run else { return Ok(()) };
+    let opts = EpisodeOptions { actions, learning: true, seed: train_episode_seed(seed, index) };
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let (_, _, ep) =
+        episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
+}
+
+/// The episode seed of training stage `index`'s life.
+pub fn train_episode_seed(run_seed: u64, index: usize) -> u64 {
+    evolve::seed::episode_seed(run_seed, index, 0, 0, 0)
+}
+
+/// `episode.json` of an evolved stage: one recorded episode of its best
+/// individual, the one `shaping replay FILE --stage S` shows by default
+/// (the run seed, the stage's life, learning on).
+fn best_episode(stage: &Stage, cp: &Checkpoint, seed: u64, dir: &Path) -> Result<(), CliError> {
+    let StageRun::Evolve(evo) = &stage.run else { return Ok(()) };
+    let Some((genome, _)) = evolve::best_of(cp) else { return Ok(()) };
+    let opts = EpisodeOptions { actions: evo.actions, learning: true, seed };
+    let (_, _, ep) =
+        episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
 }
 
 /// The final checkpoint of the nearest evolved ancestor of `index`.
@@ -266,6 +309,8 @@ pub struct BeforeAfter {
     pub after: EpisodeResult,
     /// The changed world at its start, for the trajectory picture.
     pub scene: Scene,
+    /// The recorded episode, both worlds (`episode.json`).
+    pub episode: episode::Episode,
 }
 
 pub fn before_after(
@@ -281,19 +326,30 @@ pub fn before_after(
         .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
     let opts = EpisodeOptions { actions, learning, seed };
     let mut first = Trace::default();
-    let before = ctl.run(&mut Sim::new(&parent.world, sim_seed), &opts, Some(&mut first));
+    let mut sim = Sim::new(&parent.world, sim_seed);
+    let first_scene = sim.scene();
+    let mut rec = Recorder::new(&mut sim);
+    let before = ctl.run(&mut rec, &opts, Some(&mut first));
+    let first_frames = rec.frames;
     let mut second = Trace::default();
     let after_seed = sim_seed ^ 0x9e37_79b9_7f4a_7c15;
     let mut sim = Sim::new(&stage.world, after_seed);
     let scene = sim.scene();
-    let after = ctl.run(&mut sim, &opts, Some(&mut second));
+    let mut rec = Recorder::new(&mut sim);
+    let after = ctl.run(&mut rec, &opts, Some(&mut second));
+    let second_frames = rec.frames;
     let switch = first.rows.len() as u32;
     let mut trace = first;
     trace.rows.extend(second.rows.into_iter().map(|mut r| {
         r.action += switch;
         r
     }));
-    Ok(BeforeAfter { trace, switch, before, after, scene })
+    let parts = [
+        Part { stage: &parent.name, scene: first_scene, frames: first_frames },
+        Part { stage: &stage.name, scene: scene.clone(), frames: second_frames },
+    ];
+    let episode = episode::episode(stage, seed, learning, &trace, &parts);
+    Ok(BeforeAfter { trace, switch, before, after, scene, episode })
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -319,6 +375,7 @@ fn test_stage(
     let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
     let mark = [(ba.switch, format!("world of `{}`", stage.name))];
     report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.scene, &mark)?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
     let perf = |r: &EpisodeResult| {
         serde_json::json!({

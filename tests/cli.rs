@@ -339,3 +339,111 @@ fn training_stage_runs_as_a_step_and_its_weights_reach_the_next_stage() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn report_bat() -> PathBuf {
+    root().join("tests/cli/report.bat")
+}
+
+/// The data a report embeds.
+fn report_data(path: &Path) -> serde_json::Value {
+    let html = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let open = "<script type=\"application/json\" id=\"data\">";
+    let start = html.find(open).expect("the report embeds its data") + open.len();
+    let len = html[start..].find("</script>").unwrap();
+    serde_json::from_str(&html[start..start + len]).unwrap()
+}
+
+#[test]
+fn run_writes_a_report_of_every_stage_and_report_reads_any_directory() {
+    let dir = scratch("report-run");
+    let out = run(shaping().arg("run").arg(report_bat()).arg("--out").arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    let page = dir.join("report.html");
+    assert!(err.contains(&format!("report: {}", page.display())), "{err}");
+    assert!(dir.join("program.json").exists());
+    let data = report_data(&page);
+    assert_eq!(data["kind"], "run");
+    let stages: Vec<&str> =
+        data["stages"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
+    assert_eq!(stages, ["navigation", "collect", "bigger"]);
+    // One episode per stage, the test stage's in two worlds as long as its trace.
+    let eps = data["episodes"].as_array().unwrap();
+    assert_eq!(eps.len(), 3);
+    let bigger = &eps[2];
+    assert_eq!(bigger["worlds"].as_array().unwrap().len(), 2);
+    let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
+    assert_eq!(bigger["actions"]["x"].as_array().unwrap().len(), trace.lines().count() - 1);
+    // Fitness: one series per evolved stage, as long as its generations.
+    let fit = data["fitness"].as_array().unwrap();
+    assert_eq!(fit.len(), 2);
+    assert_eq!(fit[0]["best"].as_array().unwrap().len(), 4);
+    assert_eq!(fit[1]["generation"][0], 4, "generations continue across stages");
+
+    // The evolved stage's episode is the one `replay` shows by default.
+    let rep = dir.join("rep");
+    let out = run(shaping()
+        .arg("replay")
+        .arg(report_bat())
+        .args(["--stage", "collect", "--report"])
+        .arg("--run")
+        .arg(&dir)
+        .arg("--out")
+        .arg(&rep));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("report: "), "{}", text(&out.stdout));
+    let replay = report_data(&rep.join("report.html"));
+    assert_eq!(replay["kind"], "replay");
+    assert_eq!(replay["episodes"][0]["actions"], eps[1]["actions"]);
+
+    // A stage directory, and another output file.
+    let other = dir.join("collect.html");
+    let out = run(shaping().arg("report").arg(dir.join("collect")).arg("-o").arg(&other));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stage = report_data(&other);
+    assert_eq!(stage["kind"], "stage");
+    assert_eq!(stage["episodes"].as_array().unwrap().len(), 1);
+
+    // Not a run: a clear error, exit 2.
+    let out = run(shaping().arg("report").arg(dir.join("navigation").join("nothing")));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("is not a directory"), "{}", text(&out.stderr));
+    let out = run(shaping().arg("report").arg(scratch("report-empty")));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("no `program.json`"), "{}", text(&out.stderr));
+    // A damaged episode is named.
+    std::fs::write(dir.join("collect/episode.json"), "{}").unwrap();
+    let out = run(shaping().arg("report").arg(&dir));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("collect/episode.json"), "{}", text(&out.stderr));
+
+    let quiet = scratch("report-none");
+    assert!(run(shaping().arg("run").arg(tiny()).arg("--out").arg(&quiet).args(["--quiet", "--no-report"]))
+        .status
+        .success());
+    assert!(!quiet.join("report.html").exists());
+}
+
+#[test]
+fn experiment_report_has_the_median_over_seeds() {
+    let dir = scratch("report-exp");
+    let out = run(shaping().arg("experiment").arg(tiny()).args(["--seeds", "3"]).arg("--out").arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(!dir.join("seed-1/report.html").exists(), "one report for the experiment, none per seed");
+    let data = report_data(&dir.join("report.html"));
+    assert_eq!(data["kind"], "experiment");
+    assert_eq!(data["seeds"], serde_json::json!([1, 2, 3]));
+    let first = &data["fitness"][0];
+    assert_eq!(first["seeds"][0], 3);
+    // The median of the three seeds' best of the first generation.
+    let mut bests: Vec<f64> = (1..=3)
+        .map(|s| {
+            let csv = std::fs::read_to_string(dir.join(format!("seed-{s}/first/generations.csv"))).unwrap();
+            csv.lines().nth(1).unwrap().split(',').nth(3).unwrap().parse().unwrap()
+        })
+        .collect();
+    bests.sort_by(f64::total_cmp);
+    assert!((first["best"][0].as_f64().unwrap() - bests[1]).abs() < 1e-6, "{first} vs {bests:?}");
+    assert!((first["best_min"][0].as_f64().unwrap() - bests[0]).abs() < 1e-6);
+    assert!((first["best_max"][0].as_f64().unwrap() - bests[2]).abs() < 1e-6);
+}

@@ -14,7 +14,9 @@ fn channel_name(stage: &Stage, c: u16) -> String {
     }
 }
 
-fn role_text(stage: &Stage, gene: u32) -> String {
+/// What gene `gene` of a stage's layout encodes, as the layout table shows it:
+/// `bias`, `weight ir[3]`, `link avoid -> wander`, `behavior out1 weight ir[0]`.
+pub fn role_text(stage: &Stage, gene: u32) -> String {
     let g = &stage.layout.genes[gene as usize];
     let module = stage.modules.get(g.module as usize);
     let mname =

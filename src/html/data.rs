@@ -1,0 +1,738 @@
+//! The data a report embeds, gathered from the files a run, an experiment or
+//! a replay wrote: `program.json`, and per stage `generations.csv`,
+//! `best.genome`, `episode.json` and `summary.json`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{
+    Action, Behavior, Decode, Event, LearnTarget, LearnWhen, Param, Program, Stage, StageRun, StepEnd, World,
+};
+
+use crate::episode::{Episode, EPISODE_FORMAT};
+use crate::experiment::spread;
+use crate::load::{self, CliError};
+
+/// Version of the data embedded in a report.
+pub const REPORT_FORMAT: u32 = 1;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ReportData {
+    pub format: u32,
+    /// The program's name.
+    pub title: String,
+    /// `run`, `experiment`, `stage` or `replay`.
+    pub kind: &'static str,
+    /// The directory the report was made from, as given.
+    pub source: String,
+    pub generator: String,
+    /// The seeds of an experiment (empty otherwise).
+    pub seeds: Vec<u64>,
+    /// Where the episodes come from, in words (for an experiment: which seed).
+    pub episodes_note: String,
+    /// An experiment's seed whose genomes, episodes and test results are shown.
+    pub shown_seed: Option<u64>,
+    pub stages: Vec<StageView>,
+    /// One series per evolved stage, in program order.
+    pub fitness: Vec<FitnessSeries>,
+    pub episodes: Vec<Episode>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageView {
+    pub name: String,
+    pub parent: Option<String>,
+    /// How the stage runs: `evolve, 40 generations of 100, 300 actions`.
+    pub run: String,
+    pub world: String,
+    pub fitness: String,
+    /// What this stage adds to or changes in the stage it extends.
+    pub added: Vec<String>,
+    pub sensors: Vec<String>,
+    pub modules: Vec<ModuleView>,
+    pub links: Vec<LinkView>,
+    pub genes: Vec<GeneView>,
+    /// Where the decoded gene values come from (`collect/best.genome`), if any.
+    pub genome: Option<String>,
+    /// `summary.json` of a test stage.
+    pub results: Option<serde_json::Value>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ModuleView {
+    pub name: String,
+    /// The stage that introduced the module.
+    pub stage: String,
+    /// Introduced by this stage.
+    pub new: bool,
+    pub sensors: Vec<String>,
+    pub behavior: String,
+    pub learning: Option<String>,
+    pub reinforce: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct LinkView {
+    pub from: u16,
+    pub to: u16,
+    /// `gene`, `fixed` or `random`.
+    pub kind: &'static str,
+    /// The weight: decoded from the best genome, or the constant.
+    pub weight: Option<f32>,
+    pub gene: Option<u32>,
+    pub frozen: bool,
+    pub new: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct GeneView {
+    pub index: u32,
+    pub offset: u32,
+    pub bits: u8,
+    pub stage: String,
+    pub module: String,
+    pub role: String,
+    pub lo: f32,
+    pub hi: f32,
+    pub frozen: bool,
+    /// Decoded from the best genome.
+    pub value: Option<f32>,
+    /// The gene's bits in the best genome.
+    pub code: Option<String>,
+}
+
+/// Best and mean fitness per generation of one stage; for an experiment the
+/// medians over seeds, with the range of the best.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct FitnessSeries {
+    pub stage: String,
+    /// Global generation numbers, continuing across stages.
+    pub generation: Vec<u32>,
+    pub best: Vec<f32>,
+    pub mean: Vec<f32>,
+    /// Experiment only: lowest and highest best over seeds.
+    pub best_min: Vec<f32>,
+    pub best_max: Vec<f32>,
+    /// Experiment only: how many seeds have this generation.
+    pub seeds: Vec<u32>,
+}
+
+/// One row of `generations.csv`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GenRow {
+    pub stage: String,
+    pub generation: u32,
+    pub stage_generation: u32,
+    pub best: f32,
+    pub mean: f32,
+}
+
+/// Parses `generations.csv` (columns found by name).
+pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, CliError> {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| {
+            CliError::io(format!("error: `{}` has no column `{name}` in its header", path.display()))
+        })
+    };
+    let (cs, cg, csg, cb, cm) =
+        (col("stage")?, col("generation")?, col("stage_generation")?, col("best")?, col("mean")?);
+    let mut rows = Vec::new();
+    for (i, line) in lines.enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let bad = |what: &str| CliError::io(format!("error: `{}` line {}: {what}", path.display(), i + 2));
+        let cell = |c: usize| cells.get(c).copied().ok_or_else(|| bad(&format!("has {} cells", cells.len())));
+        let int =
+            |c: usize| cell(c)?.parse::<u32>().map_err(|_| bad(&format!("`{}` is not a count", cells[c])));
+        let num =
+            |c: usize| cell(c)?.parse::<f32>().map_err(|_| bad(&format!("`{}` is not a number", cells[c])));
+        rows.push(GenRow {
+            stage: cell(cs)?.to_string(),
+            generation: int(cg)?,
+            stage_generation: int(csg)?,
+            best: num(cb)?,
+            mean: num(cm)?,
+        });
+    }
+    Ok(rows)
+}
+
+fn read_text(path: &Path) -> Result<String, CliError> {
+    let bytes = load::read_bytes(path)?;
+    String::from_utf8(bytes)
+        .map_err(|_| CliError::io(format!("error: `{}` is not UTF-8 text", path.display())))
+}
+
+fn read_episode(path: &Path) -> Result<Episode, CliError> {
+    let bytes = load::read_bytes(path)?;
+    let ep: Episode = serde_json::from_slice(&bytes).map_err(|e| {
+        CliError::io(format!("error: `{}` is not an episode written by shaping: {e}", path.display()))
+    })?;
+    if ep.format != EPISODE_FORMAT {
+        return Err(CliError::io(format!(
+            "error: `{}` has episode format {}, this shaping reads format {EPISODE_FORMAT}; replay the stage again",
+            path.display(),
+            ep.format
+        )));
+    }
+    let n = ep.actions.x.len();
+    let c = &ep.actions;
+    let per_action =
+        [c.y.len(), c.theta.len(), c.winner.len(), c.battery.len(), c.ir.len(), c.arm_down.len()];
+    let per_module = c.activation.len() == ep.modules.len()
+        && c.reinforcement.len() == ep.modules.len()
+        && c.performance.len() == ep.modules.len()
+        && c.activation.iter().chain(&c.reinforcement).chain(&c.performance).all(|v| v.len() == n);
+    if per_action.iter().any(|&k| k != n) || !per_module || ep.worlds.is_empty() {
+        return Err(CliError::io(format!(
+            "error: `{}` is inconsistent (columns of different lengths, or no world)",
+            path.display()
+        )));
+    }
+    Ok(ep)
+}
+
+fn read_genome(path: &Path, bits: u32) -> Option<Genome> {
+    let text = std::fs::read_to_string(path).ok()?;
+    Genome::from_bitstring(text.trim()).filter(|g| g.bits.len() == bits as usize)
+}
+
+fn sensor_list(stage: &Stage, channels: &[u16]) -> Vec<String> {
+    let mut out = Vec::new();
+    for s in &stage.sensors {
+        let mine: Vec<u16> =
+            channels.iter().copied().filter(|&c| s.channel <= c && c < s.channel + s.count).collect();
+        if mine.is_empty() {
+            continue;
+        }
+        let idx: Vec<u16> = mine.iter().map(|c| c - s.channel).collect();
+        let contiguous = idx.windows(2).all(|w| w[1] == w[0] + 1);
+        if s.count == 1 || idx.len() == s.count as usize && contiguous {
+            out.push(s.name.clone());
+        } else if contiguous && idx.len() > 1 {
+            out.push(format!("{}[{}..{}]", s.name, idx[0], idx[idx.len() - 1]));
+        } else {
+            out.extend(idx.iter().map(|i| format!("{}[{i}]", s.name)));
+        }
+    }
+    out
+}
+
+fn fmt_num(v: f32) -> String {
+    let s = format!("{v:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".into()
+    } else {
+        s.to_string()
+    }
+}
+
+fn action_text(stage: &Stage, a: &Action) -> String {
+    match a {
+        Action::Wheels { left, right } if left == right && *left > 0.0 => {
+            format!("forward({})", fmt_num(*left))
+        }
+        Action::Wheels { left, right } if left == right && *left < 0.0 => format!("back({})", fmt_num(-left)),
+        Action::Wheels { left, right } if *left == 0.0 && *right == 0.0 => "stop".into(),
+        Action::Wheels { left, right } if -left == *right && *right > 0.0 => "turn left".into(),
+        Action::Wheels { left, right } if -left == *right && *right < 0.0 => "turn right".into(),
+        Action::Wheels { left, right } => format!("wheels({}, {})", fmt_num(*left), fmt_num(*right)),
+        Action::Toward { channels, speed } => {
+            format!("toward({}, {})", sensor_list(stage, channels).join(", "), fmt_num(*speed))
+        }
+        Action::Arm(down) => if *down { "arm down" } else { "arm up" }.into(),
+        Action::Claw(closed) => if *closed { "claw closed" } else { "claw open" }.into(),
+        Action::Wait { charge } => if *charge { "wait, uses charger" } else { "wait" }.into(),
+        Action::Reinforce(_) => "reinforce".into(),
+    }
+}
+
+fn behavior_text(stage: &Stage, b: &Behavior) -> String {
+    match b {
+        Behavior::Script(s) => {
+            let steps: Vec<String> = s
+                .steps
+                .iter()
+                .map(|st| {
+                    let mut t = action_text(stage, &st.action);
+                    match &st.end {
+                        StepEnd::Actions(n) if *n > 1 => {
+                            let _ = write!(t, " for {n} actions");
+                        }
+                        StepEnd::Actions(_) => {}
+                        StepEnd::Until { within, .. } => {
+                            let _ = write!(t, " until … within {within}");
+                        }
+                    }
+                    if st.when.is_some() {
+                        t.push_str(" if …");
+                    }
+                    t
+                })
+                .collect();
+            let kind = if s.commit { "script commit" } else { "script" };
+            if steps.len() == 1 {
+                steps[0].clone()
+            } else {
+                format!("{kind} {{ {} }}", steps.join("; "))
+            }
+        }
+        Behavior::Neural(nb) => {
+            let hidden =
+                if nb.net.hidden > 0 { format!(", {} hidden", nb.net.hidden) } else { String::new() };
+            let decode = match &nb.decode {
+                Decode::Table(t) => format!("{} moves", t.len()),
+                Decode::Linear { scale } => format!("wheel speeds × {}", fmt_num(*scale)),
+            };
+            let weights = match nb.net.params.first() {
+                Some(Param::Random { lo, hi }) => {
+                    format!(", weights random {}..{}", fmt_num(*lo), fmt_num(*hi))
+                }
+                Some(Param::Gene(_)) => ", weights evolved".into(),
+                Some(Param::Fixed(_)) => ", weights fixed".into(),
+                Some(Param::Trained { .. }) => ", weights trained by a training stage".into(),
+                None => String::new(),
+            };
+            format!(
+                "neural: {} → {} outputs{hidden} ({decode}){weights}",
+                sensor_list(stage, &nb.inputs).join(", "),
+                nb.net.outputs
+            )
+        }
+    }
+}
+
+fn learning_text(m: &shaping_runtime::program::Module) -> Option<String> {
+    let l = m.learning.as_ref()?;
+    let on = match l.target {
+        LearnTarget::Behavior => "behavior",
+        LearnTarget::Activation => "activation",
+    };
+    let when = match l.when {
+        LearnWhen::Always => "always".to_string(),
+        LearnWhen::Below { threshold } => format!("while performance < {}", fmt_num(threshold)),
+    };
+    Some(format!(
+        "CRBP({}, {}) on {on}, {when}, over {} signals",
+        fmt_num(l.rate_reward),
+        fmt_num(l.rate_punish),
+        l.window
+    ))
+}
+
+fn wall(w: shaping_runtime::program::Wall) -> &'static str {
+    use shaping_runtime::program::Wall;
+    match w {
+        Wall::North => "north",
+        Wall::South => "south",
+        Wall::East => "east",
+        Wall::West => "west",
+    }
+}
+
+fn world_parts(w: &World) -> Vec<String> {
+    let mut parts = vec![format!("arena {} × {} mm", fmt_num(w.arena[0]), fmt_num(w.arena[1]))];
+    if let Some(c) = &w.charger {
+        let lamp = if c.lamp_height.is_some() { " with lamp" } else { "" };
+        parts.push(format!("charger {} mm on the {} wall{lamp}", fmt_num(c.length), wall(c.wall)));
+    }
+    if let Some(b) = &w.battery {
+        parts.push(format!("battery {} actions, recharge {}", b.capacity, b.recharge));
+    }
+    if let Some(o) = &w.objects {
+        let v = if o.virtual_ { ", virtual" } else { "" };
+        parts.push(format!("{} objects of {} mm{v}", o.count, fmt_num(o.diameter)));
+    }
+    parts
+}
+
+fn event(e: Event) -> &'static str {
+    match e {
+        Event::Grip => "grip",
+        Event::ReleaseOutside => "release outside",
+        Event::Recharge => "recharge",
+        Event::Collision => "collision",
+    }
+}
+
+fn fitness_parts(st: &Stage) -> Vec<String> {
+    let mut parts = Vec::new();
+    if st.fitness.per_action.is_some() {
+        parts.push("a term per action".to_string());
+    }
+    parts.extend(st.fitness.bonuses.iter().map(|b| format!("{} per {}", fmt_num(b.points), event(b.event))));
+    parts
+}
+
+fn run_text(st: &Stage) -> String {
+    match &st.run {
+        StageRun::Evolve(e) => format!(
+            "evolved: {} generations of {}, {} actions per life, seed {}",
+            e.generations, e.population, e.actions, e.seed
+        ),
+        StageRun::Train { actions } => format!(
+            "trained: one life of {actions} actions with learning on; the stages that use it start from the behavior weights learned"
+        ),
+        StageRun::Test { actions, learning } => format!(
+            "test of the parent's best: {actions} actions in the parent's world, then {actions} in this one, learning {}",
+            if *learning { "on" } else { "off" }
+        ),
+    }
+}
+
+/// What stage `index` adds to or changes in its parent.
+fn added(program: &Program, index: usize) -> Vec<String> {
+    let st = &program.stages[index];
+    let i = index as u16;
+    let mut out = Vec::new();
+    let names = |v: Vec<&str>| v.join(", ");
+    let sensors: Vec<&str> = st.sensors.iter().filter(|s| s.stage == i).map(|s| s.name.as_str()).collect();
+    let actuators: Vec<&str> =
+        st.actuators.iter().filter(|a| a.stage == i).map(|a| a.name.as_str()).collect();
+    let modules: Vec<&str> = st.modules.iter().filter(|m| m.stage == i).map(|m| m.name.as_str()).collect();
+    let Some(parent) = st.parent.map(|p| &program.stages[p]) else {
+        out.push(format!("modules {}", names(modules)));
+        return out;
+    };
+    if !sensors.is_empty() {
+        out.push(format!("sensors {}", names(sensors)));
+    }
+    if !actuators.is_empty() {
+        out.push(format!("actuators {}", names(actuators)));
+    }
+    if !modules.is_empty() {
+        out.push(format!("modules {}", names(modules)));
+    }
+    let new_genes = st.layout.genes.iter().filter(|g| !g.frozen).count();
+    if new_genes > 0 {
+        out.push(format!("{new_genes} evolvable genes ({} frozen)", st.layout.genes.len() - new_genes));
+    }
+    let (old, new) = (world_parts(&parent.world), world_parts(&st.world));
+    for p in new.iter().filter(|p| !old.contains(p)) {
+        out.push(format!("world: {p}"));
+    }
+    let (old, new) = (fitness_parts(parent), fitness_parts(st));
+    for p in new.iter().filter(|p| !old.contains(p)) {
+        out.push(format!("fitness: {p}"));
+    }
+    if out.is_empty() {
+        out.push("nothing new".into());
+    }
+    out
+}
+
+/// The view of stage `index`, with gene values decoded from `genome`.
+pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, String)>) -> StageView {
+    let st = &program.stages[index];
+    let stage_name =
+        |i: u16| program.stages.get(i as usize).map_or_else(|| format!("#{i}"), |s| s.name.clone());
+    let module_name = |i: u16| st.modules.get(i as usize).map_or_else(|| format!("#{i}"), |m| m.name.clone());
+    let g = genome.as_ref().map(|(g, _)| *g);
+    let genes = st
+        .layout
+        .genes
+        .iter()
+        .enumerate()
+        .map(|(i, gene)| GeneView {
+            index: i as u32,
+            offset: gene.offset,
+            bits: gene.bits,
+            stage: stage_name(gene.stage),
+            module: module_name(gene.module),
+            role: shaping_compiler::role_text(st, i as u32),
+            lo: gene.lo,
+            hi: gene.hi,
+            frozen: gene.frozen,
+            value: g.map(|g| g.decode(gene)),
+            code: g.map(|g| {
+                let (a, b) = (gene.offset as usize, gene.offset as usize + gene.bits as usize);
+                g.bits.get(a..b).map_or_else(String::new, |bits| {
+                    bits.iter().map(|&b| if b != 0 { '1' } else { '0' }).collect()
+                })
+            }),
+        })
+        .collect();
+    let links = st
+        .links
+        .iter()
+        .map(|l| {
+            let introduced = |m: u16| st.modules.get(m as usize).map_or(0, |m| m.stage);
+            let (kind, weight, gene, frozen, new) = match l.weight {
+                Param::Gene(i) => {
+                    let gene = st.layout.genes.get(i as usize);
+                    let w = match (g, gene) {
+                        (Some(g), Some(gene)) => Some(g.decode(gene)),
+                        _ => None,
+                    };
+                    (
+                        "gene",
+                        w,
+                        Some(i),
+                        gene.is_some_and(|x| x.frozen),
+                        gene.is_some_and(|x| x.stage as usize == index),
+                    )
+                }
+                Param::Fixed(w) => {
+                    let new = introduced(l.from).max(introduced(l.to)) as usize == index;
+                    ("fixed", Some(w), None, false, new)
+                }
+                Param::Random { .. } | Param::Trained { .. } => {
+                    let new = introduced(l.from).max(introduced(l.to)) as usize == index;
+                    let kind = if matches!(l.weight, Param::Random { .. }) { "random" } else { "trained" };
+                    (kind, None, None, false, new)
+                }
+            };
+            LinkView { from: l.from, to: l.to, kind, weight, gene, frozen, new }
+        })
+        .collect();
+    StageView {
+        name: st.name.clone(),
+        parent: st.parent.map(|p| program.stages[p].name.clone()),
+        run: run_text(st),
+        world: world_parts(&st.world).join("; "),
+        fitness: fitness_parts(st).join(", "),
+        added: added(program, index),
+        sensors: st
+            .sensors
+            .iter()
+            .map(|s| if s.count == 1 { s.name.clone() } else { format!("{}[{}]", s.name, s.count) })
+            .collect(),
+        modules: st
+            .modules
+            .iter()
+            .map(|m| ModuleView {
+                name: m.name.clone(),
+                stage: stage_name(m.stage),
+                new: m.stage as usize == index,
+                sensors: sensor_list(st, &m.inputs),
+                behavior: behavior_text(st, &m.behavior),
+                learning: learning_text(m),
+                reinforce: m.reinforce.is_some()
+                    || matches!(&m.behavior, Behavior::Script(s) if s.steps.iter().any(|x| matches!(x.action, Action::Reinforce(_)))),
+            })
+            .collect(),
+        links,
+        genes,
+        genome: genome.map(|(_, src)| src),
+        results: None,
+    }
+}
+
+/// Per evolved stage, its own rows of one run's `generations.csv` files.
+fn run_fitness(program: &Program, run: &Path) -> Result<Vec<Vec<GenRow>>, CliError> {
+    let mut out = vec![Vec::new(); program.stages.len()];
+    for (i, st) in program.stages.iter().enumerate() {
+        let path = run.join(&st.name).join("generations.csv");
+        if !matches!(st.run, StageRun::Evolve(_)) || !path.exists() {
+            continue;
+        }
+        let rows = parse_generations(&read_text(&path)?, &path)?;
+        out[i] = rows.into_iter().filter(|r| r.stage == st.name).collect();
+    }
+    Ok(out)
+}
+
+fn single_series(stage: &str, rows: &[GenRow]) -> FitnessSeries {
+    FitnessSeries {
+        stage: stage.to_string(),
+        generation: rows.iter().map(|r| r.generation).collect(),
+        best: rows.iter().map(|r| r.best).collect(),
+        mean: rows.iter().map(|r| r.mean).collect(),
+        ..FitnessSeries::default()
+    }
+}
+
+/// Median best and mean per generation over seeds, with the range of the best.
+pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
+    let mut s = FitnessSeries { stage: stage.to_string(), ..FitnessSeries::default() };
+    let n = seeds.iter().map(Vec::len).max().unwrap_or(0);
+    for k in 0..n {
+        let rows: Vec<&GenRow> = seeds.iter().filter_map(|r| r.get(k)).collect();
+        let best: Vec<f64> = rows.iter().map(|r| r.best as f64).collect();
+        let mean: Vec<f64> = rows.iter().map(|r| r.mean as f64).collect();
+        let (Some(b), Some(m)) = (spread(&best), spread(&mean)) else { continue };
+        s.generation.push(rows[0].generation);
+        s.best.push(b.median as f32);
+        s.mean.push(m.median as f32);
+        s.best_min.push(b.min as f32);
+        s.best_max.push(b.max as f32);
+        s.seeds.push(rows.len() as u32);
+    }
+    s
+}
+
+fn read_summary(path: &Path) -> Option<serde_json::Value> {
+    let bytes = std::fs::read(path).ok()?;
+    serde_json::from_slice(&bytes).ok()
+}
+
+/// The stages of one run directory, with genomes, results and episodes.
+fn run_stages(
+    program: &Program,
+    run: &Path,
+    only: Option<usize>,
+) -> Result<(Vec<StageView>, Vec<Episode>), CliError> {
+    let mut views = Vec::new();
+    let mut episodes = Vec::new();
+    for (i, st) in program.stages.iter().enumerate() {
+        let dir = run.join(&st.name);
+        if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
+            continue;
+        }
+        let genome = read_genome(&dir.join("best.genome"), st.layout.bits);
+        let src = format!("{}/best.genome", st.name);
+        let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
+        view.results = read_summary(&dir.join("summary.json"));
+        views.push(view);
+        let ep = dir.join("episode.json");
+        if ep.exists() {
+            episodes.push(read_episode(&ep)?);
+        }
+    }
+    Ok((views, episodes))
+}
+
+fn series_of(program: &Program, fitness: &[Vec<GenRow>], only: Option<usize>) -> Vec<FitnessSeries> {
+    program
+        .stages
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !fitness[*i].is_empty() && only.is_none_or(|o| o == *i))
+        .map(|(i, st)| single_series(&st.name, &fitness[i]))
+        .collect()
+}
+
+fn seed_dirs(dir: &Path) -> Vec<(u64, PathBuf)> {
+    let mut seeds: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let seed = name.strip_prefix("seed-")?.parse::<u64>().ok()?;
+            e.path().join("program.json").exists().then(|| (seed, e.path()))
+        })
+        .collect();
+    seeds.sort();
+    seeds
+}
+
+fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
+    ReportData {
+        format: REPORT_FORMAT,
+        title: program.name.clone(),
+        kind,
+        source: dir.display().to_string(),
+        generator: format!("shaping {}", env!("CARGO_PKG_VERSION")),
+        seeds: Vec::new(),
+        episodes_note: String::new(),
+        shown_seed: None,
+        stages: Vec::new(),
+        fitness: Vec::new(),
+        episodes: Vec::new(),
+    }
+}
+
+/// Gathers a report's data from a run, stage, experiment or replay directory.
+pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
+    if !dir.is_dir() {
+        return Err(CliError::io(format!("error: `{}` is not a directory", dir.display())));
+    }
+    let here = dir.join("program.json");
+    if here.exists() {
+        let program = load::load_built(&here)?;
+        if dir.join("episode.json").exists() {
+            // A replay: one episode of one stage.
+            let ep = read_episode(&dir.join("episode.json"))?;
+            let (index, _) = program.stage(&ep.stage).ok_or_else(|| {
+                CliError::io(format!(
+                    "error: `{}` replays stage `{}`, which `{}` does not have",
+                    dir.display(),
+                    ep.stage,
+                    here.display()
+                ))
+            })?;
+            let st = &program.stages[index];
+            let genome = read_genome(&dir.join("genome"), st.layout.bits);
+            let mut data = base("replay", &program, dir);
+            data.stages.push(stage_view(&program, index, genome.as_ref().map(|g| (g, "genome".to_string()))));
+            data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
+            data.episodes.push(ep);
+            return Ok(data);
+        }
+        let mut data = base("run", &program, dir);
+        let fitness = run_fitness(&program, dir)?;
+        data.fitness = series_of(&program, &fitness, None);
+        (data.stages, data.episodes) = run_stages(&program, dir, None)?;
+        data.episodes_note = "the best individual of each stage".into();
+        return Ok(data);
+    }
+    let seeds = seed_dirs(dir);
+    if !seeds.is_empty() {
+        return experiment(dir, &seeds);
+    }
+    // A stage directory inside a run.
+    let parent = dir.parent().filter(|p| p.join("program.json").exists());
+    let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
+    if let (Some(run), Some(name)) = (parent, name) {
+        let program = load::load_built(&run.join("program.json"))?;
+        if let Some((index, _)) = program.stage(&name) {
+            let mut data = base("stage", &program, dir);
+            let fitness = run_fitness(&program, run)?;
+            data.fitness = series_of(&program, &fitness, Some(index));
+            (data.stages, data.episodes) = run_stages(&program, run, Some(index))?;
+            data.episodes_note = format!("the best individual of stage `{name}`");
+            return Ok(data);
+        }
+    }
+    Err(CliError::io(format!(
+        "error: `{}` is not a run, stage, experiment or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
+        dir.display()
+    )))
+}
+
+fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, CliError> {
+    let program = load::load_built(&seeds[0].1.join("program.json"))?;
+    let mut per_seed = Vec::new();
+    for (_, run) in seeds {
+        per_seed.push(run_fitness(&program, run)?);
+    }
+    let mut data = base("experiment", &program, dir);
+    data.seeds = seeds.iter().map(|s| s.0).collect();
+    data.fitness = program
+        .stages
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| per_seed.iter().any(|f| !f[*i].is_empty()))
+        .map(|(i, st)| {
+            let rows: Vec<Vec<GenRow>> = per_seed.iter().map(|f| f[i].clone()).collect();
+            seed_series(&st.name, &rows)
+        })
+        .collect();
+    // The episodes of the median seed: the one whose final best fitness in
+    // the last evolved stage is the (lower) median.
+    let last = (0..program.stages.len()).rev().find(|&i| per_seed.iter().any(|f| !f[i].is_empty()));
+    let mut order: Vec<(f32, usize)> = per_seed
+        .iter()
+        .enumerate()
+        .map(|(k, f)| (last.and_then(|i| f[i].last()).map_or(f32::NEG_INFINITY, |r| r.best), k))
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let pick = order[(order.len() - 1) / 2].1;
+    let (seed, run) = &seeds[pick];
+    (data.stages, data.episodes) = run_stages(&program, run, None)?;
+    data.shown_seed = Some(*seed);
+    data.episodes_note = format!(
+        "seed {seed}, the median of {} seeds by the final best fitness{}; genomes and episodes of that seed",
+        seeds.len(),
+        last.map_or(String::new(), |i| format!(" of `{}`", program.stages[i].name))
+    );
+    Ok(data)
+}

@@ -1,0 +1,65 @@
+//! `report.html`: one self-contained page for a run, a stage, an experiment
+//! or a replay. The page's style and script are files next to this one,
+//! included at build time; the data (see [`data`]) are embedded as JSON.
+//! Nothing is fetched when the page opens.
+
+pub mod data;
+
+#[cfg(test)]
+mod tests;
+
+use std::path::{Path, PathBuf};
+
+use crate::load::{write_atomic, CliError};
+
+pub use data::{collect, ReportData};
+
+const TEMPLATE: &str = include_str!("page.html");
+const STYLE: &str = include_str!("page.css");
+const SCRIPT: &str = include_str!("page.js");
+
+/// The file name runs and replays write.
+pub const FILE_NAME: &str = "report.html";
+
+fn escape_html(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// The data as JSON that is safe inside a `<script>` element: every `<` is
+/// escaped, so no `</script>` or `<!--` can end it early.
+pub fn embedded_json(data: &ReportData) -> Result<String, CliError> {
+    let json = serde_json::to_string(data)
+        .map_err(|e| CliError::io(format!("error: cannot serialise the report's data: {e}")))?;
+    Ok(json.replace('<', "\\u003c"))
+}
+
+/// The page for `data`.
+pub fn page(data: &ReportData) -> Result<String, CliError> {
+    let title = escape_html(&format!("{} · shaping report", data.title));
+    let json = embedded_json(data)?;
+    // The data go in last, so nothing in them is taken for a placeholder.
+    let mut out = String::with_capacity(TEMPLATE.len() + STYLE.len() + SCRIPT.len() + json.len());
+    let mut rest = TEMPLATE;
+    for (mark, value) in
+        [("{{title}}", title.as_str()), ("{{style}}", STYLE), ("{{data}}", &json), ("{{script}}", SCRIPT)]
+    {
+        let Some(at) = rest.find(mark) else {
+            return Err(CliError::io(format!("error: the report template has no `{mark}`")));
+        };
+        out.push_str(&rest[..at]);
+        out.push_str(value);
+        rest = &rest[at + mark.len()..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// Writes the report of `dir` to `out` (default `dir/report.html`) and
+/// returns the path written.
+pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, CliError> {
+    let data = collect(dir)?;
+    let html = page(&data)?;
+    let path = out.map_or_else(|| dir.join(FILE_NAME), Path::to_path_buf);
+    write_atomic(&path, html.as_bytes())?;
+    Ok(path)
+}

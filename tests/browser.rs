@@ -1,0 +1,255 @@
+//! The HTML report in a real browser: headless Chromium opens the report of
+//! a short run, with no console message; the URL fragment takes it to an
+//! action, where the robot's position and the winning module it shows must
+//! be those of `trace.csv`; and a screenshot is saved to look at.
+//!
+//! Without a browser these tests say so and pass, except under CI
+//! (`CI=true`), where a missing browser is a failure: `.ci/run` installs
+//! the Debian package `chromium`. `SHAPING_CHROMIUM` names another binary.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn shaping() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shaping"))
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shaping-browser-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn on_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0")
+}
+
+/// The Chromium binary, if there is one.
+fn chromium() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("SHAPING_CHROMIUM") {
+        return Some(PathBuf::from(p));
+    }
+    let path = std::env::var_os("PATH")?;
+    for dir in std::env::split_paths(&path) {
+        for name in ["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"] {
+            let p = dir.join(name);
+            if p.is_file() {
+                return Some(p);
+            }
+        }
+    }
+    None
+}
+
+/// The browser, or `None` after saying why the test is skipped.
+fn browser_or_skip() -> Option<PathBuf> {
+    match chromium() {
+        Some(p) => Some(p),
+        None if on_ci() => panic!(
+            "CI is set but no Chromium was found (install the Debian package `chromium`, or set SHAPING_CHROMIUM)"
+        ),
+        None => {
+            eprintln!("skipped: no Chromium found (install `chromium` or set SHAPING_CHROMIUM to run the browser tests)");
+            None
+        }
+    }
+}
+
+/// Runs headless Chromium on `url` with its own profile; `what` is
+/// `--dump-dom` or `--screenshot=PATH`.
+fn headless(browser: &Path, profile: &Path, url: &str, what: &str) -> Output {
+    let out = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            // Containers often have a small /dev/shm, where the renderer crashes.
+            "--disable-dev-shm-usage",
+            "--no-first-run",
+            "--disable-extensions",
+            "--hide-scrollbars",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--virtual-time-budget=3000",
+            "--window-size=1300,1000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(what)
+        .arg(url)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start {}: {e}", browser.display()));
+    assert!(out.status.success(), "chromium failed: {}", String::from_utf8_lossy(&out.stderr));
+    out
+}
+
+/// Console messages the page caused (Chromium logs them as `CONSOLE`).
+fn console_messages(out: &Output) -> Vec<String> {
+    String::from_utf8_lossy(&out.stderr)
+        .lines()
+        .filter(|l| l.contains(":CONSOLE"))
+        .map(str::to_string)
+        .collect()
+}
+
+/// The text of the element with id `id` in a dumped DOM.
+fn text_of<'a>(dom: &'a str, id: &str) -> &'a str {
+    let open = format!("id=\"{id}\"");
+    let at = dom.find(&open).unwrap_or_else(|| panic!("no element #{id} in the page"));
+    let start = at + dom[at..].find('>').unwrap() + 1;
+    let end = start + dom[start..].find('<').unwrap();
+    &dom[start..end]
+}
+
+fn body_attr<'a>(dom: &'a str, name: &str) -> Option<&'a str> {
+    let body = &dom[dom.find("<body")?..];
+    let tag = &body[..body.find('>')?];
+    let key = format!("{name}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(&tag[start..start + tag[start..].find('"')?])
+}
+
+fn file_url(path: &Path) -> String {
+    let abs = std::fs::canonicalize(path).unwrap();
+    format!("file://{}", abs.display())
+}
+
+#[test]
+fn report_opens_without_console_messages_and_shows_the_trace_at_an_action() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("run");
+    let out = shaping()
+        .arg("run")
+        .arg(root().join("tests/cli/report.bat"))
+        .arg("--out")
+        .arg(&dir)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page = dir.join("report.html");
+    let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = trace.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert!(rows.len() > 20, "the test stage lasted {} actions", rows.len());
+
+    // Actions in both worlds of the test stage: before and after the change.
+    let actions = [rows.len() / 4, rows.len() * 3 / 4, rows.len() - 1];
+    for (k, &action) in actions.iter().enumerate() {
+        let url = format!("{}#stage=bigger&action={action}", file_url(&page));
+        let profile = scratch(&format!("profile-{k}"));
+        let out = headless(&browser, &profile, &url, "--dump-dom");
+        let console = console_messages(&out);
+        assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+        let dom = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(body_attr(&dom, "data-ready"), Some("1"), "the page's script did not finish");
+        assert_eq!(
+            body_attr(&dom, "data-errors"),
+            None,
+            "the page reported errors: {}",
+            text_of(&dom, "errors")
+        );
+        let row = &rows[action];
+        assert_eq!(text_of(&dom, "r-action"), action.to_string());
+        assert_eq!(body_attr(&dom, "data-stage"), Some("bigger"));
+        assert_eq!(text_of(&dom, "r-winner"), row[col("winner")], "winner at action {action}");
+        for (id, c) in [("r-x", "x"), ("r-y", "y")] {
+            let shown: f64 = text_of(&dom, id).parse().unwrap();
+            let csv: f64 = row[col(c)].parse().unwrap();
+            assert!((shown - csv).abs() <= 0.011, "{c} at action {action}: page {shown}, trace.csv {csv}");
+        }
+    }
+
+    // A screenshot of the last of them, to look at.
+    let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("report.png");
+    let _ = std::fs::remove_file(&shot);
+    let url = format!("{}#stage=bigger&action={}", file_url(&page), actions[1]);
+    let out = headless(&browser, &scratch("profile-shot"), &url, &format!("--screenshot={}", shot.display()));
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let png = std::fs::read(&shot).unwrap();
+    assert!(png.starts_with(b"\x89PNG") && png.len() > 20_000, "screenshot of {} bytes", png.len());
+    eprintln!("screenshot: {}", shot.display());
+}
+
+/// Drives the page's controls in the browser: keys, the scrub bar, a click
+/// on the timeline, play and pause, and a changed fragment. A script added
+/// to a copy of the report does it once the page has loaded, and leaves
+/// what the page showed after each step in an attribute of the body.
+#[test]
+fn keyboard_mouse_and_fragment_move_the_replay() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("controls");
+    let out = shaping()
+        .arg("run")
+        .arg(root().join("tests/cli/report.bat"))
+        .arg("--out")
+        .arg(&dir)
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let driver = r#"<script>
+window.addEventListener('load', () => {
+  const log = [];
+  const key = (k, shift) => document.dispatchEvent(new KeyboardEvent('keydown', { key: k, shiftKey: !!shift, bubbles: true }));
+  const shown = () => document.getElementById('r-action').textContent + ' ' + document.body.dataset.stage + ' ' + location.hash;
+  key('Home'); log.push(shown());
+  key('ArrowRight'); log.push(shown());
+  key('ArrowRight', true); log.push(shown());
+  key('ArrowLeft'); log.push(shown());
+  key('End'); log.push(shown());
+  const s = document.getElementById('scrub'); s.value = '5'; s.dispatchEvent(new Event('input')); log.push(shown());
+  const tl = document.getElementById('timeline'); const r = tl.getBoundingClientRect();
+  tl.dispatchEvent(new MouseEvent('mousedown', { clientX: r.left + r.width * 0.5, clientY: r.top + 10, bubbles: true }));
+  window.dispatchEvent(new MouseEvent('mouseup', {}));
+  log.push(shown());
+  key(' ');
+  setTimeout(() => {
+    key(' '); log.push(shown());
+    location.hash = '#stage=navigation&action=7';
+    setTimeout(() => { log.push(shown()); document.body.dataset.driven = JSON.stringify(log); }, 100);
+  }, 1000);
+});
+</script>
+</body>"#;
+    let driven = dir.join("driven.html");
+    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
+    let url = format!("{}#stage=bigger&action=3", file_url(&driven));
+    let out = headless(&browser, &scratch("profile-controls"), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let log: Vec<String> = serde_json::from_str(
+        &body_attr(&dom, "data-driven")
+            .expect("the driver ran")
+            .replace("&quot;", "\"")
+            .replace("&amp;", "&"),
+    )
+    .unwrap();
+    let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
+    let last = trace.lines().count() - 2;
+    let at = |a: usize| format!("{a} bigger #stage=bigger&action={a}");
+    assert_eq!(log[0], at(0), "Home");
+    assert_eq!(log[1], at(1), "Right");
+    assert_eq!(log[2], at(11), "Shift+Right");
+    assert_eq!(log[3], at(10), "Left");
+    assert_eq!(log[4], at(last), "End");
+    assert_eq!(log[5], at(5), "the scrub bar");
+    let clicked: usize = log[6].split(' ').next().unwrap().parse().unwrap();
+    assert!(
+        last / 4 < clicked && clicked < last * 3 / 4,
+        "a click in the middle of the timeline went to {clicked} of {last}"
+    );
+    assert_eq!(log[6], at(clicked));
+    let played: usize = log[7].split(' ').next().unwrap().parse().unwrap();
+    assert!(played > clicked, "a second of play moved from {clicked} to {played}");
+    assert_eq!(log[7], at(played), "the fragment follows the replay");
+    assert_eq!(log[8], "7 navigation #stage=navigation&action=7", "a changed fragment moves the replay");
+}
