@@ -84,6 +84,7 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
             json: false,
             fresh: args.fresh,
             error_format: args.error_format,
+            robot: None,
         })?;
     }
     // Titled by the file: several files may share a robot (and so a program name).

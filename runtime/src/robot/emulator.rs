@@ -2,11 +2,11 @@
 //! the real robot's quantization (integer speed units, 10-bit readings,
 //! position counters in pulses).
 //!
-//! The emulated robot has only the physical world: walls, lamp and charger
-//! bar. Virtual objects and the battery are taken out, since the host
-//! simulates them; the start pose and the random stream are those of
-//! `Sim::new(world, seed)`, so an emulator and a replay with the same seed
-//! start alike.
+//! The emulated robot has only the physical world ([`super::physical_world`]):
+//! walls, lamp and charger bar. Virtual objects and the battery are the
+//! host's. It starts at [`super::start_pose`], where the host assumes it; in a
+//! world without objects that is also where a replay with the same seed
+//! starts, and the random streams (sensor and wheel noise) are the same.
 //!
 //! Time: the simulator advances by one action of the world's period at each
 //! speed command (`D`), with the speeds it sets, and senses once after it
@@ -39,9 +39,7 @@ pub struct Emulator {
 impl Emulator {
     /// An emulated robot in `world`, seeded with `seed`.
     pub fn new(world: &World, seed: u64) -> Emulator {
-        let mut sim = Sim::new(world, seed);
-        sim.remove_virtual_objects();
-        sim.remove_battery();
+        let mut sim = Sim::new(&super::physical_world(world), seed);
         let mut percept = [0.0; CHANNELS];
         sim.sense(&mut percept);
         Emulator {

@@ -17,3 +17,26 @@ pub mod serial;
 
 pub use emulator::Emulator;
 pub use serial::{odometry, Link, LinkError, RobotError, SerialRobot};
+
+use crate::program::World;
+use crate::sim::{Pose, Sim};
+
+/// The world a robot has physically: the arena, lamp and charger bar, and
+/// physical objects, without the virtual objects and the battery (which the
+/// host simulates).
+pub fn physical_world(world: &World) -> World {
+    let mut w = world.clone();
+    if w.objects.as_ref().is_some_and(|o| o.virtual_) {
+        w.objects = None;
+    }
+    w.battery = None;
+    w
+}
+
+/// Where a robot starts an episode seeded with `sim_seed`: the start pose
+/// of its physical world, so the same seed gives the same start in every
+/// stage of an arena, whatever virtual objects a stage adds. The emulator
+/// starts there and the host assumes it (a real robot is put there by hand).
+pub fn start_pose(world: &World, sim_seed: u64) -> Pose {
+    Sim::new(&physical_world(world), sim_seed).pose()
+}

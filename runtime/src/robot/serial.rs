@@ -83,14 +83,12 @@ pub struct SerialRobot<L: Link> {
 impl<L: Link> SerialRobot<L> {
     /// A robot in `world`: the host world (virtual objects, battery,
     /// charger) is `Sim::new(world, sim_seed)`; the robot is assumed to stand
-    /// at `start` (default: that world's start pose). `gripper`: the stage
+    /// at `start` (default: [`super::start_pose`]). `gripper`: the stage
     /// has an arm or a claw, whose commands then go to the turret too.
     pub fn new(world: &World, sim_seed: u64, start: Option<Pose>, gripper: bool, link: L) -> SerialRobot<L> {
         let mut host = Sim::new(world, sim_seed);
-        if let Some(p) = start {
-            host.place(p);
-        }
-        let pose = host.pose();
+        let pose = start.unwrap_or_else(|| super::start_pose(world, sim_seed));
+        host.place(pose);
         SerialRobot {
             link,
             host,
@@ -124,10 +122,11 @@ impl<L: Link> SerialRobot<L> {
         result
     }
 
-    /// Gets the robot ready: stops the wheels, zeroes the position counters
-    /// and, with a gripper, raises the arm and opens the claw.
+    /// Gets the robot ready: zeroes the position counters and, with a
+    /// gripper, raises the arm and opens the claw. (No speed is sent: the
+    /// first `D` is the first action's, and the emulator counts actions by
+    /// them.)
     pub fn connect(&mut self) -> Result<(), RobotError> {
-        self.request(Request::SetSpeed([0, 0]))?;
         self.request(Request::SetPosition([0, 0]))?;
         self.counters = [0, 0];
         if self.gripper {

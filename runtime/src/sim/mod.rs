@@ -713,22 +713,6 @@ impl Sim {
         self.set_pose_unchecked(pose);
     }
 
-    /// Takes the virtual objects out of the world (an emulated robot's own
-    /// sensors must not see them: its host adds them). The start pose and the
-    /// random stream stay those of the full world.
-    pub fn remove_virtual_objects(&mut self) {
-        if self.obj_virtual {
-            self.objects.clear();
-            self.held = None;
-        }
-    }
-
-    /// Takes the battery out of the world (a robot's battery is simulated
-    /// by its host).
-    pub fn remove_battery(&mut self) {
-        self.battery_spec = None;
-    }
-
     /// The part of the percept a host simulates for a real robot: the IR
     /// readings of the virtual objects alone (no walls, no noise: the robot
     /// senses those), the battery and the optical barrier. Light channels
@@ -744,11 +728,6 @@ impl Sim {
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
-    }
-
-    /// True when the world's objects are virtual (or there are none).
-    pub fn objects_virtual(&self) -> bool {
-        self.obj_virtual || self.objects.is_empty()
     }
 
     /// Battery level 0..1 (1 forever without a battery).
