@@ -266,7 +266,7 @@ fn ctrl_c_stops_the_motors() {
     let dir = scratch("ctrlc");
     let emu = Emulator::start(&dir, &[]);
     let genome = "1".repeat(80);
-    let child = shaping()
+    let mut child = shaping()
         .arg("drive")
         .arg(file())
         .args(["--stage", "roam", "--period", "20", "--actions", "300", "--genome", &genome])
@@ -278,13 +278,19 @@ fn ctrl_c_stops_the_motors() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(600));
+    // Interrupted once it drives (its Ctrl-C handler is set by then).
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut first = String::new();
+    std::io::BufRead::read_line(&mut err, &mut first).unwrap();
+    assert!(first.contains("driving"), "{first}");
+    std::thread::sleep(Duration::from_millis(200));
     let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
     assert!(kill.success());
-    let out = child.wait_with_output().unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = text(&out.stderr);
-    assert!(err.contains("interrupted") && err.contains("the motors were stopped"), "{err}");
+    let mut rest = String::new();
+    err.read_to_string(&mut rest).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(2), "{rest}");
+    assert!(rest.contains("interrupted") && rest.contains("the motors were stopped"), "{rest}");
     assert_eq!(emu.last_speed(), Some((0, 0)));
 }
 
