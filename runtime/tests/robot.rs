@@ -217,9 +217,11 @@ fn an_episode_over_the_emulator_is_close_to_the_simulated_one() {
         diffs.push((real.fitness - sim.fitness).abs() / sim.fitness.abs().max(0.05));
     }
     diffs.sort_by(f32::total_cmp);
-    // Quantization (speed units, 10-bit readings, pulses) makes the paths
-    // drift apart; the median episode stays close.
-    assert!(diffs[diffs.len() / 2] < 0.25, "relative fitness differences {diffs:?}");
+    // Quantization (speed units, 10-bit readings, pulses) can make the paths
+    // drift apart; on these seeds every episode stays within 5 % and most
+    // within 0.1 % (measured: at most 0.012 %).
+    assert!(diffs[diffs.len() / 2] < 0.001, "relative fitness differences {diffs:?}");
+    assert!(diffs[diffs.len() - 1] < 0.05, "relative fitness differences {diffs:?}");
 }
 
 #[test]
@@ -250,4 +252,32 @@ fn a_lost_link_ends_the_episode_with_the_error() {
     let r = ctl.run(&mut robot, &EpisodeOptions { actions: 100, learning: true, seed: 1 }, None);
     assert!(r.actions < 20, "{} actions", r.actions);
     assert_eq!(robot.error(), Some(&RobotError::Link(LinkError("the robot does not answer".into()))));
+}
+
+#[test]
+fn the_emulator_answers_like_a_khepera() {
+    let stage = testkit::navigation();
+    let mut emu = Emulator::new(&stage.world, 4);
+    assert!(emu.answer(b"B").starts_with("b,"));
+    assert_eq!(emu.answer(b"Q,1"), "z,Protocol error\r\n");
+    assert_eq!(emu.answer(b"D,300,0"), "z,Protocol error\r\n", "speeds beyond 127 units are refused");
+    assert_eq!(emu.answer(b"G,0,0"), "g\r\n");
+    assert_eq!(emu.answer(b"H"), "h,0,0\r\n");
+    assert_eq!(emu.answer(b"D,5,5"), "d\r\n");
+    assert_eq!(emu.speed(), [5, 5]);
+    // 5 units = 40 mm/s for 250 ms = 10 mm = about 125 pulses, +-5 % noise.
+    let Ok(Reply::Position([l, r])) =
+        parse_reply(&Request::ReadPosition, emu.answer(b"H").trim_end().as_bytes())
+    else {
+        panic!("no position");
+    };
+    assert!((115..=135).contains(&l) && (115..=135).contains(&r), "{l} {r}");
+    let n = emu.answer(b"N");
+    assert!(
+        matches!(parse_reply(&Request::ReadProximity, n.trim_end().as_bytes()), Ok(Reply::Proximity(_))),
+        "{n}"
+    );
+    assert_eq!(emu.answer(b"T,1,E,249"), "t,1,e\r\n");
+    assert_eq!(emu.answer(b"T,1,D,1"), "t,1,d\r\n");
+    assert_eq!(emu.answer(b"T,1,G"), "t,1,g,0\r\n");
 }
