@@ -6,8 +6,9 @@ use std::time::{Duration, Instant};
 
 use shaping_runtime::catalog::ActuatorKind;
 use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Trace};
+use shaping_runtime::evolve::EvalOptions;
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Stage, StageRun};
+use shaping_runtime::program::Stage;
 use shaping_runtime::robot::{RobotError, SerialRobot};
 
 use super::port::{interrupt_flag, SerialPort};
@@ -87,12 +88,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
             replay::parse_genome(&path.to_string_lossy())?
         }
     };
-    let (actions, learning) = match &stage.run {
-        StageRun::Evolve(e) => (e.actions, true),
-        StageRun::Test { actions, learning } => (*actions, *learning),
-    };
-    let actions = args.actions.unwrap_or(actions);
-    let learning = learning && !args.no_learning;
+    // The life length and learning the stage declares, as in `replay`.
+    let declared = EvalOptions::of(stage);
+    let actions = args.actions.unwrap_or(declared.actions);
+    let learning = declared.learning && !args.no_learning;
     let seed = args.seed.unwrap_or_else(|| run::run_seed(&program, None));
     let (sim_seed, rng) = episode_rngs(seed);
     let mut ctl = Controller::new(stage, &genome, rng)
