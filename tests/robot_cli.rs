@@ -123,38 +123,40 @@ fn drive_runs_300_actions_and_writes_the_replay_files() {
 }
 
 /// Over the emulated link, fitness follows `replay` of the same individual
-/// and episode seed. Not exactly: the link quantizes (10-bit readings,
-/// integer speed units of 8 mm/s, odometry in 0.08 mm pulses, virtual IR
-/// added to the quantized reading), so a decision that sits on a threshold
-/// (a CRBP sample, a tie, an `until`) can go the other way, after which the
-/// paths drift apart. Most episodes agree to 0.005; the median difference
-/// over 8 seeds must stay within 0.02 (the fitness is about 0.1 to 0.5).
+/// and episode seed. The link quantizes (10-bit readings, integer speed units
+/// of 8 mm/s, odometry in 0.08 mm pulses, virtual IR added to the quantized
+/// reading), so only a decision sitting on a threshold could go the other
+/// way: with learning off (outputs thresholded at 0.5) the episodes agree to
+/// 0.01. With learning on they are not compared episode by episode: CRBP
+/// samples each output bit with probability = output, a reading quantized
+/// to 10 bits moves an output by about 1e-3, and over 300 actions some
+/// sample flips in most episodes, after which the paths differ (measured on
+/// these 8 seeds: 2 of 8 equal, differences up to 0.39).
 #[test]
 fn fitness_over_the_link_is_close_to_replay() {
     let dir = scratch("fitness");
     let runs = evolved(&dir);
-    let mut diffs = Vec::new();
+    let mut pairs = Vec::new();
     for seed in 1..=8u64 {
         let s = seed.to_string();
         let emu = Emulator::start(&dir, &["--seed", &s]);
         let replay = shaping()
             .arg("replay")
             .arg(file())
-            .args(["--stage", "roam", "--actions", "300", "--seed", &s, "--run"])
+            .args(["--stage", "roam", "--actions", "300", "--no-learning", "--seed", &s, "--run"])
             .arg(&runs)
             .arg("--out")
             .arg(dir.join("r"))
             .output()
             .unwrap();
         assert!(replay.status.success(), "{}", text(&replay.stderr));
-        let driven = drive(&emu, &runs, &dir.join("d"), &["--actions", "300", "--seed", &s]);
+        let driven = drive(&emu, &runs, &dir.join("d"), &["--actions", "300", "--no-learning", "--seed", &s]);
         assert!(driven.status.success(), "{}", text(&driven.stderr));
-        diffs.push((fitness_of(&replay.stdout) - fitness_of(&driven.stdout)).abs());
+        pairs.push((fitness_of(&replay.stdout), fitness_of(&driven.stdout)));
     }
-    diffs.sort_by(f32::total_cmp);
-    let close = diffs.iter().filter(|&&d| d <= 0.005).count();
-    assert!(diffs[diffs.len() / 2] <= 0.02, "differences {diffs:?}");
-    assert!(close >= diffs.len() / 2, "differences {diffs:?}");
+    assert!(pairs.iter().all(|(r, d)| (r - d).abs() <= 0.01), "(replay, drive): {pairs:?}");
+    // The comparison has power only if the individual does something.
+    assert!(pairs.iter().filter(|(r, _)| *r > 0.02).count() >= 2, "(replay, drive): {pairs:?}");
 }
 
 #[test]
