@@ -88,6 +88,7 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
             // One report for the whole experiment, written below.
             no_report: true,
             error_format: args.error_format,
+            robot: None,
         })?;
     }
     // Titled by the file: several files may share a robot (and so a program name).

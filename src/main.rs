@@ -9,6 +9,7 @@ mod load;
 mod plot;
 mod replay;
 mod report;
+mod robot;
 mod run;
 
 use std::path::PathBuf;
@@ -94,6 +95,85 @@ enum Command {
         /// Write no `report.html` at the end.
         #[arg(long)]
         no_report: bool,
+        /// Evaluate the individuals one after another on the robot at this
+        /// serial port (see `docs/robot.md`); every episode is saved as it ends.
+        #[arg(long)]
+        robot: Option<PathBuf>,
+        /// Baud rate of `--robot`.
+        #[arg(long, default_value_t = 9600, requires = "robot")]
+        baud: u32,
+        /// Action period in ms on the robot (default: the world's action length).
+        #[arg(long, requires = "robot")]
+        period: Option<u64>,
+        /// Longest wait for an answer of the robot, ms.
+        #[arg(long, default_value_t = 1000, requires = "robot")]
+        timeout: u64,
+        #[arg(long, value_enum, default_value = "human")]
+        error_format: ErrorFormat,
+    },
+    /// Run one individual on a Khepera over its serial port; writes the same
+    /// trace and pictures as `replay`. The motors are stopped before exiting,
+    /// whatever happens (Ctrl-C, a lost link, a bad answer).
+    Drive {
+        file: PathBuf,
+        /// Stage to drive (default: the last).
+        #[arg(long)]
+        stage: Option<String>,
+        /// The genome: a string of 0 and 1, or a file holding one.
+        #[arg(long, conflicts_with = "run")]
+        genome: Option<String>,
+        /// A run directory holding `<stage>/best.genome` (default: `runs/<file stem>`).
+        #[arg(long)]
+        run: Option<PathBuf>,
+        /// The robot's serial port (or an emulator's, see `shaping emulate`).
+        #[arg(long)]
+        port: PathBuf,
+        #[arg(long, default_value_t = 9600)]
+        baud: u32,
+        /// Actions to run (default: the stage's life length).
+        #[arg(long)]
+        actions: Option<u32>,
+        /// Output directory (default: `<run>/<stage>/drive`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Episode seed: places the virtual objects and the assumed start pose (default: the run seed).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Action period in ms (default: the world's action length; 0: as fast as the link allows).
+        #[arg(long)]
+        period: Option<u64>,
+        /// Longest wait for an answer of the robot, ms.
+        #[arg(long, default_value_t = 1000)]
+        timeout: u64,
+        /// Switch local learning off.
+        #[arg(long)]
+        no_learning: bool,
+        #[arg(long, value_enum, default_value = "human")]
+        error_format: ErrorFormat,
+    },
+    /// An emulated Khepera: answers the serial protocol from the simulator on
+    /// a pseudo-terminal made at `--port`, until Ctrl-C.
+    Emulate {
+        /// Architecture file whose world is emulated (default: the built-in `examples/khepera.bat`).
+        file: Option<PathBuf>,
+        /// Path of the pseudo-terminal to create (a symbolic link).
+        #[arg(long)]
+        port: PathBuf,
+        /// Stage whose world is emulated (default: the last).
+        #[arg(long)]
+        stage: Option<String>,
+        /// Seed of the world (default: the run seed), as `drive --seed`.
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Emulated line speed: each byte takes 11 bit times (0: no wire delay).
+        #[arg(long, default_value_t = 9600)]
+        baud: u32,
+        /// The robot's own delay before each answer, ms.
+        #[arg(long, default_value_t = 0)]
+        delay: u64,
+        /// Inject a fault at the N-th request: `drop@N` (no answer), `garbage@N`, `close@N`.
+        #[arg(long, value_parser = robot::emulate::parse_fault)]
+        fault: Option<robot::emulate::Fault>,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -220,7 +300,25 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             print_text(&shaping_compiler::render_graph(&program, index));
             Ok(())
         }
-        Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, no_report, error_format } => {
+        Command::Run {
+            file,
+            stage,
+            seed,
+            out,
+            jobs,
+            quiet,
+            json,
+            fresh,
+            no_report,
+            robot,
+            baud,
+            period,
+            timeout,
+            error_format,
+        } => {
+            let robot = robot.map(|dev| robot::RobotRun::new(dev, baud, period, timeout)).transpose()?;
+            // One robot: its individuals are evaluated one after another.
+            let jobs = if robot.is_some() { Some(1) } else { jobs };
             run::run(run::RunArgs {
                 file,
                 stage,
@@ -231,6 +329,48 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 json,
                 fresh,
                 no_report,
+                error_format,
+                robot,
+            })
+        }
+        Command::Drive {
+            file,
+            stage,
+            genome,
+            run,
+            port,
+            baud,
+            actions,
+            out,
+            seed,
+            period,
+            timeout,
+            no_learning,
+            error_format,
+        } => robot::drive::drive(robot::drive::DriveArgs {
+            file,
+            stage,
+            genome,
+            run,
+            port,
+            baud,
+            actions,
+            out,
+            seed,
+            period_ms: period,
+            timeout_ms: timeout,
+            no_learning,
+            error_format,
+        }),
+        Command::Emulate { file, port, stage, seed, baud, delay, fault, error_format } => {
+            robot::emulate::emulate(robot::emulate::EmulateArgs {
+                port,
+                file,
+                stage,
+                seed,
+                baud,
+                delay_ms: delay,
+                fault,
                 error_format,
             })
         }

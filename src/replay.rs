@@ -25,7 +25,7 @@ pub struct ReplayArgs {
 }
 
 /// Reads a genome given as a bit string or as the path of a file holding one.
-fn parse_genome(arg: &str) -> Result<Genome, CliError> {
+pub(crate) fn parse_genome(arg: &str) -> Result<Genome, CliError> {
     if arg.trim().is_empty() {
         // A stage without evolvable values has an empty genome.
         return Ok(Genome { bits: Vec::new() });
@@ -43,7 +43,7 @@ fn parse_genome(arg: &str) -> Result<Genome, CliError> {
 
 /// The stage whose best individual a replay of `index` uses by default: the
 /// stage itself if evolved, else its nearest evolved ancestor.
-fn evolved_source(program: &Program, index: usize) -> usize {
+pub(crate) fn evolved_source(program: &Program, index: usize) -> usize {
     let mut cur = Some(index);
     while let Some(i) = cur {
         if let StageRun::Evolve(_) = program.stages[i].run {

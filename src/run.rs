@@ -30,6 +30,8 @@ pub struct RunArgs {
     /// Write no `report.html` at the end.
     pub no_report: bool,
     pub error_format: crate::diag::ErrorFormat,
+    /// Evaluate on a robot (`--robot`) instead of the simulator.
+    pub robot: Option<crate::robot::RobotRun>,
 }
 
 /// The directory a run of `file` writes to by default: `runs/<file stem>`.
@@ -254,10 +256,17 @@ fn evolve_stage(
     shaping_runtime::controller::validate(stage, &probe)
         .map_err(|e| CliError::io(format!("error: stage `{}` cannot run: {e}", stage.name)))?;
     let bar = progress_bar(args, stage, evo.generations, cp.generation);
-    let eval = evaluator(stage, evo.actions);
+    let sim_eval = evaluator(stage, evo.actions);
+    let robot_eval = args.robot.as_ref().map(|r| r.evaluator(stage, evo.actions, dir)).transpose()?;
+    let eval: &(dyn Fn(&Genome, u64) -> Evaluation + Sync) = match &robot_eval {
+        Some(e) => e,
+        None => &sim_eval,
+    };
+    let fail = |e| {
+        args.robot.as_ref().and_then(|r| r.failure()).unwrap_or_else(|| CliError::io(format!("error: {e}")))
+    };
     while !evolve::is_finished(program, &cp) {
-        let stats = evolve::step_generation(program, &mut cp, &eval)
-            .map_err(|e| CliError::io(format!("error: {e}")))?;
+        let stats = evolve::step_generation(program, &mut cp, eval).map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats);
@@ -266,14 +275,8 @@ fn evolve_stage(
     if !cp.validated {
         // Pick the stage's best by its mean over fresh episodes, not by its
         // luckiest single evaluation.
-        evolve::validate_best(
-            program,
-            &mut cp,
-            &eval,
-            evolve::VALIDATE_CANDIDATES,
-            evolve::VALIDATE_EPISODES,
-        )
-        .map_err(|e| CliError::io(format!("error: {e}")))?;
+        evolve::validate_best(program, &mut cp, eval, evolve::VALIDATE_CANDIDATES, evolve::VALIDATE_EPISODES)
+            .map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
     }
     let (genome, fitness) = evolve::best_of(&cp)
@@ -562,7 +565,8 @@ mod tests {
     /// weights it uses, whatever their place in the file.
     #[test]
     fn the_chain_of_a_stage_includes_the_training_stages_it_uses() {
-        let src = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/khepera.bat")).unwrap();
+        let src =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/khepera.bat")).unwrap();
         let program = shaping_compiler::compile(&src, "khepera.bat").unwrap();
         let names = |c: Vec<usize>| c.into_iter().map(|i| program.stages[i].name.clone()).collect::<Vec<_>>();
         assert_eq!(names(chain(&program, 1)), ["avoidance", "navigation"]);

@@ -6,7 +6,9 @@
 //! - [`genome`]: bit-string genomes and decoding;
 //! - [`sim`]: the simulated Khepera world;
 //! - [`controller`]: modules, winner-take-all, behaviors, CRBP, episodes;
-//! - [`evolve`]: the incremental GA over stages, with checkpoints as data.
+//! - [`evolve`]: the incremental GA over stages, with checkpoints as data;
+//! - [`robot`]: the Khepera serial protocol, a serial robot with a host-side
+//!   virtual world, and an emulated robot.
 //!
 //! This crate never depends on the compiler and does no file I/O.
 
@@ -16,5 +18,6 @@ pub mod evolve;
 pub mod expr;
 pub mod genome;
 pub mod program;
+pub mod robot;
 pub mod sim;
 pub mod testkit;

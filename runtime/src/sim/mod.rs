@@ -151,6 +151,9 @@ pub struct Sim {
     depth: f32,
     radius: f32,
     half_axle: f32,
+    /// Distance each wheel travelled during the last action, mm (what a real
+    /// robot's wheel encoders measure).
+    travelled: [f32; 2],
     /// Wheel travel for a command of 1.0 during one action, mm.
     travel: f32,
     wheel_noise: f32,
@@ -278,6 +281,7 @@ impl Sim {
             depth,
             radius,
             half_axle,
+            travelled: [0.0; 2],
             travel,
             wheel_noise: finite_or(body.wheel_noise, 0.0).clamp(0.0, 1.0),
             sensor_noise: finite_or(body.sensor_noise, 0.0).clamp(0.0, 1.0),
@@ -438,10 +442,13 @@ impl Sim {
 
     /// Noise-free IR readings of the current state.
     fn sense_ir(&self, out: &mut [f32; ir::SENSORS]) {
-        let (wt, ct) = {
-            let t = ir::tables();
-            (&t.0, &t.1)
-        };
+        self.ir_walls(out);
+        self.ir_objects(out);
+    }
+
+    /// Adds the walls' noise-free IR readings to `out`.
+    fn ir_walls(&self, out: &mut [f32; ir::SENSORS]) {
+        let wt = &ir::tables().0;
         let centre = self.centre();
         let rot = &self.pose.rotation;
         let g = &self.geo;
@@ -460,6 +467,15 @@ impl Sim {
                 out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
             }
         }
+    }
+
+    /// Adds the floor objects' noise-free IR readings to `out`.
+    fn ir_objects(&self, out: &mut [f32; ir::SENSORS]) {
+        let ct = &ir::tables().1;
+        let centre = self.centre();
+        let rot = &self.pose.rotation;
+        let g = &self.geo;
+        let reach = self.radius + ir::RANGE;
         let r = self.obj_radius;
         let reach = reach + r;
         let reach2 = reach * reach;
@@ -546,10 +562,20 @@ impl Sim {
 
     /// Executes one action.
     pub fn step(&mut self, cmd: &Command) -> Outcome {
-        let mut out = Outcome::default();
         if !self.alive() {
-            return out;
+            return Outcome::default();
         }
+        let mut out = self.actuate(cmd);
+        out.collided = self.drive(cmd.wheels);
+        out.recharged = self.tick_battery(cmd.charge);
+        out
+    }
+
+    /// The gripper part of an action (arm, then claw, at the current pose):
+    /// grips and releases. [`Sim::step`] calls it before moving; a host
+    /// simulating the virtual objects of a real robot calls it on its own.
+    pub fn actuate(&mut self, cmd: &Command) -> Outcome {
+        let mut out = Outcome::default();
         if let Some(down) = cmd.arm {
             self.arm_down = down;
         }
@@ -569,19 +595,26 @@ impl Sim {
             Some(false) if self.claw_closed && self.release(&mut out) => self.claw_closed = false,
             _ => {}
         }
-        out.collided = self.drive(cmd.wheels);
-        if let Some((cap, rech)) = self.battery_spec {
-            let full = cap * rech;
-            if cmd.charge && self.in_contact() {
-                if self.charge < full {
-                    self.charge = (self.charge + cap).min(full);
-                    out.recharged = self.charge == full;
-                }
-            } else {
-                self.charge = self.charge.saturating_sub(rech);
-            }
-        }
         out
+    }
+
+    /// The battery part of an action, after the move: recharges when asked
+    /// to in contact with the bar, else drains one action's worth. Returns
+    /// true when this action filled the battery.
+    pub fn tick_battery(&mut self, charge: bool) -> bool {
+        let Some((cap, rech)) = self.battery_spec else {
+            return false;
+        };
+        let full = cap * rech;
+        if charge && self.in_contact() {
+            if self.charge < full {
+                self.charge = (self.charge + cap).min(full);
+                return self.charge == full;
+            }
+        } else {
+            self.charge = self.charge.saturating_sub(rech);
+        }
+        false
     }
 
     /// Opens the claw on a held object: throws it out of the arena when a
@@ -649,6 +682,7 @@ impl Sim {
             dl *= 1.0 + a;
             dr *= 1.0 + b;
         }
+        self.travelled = [dl, dr];
         if dl == 0.0 && dr == 0.0 {
             return false;
         }
@@ -690,12 +724,44 @@ impl Sim {
             (at, rot) = (next, rot * turn);
             k += 1;
         }
+        self.travelled = [dl * k as f32 / n as f32, dr * k as f32 / n as f32];
         self.pose = Isometry2::from_parts(at.into(), renormalized(rot));
         k < n
     }
 
     pub fn pose(&self) -> Pose {
         self.pose.into()
+    }
+
+    /// Distance each wheel (left, right) travelled during the last action,
+    /// mm, noise included; less than commanded when a collision stopped the
+    /// move.
+    pub fn wheel_travel(&self) -> [f32; 2] {
+        self.travelled
+    }
+
+    /// Puts the body at `pose` without any check: the pose a real robot's
+    /// odometry measured, for a host that simulates its virtual objects and
+    /// battery.
+    pub fn place(&mut self, pose: Pose) {
+        self.set_pose_unchecked(pose);
+    }
+
+    /// The part of the percept a host simulates for a real robot: the IR
+    /// readings of the virtual objects alone (no walls, no noise: the robot
+    /// senses those), the battery and the optical barrier. Light channels
+    /// are 0.
+    pub fn sense_virtual(&self, out: &mut [f32; CHANNELS]) {
+        let mut irv = [0.0f32; ir::SENSORS];
+        if self.obj_virtual {
+            self.ir_objects(&mut irv);
+        }
+        for s in 0..ir::SENSORS {
+            out[CH_IR + s] = irv[s].clamp(0.0, 1.0);
+            out[CH_LIGHT + s] = 0.0;
+        }
+        out[CH_BATTERY] = self.battery();
+        out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
     }
 
     /// Battery level 0..1 (1 forever without a battery).

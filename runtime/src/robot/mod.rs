@@ -1,0 +1,42 @@
+//! Running the controller on a Khepera over its serial protocol.
+//!
+//! - [`protocol`]: the Khepera II ASCII protocol as a pure codec (commands,
+//!   answers, line framing, unit conversions);
+//! - [`serial`]: [`SerialRobot`], the controller's [`crate::controller::Robot`]
+//!   over a [`Link`], with the battery and virtual objects simulated on the
+//!   host and the pose from odometry;
+//! - [`emulator`]: [`Emulator`], a robot answering the protocol from the
+//!   simulator, for tests and for trying without hardware.
+//!
+//! No I/O here: the CLI implements [`Link`] over a serial port and serves the
+//! emulator on a pseudo-terminal.
+
+pub mod emulator;
+pub mod protocol;
+pub mod serial;
+
+pub use emulator::Emulator;
+pub use serial::{odometry, Link, LinkError, RobotError, SerialRobot};
+
+use crate::program::World;
+use crate::sim::{Pose, Sim};
+
+/// The world a robot has physically: the arena, lamp and charger bar, and
+/// physical objects, without the virtual objects and the battery (which the
+/// host simulates).
+pub fn physical_world(world: &World) -> World {
+    let mut w = world.clone();
+    if w.objects.as_ref().is_some_and(|o| o.virtual_) {
+        w.objects = None;
+    }
+    w.battery = None;
+    w
+}
+
+/// Where a robot starts an episode seeded with `sim_seed`: the start pose
+/// of its physical world, so the same seed gives the same start in every
+/// stage of an arena, whatever virtual objects a stage adds. The emulator
+/// starts there and the host assumes it (a real robot is put there by hand).
+pub fn start_pose(world: &World, sim_seed: u64) -> Pose {
+    Sim::new(&physical_world(world), sim_seed).pose()
+}

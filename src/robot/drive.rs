@@ -1,0 +1,171 @@
+//! `shaping drive`: one individual on a robot over its serial port, with the
+//! same trace and pictures as `replay`.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use shaping_runtime::catalog::ActuatorKind;
+use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Trace};
+use shaping_runtime::evolve::EvalOptions;
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::Stage;
+use shaping_runtime::robot::{RobotError, SerialRobot};
+
+use super::port::{interrupt_flag, SerialPort};
+use crate::load::{self, create_dir, write_atomic, CliError};
+use crate::{replay, report, run};
+
+pub struct DriveArgs {
+    pub file: PathBuf,
+    pub stage: Option<String>,
+    pub genome: Option<String>,
+    pub run: Option<PathBuf>,
+    pub port: PathBuf,
+    pub baud: u32,
+    pub actions: Option<u32>,
+    pub out: Option<PathBuf>,
+    pub seed: Option<u64>,
+    pub period_ms: Option<u64>,
+    pub timeout_ms: u64,
+    pub no_learning: bool,
+    pub error_format: crate::diag::ErrorFormat,
+}
+
+/// The stage declares an arm or a claw.
+pub fn has_gripper(stage: &Stage) -> bool {
+    stage.actuators.iter().any(|a| matches!(a.kind, ActuatorKind::Lift | ActuatorKind::Grip))
+}
+
+/// A robot cannot move physical objects the host does not see.
+pub fn check_robot_world(stage: &Stage) -> Result<(), CliError> {
+    match &stage.world.objects {
+        Some(o) if !o.virtual_ && o.count > 0 => Err(CliError::io(format!(
+            "error: stage `{}` has physical objects; on a robot the objects must be `virtual` (simulated on the host, as in the paper)",
+            stage.name
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The action period: `--period`, else the world's action length.
+pub fn period(stage: &Stage, period_ms: Option<u64>) -> Duration {
+    period_ms.map_or_else(
+        || Duration::from_secs_f64(f64::from(stage.world.body.action_ms.max(0.0)) / 1000.0),
+        Duration::from_millis,
+    )
+}
+
+/// The message for a robot that failed: what happened, and whether the
+/// motors were stopped.
+pub fn failure(err: &RobotError, stopped: &Result<(), RobotError>) -> String {
+    match stopped {
+        Ok(()) => format!("error: {err}; the motors were stopped (speed 0 sent)"),
+        Err(e) => {
+            format!("error: {err}; stopping the motors failed too ({e}): the robot may still be driving")
+        }
+    }
+}
+
+pub fn drive(args: DriveArgs) -> Result<(), CliError> {
+    let program = load::load_program(&args.file, args.error_format)?;
+    let index = load::stage_index(&program, args.stage.as_deref())?;
+    let stage = &program.stages[index];
+    check_robot_world(stage)?;
+    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let genome = match &args.genome {
+        Some(g) => replay::parse_genome(g)?,
+        None if stage.layout.bits == 0 && args.run.is_none() => Genome::zeros(0),
+        None => {
+            let source = &program.stages[replay::evolved_source(&program, index)];
+            let path = run_dir.join(&source.name).join("best.genome");
+            if !path.exists() {
+                return Err(CliError::io(format!(
+                    "error: no evolved individual at `{}`; run `shaping run {}` first, or pass `--genome` or `--run`",
+                    path.display(),
+                    args.file.display()
+                )));
+            }
+            replay::parse_genome(&path.to_string_lossy())?
+        }
+    };
+    // The life length and learning the stage declares, as in `replay`.
+    let declared = EvalOptions::of(stage);
+    let actions = args.actions.unwrap_or(declared.actions);
+    let learning = declared.learning && !args.no_learning;
+    let seed = args.seed.unwrap_or_else(|| run::run_seed(&program, None));
+    let (sim_seed, rng) = episode_rngs(seed);
+    let mut ctl = Controller::new(stage, &genome, rng)
+        .map_err(|e| CliError::io(format!("error: the genome does not fit stage `{}`: {e}", stage.name)))?;
+
+    let flag = interrupt_flag()?;
+    let period = period(stage, args.period_ms);
+    let port = SerialPort::open(&args.port, args.baud, Duration::from_millis(args.timeout_ms), period, flag)?;
+    let mut robot = SerialRobot::new(&stage.world, sim_seed, None, has_gripper(stage), port);
+    let start = robot.host().pose();
+    eprintln!(
+        "driving `{}` on {} at {} baud, {} ms per action; the robot should stand at x {:.0} mm, y {:.0} mm, heading {:.0} deg",
+        stage.name,
+        args.port.display(),
+        args.baud,
+        period.as_millis(),
+        start.x,
+        start.y,
+        start.theta.to_degrees()
+    );
+    let scene = robot.host().scene();
+    let started = Instant::now();
+    let mut trace = Trace::default();
+    let result = match robot.connect() {
+        Ok(()) => Some(ctl.run(&mut robot, &EpisodeOptions { actions, learning, seed }, Some(&mut trace))),
+        Err(_) => None,
+    };
+    // Whatever happened, the wheels stop before anything else.
+    let stopped = robot.stop();
+    let elapsed = started.elapsed().as_secs_f64();
+    let error = robot.error().cloned();
+    let requests = robot.requests;
+    let bytes = robot.into_link().bytes;
+
+    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
+    create_dir(&out)?;
+    report::episode_files(&out, &stage.name, stage, &trace, &scene, &[])?;
+    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    let done = trace.rows.len();
+    let rate = if elapsed > 0.0 { done as f64 / elapsed } else { 0.0 };
+    let summary = serde_json::json!({
+        "stage": stage.name, "seed": seed, "port": args.port.display().to_string(), "baud": args.baud,
+        "period_ms": period.as_millis() as u64, "actions": done, "seconds": elapsed,
+        "actions_per_second": rate, "requests": requests, "bytes": bytes,
+        "fitness": result.as_ref().map(|r| r.fitness), "grips": result.as_ref().map(|r| r.grips),
+        "releases_outside": result.as_ref().map(|r| r.releases_outside),
+        "recharges": result.as_ref().map(|r| r.recharges), "collisions": result.as_ref().map(|r| r.collisions),
+        "error": error.as_ref().map(|e| e.to_string()),
+    });
+    write_atomic(
+        &out.join("summary.json"),
+        serde_json::to_string_pretty(&summary).unwrap_or_default().as_bytes(),
+    )?;
+    if let Some(err) = &error {
+        eprintln!("stopped after {done} actions; what ran is in {}", out.display());
+        return Err(CliError::io(failure(err, &stopped)));
+    }
+    if let Err(e) = &stopped {
+        return Err(CliError::io(format!(
+            "error: stopping the motors failed ({e}): the robot may still be driving"
+        )));
+    }
+    let r = result.unwrap_or_default();
+    println!(
+        "{}: {} actions, fitness {:.3}, {} grips, {} released outside, {} recharges, {} collisions, {:.1} actions/s -> {}",
+        stage.name,
+        r.actions,
+        r.fitness,
+        r.grips,
+        r.releases_outside,
+        r.recharges,
+        r.collisions,
+        rate,
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,197 @@
+//! `shaping run FILE --robot DEV`: the individuals of a generation are
+//! evaluated one after another on the robot, each episode written to
+//! `<stage>/robot-episodes.jsonl` as soon as it ends, so a crash or a lost
+//! link loses at most the individual being evaluated: on resume, the
+//! episodes already in the file are not run again.
+
+use std::collections::HashMap;
+use std::fs::OpenOptions;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use serde::{Deserialize, Serialize};
+use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions};
+use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Inheritance, Stage};
+use shaping_runtime::robot::SerialRobot;
+use shaping_runtime::sim::Pose;
+
+use super::drive::{check_robot_world, failure, has_gripper, period};
+use super::port::{interrupt_flag, SerialPort};
+use crate::load::{self, CliError};
+
+/// One episode done on the robot, as a line of `robot-episodes.jsonl`.
+#[derive(Serialize, Deserialize)]
+struct Episode {
+    seed: u64,
+    fitness: f32,
+    learned: Option<String>,
+    /// The robot's pose at the end of the episode (odometry).
+    pose: [f32; 3],
+}
+
+struct State {
+    port: Option<SerialPort>,
+    /// Where the robot is (odometry), carried from episode to episode.
+    pose: Option<Pose>,
+    done: HashMap<u64, Evaluation>,
+    log: Option<PathBuf>,
+    error: Option<String>,
+}
+
+/// The robot of a `run --robot`, shared by the stages of the run.
+pub struct RobotRun {
+    pub device: PathBuf,
+    pub baud: u32,
+    pub period_ms: Option<u64>,
+    pub timeout_ms: u64,
+    flag: Arc<AtomicBool>,
+    state: Mutex<State>,
+}
+
+impl RobotRun {
+    pub fn new(
+        device: PathBuf,
+        baud: u32,
+        period_ms: Option<u64>,
+        timeout_ms: u64,
+    ) -> Result<RobotRun, CliError> {
+        Ok(RobotRun {
+            device,
+            baud,
+            period_ms,
+            timeout_ms,
+            flag: interrupt_flag()?,
+            state: Mutex::new(State { port: None, pose: None, done: HashMap::new(), log: None, error: None }),
+        })
+    }
+
+    fn lock(&self) -> MutexGuard<'_, State> {
+        self.state.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The failure that stopped the evaluations, if any.
+    pub fn failure(&self) -> Option<CliError> {
+        self.lock().error.clone().map(CliError::io)
+    }
+
+    /// The evaluation of one genome on the robot for `stage`, whose
+    /// directory is `dir`: episodes already in its log are taken from there.
+    /// After a failure every evaluation gives NaN, so the generation fails
+    /// and its checkpoint is not written; [`RobotRun::failure`] says why.
+    pub fn evaluator<'a>(
+        &'a self,
+        stage: &'a Stage,
+        actions: u32,
+        dir: &Path,
+    ) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + 'a, CliError> {
+        check_robot_world(stage)?;
+        let log = dir.join("robot-episodes.jsonl");
+        {
+            let mut st = self.lock();
+            st.done.clear();
+            if log.exists() {
+                let bytes = load::read_bytes(&log)?;
+                // A torn last line (a crash while writing) is skipped.
+                for line in bytes.split(|&b| b == b'\n') {
+                    if let Ok(e) = serde_json::from_slice::<Episode>(line) {
+                        let learned = e.learned.as_deref().and_then(Genome::from_bitstring);
+                        st.done.insert(e.seed, Evaluation { fitness: e.fitness, learned });
+                        st.pose = Some(Pose { x: e.pose[0], y: e.pose[1], theta: e.pose[2] });
+                    }
+                }
+                if !st.done.is_empty() {
+                    eprintln!(
+                        "stage {}: {} episodes already done on the robot, from {}",
+                        stage.name,
+                        st.done.len(),
+                        log.display()
+                    );
+                }
+            }
+            st.log = Some(log);
+        }
+        Ok(move |genome: &Genome, seed: u64| self.evaluate(stage, actions, genome, seed))
+    }
+
+    fn evaluate(&self, stage: &Stage, actions: u32, genome: &Genome, seed: u64) -> Evaluation {
+        let nan = Evaluation { fitness: f32::NAN, learned: None };
+        let mut st = self.lock();
+        if st.error.is_some() {
+            return nan;
+        }
+        if let Some(e) = st.done.get(&seed) {
+            return e.clone();
+        }
+        let port = match st.port.take() {
+            Some(p) => p,
+            None => {
+                let opened = SerialPort::open(
+                    &self.device,
+                    self.baud,
+                    Duration::from_millis(self.timeout_ms),
+                    period(stage, self.period_ms),
+                    Arc::clone(&self.flag),
+                );
+                match opened {
+                    Ok(p) => p,
+                    Err(e) => {
+                        st.error = Some(e.to_string());
+                        return nan;
+                    }
+                }
+            }
+        };
+        let (sim_seed, rng) = episode_rngs(seed);
+        let Ok(mut ctl) = Controller::new(stage, genome, rng) else {
+            st.error = Some(format!("error: a genome does not fit stage `{}`", stage.name));
+            return nan;
+        };
+        let mut robot = SerialRobot::new(&stage.world, sim_seed, st.pose, has_gripper(stage), port);
+        let result = robot
+            .connect()
+            .ok()
+            .map(|()| ctl.run(&mut robot, &EpisodeOptions { actions, learning: true, seed }, None));
+        let stopped = robot.stop();
+        let pose = robot.host().pose();
+        if let Some(err) = robot.error().cloned() {
+            st.error = Some(format!(
+                "{} (the individual being evaluated is lost; run the same command again to resume)",
+                failure(&err, &stopped)
+            ));
+            return nan;
+        }
+        st.port = Some(robot.into_link());
+        let Some(r) = result else { return nan };
+        let learned = (stage.inheritance == Inheritance::Lamarckian).then(|| ctl.write_back(genome));
+        let line = Episode {
+            seed,
+            fitness: r.fitness,
+            learned: learned.as_ref().map(Genome::to_bitstring),
+            pose: [pose.x, pose.y, pose.theta],
+        };
+        if let Some(log) = st.log.clone() {
+            if let Err(e) = append_line(&log, &line) {
+                st.error = Some(format!("error: cannot write `{}`: {e}", log.display()));
+                return nan;
+            }
+        }
+        st.pose = Some(pose);
+        let ev = Evaluation { fitness: r.fitness, learned };
+        st.done.insert(seed, ev.clone());
+        ev
+    }
+}
+
+/// Appends one JSON line and makes it durable before the next episode.
+fn append_line(path: &Path, episode: &Episode) -> std::io::Result<()> {
+    let mut text = serde_json::to_string(episode).map_err(std::io::Error::other)?;
+    text.push('\n');
+    let mut f = OpenOptions::new().create(true).append(true).open(path)?;
+    f.write_all(text.as_bytes())?;
+    f.sync_data()
+}
