@@ -57,3 +57,16 @@ for f in khepera pretrained forward-only scratch-full; do
   cat $R/$f/summary.md
 done
 python3 docs/experiments/analyse.py "$R" "$SEEDS"
+
+# Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.
+times=""
+for i in 1 2 3; do
+  t0=$(date +%s.%N)
+  $B run examples/khepera.bat --fresh --quiet --no-report --out $R/speed > /dev/null
+  t1=$(date +%s.%N)
+  times="$times $(echo "$t1 - $t0" | bc -l)"
+done
+echo "== speed"
+python3 -c 'import sys, statistics as st; t = sorted(map(float, sys.argv[1:])); print("one seed of khepera.bat: median %.2f s, runs %s" % (st.median(t), " ".join("%.2f" % x for x in t)))' $times
+$B bench examples/khepera.bat --stage navigation
+$B bench examples/khepera.bat --stage collect
