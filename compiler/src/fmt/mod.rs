@@ -12,7 +12,8 @@
 //! - two spaces of indentation per level; one space between words;
 //! - a block written on one line (no line break nor comment inside) stays on
 //!   one line if it fits in [`WIDTH`] columns (the width of `rustfmt.toml`),
-//!   items separated by two spaces, else each item gets a line; any other block has its items on their own lines, except items
+//!   items separated by two spaces, else each item gets a line (so does a
+//!   block whose first item is on the line of its `{`); any other block has its items on their own lines, except items
 //!   written on the same line as the previous one, which stay there;
 //! - blank lines between items are kept, at most one, never after `{` nor
 //!   before `}`; separators `,` and `;` are kept between items on one line
@@ -121,6 +122,9 @@ struct Block {
     pieces: Vec<Piece>,
     /// Written on one line, without comments.
     flat: bool,
+    /// Written with its first item on the line of its `{`: if it cannot
+    /// stay on one line, each item gets its own.
+    opens_inline: bool,
     /// Between the braces, exclusive.
     interior: (usize, usize),
 }
@@ -260,8 +264,9 @@ fn render_doc(doc: &Doc, flat: Option<String>, indent: usize, out: &mut Vec<Line
                 let mut head = Line::new(indent, vec![format!("{} {{", b.head)]);
                 head.comment = b.head_comment.clone();
                 out.push(head);
-                // A block written on one line but too wide gets one item per line.
-                render_pieces(&b.pieces, indent + INDENT, b.flat, out);
+                // A block begun on the line of its `{` that cannot stay on one
+                // line gets one item per line.
+                render_pieces(&b.pieces, indent + INDENT, b.flat || b.opens_inline, out);
                 out.push(Line::new(indent, vec!["}".into()]));
             }
         },
@@ -378,8 +383,9 @@ impl F<'_> {
         let flat = !self.has_newline(open, close)
             && self.lx.comments_in(span.start, close).is_empty()
             && items.iter().all(|i| i.doc.flat().is_some());
+        let opens_inline = !self.has_newline(open, items.first().map_or(close, |i| i.start));
         let (head_comment, pieces) = self.pieces(items, open + 1, close, true);
-        Doc::Block(Block { head, head_comment, pieces, flat, interior: (open + 1, close) })
+        Doc::Block(Block { head, head_comment, pieces, flat, opens_inline, interior: (open + 1, close) })
     }
 
     /// Places the comments between `lo` and `hi` around the items.

@@ -130,6 +130,7 @@ fn a_file_that_does_not_parse_is_an_error() {
 fn layout_rules() {
     let src = "robot r{sensor ir[8] proximity   actuator wheels[2] speed}\n\n\n\
                // the stage\nstage s { fitness per action (wheels[0]) + ((1 - max(ir))) // f\n\
+               world {\narena 400mm x 600mm\nbattery 200 actions, recharge 20 actions;\n}\n\
                module m { sense ir , ir[0 .. 2]  behavior   neural{outputs sign(1)->forward|left}\n\
                learn crbp on behavior always  reinforce a ? 1 : b ? 2 : 3 }\n\
                module n {\nsense ir /* x */ behavior script { forward(1.0) for 2 actions; turn left(0.5) } } }\n";
@@ -140,9 +141,15 @@ robot r { sensor ir[8] proximity  actuator wheels[2] speed }
 // the stage
 stage s {
   fitness per action wheels[0] + (1 - max(ir))  // f
+  world {
+    arena 400mm x 600mm
+    battery 200 actions, recharge 20 actions
+  }
   module m {
-    sense ir, ir[0..2]  behavior neural { outputs sign(1) -> forward | left }
-    learn crbp on behavior always  reinforce a ? 1 : b ? 2 : 3
+    sense ir, ir[0..2]
+    behavior neural { outputs sign(1) -> forward | left }
+    learn crbp on behavior always
+    reinforce a ? 1 : b ? 2 : 3
   }
   module n {
     sense ir  /* x */
