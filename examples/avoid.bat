@@ -14,7 +14,7 @@
 // Nothing is evolved: every weight is fixed or random.
 
 robot khepera {
-  sensor ir[8] proximity
+  sensor ir[8]       proximity
   actuator wheels[2] speed
 }
 
@@ -28,7 +28,7 @@ stage avoid {
   }
   module avoid {
     sense ir
-    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]   // wins when sum(ir) > 0.3
+    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]  // wins when sum(ir) > 0.3
     behavior neural {
       outputs sign(2) -> forward | right | left | back
       weights random -0.5..0.5

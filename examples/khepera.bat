@@ -10,9 +10,9 @@
 //               modules re-adapt by local learning only
 
 robot khepera {
-  sensor ir[8]      proximity   // 6 front, 2 back: 0 far .. 1 touching
-  sensor light[8]   ambient     // 0 dark .. 1 bright
-  sensor battery    level       // 0 empty .. 1 full
+  sensor ir[8]       proximity  // 6 front, 2 back: 0 far .. 1 touching
+  sensor light[8]    ambient    // 0 dark .. 1 bright
+  sensor battery     level      // 0 empty .. 1 full
   actuator wheels[2] speed      // -1..1 of v_max
 }
 
@@ -40,7 +40,7 @@ stage avoidance {
   }
   module avoid {
     sense ir
-    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]   // wins when sum(ir) > 0.3
+    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]  // wins when sum(ir) > 0.3
     behavior neural {
       outputs sign(2) -> forward | right | left | back
       weights random -0.5..0.5
@@ -102,9 +102,9 @@ stage navigation {
 
 stage collect extends navigation {
   robot adds {
-    sensor barrier optical   // between the gripper's arms: 0 or 1
-    actuator arm lift        // up | down
-    actuator claw grip       // open | closed
+    sensor barrier optical  // between the gripper's arms: 0 or 1
+    actuator arm   lift     // up | down
+    actuator claw  grip     // open | closed
   }
   world adds { objects 8 diameter 10mm virtual }
   evolve { generations 40 }

@@ -7,9 +7,9 @@
 // charger can recharge. World, fitness and genes are those of khepera.bat.
 
 robot khepera {
-  sensor ir[8]      proximity
-  sensor light[8]   ambient
-  sensor battery    level
+  sensor ir[8]       proximity
+  sensor light[8]    ambient
+  sensor battery     level
   actuator wheels[2] speed
 }
 genome { bits 4  range -4..4 }

@@ -11,9 +11,9 @@
 //   navigation  wander, avoid obstacles, follow the light, recharge
 
 robot khepera {
-  sensor ir[8]      proximity   // 6 front, 2 back: 0 far .. 1 touching
-  sensor light[8]   ambient     // 0 dark .. 1 bright
-  sensor battery    level       // 0 empty .. 1 full
+  sensor ir[8]       proximity  // 6 front, 2 back: 0 far .. 1 touching
+  sensor light[8]    ambient    // 0 dark .. 1 bright
+  sensor battery     level      // 0 empty .. 1 full
   actuator wheels[2] speed      // -1..1 of v_max
 }
 
@@ -41,7 +41,7 @@ stage avoidance {
   }
   module avoid {
     sense ir
-    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]   // wins when sum(ir) > 0.3
+    activation fixed [-0.3, 1, 1, 1, 1, 1, 1, 1, 1]  // wins when sum(ir) > 0.3
     behavior neural {
       outputs sign(2) -> forward | right | left | back
       weights random -0.5..0.5

@@ -7,13 +7,13 @@
 // same population (100) and total generations (40 + 40) as khepera.bat.
 
 robot khepera {
-  sensor ir[8]      proximity
-  sensor light[8]   ambient
-  sensor battery    level
-  sensor barrier    optical
+  sensor ir[8]       proximity
+  sensor light[8]    ambient
+  sensor battery     level
+  sensor barrier     optical
   actuator wheels[2] speed
-  actuator arm lift
-  actuator claw grip
+  actuator arm       lift
+  actuator claw      grip
 }
 
 genome { bits 4  range -4..4 }

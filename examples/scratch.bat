@@ -11,9 +11,9 @@
 // the same.
 
 robot khepera {
-  sensor ir[8]      proximity
-  sensor light[8]   ambient
-  sensor battery    level
+  sensor ir[8]       proximity
+  sensor light[8]    ambient
+  sensor battery     level
   actuator wheels[2] speed
 }
 

@@ -31,8 +31,8 @@ stage explore {
   // the links from the other modules) gives a level in 0..1; the module
   // with the highest level drives the wheels for that action.
   module cruise {
-    sense ir[2..3]                  // the two front sensors
-    behavior forward(0.8)           // a one-step script, repeated
+    sense ir[2..3]         // the two front sensors
+    behavior forward(0.8)  // a one-step script, repeated
   }
 
   module dodge {
@@ -46,7 +46,7 @@ stage explore {
     }
   }
 
-  links all evolvable               // every module excites or inhibits the others
+  links all evolvable  // every module excites or inhibits the others
 }
 
 // 4. A later stage: the old modules and links are frozen; only the new
@@ -54,7 +54,7 @@ stage explore {
 stage escape extends explore {
   evolve { generations 10 }
   module reverse {
-    sense ir[6..7]                  // the back sensors
+    sense ir[6..7]  // the back sensors
     behavior forward(1.0) for 3 actions
   }
   links all evolvable

@@ -88,10 +88,18 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliErro
     if path.extension().is_some_and(|e| e == "json") {
         return load_built(path);
     }
+    let source = read_source(path, format)?;
+    let name = path.display().to_string();
+    shaping_compiler::compile(&source, &name).map_err(|d| CliError::Diagnostics(diag::render(&d, format)))
+}
+
+/// Reads a `.bat` source; a file that is not UTF-8 is a diagnostic that
+/// points at the first invalid byte.
+pub fn read_source(path: &Path, format: ErrorFormat) -> Result<String, CliError> {
     let bytes = read_bytes(path)?;
     let name = path.display().to_string();
-    let source = match String::from_utf8(bytes) {
-        Ok(s) => s,
+    match String::from_utf8(bytes) {
+        Ok(s) => Ok(s),
         Err(e) => {
             let at = e.utf8_error().valid_up_to();
             let mut lossy = String::from_utf8_lossy(e.as_bytes()).into_owned();
@@ -105,10 +113,9 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliErro
             let column = at - lossy[..at].rfind('\n').map_or(0, |i| i + 1);
             let src = (column <= 1000).then(|| NamedSource::new(&name, lossy));
             let report = NotUtf8 { src, name, at: (at, 1).into() };
-            return Err(CliError::Diagnostics(diag::render(&report, format)));
+            Err(CliError::Diagnostics(diag::render(&report, format)))
         }
-    };
-    shaping_compiler::compile(&source, &name).map_err(|d| CliError::Diagnostics(diag::render(&d, format)))
+    }
 }
 
 /// Loads a `Program` written by `shaping build`.

@@ -4,8 +4,10 @@ mod bench;
 mod diag;
 mod episode;
 mod experiment;
+mod fmt;
 mod html;
 mod load;
+mod lsp;
 mod plot;
 mod replay;
 mod report;
@@ -39,6 +41,19 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
+    /// Format architecture files in place (standard input to standard output
+    /// when no file is given); a file that does not parse is left untouched.
+    Fmt {
+        /// `.bat` files to format.
+        files: Vec<PathBuf>,
+        /// Change nothing; name the files that would change and exit 1 if any.
+        #[arg(long)]
+        check: bool,
+        #[arg(long, value_enum, default_value = "human")]
+        error_format: ErrorFormat,
+    },
+    /// Run the language server on standard input and output (for editors).
+    Lsp,
     /// Show the genome layout the compiler derived for a stage.
     Layout {
         file: PathBuf,
@@ -281,6 +296,8 @@ fn main() -> ExitCode {
 fn dispatch(command: Command) -> Result<(), CliError> {
     match command {
         Command::Check { files, error_format } => check(&files, error_format),
+        Command::Fmt { files, check, error_format } => fmt::fmt(&files, check, error_format),
+        Command::Lsp => lsp::lsp(),
         Command::Layout { file, stage, format, error_format } => {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;

@@ -8,9 +8,11 @@
 //! - [`syntax`]: the pest grammar (`grammar/shaping.pest`), AST and spans;
 //! - [`lower`]: resolves names, checks everything, derives genome layouts;
 //! - [`layout`]: readable renderings of a compiled stage (layout table, DOT graph);
+//! - [`fmt`]: the formatter (`shaping fmt`, the language server's formatting);
 //! - [`diag`]: the error enum and the [`Diagnostics`] collection.
 
 pub mod diag;
+pub mod fmt;
 pub mod layout;
 pub mod lower;
 pub mod syntax;

@@ -187,6 +187,20 @@ fn default_evolution() -> Evolution {
 }
 
 /// Lowers a parsed file to a [`Program`], or every error found.
+/// Whether an error of a stage whose parent is unknown stands without the
+/// parent: a sensor or actuator that no stage declares, an index out of
+/// range, a bad range, unit or gene size, an unknown function or event.
+fn checkable_without_parent(e: &Error) -> bool {
+    matches!(
+        e,
+        Error::Unknown { what: "sensor" | "actuator" | "function" | "event", .. }
+            | Error::IndexOutOfRange { .. }
+            | Error::BadRange { .. }
+            | Error::Bits { .. }
+            | Error::Unit { .. }
+    )
+}
+
 pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
     let mut lw = Lower {
         errors: Vec::new(),
@@ -508,11 +522,14 @@ impl<'a> Lower<'a> {
                 None => self.root_state(s),
             };
             // A stage whose parent is unknown is checked as if it had none;
-            // its errors would mostly be consequences of the missing parent.
+            // most of its errors would be consequences of the missing parent,
+            // but those about the robot, numbers and names that no stage of
+            // the file could have declared are its own.
             let saved = self.errors.len();
             let (state, stage) = self.stage(decl, s, parent_index, base);
             if orphan[i] {
-                self.errors.truncate(saved);
+                let own: Vec<Error> = self.errors.drain(saved..).filter(checkable_without_parent).collect();
+                self.errors.extend(own);
             }
             if let Some(p) = parent_index {
                 if let (StageRun::Train { .. }, Some(e)) = (&stages[p].run, &decl.extends) {

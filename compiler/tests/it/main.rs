@@ -4,6 +4,7 @@
 
 mod docs;
 mod examples;
+mod fmt;
 mod layout;
 mod limits;
 mod parse;

@@ -1,0 +1,81 @@
+//! `shaping fmt`: formats files in place, or stdin to stdout.
+
+use std::io::{Read, Write};
+use std::path::PathBuf;
+
+use shaping_compiler::fmt::{format, FormatError};
+
+use crate::diag::{self, ErrorFormat};
+use crate::load::{self, CliError};
+
+/// Formats the files (stdin to stdout when there are none). With `check`,
+/// writes nothing and names the files that would change (exit 1).
+pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
+    if files.is_empty() {
+        return fmt_stdin(check, error_format);
+    }
+    let mut worst: Option<CliError> = None;
+    let mut changed = 0;
+    for file in files {
+        let result = load::read_source(file, error_format).and_then(|src| {
+            let out = format_one(&src, &file.display().to_string(), error_format)?;
+            if out == src {
+                return Ok(());
+            }
+            changed += 1;
+            if check {
+                println!("{}", file.display());
+                Ok(())
+            } else {
+                load::write_atomic(file, out.as_bytes())?;
+                eprintln!("formatted {}", file.display());
+                Ok(())
+            }
+        });
+        if let Err(e) = result {
+            eprintln!("{e}");
+            if worst.as_ref().is_none_or(|w| w.exit_code() < e.exit_code()) {
+                worst = Some(e);
+            }
+        }
+    }
+    match worst {
+        Some(CliError::Io(_)) => Err(CliError::Io(String::new())),
+        Some(CliError::Diagnostics(_)) => Err(CliError::Diagnostics(String::new())),
+        None if check && changed > 0 => Err(CliError::Diagnostics(format!(
+            "{changed} file{} would be reformatted by `shaping fmt`",
+            if changed == 1 { "" } else { "s" }
+        ))),
+        None => Ok(()),
+    }
+}
+
+fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
+    let mut src = String::new();
+    std::io::stdin()
+        .read_to_string(&mut src)
+        .map_err(|e| CliError::io(format!("error: cannot read standard input: {e}")))?;
+    let out = format_one(&src, "<stdin>", error_format)?;
+    if check {
+        if out != src {
+            println!("<stdin>");
+            return Err(CliError::Diagnostics("standard input would be reformatted by `shaping fmt`".into()));
+        }
+        return Ok(());
+    }
+    std::io::stdout()
+        .write_all(out.as_bytes())
+        .map_err(|e| CliError::io(format!("error: cannot write standard output: {e}")))
+}
+
+fn format_one(src: &str, name: &str, error_format: ErrorFormat) -> Result<String, CliError> {
+    format(src, name).map_err(|e| match e {
+        FormatError::Syntax(d) => CliError::Diagnostics(format!(
+            "{}\n{name}: not formatted (it does not parse)",
+            diag::render(&d, error_format).trim_end()
+        )),
+        FormatError::Changed(why) => {
+            CliError::io(format!("error: `{name}` was left as it is: {why} (a bug of `shaping fmt`)"))
+        }
+    })
+}
