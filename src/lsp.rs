@@ -373,36 +373,14 @@ fn channel(p: &Program, stage: usize, c: u16) -> String {
 
 // ------------------------------------------------------------------ completion, symbols, formatting
 
-const KEYWORDS: &[&str] = &[
-    "robot",
-    "sensor",
-    "actuator",
-    "genome",
-    "stage",
-    "extends",
-    "module",
-    "sense",
-    "activation",
-    "behavior",
-    "learn",
-    "reinforce",
-    "links",
-    "link",
-    "world",
-    "evolve",
-    "test",
-    "fitness",
-    "and",
-    "or",
-    "not",
-    "prev",
-    "until",
-    "within",
-    "for",
-    "uses",
-    "per",
-    "adds",
-    "changes",
+/// Words of the language that are not reserved (those are
+/// `syntax::RESERVED`), offered by completion.
+const WORDS: &[&str] = &[
+    "train",
+    "trained",
+    "error",
+    "difference",
+    "squared",
     "if",
     "script",
     "commit",
@@ -454,8 +432,9 @@ const KEYWORDS: &[&str] = &[
 ];
 
 fn completion(text: &str) -> Value {
-    let mut items: Vec<lt::CompletionItem> = KEYWORDS
+    let mut items: Vec<lt::CompletionItem> = syntax::RESERVED
         .iter()
+        .chain(WORDS)
         .map(|k| lt::CompletionItem {
             label: k.to_string(),
             kind: Some(lt::CompletionItemKind::KEYWORD),
@@ -484,7 +463,7 @@ fn completion(text: &str) -> Value {
         let mut seen = std::collections::HashSet::new();
         for t in lex(text).tokens.iter().filter(|t| t.kind == TokenKind::Word) {
             let w = &text[t.span.start..t.span.end];
-            if !KEYWORDS.contains(&w) && seen.insert(w) {
+            if !syntax::RESERVED.contains(&w) && !WORDS.contains(&w) && seen.insert(w) {
                 items.push(lt::CompletionItem { label: w.to_string(), ..Default::default() });
             }
         }

@@ -4,5 +4,5 @@ pub mod ast;
 mod parser;
 pub mod span;
 
-pub use parser::parse;
+pub use parser::{parse, RESERVED};
 pub use span::Span;

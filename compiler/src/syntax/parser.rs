@@ -13,7 +13,7 @@ use crate::diag::Error;
 struct BatParser;
 
 /// The reserved words of the grammar's `keyword` rule.
-const RESERVED: [&str; 29] = [
+pub const RESERVED: [&str; 29] = [
     "robot",
     "sensor",
     "actuator",
