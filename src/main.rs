@@ -1,6 +1,7 @@
 //! The `shaping` command line: the only place that touches files and terminals.
 
 mod bench;
+mod cluster;
 mod diag;
 mod experiment;
 mod load;
@@ -89,6 +90,10 @@ enum Command {
         /// Ignore existing checkpoints and start every stage again.
         #[arg(long)]
         fresh: bool,
+        /// Under MPI: seconds rank 0 waits for a rank's answer to a batch
+        /// before it ends the run, naming the rank.
+        #[arg(long, value_name = "SECONDS", default_value_t = cluster::DEFAULT_RANK_TIMEOUT)]
+        rank_timeout: u64,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -141,6 +146,10 @@ enum Command {
         /// Ignore existing checkpoints.
         #[arg(long)]
         fresh: bool,
+        /// Under MPI: seconds rank 0 waits for a rank's answer to a batch
+        /// before it ends the run, naming the rank.
+        #[arg(long, value_name = "SECONDS", default_value_t = cluster::DEFAULT_RANK_TIMEOUT)]
+        rank_timeout: u64,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -165,6 +174,10 @@ enum LayoutFormat {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = refuse_without_mpi(&cli.command) {
+        eprintln!("{e}");
+        return ExitCode::from(e.exit_code() as u8);
+    }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -199,8 +212,14 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             print_text(&shaping_compiler::render_graph(&program, index));
             Ok(())
         }
-        Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, error_format } => {
-            run::run(run::RunArgs { file, stage, seed, out, jobs, quiet, json, fresh, error_format })
+        Command::Run { file, stage, seed, out, jobs, quiet, json, fresh, rank_timeout, error_format } => {
+            let args = run::RunArgs { file, stage, seed, out, jobs, quiet, json, fresh, error_format };
+            #[cfg(feature = "mpi")]
+            if cluster::launcher().is_some() {
+                return cluster::with_mpi(jobs, rank_timeout, quiet || json, |c| run::run(args, Some(c)));
+            }
+            let _ = rank_timeout;
+            run::run(args, None)
         }
         Command::Replay { file, stage, genome, run, actions, out, seed, no_learning, error_format } => {
             replay::replay(replay::ReplayArgs {
@@ -215,8 +234,18 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 error_format,
             })
         }
-        Command::Experiment { file, seeds, first_seed, out, jobs, criterion, fresh, error_format } => {
-            experiment::experiment(experiment::ExperimentArgs {
+        Command::Experiment {
+            file,
+            seeds,
+            first_seed,
+            out,
+            jobs,
+            criterion,
+            fresh,
+            rank_timeout,
+            error_format,
+        } => {
+            let args = experiment::ExperimentArgs {
                 file,
                 seeds,
                 first_seed,
@@ -225,7 +254,15 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 criterion,
                 fresh,
                 error_format,
-            })
+            };
+            #[cfg(feature = "mpi")]
+            if cluster::launcher().is_some() {
+                return cluster::with_mpi(jobs, rank_timeout, false, |c| {
+                    experiment::experiment(args, Some(c))
+                });
+            }
+            let _ = rank_timeout;
+            experiment::experiment(args, None)
         }
         Command::Bench { file, stage, runs, error_format } => {
             bench::bench(bench::BenchArgs { file, stage, runs, error_format })
@@ -238,6 +275,25 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
             Ok(())
         }
+    }
+}
+
+/// A build without MPI support started by an MPI launcher with several
+/// processes would run that many independent copies writing the same files:
+/// `run` and `experiment` refuse.
+fn refuse_without_mpi(command: &Command) -> Result<(), CliError> {
+    if cfg!(feature = "mpi") || !matches!(command, Command::Run { .. } | Command::Experiment { .. }) {
+        return Ok(());
+    }
+    match cluster::launcher() {
+        Some((_, Some(size))) if size <= 1 => Ok(()),
+        Some((var, size)) => {
+            let n = size.map_or_else(|| "several".to_string(), |n| n.to_string());
+            Err(CliError::io(format!(
+                "error: this `shaping` was built without MPI support, but an MPI launcher started it as one of {n} processes (`{var}` is set); rebuild it with `cargo build --release --features mpi`, or run it without `mpirun`"
+            )))
+        }
+        None => Ok(()),
     }
 }
 

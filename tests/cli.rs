@@ -308,3 +308,31 @@ fn replay_of_a_stage_without_genes_needs_no_genome() {
     assert!(last > first + 0.1 && last > 0.15, "performance {first} -> {last}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Without the `mpi` feature, `run` under an MPI launcher would be N copies
+/// writing the same files: it refuses; one process is fine.
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn run_under_an_mpi_launcher_without_mpi_support_refuses() {
+    let dir = scratch("no-mpi");
+    for var in ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"] {
+        let out = run(shaping().arg("run").arg(tiny()).arg("--out").arg(dir.join("x")).env(var, "4"));
+        assert_eq!(out.status.code(), Some(2));
+        let err = text(&out.stderr);
+        assert!(err.contains("built without MPI support") && err.contains(var), "{err}");
+        assert!(err.contains("--features mpi"), "{err}");
+        assert!(!dir.join("x").exists(), "it wrote files before refusing");
+    }
+    let out = run(shaping().args(["experiment", "--seeds", "1"]).arg(tiny()).env("PMIX_RANK", "0"));
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    let out = run_tiny(&dir.join("one"), &[]);
+    assert!(out.status.success());
+    let out = run(shaping()
+        .arg("run")
+        .arg(tiny())
+        .arg("--out")
+        .arg(dir.join("y"))
+        .arg("--quiet")
+        .env("OMPI_COMM_WORLD_SIZE", "1"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
