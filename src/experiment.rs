@@ -65,7 +65,12 @@ fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Cl
         .collect()
 }
 
-pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
+/// Runs the seeds one after the other; with `cluster` (rank 0 of an MPI run)
+/// the episodes of each generation are spread over the ranks.
+pub fn experiment(
+    args: ExperimentArgs,
+    cluster: Option<&crate::cluster::Coordinator>,
+) -> Result<(), CliError> {
     let program = load::load_program(&args.file, args.error_format)?;
     let criteria = criteria(&program, &args.criterion)?;
     if args.seeds == 0 {
@@ -76,20 +81,23 @@ pub fn experiment(args: ExperimentArgs) -> Result<(), CliError> {
     let seeds: Vec<u64> = (args.first_seed..args.first_seed + args.seeds).collect();
     for (i, &seed) in seeds.iter().enumerate() {
         eprintln!("seed {seed} ({}/{})", i + 1, seeds.len());
-        run::run(run::RunArgs {
-            file: args.file.clone(),
-            stage: None,
-            seed: Some(seed),
-            out: Some(out.join(format!("seed-{seed}"))),
-            jobs: args.jobs,
-            quiet: false,
-            json: false,
-            fresh: args.fresh,
-            // One report for the whole experiment, written below.
-            no_report: true,
-            error_format: args.error_format,
-            robot: None,
-        })?;
+        run::run(
+            run::RunArgs {
+                file: args.file.clone(),
+                stage: None,
+                seed: Some(seed),
+                out: Some(out.join(format!("seed-{seed}"))),
+                jobs: args.jobs,
+                quiet: false,
+                json: false,
+                fresh: args.fresh,
+                // One report for the whole experiment, written below.
+                no_report: true,
+                error_format: args.error_format,
+                robot: None,
+            },
+            cluster,
+        )?;
     }
     // Titled by the file: several files may share a robot (and so a program name).
     let title =

@@ -1,6 +1,7 @@
 //! The `shaping` command line: the only place that touches files and terminals.
 
 mod bench;
+mod cluster;
 mod diag;
 mod episode;
 mod experiment;
@@ -110,6 +111,10 @@ enum Command {
         /// Write no `report.html` at the end.
         #[arg(long)]
         no_report: bool,
+        /// Under MPI: seconds rank 0 waits for a rank's answer to a batch
+        /// before it ends the run, naming the rank.
+        #[arg(long, value_name = "SECONDS", default_value_t = cluster::DEFAULT_RANK_TIMEOUT)]
+        rank_timeout: u64,
         /// Evaluate the individuals one after another on the robot at this
         /// serial port (see `docs/robot.md`); every episode is saved as it ends.
         #[arg(long)]
@@ -247,6 +252,10 @@ enum Command {
         /// Write no `report.html` at the end.
         #[arg(long)]
         no_report: bool,
+        /// Under MPI: seconds rank 0 waits for a rank's answer to a batch
+        /// before it ends the run, naming the rank.
+        #[arg(long, value_name = "SECONDS", default_value_t = cluster::DEFAULT_RANK_TIMEOUT)]
+        rank_timeout: u64,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
@@ -281,6 +290,10 @@ enum LayoutFormat {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(e) = refuse_without_mpi(&cli.command) {
+        eprintln!("{e}");
+        return ExitCode::from(e.exit_code() as u8);
+    }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -327,6 +340,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             json,
             fresh,
             no_report,
+            rank_timeout,
             robot,
             baud,
             period,
@@ -336,7 +350,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             let robot = robot.map(|dev| robot::RobotRun::new(dev, baud, period, timeout)).transpose()?;
             // One robot: its individuals are evaluated one after another.
             let jobs = if robot.is_some() { Some(1) } else { jobs };
-            run::run(run::RunArgs {
+            let args = run::RunArgs {
                 file,
                 stage,
                 seed,
@@ -348,7 +362,18 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 no_report,
                 error_format,
                 robot,
-            })
+            };
+            #[cfg(feature = "mpi")]
+            if cluster::launcher().is_some() {
+                if args.robot.is_some() {
+                    return Err(CliError::io(
+                        "error: `--robot` evaluates on one robot; run it without `mpirun`",
+                    ));
+                }
+                return cluster::with_mpi(jobs, rank_timeout, quiet || json, |c| run::run(args, Some(c)));
+            }
+            let _ = rank_timeout;
+            run::run(args, None)
         }
         Command::Drive {
             file,
@@ -423,18 +448,29 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             criterion,
             fresh,
             no_report,
+            rank_timeout,
             error_format,
-        } => experiment::experiment(experiment::ExperimentArgs {
-            file,
-            seeds,
-            first_seed,
-            out,
-            jobs,
-            criterion,
-            fresh,
-            no_report,
-            error_format,
-        }),
+        } => {
+            let args = experiment::ExperimentArgs {
+                file,
+                seeds,
+                first_seed,
+                out,
+                jobs,
+                criterion,
+                fresh,
+                no_report,
+                error_format,
+            };
+            #[cfg(feature = "mpi")]
+            if cluster::launcher().is_some() {
+                return cluster::with_mpi(jobs, rank_timeout, false, |c| {
+                    experiment::experiment(args, Some(c))
+                });
+            }
+            let _ = rank_timeout;
+            experiment::experiment(args, None)
+        }
         Command::Report { dir, output } => {
             let path = html::write(&dir, output.as_deref())?;
             let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
@@ -452,6 +488,25 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
             Ok(())
         }
+    }
+}
+
+/// A build without MPI support started by an MPI launcher with several
+/// processes would run that many independent copies writing the same files:
+/// `run` and `experiment` refuse.
+fn refuse_without_mpi(command: &Command) -> Result<(), CliError> {
+    if cfg!(feature = "mpi") || !matches!(command, Command::Run { .. } | Command::Experiment { .. }) {
+        return Ok(());
+    }
+    match cluster::launcher() {
+        Some((_, Some(size))) if size <= 1 => Ok(()),
+        Some((var, size)) => {
+            let n = size.map_or_else(|| "several".to_string(), |n| n.to_string());
+            Err(CliError::io(format!(
+                "error: this `shaping` was built without MPI support, but an MPI launcher started it as one of {n} processes (`{var}` is set); rebuild it with `cargo build --release --features mpi`, or run it without `mpirun`"
+            )))
+        }
+        None => Ok(()),
     }
 }
 

@@ -14,6 +14,7 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Behavior, Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
+use crate::cluster::Coordinator;
 use crate::episode::{self, Part, Recorder};
 use crate::load::{self, create_dir, write_atomic, CliError};
 use crate::{html, report};
@@ -106,7 +107,9 @@ fn to_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
     serde_json::to_string_pretty(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
 }
 
-pub fn run(args: RunArgs) -> Result<(), CliError> {
+/// Runs the stages; with `cluster` (rank 0 of an MPI run) the episodes of
+/// each generation are spread over the ranks.
+pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError> {
     let mut program = load::load_program(&args.file, args.error_format)?;
     let target = match args.stage.as_deref() {
         Some(_) => load::stage_index(&program, args.stage.as_deref())?,
@@ -144,7 +147,13 @@ pub fn run(args: RunArgs) -> Result<(), CliError> {
         match &stage.run {
             StageRun::Evolve(_) => {
                 let parent = evolved_parent(&program, index, &finals)?;
-                let cp = pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args))?;
+                let cp = match cluster {
+                    None => {
+                        pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args, None))?
+                    }
+                    // The coordinator's loop calls MPI, so it stays on this thread.
+                    Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c))?,
+                };
                 best_episode(stage, &cp, seed, &dir)?;
                 finals[index] = Some(cp);
             }
@@ -224,6 +233,7 @@ fn evolve_stage(
     parent: Option<&Checkpoint>,
     dir: &Path,
     args: &RunArgs,
+    cluster: Option<&Coordinator>,
 ) -> Result<Checkpoint, CliError> {
     let stage = &program.stages[index];
     let StageRun::Evolve(evo) = &stage.run else { unreachable!("evolve_stage is called for evolved stages") };
@@ -265,8 +275,18 @@ fn evolve_stage(
     let fail = |e| {
         args.robot.as_ref().and_then(|r| r.failure()).unwrap_or_else(|| CliError::io(format!("error: {e}")))
     };
+    let many = |jobs: &[(&Genome, u64)]| match cluster {
+        Some(c) => c.evaluate(program, index, evo.actions, jobs),
+        None => evolve::evaluate_many(eval, jobs),
+    };
+    let context = |what: String| {
+        if let Some(c) = cluster {
+            c.set_context(what, &path);
+        }
+    };
     while !evolve::is_finished(program, &cp) {
-        let stats = evolve::step_generation(program, &mut cp, eval).map_err(fail)?;
+        context(format!("generation {} of stage `{}`", cp.generation, stage.name));
+        let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats);
@@ -275,8 +295,15 @@ fn evolve_stage(
     if !cp.validated {
         // Pick the stage's best by its mean over fresh episodes, not by its
         // luckiest single evaluation.
-        evolve::validate_best(program, &mut cp, eval, evolve::VALIDATE_CANDIDATES, evolve::VALIDATE_EPISODES)
-            .map_err(fail)?;
+        context(format!("the choice of the best of stage `{}`", stage.name));
+        evolve::validate_best_with(
+            program,
+            &mut cp,
+            &many,
+            evolve::VALIDATE_CANDIDATES,
+            evolve::VALIDATE_EPISODES,
+        )
+        .map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
     }
     let (genome, fitness) = evolve::best_of(&cp)

@@ -447,3 +447,31 @@ fn experiment_report_has_the_median_over_seeds() {
     assert!((first["best_min"][0].as_f64().unwrap() - bests[0]).abs() < 1e-6);
     assert!((first["best_max"][0].as_f64().unwrap() - bests[2]).abs() < 1e-6);
 }
+
+/// Without the `mpi` feature, `run` under an MPI launcher would be N copies
+/// writing the same files: it refuses; one process is fine.
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn run_under_an_mpi_launcher_without_mpi_support_refuses() {
+    let dir = scratch("no-mpi");
+    for var in ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE"] {
+        let out = run(shaping().arg("run").arg(tiny()).arg("--out").arg(dir.join("x")).env(var, "4"));
+        assert_eq!(out.status.code(), Some(2));
+        let err = text(&out.stderr);
+        assert!(err.contains("built without MPI support") && err.contains(var), "{err}");
+        assert!(err.contains("--features mpi"), "{err}");
+        assert!(!dir.join("x").exists(), "it wrote files before refusing");
+    }
+    let out = run(shaping().args(["experiment", "--seeds", "1"]).arg(tiny()).env("PMIX_RANK", "0"));
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    let out = run_tiny(&dir.join("one"), &[]);
+    assert!(out.status.success());
+    let out = run(shaping()
+        .arg("run")
+        .arg(tiny())
+        .arg("--out")
+        .arg(dir.join("y"))
+        .arg("--quiet")
+        .env("OMPI_COMM_WORLD_SIZE", "1"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}

@@ -31,7 +31,10 @@
 //! episode from `(run seed, stage, g, individual, episode)` (see [`seed`]).
 //! Evaluations run on rayon's current thread pool and are collected in index
 //! order, so any thread count gives bit-identical results, and a run resumed
-//! from a checkpoint equals the same run done straight.
+//! from a checkpoint equals the same run done straight. The `_with` variants
+//! take an [`EvaluateMany`] that runs a generation's list of episodes
+//! wherever it likes (the CLI spreads them over MPI ranks) and returns the
+//! results in order, which keeps the same guarantee.
 
 pub mod error;
 pub mod fingerprint;
@@ -57,6 +60,17 @@ pub const CHECKPOINT_FORMAT: u32 = 1;
 
 /// Runs one episode of a genome with the given episode seed.
 pub type Evaluate<'a> = &'a (dyn Fn(&Genome, u64) -> Evaluation + Sync);
+
+/// Runs a list of episodes, each a genome and its episode seed, and returns
+/// their results in the same order: the hook through which the episodes of a
+/// generation can be spread over several processes (the CLI's MPI backend).
+/// Which process or thread runs an episode must not change its result.
+pub type EvaluateMany<'a> = &'a dyn Fn(&[(&Genome, u64)]) -> Vec<Evaluation>;
+
+/// [`EvaluateMany`] over `evaluate` on rayon's current thread pool.
+pub fn evaluate_many(evaluate: Evaluate, jobs: &[(&Genome, u64)]) -> Vec<Evaluation> {
+    jobs.par_iter().map(|&(genome, seed)| evaluate(genome, seed)).collect()
+}
 
 /// The result of one episode.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -225,6 +239,15 @@ pub fn step_generation(
     cp: &mut Checkpoint,
     evaluate: Evaluate,
 ) -> Result<GenStats, EvolveError> {
+    step_generation_with(program, cp, &|jobs| evaluate_many(evaluate, jobs))
+}
+
+/// [`step_generation`] with the episodes of the generation run by `many`.
+pub fn step_generation_with(
+    program: &Program,
+    cp: &mut Checkpoint,
+    many: EvaluateMany,
+) -> Result<GenStats, EvolveError> {
     let st = get_stage(program, cp.stage)?;
     let evo = evolution(st)?;
     validate_evolution(st, evo)?;
@@ -242,14 +265,26 @@ pub fn step_generation(
 
     let (run_seed, stage) = (cp.seed, cp.stage);
     let episodes = evo.evaluations.max(1);
-    let results: Vec<(f32, Option<Genome>)> = population
-        .par_iter()
+    let jobs: Vec<(&Genome, u64)> = population
+        .iter()
         .enumerate()
-        .map(|(i, genome)| {
+        .flat_map(|(i, genome)| {
+            (0..episodes).map(move |e| (genome, seed::episode_seed(run_seed, stage, g, i, e)))
+        })
+        .collect();
+    let evaluations = many(&jobs);
+    if evaluations.len() != jobs.len() {
+        return Err(EvolveError::Inconsistent {
+            stage: st.name.clone(),
+            what: format!("{} results for {} episodes", evaluations.len(), jobs.len()),
+        });
+    }
+    let mut evaluations = evaluations.into_iter();
+    let results: Vec<(f32, Option<Genome>)> = (0..population.len())
+        .map(|_| {
             let mut sum = 0.0f64;
             let mut learned = None;
-            for e in 0..episodes {
-                let ev = evaluate(genome, seed::episode_seed(run_seed, stage, g, i, e));
+            for ev in evaluations.by_ref().take(episodes as usize) {
                 sum += ev.fitness as f64;
                 learned = ev.learned;
             }
@@ -372,6 +407,17 @@ pub fn validate_best(
     candidates: usize,
     episodes: u32,
 ) -> Result<(Genome, f32), EvolveError> {
+    validate_best_with(program, cp, &|jobs| evaluate_many(evaluate, jobs), candidates, episodes)
+}
+
+/// [`validate_best`] with the episodes run by `many`.
+pub fn validate_best_with(
+    program: &Program,
+    cp: &mut Checkpoint,
+    many: EvaluateMany,
+    candidates: usize,
+    episodes: u32,
+) -> Result<(Genome, f32), EvolveError> {
     if cp.validated {
         if let Some(best) = &cp.best {
             return Ok(best.clone());
@@ -398,11 +444,17 @@ pub fn validate_best(
     }
     let episodes = episodes.max(1);
     let (run_seed, stage) = (cp.seed, cp.stage);
-    let jobs: Vec<(usize, u32)> = (0..pool.len()).flat_map(|c| (0..episodes).map(move |e| (c, e))).collect();
-    let scores: Vec<f32> = jobs
-        .par_iter()
-        .map(|&(c, e)| evaluate(pool[c], seed::validate_seed(run_seed, stage, e)).fitness)
+    let jobs: Vec<(&Genome, u64)> = pool
+        .iter()
+        .flat_map(|&g| (0..episodes).map(move |e| (g, seed::validate_seed(run_seed, stage, e))))
         .collect();
+    let scores: Vec<f32> = many(&jobs).into_iter().map(|ev| ev.fitness).collect();
+    if scores.len() != jobs.len() {
+        return Err(EvolveError::Inconsistent {
+            stage: name,
+            what: format!("{} results for {} episodes", scores.len(), jobs.len()),
+        });
+    }
     let mut best = (0usize, f64::NEG_INFINITY);
     for c in 0..pool.len() {
         let per = &scores[c * episodes as usize..(c + 1) * episodes as usize];

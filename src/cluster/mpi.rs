@@ -1,0 +1,488 @@
+//! The MPI side of [`super`]: rank 0's [`Coordinator`] and the other ranks'
+//! [`serve`] loop. Every exchange is a request from a worker answered by one
+//! reply from rank 0, so neither side ever waits on a send to a process that
+//! is itself sending. Only the main thread calls MPI.
+
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{mpsc, Arc};
+use std::time::{Duration, Instant};
+
+use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
+use mpi::topology::{Communicator, Rank, SimpleCommunicator};
+use mpi::Threading;
+use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::Program;
+
+use super::wire::{self, Reply, Request};
+use crate::load::CliError;
+
+const TAG_REQUEST: i32 = 1;
+const TAG_REPLY: i32 = 2;
+/// Pause between two looks for a message when none is there (MPI's own
+/// blocking receive would spin a core).
+const POLL: Duration = Duration::from_micros(100);
+
+/// Initialises MPI and runs `body` on rank 0 with the coordinator; the other
+/// ranks serve batches until rank 0 is done. `jobs` is the rayon thread count
+/// of each rank (default: the node's cores shared among its ranks).
+pub fn with_mpi(
+    jobs: Option<usize>,
+    rank_timeout: u64,
+    quiet: bool,
+    body: impl FnOnce(&Coordinator) -> Result<(), CliError>,
+) -> Result<(), CliError> {
+    let Some((universe, _)) = mpi::initialize_with_threading(Threading::Funneled) else {
+        return Err(CliError::io("error: MPI was already initialised"));
+    };
+    let world = universe.world();
+    let (rank, size) = (world.rank(), world.size() as usize);
+    let on_node = world.split_shared(rank).size().max(1) as usize;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = jobs.unwrap_or_else(|| (cores / on_node).max(1));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| CliError::io(format!("error: rank {rank}: cannot start worker threads: {e}")))?;
+    if rank != 0 {
+        return serve(&world, &pool);
+    }
+    let term = Arc::new(AtomicBool::new(false));
+    signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&term))
+        .map_err(|e| CliError::io(format!("error: cannot watch for SIGTERM: {e}")))?;
+    let host = mpi::environment::processor_name().unwrap_or_default();
+    let coordinator = Coordinator {
+        world,
+        size,
+        pool,
+        timeout: Duration::from_secs(rank_timeout.max(1)),
+        term,
+        host,
+        state: RefCell::new(State::default()),
+    };
+    let result = body(&coordinator);
+    coordinator.finish();
+    if !quiet {
+        coordinator.report(threads);
+    }
+    result
+}
+
+/// Rank 0's side: spreads the episodes of a generation over the ranks.
+pub struct Coordinator {
+    world: SimpleCommunicator,
+    size: usize,
+    pool: rayon::ThreadPool,
+    timeout: Duration,
+    term: Arc<AtomicBool>,
+    host: String,
+    state: RefCell<State>,
+}
+
+#[derive(Default)]
+struct State {
+    workers: HashMap<Rank, Worker>,
+    /// Workers waiting for a reply with nothing to do.
+    idle: Vec<Rank>,
+    /// Version of the program last loaded (0: none yet) and its JSON.
+    version: u32,
+    program: Vec<u8>,
+    next_batch: u64,
+    /// What is being evaluated and the checkpoint to resume from, for messages.
+    context: String,
+    checkpoint: PathBuf,
+    stats: Stats,
+}
+
+struct Worker {
+    pid: u32,
+    host: String,
+    version: u32,
+}
+
+#[derive(Default)]
+struct Stats {
+    rounds: u64,
+    episodes: u64,
+    remote_episodes: u64,
+    messages: u64,
+    bytes: u64,
+    /// Time rank 0 spent in sends and in receives of messages that were there.
+    in_mpi: Duration,
+    /// Wall time of the rounds.
+    wall: Duration,
+}
+
+impl Coordinator {
+    /// Names what the next evaluations are for, and the checkpoint a new run
+    /// would resume from, for the failure messages.
+    pub fn set_context(&self, what: String, checkpoint: &Path) {
+        let mut st = self.state.borrow_mut();
+        st.context = what;
+        st.checkpoint = checkpoint.to_path_buf();
+    }
+
+    /// Runs episodes of evolved stage `index` (`actions` actions, learning on)
+    /// over every rank and returns the results in order.
+    pub fn evaluate(
+        &self,
+        program: &Program,
+        index: usize,
+        actions: u32,
+        jobs: &[(&Genome, u64)],
+    ) -> Vec<Evaluation> {
+        let started = Instant::now();
+        let stage = &program.stages[index];
+        let mut st = self.state.borrow_mut();
+        if self.size == 1 {
+            let out = self.pool.install(|| super::evaluate_local(stage, actions, jobs));
+            st.stats.rounds += 1;
+            st.stats.episodes += jobs.len() as u64;
+            st.stats.wall += started.elapsed();
+            return out;
+        }
+        self.load(&mut st, program);
+        let bounds = wire::batches(jobs.len(), self.size);
+        let count = bounds.len();
+        let base = st.next_batch;
+        st.next_batch += count as u64;
+        let next = AtomicUsize::new(0);
+        let mut results: Vec<Option<Vec<Evaluation>>> = vec![None; count];
+        let mut done = 0;
+        let mut outstanding: HashMap<Rank, (usize, Instant)> = HashMap::new();
+        let mut remote = 0u64;
+        std::thread::scope(|s| {
+            let (tx, rx) = mpsc::channel();
+            let (next, bounds, pool) = (&next, &bounds, &self.pool);
+            s.spawn(move || loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                if k >= count {
+                    break;
+                }
+                let (a, b) = bounds[k];
+                let out = pool.install(|| super::evaluate_local(stage, actions, &jobs[a..b]));
+                if tx.send((k, out)).is_err() {
+                    break;
+                }
+            });
+            let mut local_gone = false;
+            // Hands the next batch (or the program first) to a waiting worker.
+            let give = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
+                let version = st.version;
+                let known = st.workers.get(&rank).map_or(0, |w| w.version);
+                if known != version {
+                    let msg = Reply::Load { version, program: st.program.clone() }.encode();
+                    self.send(st, rank, &msg);
+                    if let Some(w) = st.workers.get_mut(&rank) {
+                        w.version = version;
+                    }
+                    return;
+                }
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                if k < count {
+                    let (a, b) = bounds[k];
+                    let msg =
+                        Reply::encode_work(version, base + k as u64, index as u32, actions, &jobs[a..b]);
+                    self.send(st, rank, &msg);
+                    outstanding.insert(rank, (k, Instant::now()));
+                } else if !st.idle.contains(&rank) {
+                    st.idle.push(rank);
+                }
+            };
+            let waiting = std::mem::take(&mut st.idle);
+            for rank in waiting {
+                give(&mut st, rank, &mut outstanding);
+            }
+            while done < count {
+                let mut busy = false;
+                while let Some((rank, request)) = self.poll(&mut st) {
+                    busy = true;
+                    match request {
+                        Request::Hello { pid, host } => {
+                            st.workers.insert(rank, Worker { pid, host, version: 0 });
+                        }
+                        Request::Ready => {}
+                        Request::Results { batch, evaluations } => {
+                            let Some((k, _)) = outstanding.remove(&rank) else {
+                                self.fatal(&st, format!("rank {rank} sent results it was not asked for"));
+                            };
+                            let (a, b) = bounds[k];
+                            if batch != base + k as u64 || evaluations.len() != b - a {
+                                self.fatal(
+                                    &st,
+                                    format!(
+                                        "rank {rank} answered batch {} with {} results for batch {batch}, {} expected",
+                                        base + k as u64,
+                                        evaluations.len(),
+                                        b - a
+                                    ),
+                                );
+                            }
+                            remote += evaluations.len() as u64;
+                            results[k] = Some(evaluations);
+                            done += 1;
+                        }
+                        Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
+                    }
+                    give(&mut st, rank, &mut outstanding);
+                }
+                loop {
+                    match rx.try_recv() {
+                        Ok((k, out)) => {
+                            results[k] = Some(out);
+                            done += 1;
+                            busy = true;
+                        }
+                        Err(mpsc::TryRecvError::Empty) => break,
+                        Err(mpsc::TryRecvError::Disconnected) => {
+                            local_gone = true;
+                            break;
+                        }
+                    }
+                }
+                if local_gone
+                    && done < count
+                    && outstanding.is_empty()
+                    && next.load(Ordering::SeqCst) >= count
+                {
+                    self.fatal(&st, "an evaluation on rank 0 failed".into());
+                }
+                if let Some((&rank, _)) = outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout) {
+                    let who = self.who(&st, rank);
+                    let msg = format!(
+                        "{who} did not answer within {} s during {}: it died or hangs (`--rank-timeout` sets the limit)",
+                        self.timeout.as_secs(),
+                        st.context
+                    );
+                    self.fatal(&st, msg);
+                }
+                self.check_term(&st, &outstanding);
+                if !busy {
+                    std::thread::sleep(POLL);
+                }
+            }
+        });
+        st.stats.rounds += 1;
+        st.stats.episodes += jobs.len() as u64;
+        st.stats.remote_episodes += remote;
+        st.stats.wall += started.elapsed();
+        results.into_iter().flatten().flatten().collect()
+    }
+
+    /// Makes `program` the one batches refer to (a new version when it changed).
+    fn load(&self, st: &mut State, program: &Program) {
+        let json = serde_json::to_vec(program).unwrap_or_default();
+        if st.version == 0 || json != st.program {
+            st.version += 1;
+            st.program = json;
+        }
+    }
+
+    /// Sends without blocking on a rank that hangs (a large message waits
+    /// for the receiver): gives up after the timeout.
+    fn send(&self, st: &mut State, rank: Rank, msg: &[u8]) {
+        let t = Instant::now();
+        mpi::request::scope(|scope| {
+            let mut request = self.world.process_at_rank(rank).immediate_send_with_tag(scope, msg, TAG_REPLY);
+            loop {
+                match request.test() {
+                    Ok(_) => return,
+                    Err(pending) => request = pending,
+                }
+                self.check_term(st, &HashMap::from([(rank, (0, t))]));
+                if t.elapsed() > self.timeout {
+                    // MPI_Abort ends the process with the request pending.
+                    let msg = format!(
+                        "{} did not take a message within {} s during {}: it died or hangs (`--rank-timeout` sets the limit)",
+                        self.who(st, rank),
+                        self.timeout.as_secs(),
+                        st.context
+                    );
+                    self.fatal(st, msg);
+                }
+                std::thread::sleep(POLL);
+            }
+        });
+        st.stats.in_mpi += t.elapsed();
+        st.stats.messages += 1;
+        st.stats.bytes += msg.len() as u64;
+    }
+
+    /// The next request from any worker, if one is there.
+    fn poll(&self, st: &mut State) -> Option<(Rank, Request)> {
+        let t = Instant::now();
+        let probed = self.world.any_process().immediate_matched_probe_with_tag(TAG_REQUEST)?;
+        let (bytes, status) = probed.matched_receive_vec::<u8>();
+        st.stats.in_mpi += t.elapsed();
+        st.stats.messages += 1;
+        st.stats.bytes += bytes.len() as u64;
+        let rank = status.source_rank();
+        match Request::decode(&bytes) {
+            Ok(r) => Some((rank, r)),
+            Err(e) => self.fatal(st, format!("cannot read a message from rank {rank}: {e}")),
+        }
+    }
+
+    /// Waits until every worker is waiting for a reply and tells it to leave.
+    fn finish(&self) {
+        let mut st = self.state.borrow_mut();
+        let started = Instant::now();
+        loop {
+            while let Some((rank, request)) = self.poll(&mut st) {
+                match request {
+                    Request::Hello { pid, host } => {
+                        st.workers.insert(rank, Worker { pid, host, version: 0 });
+                    }
+                    Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
+                    Request::Ready | Request::Results { .. } => {}
+                }
+                if !st.idle.contains(&rank) {
+                    st.idle.push(rank);
+                }
+            }
+            if st.idle.len() + 1 >= self.size {
+                break;
+            }
+            if started.elapsed() > self.timeout {
+                let missing: Vec<Rank> = (1..self.size as Rank).filter(|r| !st.idle.contains(r)).collect();
+                let msg = format!(
+                    "rank {} did not report within {} s at the end of the run (`--rank-timeout` sets the limit)",
+                    missing.first().copied().unwrap_or(0),
+                    self.timeout.as_secs()
+                );
+                self.fatal(&st, msg);
+            }
+            self.check_term(&st, &HashMap::new());
+            std::thread::sleep(POLL);
+        }
+        let idle = std::mem::take(&mut st.idle);
+        let stop = Reply::Stop.encode();
+        for rank in idle {
+            self.send(&mut st, rank, &stop);
+        }
+    }
+
+    fn report(&self, threads: usize) {
+        let st = self.state.borrow();
+        let s = &st.stats;
+        let rounds = s.rounds.max(1) as f64;
+        eprintln!(
+            "mpi: {} ranks x {threads} threads; {} rounds, {} episodes ({} on other ranks), {:.0} episodes/s; {} messages, {:.2} MB, {:.1} us each; rank 0 spent {:.3} ms per round in sends and receives, {:.1} ms per round in all",
+            self.size,
+            s.rounds,
+            s.episodes,
+            s.remote_episodes,
+            s.episodes as f64 / s.wall.as_secs_f64().max(1e-9),
+            s.messages,
+            s.bytes as f64 / 1e6,
+            s.in_mpi.as_secs_f64() * 1e6 / s.messages.max(1) as f64,
+            s.in_mpi.as_secs_f64() * 1e3 / rounds,
+            s.wall.as_secs_f64() * 1e3 / rounds,
+        );
+    }
+
+    fn who(&self, st: &State, rank: Rank) -> String {
+        match st.workers.get(&rank) {
+            Some(w) => format!("rank {rank} (pid {} on {})", w.pid, w.host),
+            None => format!("rank {rank}"),
+        }
+    }
+
+    /// mpirun sends SIGTERM to the surviving ranks when one dies (or when the
+    /// job is interrupted): say which rank is gone, if it ran on this node.
+    fn check_term(&self, st: &State, outstanding: &HashMap<Rank, (usize, Instant)>) {
+        if !self.term.load(Ordering::SeqCst) {
+            return;
+        }
+        let mut dead: Vec<Rank> = st
+            .workers
+            .iter()
+            .filter(|(_, w)| w.host == self.host && !alive(w.pid))
+            .map(|(&r, _)| r)
+            .collect();
+        dead.sort_unstable();
+        let what = if dead.is_empty() {
+            let mut waiting: Vec<Rank> = outstanding.keys().copied().collect();
+            waiting.sort_unstable();
+            format!(
+                "mpirun ended the run during {} (a rank died on another node, or the job was interrupted; rank 0 was waiting for ranks {waiting:?})",
+                st.context
+            )
+        } else {
+            let names: Vec<String> = dead.iter().map(|&r| self.who(st, r)).collect();
+            format!("{} died during {}, and mpirun ended the run", names.join(", "), st.context)
+        };
+        self.fatal(st, what);
+    }
+
+    fn fatal(&self, st: &State, what: String) -> ! {
+        let resume = if st.checkpoint.as_os_str().is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the checkpoint `{}` is valid: run the same command again (without `--fresh`), with any number of ranks, to resume",
+                st.checkpoint.display()
+            )
+        };
+        eprintln!("\nerror: {what}{resume}");
+        self.world.abort(1)
+    }
+}
+
+/// A process of this node is alive (a zombie is not).
+fn alive(pid: u32) -> bool {
+    match std::fs::read_to_string(format!("/proc/{pid}/stat")) {
+        Ok(stat) => stat.rsplit_once(')').is_none_or(|(_, rest)| !rest.trim_start().starts_with('Z')),
+        Err(_) => false,
+    }
+}
+
+/// A worker rank: evaluates the batches rank 0 sends until told to stop.
+fn serve(world: &SimpleCommunicator, pool: &rayon::ThreadPool) -> Result<(), CliError> {
+    let root = world.process_at_rank(0);
+    let send = |r: Request| root.send_with_tag(&r.encode()[..], TAG_REQUEST);
+    let receive = || loop {
+        if let Some(probed) = root.immediate_matched_probe_with_tag(TAG_REPLY) {
+            return probed.matched_receive_vec::<u8>().0;
+        }
+        std::thread::sleep(POLL);
+    };
+    // After a failure rank 0 ends the job; wait for it.
+    let fail = |message: String| -> ! {
+        send(Request::Failed { message });
+        loop {
+            std::thread::sleep(Duration::from_secs(1));
+        }
+    };
+    let host = mpi::environment::processor_name().unwrap_or_default();
+    send(Request::Hello { pid: std::process::id(), host });
+    let mut program: Option<(u32, Program)> = None;
+    loop {
+        match Reply::decode(&receive()) {
+            Err(e) => fail(format!("cannot read a message from rank 0: {e}")),
+            Ok(Reply::Stop) => return Ok(()),
+            Ok(Reply::Load { version, program: json }) => match serde_json::from_slice::<Program>(&json) {
+                Ok(p) => {
+                    program = Some((version, p));
+                    send(Request::Ready);
+                }
+                Err(e) => fail(format!("cannot read the program rank 0 sent: {e}")),
+            },
+            Ok(Reply::Work { version, batch, stage, actions, jobs }) => {
+                let Some((loaded, p)) = &program else { fail("work came before the program".into()) };
+                if *loaded != version {
+                    fail(format!("work for program version {version}, version {loaded} is loaded"));
+                }
+                let Some(st) = p.stages.get(stage as usize) else {
+                    fail(format!("work for stage {stage}, the program has {}", p.stages.len()))
+                };
+                let refs: Vec<(&Genome, u64)> = jobs.iter().map(|(seed, g)| (g, *seed)).collect();
+                let evaluations = pool.install(|| super::evaluate_local(st, actions, &refs));
+                send(Request::Results { batch, evaluations });
+            }
+        }
+    }
+}

@@ -1,0 +1,207 @@
+//! `mpirun -n N shaping run` against a single process (built with `--features
+//! mpi`, with Open MPI's `mpirun` on the path): the same files byte for byte,
+//! and a rank that dies or hangs ends the run with a message from rank 0 and
+//! a checkpoint that any number of ranks resumes to the same result.
+#![cfg(feature = "mpi")]
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("shaping-mpi-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn single() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_shaping"))
+}
+
+/// `mpirun -n N shaping`; CI runs as root, which Open MPI refuses unless told.
+fn mpirun(n: usize) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args(["-n", &n.to_string(), "--oversubscribe"])
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .arg(env!("CARGO_BIN_EXE_shaping"));
+    c
+}
+
+fn ok(cmd: &mut Command) -> Output {
+    let out = cmd.output().expect("the command starts");
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Every file the comparison covers, relative to `dir`, sorted.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let name = p.file_name().unwrap().to_string_lossy().into_owned();
+                if ["generations.csv", "best.genome", "checkpoint.json", "summary.md", "summary.json"]
+                    .contains(&name.as_str())
+                {
+                    out.push(p.strip_prefix(dir).unwrap().to_path_buf());
+                }
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+fn assert_same_files(a: &Path, b: &Path) {
+    let (fa, fb) = (files(a), files(b));
+    assert!(fa.len() >= 4, "too few files in {}: {fa:?}", a.display());
+    assert_eq!(fa, fb, "{} and {} hold different files", a.display(), b.display());
+    for f in &fa {
+        let (x, y) = (std::fs::read(a.join(f)).unwrap(), std::fs::read(b.join(f)).unwrap());
+        assert!(x == y, "{} differs between {} and {}", f.display(), a.display(), b.display());
+    }
+}
+
+#[test]
+fn any_number_of_ranks_writes_the_single_process_files() {
+    let dir = scratch("ranks");
+    let tiny = root().join("tests/cli/tiny.bat");
+    let one = dir.join("one");
+    ok(single().arg("run").arg(&tiny).arg("--out").arg(&one).arg("--quiet"));
+    for n in [1, 2, 3, 5] {
+        let out = dir.join(format!("n{n}"));
+        let done = ok(mpirun(n).arg("run").arg(&tiny).arg("--out").arg(&out));
+        let err = String::from_utf8_lossy(&done.stderr);
+        assert!(err.contains(&format!("mpi: {n} ranks")), "no MPI summary from rank 0:\n{err}");
+        assert_same_files(&one, &out);
+    }
+}
+
+#[test]
+fn experiment_on_three_ranks_matches_one_process() {
+    let dir = scratch("experiment");
+    let tiny = root().join("tests/cli/tiny.bat");
+    let args = |out: &Path| {
+        vec![
+            "experiment".into(),
+            tiny.clone().into_os_string(),
+            "--seeds".into(),
+            "2".into(),
+            "--out".into(),
+            out.into(),
+        ]
+    };
+    let one = dir.join("one");
+    ok(single().args(args(&one)));
+    let three = dir.join("three");
+    ok(mpirun(3).args(args(&three)));
+    assert!(three.join("summary.md").exists() && three.join("seed-2/second/best.genome").exists());
+    assert_same_files(&one, &three);
+}
+
+/// The pid of rank `rank` among the children of `mpirun`.
+fn rank_pid(mpirun: u32, rank: usize) -> Option<u32> {
+    let want = format!("OMPI_COMM_WORLD_RANK={rank}");
+    for e in std::fs::read_dir("/proc").ok()? {
+        let Ok(pid) = e.ok()?.file_name().to_string_lossy().parse::<u32>() else { continue };
+        let Ok(stat) = std::fs::read_to_string(format!("/proc/{pid}/stat")) else { continue };
+        let ppid = stat.rsplit_once(')').and_then(|(_, r)| r.split_whitespace().nth(1)?.parse::<u32>().ok());
+        if ppid != Some(mpirun) {
+            continue;
+        }
+        let env = std::fs::read(format!("/proc/{pid}/environ")).unwrap_or_default();
+        if env.split(|&b| b == 0).any(|v| v == want.as_bytes()) {
+            return Some(pid);
+        }
+    }
+    None
+}
+
+/// Starts `mpirun -n 3` on the long run, waits for `generations` JSON lines,
+/// sends `signal` to rank `rank` and returns rank 0's stderr and the exit status.
+fn disturb(out: &Path, rank: usize, signal: &str, generations: usize) -> (String, u32, bool) {
+    let long = root().join("tests/mpi/long.bat");
+    let mut child: Child = mpirun(3)
+        .arg("run")
+        .arg(&long)
+        .arg("--out")
+        .arg(out)
+        .args(["--json", "--rank-timeout", "3"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    for _ in 0..generations {
+        lines.next().expect("a generation line").unwrap();
+    }
+    let pid = rank_pid(child.id(), rank).expect("the rank's process");
+    assert!(Command::new("kill").args([signal, &pid.to_string()]).status().unwrap().success());
+    let started = Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if started.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("mpirun still runs 60 s after rank {rank} got {signal}");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    for _ in lines {}
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+    (err, pid, status.success())
+}
+
+fn straight(dir: &Path) -> PathBuf {
+    let one = dir.join("one");
+    ok(single().arg("run").arg(root().join("tests/mpi/long.bat")).arg("--out").arg(&one).arg("--quiet"));
+    one
+}
+
+#[test]
+fn a_dead_rank_is_named_and_the_checkpoint_resumes_on_other_ranks() {
+    let dir = scratch("dead");
+    let out = dir.join("mpi");
+    let (err, pid, success) = disturb(&out, 2, "-KILL", 3);
+    assert!(!success, "the run succeeded with a dead rank:\n{err}");
+    assert!(err.contains(&format!("error: rank 2 (pid {pid} on ")), "rank 0 did not name the rank:\n{err}");
+    assert!(err.contains("died during generation"), "no generation in the message:\n{err}");
+    assert!(err.contains("checkpoint.json` is valid"), "no word on the checkpoint:\n{err}");
+    ok(mpirun(2).arg("run").arg(root().join("tests/mpi/long.bat")).arg("--out").arg(&out).arg("--quiet"));
+    assert_same_files(&straight(&dir), &out);
+}
+
+#[test]
+fn a_hung_rank_times_out_and_the_checkpoint_resumes_on_one_process() {
+    let dir = scratch("hung");
+    let out = dir.join("mpi");
+    let (err, pid, success) = disturb(&out, 1, "-STOP", 2);
+    assert!(!success, "the run succeeded with a stopped rank:\n{err}");
+    assert!(err.contains(&format!("error: rank 1 (pid {pid} on ")), "rank 0 did not name the rank:\n{err}");
+    assert!(err.contains("within 3 s during "), "no timeout in the message:\n{err}");
+    assert!(
+        err.contains("generation") || err.contains("the best of stage"),
+        "no generation in the message:\n{err}"
+    );
+    let _ = Command::new("kill").args(["-KILL", &pid.to_string()]).status();
+    ok(single().arg("run").arg(root().join("tests/mpi/long.bat")).arg("--out").arg(&out).arg("--quiet"));
+    assert_same_files(&straight(&dir), &out);
+}
