@@ -5,7 +5,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
-use shaping_runtime::program::{Program, FORMAT_VERSION};
+use shaping_runtime::limits;
+use shaping_runtime::program::{Program, StageRun, FORMAT_VERSION};
 
 use crate::diag::{self, ErrorFormat};
 
@@ -108,7 +109,14 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliErro
             return Err(CliError::Diagnostics(diag::render(&report, format)));
         }
     };
-    shaping_compiler::compile(&source, &name).map_err(|d| CliError::Diagnostics(diag::render(&d, format)))
+    let program = shaping_compiler::compile(&source, &name)
+        .map_err(|d| CliError::Diagnostics(diag::render(&d, format)))?;
+    // The compiler's output always validates (a property test checks it);
+    // validating here too makes every command run only validated programs.
+    program.validate().map_err(|e| {
+        CliError::io(format!("error: internal error: `{name}` compiled to an invalid program: {e}"))
+    })?;
+    Ok(program)
 }
 
 /// Loads a `Program` written by `shaping build`.
@@ -128,6 +136,58 @@ pub fn load_built(path: &Path) -> Result<Program, CliError> {
         return Err(CliError::io(format!("error: `{}` is not a valid program: {e}", path.display())));
     }
     Ok(program)
+}
+
+/// The memory a run of `stages` of `program` needs at its peak (its largest
+/// stage: see `shaping_runtime::limits`), in bytes.
+pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
+    stages
+        .iter()
+        .map(|&i| {
+            let s = &program.stages[i];
+            match &s.run {
+                StageRun::Evolve(e) => limits::population_bytes(e.population.into(), s.layout.bits.into()),
+                StageRun::Test { actions, .. } => {
+                    limits::trace_bytes((*actions).into(), s.modules.len() as u64)
+                }
+            }
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// The memory this machine has available (Linux: `MemAvailable` of
+/// `/proc/meminfo`), or `None` where it cannot be read.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses, before anything starts, a run of `stages` that would need more
+/// memory than the machine has available, with the estimate. `copies` runs
+/// are held at once (an experiment's seeds run one after another: 1).
+pub fn check_memory(program: &Program, stages: &[usize], copies: u64) -> Result<(), CliError> {
+    let need = memory_estimate(program, stages).saturating_mul(copies.max(1));
+    match available_memory() {
+        Some(have) if need > have => {
+            let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+            let biggest = stages
+                .iter()
+                .copied()
+                .max_by_key(|&i| memory_estimate(program, &[i]))
+                .map(|i| program.stages[i].name.clone())
+                .unwrap_or_default();
+            Err(CliError::io(format!(
+                "error: this run needs about {:.1} GiB of memory (stage `{biggest}`), but only {:.1} GiB are available; \
+                 reduce the population, the genome or the number of actions",
+                gib(need),
+                gib(have)
+            )))
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Resolves `--stage NAME` to a stage index; without a name, the last stage.

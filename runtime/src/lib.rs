@@ -6,7 +6,8 @@
 //! - [`genome`]: bit-string genomes and decoding;
 //! - [`sim`]: the simulated Khepera world;
 //! - [`controller`]: modules, winner-take-all, behaviors, CRBP, episodes;
-//! - [`evolve`]: the incremental GA over stages, with checkpoints as data.
+//! - [`evolve`]: the incremental GA over stages, with checkpoints as data;
+//! - [`validate`]: the one validation of a `Program`, with the [`limits`].
 //!
 //! This crate never depends on the compiler and does no file I/O.
 
@@ -15,6 +16,8 @@ pub mod controller;
 pub mod evolve;
 pub mod expr;
 pub mod genome;
+pub mod limits;
 pub mod program;
 pub mod sim;
 pub mod testkit;
+pub mod validate;
