@@ -22,6 +22,7 @@ use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use rand::{Rng, SeedableRng};
@@ -243,8 +244,12 @@ fn mutate_tree(rng: &mut ChaCha8Rng, v: &mut Value) {
     };
 }
 
+/// Inputs accepted (compiled, or loaded and validated) and run.
+static ACCEPTED: AtomicU64 = AtomicU64::new(0);
+
 /// Runs a short episode of every stage of an accepted program.
 fn run_all(p: &Program) {
+    ACCEPTED.fetch_add(1, Ordering::Relaxed);
     for s in &p.stages {
         let g = Genome::zeros(s.layout.bits as usize);
         let opts = EpisodeOptions { actions: EPISODE_ACTIONS, learning: true, seed: 1 };
@@ -350,6 +355,7 @@ fn main() {
         let run: Target = if *target == "text" { text_target } else { json_target };
         let start = Instant::now();
         let mut execs = 0u64;
+        ACCEPTED.store(0, Ordering::Relaxed);
         while start.elapsed() < budget {
             let input = if *target == "json" && rng.random_range(0..3) > 0 {
                 let mut v = programs[rng.random_range(0..programs.len())].clone();
@@ -379,8 +385,9 @@ fn main() {
             }
         }
         println!(
-            "{target}: {execs} inputs in {:.1} s, corpus {} files",
+            "{target}: {execs} inputs in {:.1} s, {} accepted and run, corpus {} files",
             start.elapsed().as_secs_f64(),
+            ACCEPTED.load(Ordering::Relaxed),
             corpus.len()
         );
     }

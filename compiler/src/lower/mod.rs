@@ -288,11 +288,12 @@ impl<'a> Lower<'a> {
                 return None;
             }
         };
-        if !(q.value > 0.0 && q.value.is_finite()) {
+        let mm = q.value * factor;
+        // Checked as the runtime will hold it: `1e-46` is 0 in f32.
+        if !(q.value.is_finite() && mm as f32 > 0.0) {
             self.value_error(q.span, format!("{what} must be positive"), "not positive", None);
             return None;
         }
-        let mm = q.value * factor;
         if mm > MAX_LENGTH_MM as f64 {
             self.value_error(
                 q.span,

@@ -482,7 +482,8 @@ impl Lower<'_> {
             }
             Some(ast::OutputsDecl::Linear { scale, span }) => {
                 let scale = scale.unwrap_or(1.0);
-                if !(scale > 0.0 && scale <= 1.0) {
+                // Checked as the runtime will hold it: `1e-46` is 0 in f32.
+                if !(scale as f32 > 0.0 && scale <= 1.0) {
                     self.value_error(
                         *span,
                         format!("the scale is between 0 and 1, not {scale}"),
