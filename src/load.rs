@@ -169,8 +169,17 @@ fn available_memory() -> Option<u64> {
 /// memory than the machine has available, with the estimate. `copies` runs
 /// are held at once (an experiment's seeds run one after another: 1).
 pub fn check_memory(program: &Program, stages: &[usize], copies: u64) -> Result<(), CliError> {
+    check_memory_within(program, stages, copies, available_memory())
+}
+
+fn check_memory_within(
+    program: &Program,
+    stages: &[usize],
+    copies: u64,
+    available: Option<u64>,
+) -> Result<(), CliError> {
     let need = memory_estimate(program, stages).saturating_mul(copies.max(1));
-    match available_memory() {
+    match available {
         Some(have) if need > have => {
             let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
             let biggest = stages
@@ -223,4 +232,32 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), CliError> {
 pub fn create_dir(path: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(path)
         .map_err(|e| CliError::io(format!("error: cannot create directory `{}`: {e}", path.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn program(population: u32, bits: u32) -> Program {
+        let mut stage = shaping_runtime::testkit::navigation();
+        if let StageRun::Evolve(e) = &mut stage.run {
+            e.population = population;
+        }
+        stage.layout.bits = bits;
+        Program { format: FORMAT_VERSION, name: "p".into(), stages: vec![stage] }
+    }
+
+    #[test]
+    fn a_run_larger_than_the_available_memory_is_refused_with_the_estimate() {
+        let p = program(100_000, 5_000);
+        let need = memory_estimate(&p, &[0]);
+        assert_eq!(need, 100_000 * 5_000 * (2 + limits::CHECKPOINT_BYTES_PER_BIT));
+        assert!(check_memory_within(&p, &[0], 1, Some(need)).is_ok());
+        assert!(check_memory_within(&p, &[0], 1, None).is_ok(), "unknown memory: no refusal");
+        let err = check_memory_within(&p, &[0], 1, Some(4 << 30)).unwrap_err().to_string();
+        assert!(
+            err.contains("needs about 6.5 GiB of memory (stage `navigation`), but only 4.0 GiB"),
+            "{err}"
+        );
+    }
 }

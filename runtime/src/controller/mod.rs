@@ -59,8 +59,9 @@
 //!
 //! [`run_episode`] (the contract used by the GA and the CLI) builds a
 //! [`Controller`] and a [`Sim`] from the episode seed ([`episode_rngs`]) and
-//! runs them. [`validate`] checks a stage once; [`try_run_episode`] reports
-//! what [`run_episode`] would silently score 0. [`Controller::act`] runs one
+//! runs them on a stage that passed [`crate::validate`] (the controller
+//! trusts it). [`validate`] checks a stage of unknown origin and a genome;
+//! [`try_run_episode`] validates first and reports what is wrong. [`Controller::act`] runs one
 //! action on anything implementing [`Robot`] (the simulator, or a test's
 //! hand-driven robot).
 //!
