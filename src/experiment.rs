@@ -78,7 +78,13 @@ pub fn experiment(
     }
     let out = args.out.clone().unwrap_or_else(|| run::default_out(&args.file).join("experiment"));
     load::create_dir(&out)?;
-    let seeds: Vec<u64> = (args.first_seed..args.first_seed + args.seeds).collect();
+    let end = args.first_seed.checked_add(args.seeds).ok_or_else(|| {
+        CliError::io(format!(
+            "error: `--first-seed {}` plus `--seeds {}` is past the largest seed",
+            args.first_seed, args.seeds
+        ))
+    })?;
+    let seeds: Vec<u64> = (args.first_seed..end).collect();
     for (i, &seed) in seeds.iter().enumerate() {
         eprintln!("seed {seed} ({}/{})", i + 1, seeds.len());
         run::run(

@@ -5,7 +5,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use miette::{Diagnostic, NamedSource, SourceSpan};
-use shaping_runtime::program::{Program, FORMAT_VERSION};
+use shaping_runtime::limits;
+use shaping_runtime::program::{Program, StageRun, FORMAT_VERSION};
 
 use crate::diag::{self, ErrorFormat};
 
@@ -90,7 +91,14 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliErro
     }
     let source = read_source(path, format)?;
     let name = path.display().to_string();
-    shaping_compiler::compile(&source, &name).map_err(|d| CliError::Diagnostics(diag::render(&d, format)))
+    let program = shaping_compiler::compile(&source, &name)
+        .map_err(|d| CliError::Diagnostics(diag::render(&d, format)))?;
+    // The compiler's output always validates (a property test checks it);
+    // validating here too makes every command run only validated programs.
+    program.validate().map_err(|e| {
+        CliError::io(format!("error: internal error: `{name}` compiled to an invalid program: {e}"))
+    })?;
+    Ok(program)
 }
 
 /// Reads a `.bat` source; a file that is not UTF-8 is a diagnostic that
@@ -137,6 +145,67 @@ pub fn load_built(path: &Path) -> Result<Program, CliError> {
     Ok(program)
 }
 
+/// The memory a run of `stages` of `program` needs at its peak (its largest
+/// stage: see `shaping_runtime::limits`), in bytes.
+pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
+    stages
+        .iter()
+        .map(|&i| {
+            let s = &program.stages[i];
+            match &s.run {
+                StageRun::Evolve(e) => limits::population_bytes(e.population.into(), s.layout.bits.into()),
+                StageRun::Test { actions, .. } | StageRun::Train { actions } => {
+                    limits::trace_bytes((*actions).into(), s.modules.len() as u64)
+                }
+            }
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+/// The memory this machine has available (Linux: `MemAvailable` of
+/// `/proc/meminfo`), or `None` where it cannot be read.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses, before anything starts, a run of `stages` that would need more
+/// memory than the machine has available, with the estimate. `copies` runs
+/// are held at once (an experiment's seeds run one after another: 1).
+pub fn check_memory(program: &Program, stages: &[usize], copies: u64) -> Result<(), CliError> {
+    check_memory_within(program, stages, copies, available_memory())
+}
+
+fn check_memory_within(
+    program: &Program,
+    stages: &[usize],
+    copies: u64,
+    available: Option<u64>,
+) -> Result<(), CliError> {
+    let need = memory_estimate(program, stages).saturating_mul(copies.max(1));
+    match available {
+        Some(have) if need > have => {
+            let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+            let biggest = stages
+                .iter()
+                .copied()
+                .max_by_key(|&i| memory_estimate(program, &[i]))
+                .map(|i| program.stages[i].name.clone())
+                .unwrap_or_default();
+            Err(CliError::io(format!(
+                "error: this run needs about {:.1} GiB of memory (stage `{biggest}`), but only {:.1} GiB are available; \
+                 reduce the population, the genome or the number of actions",
+                gib(need),
+                gib(have)
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Resolves `--stage NAME` to a stage index; without a name, the last stage.
 pub fn stage_index(program: &Program, stage: Option<&str>) -> Result<usize, CliError> {
     match stage {
@@ -170,4 +239,32 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), CliError> {
 pub fn create_dir(path: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(path)
         .map_err(|e| CliError::io(format!("error: cannot create directory `{}`: {e}", path.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn program(population: u32, bits: u32) -> Program {
+        let mut stage = shaping_runtime::testkit::navigation();
+        if let StageRun::Evolve(e) = &mut stage.run {
+            e.population = population;
+        }
+        stage.layout.bits = bits;
+        Program { format: FORMAT_VERSION, name: "p".into(), stages: vec![stage] }
+    }
+
+    #[test]
+    fn a_run_larger_than_the_available_memory_is_refused_with_the_estimate() {
+        let p = program(100_000, 5_000);
+        let need = memory_estimate(&p, &[0]);
+        assert_eq!(need, 100_000 * 5_000 * (2 + limits::CHECKPOINT_BYTES_PER_BIT));
+        assert!(check_memory_within(&p, &[0], 1, Some(need)).is_ok());
+        assert!(check_memory_within(&p, &[0], 1, None).is_ok(), "unknown memory: no refusal");
+        let err = check_memory_within(&p, &[0], 1, Some(4 << 30)).unwrap_err().to_string();
+        assert!(
+            err.contains("needs about 6.5 GiB of memory (stage `navigation`), but only 4.0 GiB"),
+            "{err}"
+        );
+    }
 }

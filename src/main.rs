@@ -23,6 +23,11 @@ use clap::{Parser, Subcommand, ValueEnum};
 use diag::ErrorFormat;
 use load::CliError;
 
+/// Most worker threads `--jobs` accepts.
+const MAX_JOBS: u64 = 1024;
+/// Most seeds an experiment runs.
+const MAX_SEEDS: u64 = 10_000;
+
 /// Declarative behavior architectures for autonomous robots, evolved and
 /// trained incrementally (Urzelai, Floreano, Dorigo, Colombetti 1998).
 #[derive(Parser)]
@@ -97,7 +102,7 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Worker threads (default: one per core). Results do not depend on it.
-        #[arg(long)]
+        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=MAX_JOBS))]
         jobs: Option<usize>,
         /// No progress bar and no summary.
         #[arg(long)]
@@ -211,7 +216,7 @@ enum Command {
         #[arg(long)]
         run: Option<PathBuf>,
         /// Actions to run (default: the stage's life length).
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(shaping_runtime::limits::MAX_ACTIONS)))]
         actions: Option<u32>,
         /// Output directory (default: `<run>/<stage>/replay`).
         #[arg(long)]
@@ -233,7 +238,7 @@ enum Command {
     Experiment {
         file: PathBuf,
         /// Number of seeds.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(1..=MAX_SEEDS))]
         seeds: u64,
         /// First seed; the seeds are consecutive.
         #[arg(long, default_value_t = 1)]
@@ -241,7 +246,7 @@ enum Command {
         /// Output directory (default: `runs/<file stem>/experiment`).
         #[arg(long)]
         out: Option<PathBuf>,
-        #[arg(long)]
+        #[arg(long, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=MAX_JOBS))]
         jobs: Option<usize>,
         /// `STAGE=FITNESS`: report the generation at which the best reaches it.
         #[arg(long)]
@@ -275,7 +280,7 @@ enum Command {
         #[arg(long)]
         stage: Option<String>,
         /// Timed runs; the median is reported.
-        #[arg(long, default_value_t = 5)]
+        #[arg(long, default_value_t = 5, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
         runs: usize,
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
@@ -528,7 +533,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
                 if format != ErrorFormat::Json {
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();
-                    eprintln!("{}: ok ({})", file.display(), genes.join(", "));
+                    println!("{}: ok ({})", file.display(), genes.join(", "));
                 }
             }
             Err(e) => {

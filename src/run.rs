@@ -120,6 +120,7 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
     }
     let stages =
         if args.stage.is_some() { chain(&program, target) } else { (0..program.stages.len()).collect() };
+    load::check_memory(&program, &stages, 1)?;
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.file));
     let seed = run_seed(&program, args.seed);
     let pool = rayon::ThreadPoolBuilder::new()

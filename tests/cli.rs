@@ -16,12 +16,31 @@ fn tiny() -> PathBuf {
     root().join("tests/cli/tiny.bat")
 }
 
-/// A fresh, empty scratch directory for one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("shaping-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh, empty scratch directory for one test, removed when dropped
+/// (also when the test fails).
+struct Scratch(tempfile::TempDir);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.path().as_os_str()
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        self.0.path()
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
+    Scratch(tempfile::Builder::new().prefix(&format!("shaping-cli-{name}-")).tempdir().unwrap())
 }
 
 fn run(cmd: &mut Command) -> Output {
@@ -46,7 +65,9 @@ fn check_accepts_every_example() {
     assert!(examples.len() >= 3);
     let out = run(shaping().arg("check").args(&examples));
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stderr).contains("khepera.bat: ok"));
+    // The ok lines go to stdout, diagnostics to stderr.
+    assert!(text(&out.stdout).contains("khepera.bat: ok"), "{}", text(&out.stdout));
+    assert!(!text(&out.stderr).contains(": ok"), "{}", text(&out.stderr));
 }
 
 #[test]
@@ -149,6 +170,60 @@ fn build_then_run_the_built_program() {
     let out = run(shaping().arg("run").arg(&program).arg("--out").arg(dir.join("run2")));
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("tiny.json"));
+}
+
+/// A built program edited into nonsense is refused before anything runs,
+/// naming the stage and the field; nothing is written.
+#[test]
+fn an_edited_program_is_refused_naming_the_stage_and_field() {
+    let dir = scratch("edited");
+    let program = dir.join("tiny.json");
+    let out = run(shaping().arg("build").arg(tiny()).arg("-o").arg(&program));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let good: serde_json::Value = serde_json::from_slice(&std::fs::read(&program).unwrap()).unwrap();
+    let cases: [(&str, serde_json::Value, &str); 4] = [
+        (
+            "/stages/0/world/arena",
+            serde_json::json!([1e30, -5]),
+            "`world.arena[0]`: 1000000000000000000000000000000 mm",
+        ),
+        ("/stages/0/world/body/radius", serde_json::json!(-3), "`world.body.radius`: -3 mm is not a length"),
+        (
+            "/stages/0/run/Evolve/population",
+            serde_json::json!(4_000_000_000u64),
+            "`run.evolve.population`: 4000000000 is not between 1 and 100000",
+        ),
+        (
+            "/stages/0/run/Evolve/mutation",
+            serde_json::json!(1.5),
+            "`run.evolve.mutation`: 1.5 is not between 0 and 1",
+        ),
+    ];
+    for (pointer, value, message) in cases {
+        let mut edited = good.clone();
+        *edited.pointer_mut(pointer).unwrap_or_else(|| panic!("{pointer}")) = value;
+        std::fs::write(&program, serde_json::to_vec(&edited).unwrap()).unwrap();
+        let out_dir = dir.join("run");
+        let out = run(shaping().arg("run").arg(&program).arg("--out").arg(&out_dir));
+        assert_eq!(out.status.code(), Some(2), "{pointer}: {}", text(&out.stderr));
+        let err = text(&out.stderr);
+        assert!(err.contains("stage `first`") && err.contains(message), "{pointer}: {err}");
+        assert!(!out_dir.exists(), "{pointer}: nothing is written");
+    }
+}
+
+/// A population too large for the machine is a diagnostic on the number.
+#[test]
+fn a_population_beyond_the_limit_is_a_diagnostic() {
+    let dir = scratch("limit");
+    let src = std::fs::read_to_string(tiny()).unwrap();
+    let big = dir.join("big.bat");
+    let replaced = src.replacen("population 12", "population 4000000000", 1);
+    assert_ne!(replaced, src, "tiny.bat sets a population");
+    std::fs::write(&big, replaced).unwrap();
+    let out = run(shaping().arg("check").arg(&big).arg("--error-format").arg("plain"));
+    assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("`population` must be at most 100000"), "{}", text(&out.stderr));
 }
 
 #[test]
@@ -408,7 +483,8 @@ fn run_writes_a_report_of_every_stage_and_report_reads_any_directory() {
     let out = run(shaping().arg("report").arg(dir.join("navigation").join("nothing")));
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("is not a directory"), "{}", text(&out.stderr));
-    let out = run(shaping().arg("report").arg(scratch("report-empty")));
+    let empty = scratch("report-empty");
+    let out = run(shaping().arg("report").arg(&*empty));
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("no `program.json`"), "{}", text(&out.stderr));
     // A damaged episode is named.

@@ -9,6 +9,7 @@
 //! - [`evolve`]: the incremental GA over stages, with checkpoints as data;
 //! - [`robot`]: the Khepera serial protocol, a serial robot with a host-side
 //!   virtual world, and an emulated robot.
+//! - [`validate`]: the one validation of a `Program`, with the [`limits`].
 //!
 //! This crate never depends on the compiler and does no file I/O.
 
@@ -17,7 +18,9 @@ pub mod controller;
 pub mod evolve;
 pub mod expr;
 pub mod genome;
+pub mod limits;
 pub mod program;
 pub mod robot;
 pub mod sim;
 pub mod testkit;
+pub mod validate;

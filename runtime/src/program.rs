@@ -470,100 +470,10 @@ impl Program {
 }
 
 impl Program {
-    /// Checks the internal consistency a `Program` loaded from outside the
-    /// compiler must have before the runtime may index with it: gene, channel,
-    /// module and stage references in range, network shapes matching their
-    /// parameter counts, expressions well formed, layouts contiguous.
-    pub fn validate(&self) -> Result<(), String> {
-        use crate::catalog::CHANNELS;
-        for (si, stage) in self.stages.iter().enumerate() {
-            let at = |what: String| format!("stage `{}`: {what}", stage.name);
-            if let Some(p) = stage.parent {
-                if p >= si {
-                    return Err(at(format!("extends stage {p}, which does not come before it")));
-                }
-            }
-            let genes = stage.layout.genes.len();
-            let mut offset = 0u32;
-            for (gi, g) in stage.layout.genes.iter().enumerate() {
-                if g.offset != offset || g.bits == 0 || g.bits > 16 {
-                    return Err(at(format!("gene {gi} is not laid out contiguously or has {} bits", g.bits)));
-                }
-                if (g.module as usize) >= stage.modules.len() {
-                    return Err(at(format!(
-                        "gene {gi} belongs to module {}, which does not exist",
-                        g.module
-                    )));
-                }
-                offset += g.bits as u32;
-            }
-            if offset != stage.layout.bits {
-                return Err(at(format!("the layout has {offset} bits but declares {}", stage.layout.bits)));
-            }
-            let param_ok = |p: &Param| match *p {
-                Param::Gene(i) => (i as usize) < genes,
-                Param::Fixed(v) => v.is_finite(),
-                Param::Random { lo, hi } => lo.is_finite() && hi.is_finite() && lo <= hi,
-                Param::Trained { stage: t, .. } => {
-                    (t as usize) < si && matches!(self.stages[t as usize].run, StageRun::Train { .. })
-                }
-            };
-            let net_ok = |n: &Network, inputs: usize| {
-                n.inputs as usize == inputs
-                    && n.outputs > 0
-                    && n.params.len() == Network::param_count(inputs, n.hidden as usize, n.outputs as usize)
-                    && n.params.iter().all(param_ok)
-            };
-            let chans_ok = |c: &[u16]| c.iter().all(|&c| (c as usize) < CHANNELS);
-            for m in &stage.modules {
-                let at = |what: &str| at(format!("module `{}`: {what}", m.name));
-                if !chans_ok(&m.inputs) || m.activation.outputs != 1 || !net_ok(&m.activation, m.inputs.len())
-                {
-                    return Err(at("malformed activation network"));
-                }
-                match &m.behavior {
-                    Behavior::Neural(nb) => {
-                        let table_ok = match &nb.decode {
-                            Decode::Table(t) => t.len() == 1usize << nb.net.outputs.min(16),
-                            Decode::Linear { .. } => nb.net.outputs == 2,
-                        };
-                        if !chans_ok(&nb.inputs) || !net_ok(&nb.net, nb.inputs.len()) || !table_ok {
-                            return Err(at("malformed neural behavior"));
-                        }
-                    }
-                    Behavior::Script(s) => {
-                        for step in &s.steps {
-                            let expr_ok = match &step.action {
-                                Action::Reinforce(e) => e.is_valid(),
-                                Action::Toward { channels, .. } => chans_ok(channels),
-                                _ => true,
-                            } && match &step.end {
-                                StepEnd::Until { cond, .. } => cond.is_valid(),
-                                StepEnd::Actions(_) => true,
-                            } && step.when.as_ref().is_none_or(Expr::is_valid);
-                            if !expr_ok {
-                                return Err(at("malformed script step"));
-                            }
-                        }
-                    }
-                }
-                if m.reinforce.as_ref().is_some_and(|e| !e.is_valid()) {
-                    return Err(at("malformed reinforcement program"));
-                }
-            }
-            for l in &stage.links {
-                if (l.from as usize) >= stage.modules.len()
-                    || (l.to as usize) >= stage.modules.len()
-                    || !param_ok(&l.weight)
-                {
-                    return Err(at(format!("malformed link {} -> {}", l.from, l.to)));
-                }
-            }
-            if stage.fitness.per_action.as_ref().is_some_and(|e| !e.is_valid()) {
-                return Err(at("malformed fitness expression".into()));
-            }
-        }
-        Ok(())
+    /// The one validation of a program (see [`crate::validate`]): what the
+    /// runtime needs before it may index and compute with it.
+    pub fn validate(&self) -> Result<(), crate::validate::Invalid> {
+        crate::validate::program(self)
     }
 }
 

@@ -531,10 +531,13 @@ fn invalid_stages_are_errors_not_panics() {
     let mut bad = s.clone();
     bad.modules[0].inputs[0] = 99;
     let g = Genome::zeros(s.layout.bits as usize);
-    assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadModule { .. })));
+    let e = try_run_episode(&bad, &g, &opts, None).unwrap_err();
+    assert!(matches!(e, ControllerError::Invalid(_)), "{e}");
+    assert!(e.to_string().contains("`modules[0].inputs[0]`: channel 99 does not exist"), "{e}");
     let mut bad = s.clone();
     bad.links[0].to = 42;
-    assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadLink { .. })));
+    let e = try_run_episode(&bad, &g, &opts, None).unwrap_err();
+    assert!(e.to_string().contains("`links[0].to`: module 42 does not exist"), "{e}");
 
     // A script step's `if` condition reading a channel that does not exist,
     // as a hand-edited program.json could hold.
@@ -543,11 +546,11 @@ fn invalid_stages_are_errors_not_panics() {
     let m = bad.modules.iter().position(|m| matches!(m.behavior, Behavior::Script(_))).unwrap();
     let Behavior::Script(script) = &mut bad.modules[m].behavior else { unreachable!() };
     script.steps[0].when = Some(Expr { ops: vec![Op::Chan(99)], depth: 1 });
-    assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::BadModule { .. })));
+    assert!(matches!(try_run_episode(&bad, &g, &opts, None), Err(ControllerError::Invalid(_))));
     let program =
         Program { format: FORMAT_VERSION, name: "bad".into(), stages: vec![testkit::navigation(), bad] };
-    let e = program.validate().unwrap_err();
-    assert!(e.contains("malformed script step"), "{e}");
+    let e = program.validate().unwrap_err().to_string();
+    assert!(e.contains(&format!("`modules[{m}].behavior.steps[0].when.ops[0]`: channel 99")), "{e}");
 }
 
 #[test]
@@ -652,8 +655,9 @@ fn decode_tables_must_have_a_row_per_bit_pattern() {
     let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
     nb.decode = Decode::Table(vec![[1.0, 1.0]; 3]);
     let g = Genome::zeros(0);
-    let err = Controller::new(&s, &g, ChaCha8Rng::seed_from_u64(1)).err();
-    assert!(matches!(err, Some(ControllerError::BadModule { .. })), "{err:?}");
+    let opts = EpisodeOptions { actions: 1, learning: false, seed: 1 };
+    let err = try_run_episode(&s, &g, &opts, None).unwrap_err().to_string();
+    assert!(err.contains("`modules[0].behavior.decode`: 3 rows for 2 outputs"), "{err}");
 }
 
 #[test]

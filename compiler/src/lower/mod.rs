@@ -17,6 +17,7 @@ use std::collections::HashMap;
 
 use shaping_runtime::catalog::{self, ActuatorKind, SensorKind};
 use shaping_runtime::expr::Expr;
+use shaping_runtime::limits::*;
 use shaping_runtime::program::*;
 
 use crate::diag::{did_you_mean, Error};
@@ -126,6 +127,9 @@ struct StageSt {
     world: WorldSt,
     genome: GenomeSt,
     evolution: Evolution,
+    /// Where the population was set (here or in an ancestor), for the
+    /// resource-limit diagnostic.
+    population_span: Option<Span>,
     /// No `selection truncation keep N` written here or in an ancestor: the
     /// truncation keeps a fifth of the population (20 of the paper's 100).
     keep_default: bool,
@@ -162,11 +166,6 @@ pub(crate) struct Lower<'a> {
 pub(crate) type TrainedModule = (String, Option<(u16, u16, u16)>);
 
 const DEFAULT_BITS: u8 = 4;
-/// Most modules in a stage (module indices are `u16`, and `links all`
-/// makes n * (n - 1) links).
-const MAX_MODULES: usize = 256;
-/// Most stages in a file (stage indices are `u16`; real files have a few).
-const MAX_STAGES: usize = 64;
 const DEFAULT_WINDOW: u32 = 30;
 const DEFAULT_LAMP_HEIGHT: f32 = 150.0;
 const DEFAULT_RECHARGE: u32 = 20;
@@ -261,6 +260,12 @@ impl<'a> Lower<'a> {
 
     /// A whole number, with no unit or `actions`.
     fn count(&mut self, q: &Quantity, what: &str, min: u64) -> Option<u64> {
+        self.count_in(q, what, min, u32::MAX as u64)
+    }
+
+    /// A whole number in `min..=max`; above `max` it is refused as a
+    /// resource limit (see `shaping_runtime::limits`).
+    fn count_in(&mut self, q: &Quantity, what: &str, min: u64, max: u64) -> Option<u64> {
         if let Some(u) = q.unit {
             if u != Unit::Actions {
                 self.errors.push(Error::Unit {
@@ -276,8 +281,10 @@ impl<'a> Lower<'a> {
             self.value_error(q.span, format!("{what} must be a whole number"), "not a whole number", None);
             return None;
         }
-        if q.value > u32::MAX as f64 {
-            self.value_error(q.span, format!("{what} must be at most {}", u32::MAX), "too large", None);
+        if q.value > max as f64 {
+            let help = (max < u32::MAX as u64)
+                .then(|| "this limit keeps a run within the memory and time of one machine".to_string());
+            self.value_error(q.span, format!("{what} must be at most {max}"), "too large", help);
             return None;
         }
         let v = q.value as u64;
@@ -303,11 +310,22 @@ impl<'a> Lower<'a> {
                 return None;
             }
         };
-        if !(q.value > 0.0 && q.value.is_finite()) {
+        let mm = q.value * factor;
+        // Checked as the runtime will hold it: `1e-46` is 0 in f32.
+        if !(q.value.is_finite() && mm as f32 > 0.0) {
             self.value_error(q.span, format!("{what} must be positive"), "not positive", None);
             return None;
         }
-        Some((q.value * factor) as f32)
+        if mm > MAX_LENGTH_MM as f64 {
+            self.value_error(
+                q.span,
+                format!("{what} must be at most {MAX_LENGTH_MM} mm"),
+                "too long",
+                Some("lengths are in mm (or `cm`); an arena is a few metres at most".into()),
+            );
+            return None;
+        }
+        Some(mm as f32)
     }
 
     /// A plain number (no unit), within `lo..=hi`.
@@ -598,6 +616,7 @@ impl<'a> Lower<'a> {
             genome: GenomeSt { links: spec, weights: spec, biases: spec },
             evolution: default_evolution(),
             keep_default: true,
+            population_span: None,
             inheritance: Inheritance::Darwinian,
             run: StageRun::Evolve(default_evolution()),
             fitness: Fitness { per_action: None, bonuses: Vec::new() },
@@ -808,6 +827,7 @@ impl<'a> Lower<'a> {
             }
         }
         self.check_charger(&st.world);
+        self.check_fit(&st.world, decl.name.span);
         self.run(&mut st, decl, parent.is_some());
         let hw = Hw {
             stage: sname.clone(),
@@ -871,8 +891,43 @@ impl<'a> Lower<'a> {
             );
         }
         self.allocate(&mut st, s);
+        self.check_genome_size(&st, decl);
         let stage = assemble(&st, &sname, s, parent);
         (st, stage)
+    }
+}
+
+impl Lower<'_> {
+    /// The genome and the population's genomes within the resource limits
+    /// (`shaping_runtime::limits`), checked before anything is allocated.
+    fn check_genome_size(&mut self, st: &StageSt, decl: &ast::StageDecl) {
+        let help = Some("this limit keeps a run within the memory of one machine".to_string());
+        if st.bits > MAX_GENOME_BITS {
+            self.value_error(
+                decl.name.span,
+                format!(
+                    "stage `{}` has a genome of {} bits, more than the limit of {MAX_GENOME_BITS}",
+                    decl.name.text, st.bits
+                ),
+                "genome too long",
+                Some("use fewer evolvable weights, fewer hidden units or fewer bits per gene".into()),
+            );
+            return;
+        }
+        if let StageRun::Evolve(e) = &st.run {
+            let total = u64::from(e.population) * u64::from(st.bits);
+            if total > MAX_POPULATION_BITS {
+                self.value_error(
+                    st.population_span.unwrap_or(decl.name.span),
+                    format!(
+                        "a population of {} genomes of {} bits makes {total} bits, more than the limit of {MAX_POPULATION_BITS}",
+                        e.population, st.bits
+                    ),
+                    "population too large for this genome",
+                    help,
+                );
+            }
+        }
     }
 }
 

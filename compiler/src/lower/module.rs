@@ -1,6 +1,7 @@
 //! Modules: inputs, activation networks, behaviors, learning, reinforcement.
 
 use shaping_runtime::catalog::{self, ActuatorKind};
+use shaping_runtime::limits::MAX_HIDDEN;
 use shaping_runtime::program::*;
 
 use super::{expr::Scope, Hw, Lower, ModuleSt, Source, DEFAULT_RATES, DEFAULT_WINDOW};
@@ -207,7 +208,7 @@ impl Lower<'_> {
 
     fn activation(&mut self, a: &ast::ActivationDecl) -> Option<(u16, Source)> {
         let hidden = match &a.hidden {
-            Some(q) => self.count(q, "the number of hidden units", 0)? as u16,
+            Some(q) => self.count_in(q, "the number of hidden units", 0, MAX_HIDDEN.into())? as u16,
             None => 0,
         };
         let range = match &a.range {
@@ -473,7 +474,7 @@ impl Lower<'_> {
             None => module_inputs.to_vec(),
         };
         let hidden = match &n.hidden {
-            Some(q) => match self.count(q, "the number of hidden units", 0) {
+            Some(q) => match self.count_in(q, "the number of hidden units", 0, MAX_HIDDEN.into()) {
                 Some(h) => h as u16,
                 None => return (None, None),
             },
@@ -491,7 +492,8 @@ impl Lower<'_> {
             }
             Some(ast::OutputsDecl::Linear { scale, span }) => {
                 let scale = scale.unwrap_or(1.0);
-                if !(scale > 0.0 && scale <= 1.0) {
+                // Checked as the runtime will hold it: `1e-46` is 0 in f32.
+                if !(scale as f32 > 0.0 && scale <= 1.0) {
                     self.value_error(
                         *span,
                         format!("the scale is between 0 and 1, not {scale}"),

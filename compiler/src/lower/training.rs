@@ -2,6 +2,7 @@
 
 use shaping_runtime::catalog::ActuatorKind;
 use shaping_runtime::expr::{Expr, Op};
+use shaping_runtime::limits::*;
 use shaping_runtime::program::*;
 
 use super::*;
@@ -29,7 +30,7 @@ impl Lower<'_> {
                             Some("a training stage stands alone; later stages use what it learned with `weights trained STAGE`".into()),
                         );
                     }
-                    if let Some(n) = self.count(actions, "the training length", 1) {
+                    if let Some(n) = self.count_in(actions, "the training length", 1, MAX_ACTIONS.into()) {
                         st.run = StageRun::Train { actions: n as u32 };
                     }
                 }
@@ -59,7 +60,7 @@ impl Lower<'_> {
                             ),
                         );
                     }
-                    if let Some(n) = self.count(actions, "the test length", 1) {
+                    if let Some(n) = self.count_in(actions, "the test length", 1, MAX_ACTIONS.into()) {
                         st.run = StageRun::Test { actions: n as u32, learning: *learning };
                     }
                 }
@@ -98,6 +99,7 @@ impl Lower<'_> {
         ];
         let ev = &mut st.evolution;
         let mut keep_span = None;
+        let mut population_span = None;
         for set in settings {
             let n = set.name.text.as_str();
             match (&set.value, n) {
@@ -136,7 +138,17 @@ impl Lower<'_> {
                     "population" | "generations" | "actions" | "elitism" | "evaluations" | "seed",
                 ) => {
                     let min = if n == "elitism" || n == "seed" { 0 } else { 1 };
-                    if let Some(v) = self.count(q, &format!("`{n}`"), min) {
+                    let max = match n {
+                        "population" => MAX_POPULATION,
+                        "generations" => MAX_GENERATIONS,
+                        "actions" => MAX_ACTIONS,
+                        "evaluations" => MAX_EVALUATIONS,
+                        _ => u32::MAX,
+                    };
+                    if let Some(v) = self.count_in(q, &format!("`{n}`"), min, max.into()) {
+                        if n == "population" {
+                            population_span = Some(q.span);
+                        }
                         match n {
                             "population" => ev.population = v as u32,
                             "generations" => ev.generations = v as u32,
@@ -174,6 +186,9 @@ impl Lower<'_> {
         }
         if keep_span.is_some() || ev.selection == Selection::Roulette {
             st.keep_default = false;
+        }
+        if population_span.is_some() {
+            st.population_span = population_span;
         }
         let ev = &mut st.evolution;
         if st.keep_default {

@@ -1,6 +1,7 @@
 //! The world: arena, charger, battery, objects and body, with `world adds` and
 //! `world changes` checked against the inherited world.
 
+use shaping_runtime::limits::MAX_OBJECTS;
 use shaping_runtime::program::*;
 
 use super::*;
@@ -51,11 +52,12 @@ impl Lower<'_> {
                 }
             }
             match item {
-                W::Arena { width, depth, .. } => {
+                W::Arena { width, depth, span } => {
                     let w = self.length(width, "the arena width");
                     let d = self.length(depth, "the arena depth");
                     if let (Some(w), Some(d)) = (w, d) {
                         ws.world.arena = [w, d];
+                        ws.spans.insert("arena", *span);
                     }
                 }
                 W::Charger { length, wall, lamp, span } => {
@@ -122,7 +124,10 @@ impl Lower<'_> {
                         diameter: 25.0,
                         virtual_: false,
                     });
-                    if let Some(c) = count.as_ref().and_then(|q| self.count(q, "the number of objects", 0)) {
+                    if let Some(c) = count
+                        .as_ref()
+                        .and_then(|q| self.count_in(q, "the number of objects", 0, MAX_OBJECTS.into()))
+                    {
                         o.count = c as u32;
                     }
                     if let Some(d) = diameter.as_ref().and_then(|q| self.length(q, "the object diameter")) {
@@ -134,7 +139,10 @@ impl Lower<'_> {
                     ws.world.objects = Some(o);
                     ws.spans.insert("objects", *span);
                 }
-                W::Body(settings, _) => self.body(&mut ws.world.body, settings),
+                W::Body(settings, span) => {
+                    self.body(&mut ws.world.body, settings);
+                    ws.spans.insert("body", *span);
+                }
             }
         }
     }
@@ -154,6 +162,21 @@ impl Lower<'_> {
                     None,
                 );
             }
+        }
+    }
+
+    /// The body must fit in the arena.
+    pub(super) fn check_fit(&mut self, ws: &WorldSt, stage: Span) {
+        let [w, d] = ws.world.arena;
+        let diameter = 2.0 * ws.world.body.radius;
+        if diameter >= w.min(d) {
+            let sp = ws.spans.get("body").or(ws.spans.get("arena")).copied().unwrap_or(stage);
+            self.value_error(
+                sp,
+                format!("a body {diameter} mm wide does not fit in an arena of {w} x {d} mm"),
+                "does not fit",
+                None,
+            );
         }
     }
 

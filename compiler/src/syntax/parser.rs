@@ -70,6 +70,9 @@ fn parse_with_limit(src: &str, call_limit: usize) -> Result<File, Vec<Error>> {
         Ok(p) => p,
         Err(e) => return Err(vec![syntax_error(src, e)]),
     };
+    if let Some(err) = check_numbers(&pairs) {
+        return Err(vec![err]);
+    }
     let mut b = Builder { pratt: pratt(), errors: Vec::new() };
     let file =
         pairs.next().map(|p| b.file(p)).unwrap_or(File { robots: vec![], genomes: vec![], stages: vec![] });
@@ -95,6 +98,20 @@ fn pratt() -> PrattParser<Rule> {
         .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
         .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
         .op(Op::prefix(Rule::neg) | Op::prefix(Rule::prev))
+}
+
+/// Rejects the first number a 32-bit float cannot hold (the runtime computes
+/// in `f32`, so `1e39` would become infinite).
+fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
+    pairs.clone().flatten().filter(|p| matches!(p.as_rule(), Rule::number | Rule::unsigned)).find_map(|p| {
+        let v = num(&p);
+        (v.is_nan() || v.abs() > f32::MAX as f64).then(|| Error::Value {
+            span: span(&p).into(),
+            message: format!("the number `{}` is too large", p.as_str()),
+            label: "too large".into(),
+            help: Some(format!("numbers are at most {:e} in magnitude", f32::MAX)),
+        })
+    })
 }
 
 /// Rejects the first line longer than [`MAX_LINE`], labelled at its start.

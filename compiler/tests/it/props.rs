@@ -193,6 +193,87 @@ proptest! {
     }
 }
 
+/// Values a mutated program's field may take: extremes of every kind.
+fn extreme_values() -> Vec<serde_json::Value> {
+    use serde_json::json;
+    vec![
+        json!(0),
+        json!(-1),
+        json!(1),
+        json!(17),
+        json!(18),
+        json!(65535),
+        json!(4_000_000_000u64),
+        json!(-1e30),
+        json!(1e30),
+        json!(0.5),
+        json!(2),
+        json!([]),
+        json!(null),
+        json!(true),
+    ]
+}
+
+/// Replaces the node reached by `path` (child indices, taken modulo the
+/// number of children; the walk stops at a leaf or after `depth` steps).
+fn mutate_at(v: &mut serde_json::Value, path: &[usize], depth: usize, new: serde_json::Value) {
+    let child = match (path.first(), depth > 0) {
+        (Some(&k), true) => match v {
+            serde_json::Value::Array(a) if !a.is_empty() => {
+                let n = a.len();
+                Some(&mut a[k % n])
+            }
+            serde_json::Value::Object(o) if !o.is_empty() => {
+                let n = o.len();
+                o.values_mut().nth(k % n)
+            }
+            _ => None,
+        },
+        _ => None,
+    };
+    match child {
+        Some(c) => mutate_at(c, &path[1..], depth - 1, new),
+        None => *v = new,
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// A compiled program with one field changed is either refused with a
+    /// message naming the field, or accepted and runs every stage without a
+    /// panic.
+    #[test]
+    fn a_mutated_program_is_refused_or_runs(
+        example in prop::sample::select(vec!["khepera.bat", "tutorial.bat", "scratch.bat", "avoid.bat"]),
+        path in prop::collection::vec(any::<usize>(), 12),
+        depth in 1usize..12,
+        new in prop::sample::select(extreme_values()),
+    ) {
+        use shaping_runtime::controller::{run_episode, EpisodeOptions};
+        use shaping_runtime::genome::Genome;
+        let src = std::fs::read_to_string(root().join("examples").join(example)).unwrap();
+        let p = crate::compile_ok(&src, example);
+        let mut v = serde_json::to_value(&p).unwrap();
+        mutate_at(&mut v, &path, depth, new);
+        let Ok(m) = serde_json::from_value::<Program>(v) else { return Ok(()) };
+        match m.validate() {
+            Err(e) => prop_assert!(e.to_string().contains('`'), "{e}"),
+            Ok(()) => {
+                // Bind what the training stages learn, as the CLI does.
+                let mut m = m;
+                if shaping_runtime::evolve::train_all(&mut m, 1).is_err() {
+                    return Ok(());
+                }
+                for s in &m.stages {
+                    let g = Genome::zeros(s.layout.bits as usize);
+                    run_episode(s, &g, &EpisodeOptions { actions: 30, learning: true, seed: 1 }, None);
+                }
+            }
+        }
+    }
+}
+
 fn serde_roundtrip(p: &Program) -> bool {
     let json = serde_json::to_string(p).unwrap();
     let back: Program = serde_json::from_str(&json).unwrap();

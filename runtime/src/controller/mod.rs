@@ -64,8 +64,9 @@
 //!
 //! [`run_episode`] (the contract used by the GA and the CLI) builds a
 //! [`Controller`] and a [`Sim`] from the episode seed ([`episode_rngs`]) and
-//! runs them. [`validate`] checks a stage once; [`try_run_episode`] reports
-//! what [`run_episode`] would silently score 0. [`Controller::act`] runs one
+//! runs them on a stage that passed [`crate::validate`] (the controller
+//! trusts it). [`validate`] checks a stage of unknown origin and a genome;
+//! [`try_run_episode`] validates first and reports what is wrong. [`Controller::act`] runs one
 //! action on anything implementing [`Robot`] (the simulator, or a test's
 //! hand-driven robot).
 //!
@@ -87,11 +88,9 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
-use crate::expr::{Env, Expr};
+use crate::expr::Env;
 use crate::genome::Genome;
-use crate::program::{
-    Behavior, Decode, Event, Inheritance, LearnTarget, LearnWhen, Learning, Network, Param, Stage,
-};
+use crate::program::{Behavior, Decode, Event, Inheritance, LearnTarget, LearnWhen, Learning, Param, Stage};
 use crate::sim::{Command, Outcome, Pose, Sim};
 
 pub use fast_expr::FastExpr;
@@ -167,14 +166,8 @@ pub struct TraceRow {
 pub enum ControllerError {
     #[error("the genome has {have} bits but the layout needs {need}")]
     GenomeTooShort { have: usize, need: usize },
-    #[error("gene {gene} is out of the genome or has {bits} bits (1..=32 allowed)")]
-    BadGene { gene: usize, bits: u8 },
-    #[error("module `{module}`: {what}")]
-    BadModule { module: String, what: String },
-    #[error("link {index}: {what}")]
-    BadLink { index: usize, what: String },
-    #[error("the fitness expression is malformed")]
-    BadFitness,
+    #[error("{0}")]
+    Invalid(#[from] crate::validate::Invalid),
 }
 
 // ------------------------------------------------------------------ robot
@@ -311,12 +304,17 @@ pub struct Controller<'s> {
 impl<'s> Controller<'s> {
     /// Decodes `genome` through `stage.layout` and builds the modules. Random
     /// initial weights are drawn from `rng`, which then drives CRBP sampling.
+    ///
+    /// The stage must have passed [`crate::validate`] (the entry points
+    /// validate a program once; the controller trusts it); only the genome's
+    /// length, and that trained weights have been bound, are checked here.
     pub fn new(
         stage: &'s Stage,
         genome: &Genome,
         mut rng: ChaCha8Rng,
     ) -> Result<Controller<'s>, ControllerError> {
-        validate(stage, genome)?;
+        check_genome(stage, genome)?;
+        crate::validate::bound(stage)?;
         let genes = genome.decode_all(&stage.layout);
         let mut value = |p: &Param| match *p {
             Param::Gene(i) => genes[i as usize],
@@ -328,7 +326,7 @@ impl<'s> Controller<'s> {
                     lo
                 }
             }
-            Param::Trained { .. } => unreachable!("validate refuses unbound trained weights"),
+            Param::Trained { .. } => unreachable!("`validate::bound` refused unbound trained weights"),
         };
         let mut mods = Vec::with_capacity(stage.modules.len());
         for m in &stage.modules {
@@ -729,20 +727,31 @@ pub fn episode_rngs(seed: u64) -> (u64, ChaCha8Rng) {
     (seed, rng)
 }
 
-/// Runs one episode of `genome` on `stage`. An invalid stage or genome (see
-/// [`validate`]; the compiler's output always passes) gives an empty result
-/// with fitness 0; use [`try_run_episode`] to get the error.
+/// Runs one episode of `genome` on `stage`, which must have passed
+/// [`crate::validate`]. A genome shorter than the layout gives an empty
+/// result with fitness 0; use [`try_run_episode`] to get the error.
 pub fn run_episode(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
     trace: Option<&mut Trace>,
 ) -> EpisodeResult {
-    try_run_episode(stage, genome, opts, trace).unwrap_or_default()
+    episode(stage, genome, opts, trace).unwrap_or_default()
 }
 
-/// [`run_episode`], reporting an invalid stage or genome.
+/// [`run_episode`] on a stage that may not have been validated: validates
+/// it and the genome first and reports what is wrong.
 pub fn try_run_episode(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    trace: Option<&mut Trace>,
+) -> Result<EpisodeResult, ControllerError> {
+    validate(stage, genome)?;
+    episode(stage, genome, opts, trace)
+}
+
+fn episode(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
@@ -758,108 +767,19 @@ pub fn try_run_episode(
     Ok(res)
 }
 
-/// Checks that the controller can run `stage` with `genome`: gene indices,
-/// network shapes, channels, links, expressions and decode tables.
+/// Checks that the controller can run `stage` with `genome`: the stage passes
+/// the one validation of a program ([`crate::validate::stage`]) and the
+/// genome is long enough for its layout.
 pub fn validate(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
-    let layout = &stage.layout;
-    if genome.bits.len() < layout.bits as usize {
-        return Err(ControllerError::GenomeTooShort { have: genome.bits.len(), need: layout.bits as usize });
-    }
-    for (i, g) in layout.genes.iter().enumerate() {
-        if g.bits == 0 || g.bits > 32 || g.offset as usize + g.bits as usize > genome.bits.len() {
-            return Err(ControllerError::BadGene { gene: i, bits: g.bits });
-        }
-    }
-    let n_genes = layout.genes.len();
-    let param_ok = |p: &Param| match *p {
-        Param::Gene(i) => (i as usize) < n_genes,
-        Param::Fixed(v) => v.is_finite(),
-        Param::Random { lo, hi } => lo.is_finite() && hi.is_finite() && lo <= hi,
-        Param::Trained { .. } => false,
-    };
-    let chans_ok = |c: &[u16]| c.iter().all(|&c| (c as usize) < CHANNELS);
-    let net_ok = |net: &Network, inputs: &[u16]| -> Result<(), String> {
-        if net.inputs as usize != inputs.len() || !chans_ok(inputs) {
-            return Err("network inputs do not match its channels".into());
-        }
-        if net.params.len() != Network::param_count(inputs.len(), net.hidden as usize, net.outputs as usize) {
-            return Err(format!("network has {} parameters for its shape", net.params.len()));
-        }
-        if !net.params.iter().all(param_ok) {
-            return Err(if net.params.iter().any(|p| matches!(p, Param::Trained { .. })) {
-                "its weights come from a training stage that has not run".into()
-            } else {
-                "a network parameter refers to a missing gene or is not finite".into()
-            });
-        }
-        Ok(())
-    };
-    let expr_ok = |e: &Expr| e.is_valid();
-    for m in &stage.modules {
-        let bad = |what: String| ControllerError::BadModule { module: m.name.clone(), what };
-        net_ok(&m.activation, &m.inputs).map_err(|w| bad(format!("activation: {w}")))?;
-        if m.activation.outputs != 1 {
-            return Err(bad("the activation network must have one output".into()));
-        }
-        match &m.behavior {
-            Behavior::Neural(nb) => {
-                net_ok(&nb.net, &nb.inputs).map_err(|w| bad(format!("behavior: {w}")))?;
-                match &nb.decode {
-                    Decode::Table(t) => {
-                        if nb.net.outputs > 16 || t.len() != 1usize << nb.net.outputs {
-                            return Err(bad("the decode table needs 2^outputs rows".into()));
-                        }
-                    }
-                    Decode::Linear { .. } => {
-                        if nb.net.outputs != 2 {
-                            return Err(bad("linear decoding needs two outputs".into()));
-                        }
-                    }
-                }
-            }
-            Behavior::Script(s) => {
-                for st in &s.steps {
-                    let ok = match &st.action {
-                        crate::program::Action::Toward { channels, .. } => chans_ok(channels),
-                        crate::program::Action::Reinforce(e) => expr_ok(e),
-                        _ => true,
-                    } && match &st.end {
-                        crate::program::StepEnd::Until { cond, .. } => expr_ok(cond),
-                        crate::program::StepEnd::Actions(_) => true,
-                    } && st.when.as_ref().is_none_or(expr_ok);
-                    if !ok {
-                        return Err(bad("a script step has a bad channel or expression".into()));
-                    }
-                }
-            }
-        }
-        if let Some(e) = &m.reinforce {
-            if !expr_ok(e) {
-                return Err(bad("the reinforcement program is malformed".into()));
-            }
-        }
-        if let Some(l) = &m.learning {
-            if l.window == 0 {
-                return Err(bad("the performance window must be at least 1".into()));
-            }
-            if l.target == LearnTarget::Behavior && !matches!(m.behavior, Behavior::Neural(_)) {
-                return Err(bad("only a neural behavior can learn".into()));
-            }
-        }
-    }
-    for (i, l) in stage.links.iter().enumerate() {
-        let n = stage.modules.len();
-        if l.from as usize >= n || l.to as usize >= n {
-            return Err(ControllerError::BadLink { index: i, what: "refers to a missing module".into() });
-        }
-        if !param_ok(&l.weight) {
-            return Err(ControllerError::BadLink { index: i, what: "bad weight".into() });
-        }
-    }
-    if let Some(e) = &stage.fitness.per_action {
-        if !expr_ok(e) {
-            return Err(ControllerError::BadFitness);
-        }
+    crate::validate::stage(stage)?;
+    crate::validate::bound(stage)?;
+    check_genome(stage, genome)
+}
+
+fn check_genome(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
+    let need = stage.layout.bits as usize;
+    if genome.bits.len() < need {
+        return Err(ControllerError::GenomeTooShort { have: genome.bits.len(), need });
     }
     Ok(())
 }

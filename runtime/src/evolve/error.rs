@@ -20,12 +20,6 @@ pub enum EvolveError {
     #[error("stage `{stage}` is not a training stage")]
     NotTrained { stage: String },
 
-    #[error("stage `{stage}`: invalid evolution parameter: {what}")]
-    InvalidParameter { stage: String, what: String },
-
-    #[error("stage `{stage}`: gene {gene} {what}")]
-    InvalidLayout { stage: String, gene: usize, what: String },
-
     #[error("stage `{stage}` extends no stage but its gene {gene} is frozen")]
     FrozenWithoutParent { stage: String, gene: usize },
 

@@ -8,6 +8,11 @@
 //! injected as an [`Evaluate`] function, so this module knows nothing of the
 //! simulator or the controller.
 //!
+//! **Trust.** The program must have passed [`crate::validate`]: the GA takes
+//! its evolution settings and layouts as valid (population, selection,
+//! probabilities, gene sizes) and checks only what a checkpoint brings
+//! (its stage, population and parent).
+//!
 //! **Generation semantics.** Generation `g` of a stage (0-based,
 //! `Checkpoint::generation` counts the generations done) is: for `g > 0`,
 //! breed a new population from the evaluated population of `g - 1` (see
@@ -53,7 +58,7 @@ pub use glue::{evaluate_with_controller, EvalOptions};
 pub use train::{train_all, train_stage, Trained};
 
 use crate::genome::Genome;
-use crate::program::{Evolution, Inheritance, Program, Selection, Stage, StageRun};
+use crate::program::{Evolution, Inheritance, Program, Stage, StageRun};
 
 /// Version of the [`Checkpoint`] format.
 pub const CHECKPOINT_FORMAT: u32 = 1;
@@ -153,8 +158,6 @@ pub fn start_stage(
 ) -> Result<Checkpoint, EvolveError> {
     let st = get_stage(program, stage)?;
     let evo = evolution(st)?;
-    validate_evolution(st, evo)?;
-    validate_layout(st)?;
     let bits = st.layout.bits as usize;
     let mut rng = seed::rng(seed::init_seed(seed, stage));
     let random_bits = |rng: &mut rand_chacha::ChaCha8Rng, out: &mut Vec<u8>, n: usize| {
@@ -250,7 +253,6 @@ pub fn step_generation_with(
 ) -> Result<GenStats, EvolveError> {
     let st = get_stage(program, cp.stage)?;
     let evo = evolution(st)?;
-    validate_evolution(st, evo)?;
     check_population(st, cp)?;
     let mask = frozen_mask(&st.layout);
     let g = cp.generation;
@@ -571,53 +573,6 @@ fn evolved_ancestor(program: &Program, stage: usize) -> Result<Option<usize>, Ev
         current = pst.parent;
     }
     Ok(None)
-}
-
-fn validate_evolution(st: &Stage, evo: &Evolution) -> Result<(), EvolveError> {
-    let bad = |what: String| Err(EvolveError::InvalidParameter { stage: st.name.clone(), what });
-    if evo.population == 0 {
-        return bad("population must be at least 1".into());
-    }
-    if let Selection::Truncation { keep } = evo.selection {
-        if keep == 0 || keep > evo.population {
-            return bad(format!(
-                "truncation keeps {keep}, must be 1 to the population size {}",
-                evo.population
-            ));
-        }
-    }
-    for (name, p) in [("crossover", evo.crossover), ("mutation", evo.mutation)] {
-        if !(0.0..=1.0).contains(&p) {
-            return bad(format!("{name} probability {p} is not in 0..1"));
-        }
-    }
-    if evo.elitism > evo.population {
-        return bad(format!("elitism {} exceeds the population size {}", evo.elitism, evo.population));
-    }
-    if evo.evaluations == 0 {
-        return bad("evaluations must be at least 1".into());
-    }
-    Ok(())
-}
-
-fn validate_layout(st: &Stage) -> Result<(), EvolveError> {
-    for (i, g) in st.layout.genes.iter().enumerate() {
-        if g.bits == 0 || g.bits > 32 {
-            return Err(EvolveError::InvalidLayout {
-                stage: st.name.clone(),
-                gene: i,
-                what: format!("has {} bits, must be 1 to 32", g.bits),
-            });
-        }
-        if g.offset as u64 + g.bits as u64 > st.layout.bits as u64 {
-            return Err(EvolveError::InvalidLayout {
-                stage: st.name.clone(),
-                gene: i,
-                what: format!("ends after the genome's {} bits", st.layout.bits),
-            });
-        }
-    }
-    Ok(())
 }
 
 /// The child's layout must start with the parent's genes (same place, size and

@@ -51,7 +51,7 @@ pub fn train_stage(
     let (sim_seed, rng) = episode_rngs(episode);
     let genome = Genome::zeros(stage.layout.bits as usize);
     let mut ctl = Controller::new(stage, &genome, rng)
-        .map_err(|e| EvolveError::InvalidParameter { stage: stage.name.clone(), what: e.to_string() })?;
+        .map_err(|e| EvolveError::Inconsistent { stage: stage.name.clone(), what: e.to_string() })?;
     let mut sim = Sim::new(&stage.world, sim_seed);
     let result = ctl.run(&mut sim, &EpisodeOptions { actions, learning: true, seed: episode }, trace);
     let n = stage.modules.len();
@@ -72,7 +72,7 @@ pub fn bind(program: &mut Program, index: usize, trained: &Trained) -> Result<us
     let stage =
         program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })?;
     if trained.stage != stage.name || trained.fingerprint != training_fingerprint(stage) {
-        return Err(EvolveError::InvalidParameter {
+        return Err(EvolveError::Inconsistent {
             stage: stage.name.clone(),
             what: format!(
                 "the trained weights were made by another stage or another version of `{}`",

@@ -1,0 +1,522 @@
+//! The one validation of a [`Program`]: it accepts what the compiler can
+//! produce and refuses everything else with a message naming the stage and
+//! the field. Every entry point that runs a program (the CLI's `run`,
+//! `replay`, `bench`, `experiment`) validates it once; the controller and the
+//! GA then trust it and index with it without checking again.
+//!
+//! Organised like the `Program` types: one function per part of a stage
+//! ([`world`], [`modules`], [`links`], [`layout`], [`fitness`], [`run`], ...),
+//! each checking its fields in declaration order. A new field of the program
+//! gets its check in the function of the part that holds it. Resource limits
+//! are the constants of [`crate::limits`], which the compiler checks too.
+
+use std::fmt;
+
+use crate::catalog::{self, ACT_SLOTS, CHANNELS};
+use crate::expr::{Expr, Op};
+use crate::limits::*;
+use crate::program::*;
+
+/// Why a program was refused: the stage (when the problem is in one), the
+/// field (a path like `modules[1] (avoid).activation.params[3]`) and what is
+/// wrong with it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    pub stage: Option<String>,
+    pub field: String,
+    pub message: String,
+}
+
+impl fmt::Display for Invalid {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.stage {
+            Some(s) => write!(f, "stage `{s}`, `{}`: {}", self.field, self.message),
+            None => write!(f, "`{}`: {}", self.field, self.message),
+        }
+    }
+}
+
+impl std::error::Error for Invalid {}
+
+type R = Result<(), Invalid>;
+
+/// Where a check is: the stage and the field path so far.
+#[derive(Clone)]
+struct At<'a> {
+    stage: Option<&'a str>,
+    path: String,
+}
+
+impl At<'_> {
+    fn field(&self, name: impl fmt::Display) -> Self {
+        let path = if self.path.is_empty() { name.to_string() } else { format!("{}.{name}", self.path) };
+        At { stage: self.stage, path }
+    }
+
+    fn index(&self, i: usize) -> Self {
+        At { stage: self.stage, path: format!("{}[{i}]", self.path) }
+    }
+
+    fn err(&self, message: impl Into<String>) -> R {
+        Err(Invalid {
+            stage: self.stage.map(str::to_string),
+            field: self.path.clone(),
+            message: message.into(),
+        })
+    }
+
+    /// `cond` must hold, else `message`.
+    fn ensure(&self, cond: bool, message: impl FnOnce() -> String) -> R {
+        if cond {
+            Ok(())
+        } else {
+            self.err(message())
+        }
+    }
+
+    fn finite(&self, v: f32) -> R {
+        self.ensure(v.is_finite(), || format!("{v} is not a finite number"))
+    }
+
+    fn within(&self, v: f32, lo: f32, hi: f32) -> R {
+        self.ensure(v >= lo && v <= hi, || format!("{v} is not between {lo} and {hi}"))
+    }
+
+    fn count(&self, v: u32, lo: u32, hi: u32) -> R {
+        self.ensure(v >= lo && v <= hi, || format!("{v} is not between {lo} and {hi}"))
+    }
+
+    /// A length in mm: positive and at most [`MAX_LENGTH_MM`].
+    fn length(&self, v: f32) -> R {
+        self.ensure(v > 0.0 && v <= MAX_LENGTH_MM, || {
+            format!("{v} mm is not a length between 0 (excluded) and {MAX_LENGTH_MM} mm")
+        })
+    }
+
+    fn channel(&self, c: u16) -> R {
+        self.ensure((c as usize) < CHANNELS, || {
+            format!("channel {c} does not exist (the percept has {CHANNELS})")
+        })
+    }
+
+    fn channels(&self, cs: &[u16]) -> R {
+        cs.iter().enumerate().try_for_each(|(i, &c)| self.index(i).channel(c))
+    }
+}
+
+/// Validates a whole program: its format, its stages and how they extend
+/// each other.
+pub fn program(p: &Program) -> R {
+    let at = At { stage: None, path: String::new() };
+    at.field("format")
+        .ensure(p.format == FORMAT_VERSION, || format!("format {} is not {FORMAT_VERSION}", p.format))?;
+    let stages = at.field("stages");
+    stages.ensure(!p.stages.is_empty(), || "the program has no stages".into())?;
+    stages.ensure(p.stages.len() <= MAX_STAGES, || {
+        format!("{} stages, more than the limit of {MAX_STAGES}", p.stages.len())
+    })?;
+    for (i, s) in p.stages.iter().enumerate() {
+        if let Some(j) = p.stages[..i].iter().position(|t| t.name == s.name) {
+            return stages.index(i).field("name").err(format!("`{}` is also the name of stage {j}", s.name));
+        }
+        stage(s)?;
+        extension(p, i)?;
+        trained(p, i)?;
+    }
+    Ok(())
+}
+
+/// Weights that a training stage learns (`Param::Trained`) refer to an
+/// earlier training stage, one of its modules with a neural behavior, and
+/// one of that behavior's weights.
+fn trained(p: &Program, i: usize) -> R {
+    let s = &p.stages[i];
+    let at = At { stage: Some(&s.name), path: String::new() };
+    for (mi, m) in s.modules.iter().enumerate() {
+        let Behavior::Neural(nb) = &m.behavior else { continue };
+        for (k, q) in nb.net.params.iter().enumerate() {
+            let Param::Trained { stage: t, module, index } = *q else { continue };
+            let at = at.field("modules").index(mi).field("behavior.net.params").index(k);
+            let source = p.stages.get(t as usize).filter(|_| (t as usize) < i);
+            let Some(source) = source.filter(|x| matches!(x.run, StageRun::Train { .. })) else {
+                return at.err(format!("stage {t} is not a training stage before this one"));
+            };
+            let weights = match source.modules.get(module as usize).map(|x| &x.behavior) {
+                Some(Behavior::Neural(trained)) => trained.net.params.len(),
+                _ => return at.err(format!("module {module} of `{}` has no neural behavior", source.name)),
+            };
+            at.ensure((index as usize) < weights, || {
+                format!("weight {index} of a network of {weights} weights")
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// No weight still waits for a training stage: what a controller needs (the
+/// CLI binds trained weights before anything runs).
+pub fn bound(s: &Stage) -> R {
+    let at = At { stage: Some(&s.name), path: String::new() };
+    for (mi, m) in s.modules.iter().enumerate() {
+        if let Behavior::Neural(nb) = &m.behavior {
+            if nb.net.params.iter().any(|q| matches!(q, Param::Trained { .. })) {
+                return at
+                    .field("modules")
+                    .index(mi)
+                    .field("behavior.net.params")
+                    .err("its weights come from a training stage that has not run");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Validates one stage on its own: everything the controller and the
+/// simulator index with, the numbers they compute with and the limits.
+pub fn stage(s: &Stage) -> R {
+    let at = At { stage: Some(&s.name), path: String::new() };
+    hardware(&at, s)?;
+    world(&at.field("world"), &s.world)?;
+    layout(&at.field("layout"), s)?;
+    modules(&at, s)?;
+    links(&at, s)?;
+    fitness(&at.field("fitness"), &s.fitness)?;
+    run(&at.field("run"), s)?;
+    Ok(())
+}
+
+/// A stage extends its parent: the parent comes before it, its layout starts
+/// with the parent's genes (same place, size and range), and exactly the
+/// genes of earlier stages are frozen.
+fn extension(p: &Program, i: usize) -> R {
+    let s = &p.stages[i];
+    let at = At { stage: Some(&s.name), path: String::new() };
+    let genes = &s.layout.genes;
+    let inherited = match s.parent {
+        None => 0,
+        Some(j) => {
+            at.field("parent").ensure(j < i, || format!("stage {j} does not come before this stage"))?;
+            let parent = &p.stages[j].layout;
+            let n = parent.genes.len();
+            at.field("layout.genes").ensure(genes.len() >= n && s.layout.bits >= parent.bits, || {
+                format!("{} genes, fewer than the {n} of the stage it extends", genes.len())
+            })?;
+            for (k, (c, q)) in genes.iter().zip(&parent.genes).enumerate() {
+                at.field("layout.genes").index(k).ensure(
+                    (c.offset, c.bits, c.lo, c.hi, c.stage, c.module)
+                        == (q.offset, q.bits, q.lo, q.hi, q.stage, q.module),
+                    || "differs from the gene of the stage it extends".into(),
+                )?;
+            }
+            n
+        }
+    };
+    for (k, g) in genes.iter().enumerate() {
+        let frozen = k < inherited;
+        at.field("layout.genes").index(k).field("frozen").ensure(g.frozen == frozen, || {
+            if frozen {
+                "a gene of an earlier stage must be frozen".into()
+            } else {
+                "a gene this stage introduces cannot be frozen".into()
+            }
+        })?;
+    }
+    Ok(())
+}
+
+/// Declared sensors and actuators: each sensor's channels are those of its
+/// kind in the catalog.
+fn hardware(at: &At, s: &Stage) -> R {
+    for (i, d) in s.sensors.iter().enumerate() {
+        let at = at.field("sensors").index(i);
+        let info = catalog::sensor_info(d.kind);
+        at.field("count").ensure(d.count >= 1 && (d.count as usize) <= info.max_count, || {
+            format!("{} is not between 1 and {}", d.count, info.max_count)
+        })?;
+        at.field("channel").ensure(d.channel as usize == info.channel, || {
+            format!("{} is not the first channel of its kind ({})", d.channel, info.channel)
+        })?;
+    }
+    let _ = &s.actuators;
+    Ok(())
+}
+
+/// The world: a positive arena the body fits in, a charger on a wall long
+/// enough, a battery, objects within the limits.
+fn world(at: &At, w: &World) -> R {
+    let [width, depth] = w.arena;
+    at.field("arena").index(0).length(width)?;
+    at.field("arena").index(1).length(depth)?;
+    body(&at.field("body"), &w.body)?;
+    let diameter = 2.0 * w.body.radius;
+    at.field("body.radius").ensure(diameter < width.min(depth), || {
+        format!("a body {diameter} mm wide does not fit in an arena of {width} x {depth} mm")
+    })?;
+    if let Some(c) = &w.charger {
+        let at = at.field("charger");
+        at.field("length").length(c.length)?;
+        let wall = match c.wall {
+            Wall::North | Wall::South => width,
+            Wall::East | Wall::West => depth,
+        };
+        at.field("length").ensure(c.length <= wall, || {
+            format!("the charger ({} mm) is longer than its wall ({wall} mm)", c.length)
+        })?;
+        if let Some(h) = c.lamp_height {
+            at.field("lamp_height").length(h)?;
+        }
+    }
+    if let Some(b) = &w.battery {
+        let at = at.field("battery");
+        at.field("capacity").count(b.capacity, 1, u32::MAX)?;
+        at.field("recharge").count(b.recharge, 1, u32::MAX)?;
+    }
+    if let Some(o) = &w.objects {
+        let at = at.field("objects");
+        at.field("count").count(o.count, 0, MAX_OBJECTS)?;
+        at.field("diameter").length(o.diameter)?;
+    }
+    Ok(())
+}
+
+fn body(at: &At, b: &Body) -> R {
+    at.field("radius").length(b.radius)?;
+    at.field("wheel_base").length(b.wheel_base)?;
+    at.field("v_max").within(b.v_max, 1e-3, 1e4)?;
+    at.field("action_ms").within(b.action_ms, 1.0, 1e5)?;
+    at.field("wheel_noise").within(b.wheel_noise, 0.0, 1.0)?;
+    at.field("sensor_noise").within(b.sensor_noise, 0.0, 1.0)
+}
+
+/// The genome layout: contiguous genes of 1 to 16 bits with finite ranges,
+/// belonging to existing modules and stages, within the limits.
+fn layout(at: &At, s: &Stage) -> R {
+    let l = &s.layout;
+    at.field("bits").count(l.bits, 0, MAX_GENOME_BITS)?;
+    let mut offset = 0u64;
+    for (i, g) in l.genes.iter().enumerate() {
+        let at = at.field("genes").index(i);
+        at.field("offset").ensure(u64::from(g.offset) == offset, || {
+            format!("{} does not follow the previous gene (expected {offset})", g.offset)
+        })?;
+        at.field("bits")
+            .ensure((1..=16).contains(&g.bits), || format!("{} is not between 1 and 16", g.bits))?;
+        at.field("lo").finite(g.lo)?;
+        at.field("hi").finite(g.hi)?;
+        at.ensure(g.lo <= g.hi, || format!("the range {}..{} is empty", g.lo, g.hi))?;
+        at.field("module").ensure((g.module as usize) < s.modules.len(), || {
+            format!("module {} does not exist", g.module)
+        })?;
+        offset += u64::from(g.bits);
+    }
+    at.field("bits")
+        .ensure(offset == u64::from(l.bits), || format!("{} bits, but the genes take {offset}", l.bits))
+}
+
+/// Every module: input channels, activation network (one output), behavior,
+/// learning, reinforcement.
+fn modules(at: &At, s: &Stage) -> R {
+    at.field("modules").ensure(!s.modules.is_empty() && s.modules.len() <= MAX_MODULES, || {
+        format!("{} modules, not between 1 and {MAX_MODULES}", s.modules.len())
+    })?;
+    for (i, m) in s.modules.iter().enumerate() {
+        let at = at.field("modules").index(i);
+        if let Some(j) = s.modules[..i].iter().position(|n| n.name == m.name) {
+            return at.field("name").err(format!("`{}` is also the name of module {j}", m.name));
+        }
+        at.field("inputs").channels(&m.inputs)?;
+        let act = at.field("activation");
+        network(&act, s, &m.activation, m.inputs.len())?;
+        act.field("outputs")
+            .ensure(m.activation.outputs == 1, || "an activation network has one output".into())?;
+        match &m.behavior {
+            Behavior::Neural(nb) => {
+                let at = at.field("behavior");
+                at.field("inputs").channels(&nb.inputs)?;
+                network(&at.field("net"), s, &nb.net, nb.inputs.len())?;
+                let outputs = nb.net.outputs;
+                match &nb.decode {
+                    Decode::Table(t) => {
+                        let at = at.field("decode");
+                        at.ensure((1..=4).contains(&outputs) && t.len() == 1 << outputs, || {
+                            format!("{} rows for {outputs} outputs (1 to 4 outputs, 2^outputs rows)", t.len())
+                        })?;
+                        for (k, row) in t.iter().enumerate() {
+                            at.index(k).index(0).within(row[0], -1.0, 1.0)?;
+                            at.index(k).index(1).within(row[1], -1.0, 1.0)?;
+                        }
+                    }
+                    Decode::Linear { scale } => {
+                        at.field("net.outputs")
+                            .ensure(outputs == 2, || "linear decoding has two outputs".into())?;
+                        let at = at.field("decode.scale");
+                        at.ensure(*scale > 0.0 && *scale <= 1.0, || {
+                            format!("{scale} is not in 0 (excluded) .. 1")
+                        })?;
+                    }
+                }
+            }
+            Behavior::Script(sc) => script(&at.field("behavior"), sc)?,
+        }
+        if let Some(l) = &m.learning {
+            let at = at.field("learning");
+            at.field("rate_reward").within(l.rate_reward, 0.0, 1.0)?;
+            at.field("rate_punish").within(l.rate_punish, 0.0, 1.0)?;
+            if let LearnWhen::Below { threshold } = l.when {
+                at.field("when.threshold").within(threshold, -1.0, 1.0)?;
+            }
+            at.field("window").count(l.window, 1, u32::MAX)?;
+            at.field("target").ensure(
+                l.target == LearnTarget::Activation || matches!(m.behavior, Behavior::Neural(_)),
+                || "only a neural behavior can learn".into(),
+            )?;
+        }
+        if let Some(e) = &m.reinforce {
+            expr(&at.field("reinforce"), e)?;
+        }
+    }
+    Ok(())
+}
+
+/// A network's shape matches its inputs and parameter list; every parameter
+/// is a gene of the layout, a finite constant or a finite random range.
+fn network(at: &At, s: &Stage, n: &Network, inputs: usize) -> R {
+    at.field("inputs").ensure(n.inputs as usize == inputs, || {
+        format!("{} inputs, but {inputs} input channels", n.inputs)
+    })?;
+    at.field("hidden").ensure(n.hidden <= MAX_HIDDEN, || {
+        format!("{} hidden units, more than the limit of {MAX_HIDDEN}", n.hidden)
+    })?;
+    at.field("outputs").ensure(n.outputs >= 1, || "a network has at least one output".into())?;
+    let want = Network::param_count(inputs, n.hidden as usize, n.outputs as usize);
+    at.field("params").ensure(n.params.len() == want, || {
+        format!("{} parameters, but its shape has {want}", n.params.len())
+    })?;
+    for (i, p) in n.params.iter().enumerate() {
+        param(&at.field("params").index(i), s, p)?;
+    }
+    Ok(())
+}
+
+fn param(at: &At, s: &Stage, p: &Param) -> R {
+    match *p {
+        Param::Gene(g) => {
+            at.ensure((g as usize) < s.layout.genes.len(), || format!("gene {g} does not exist"))
+        }
+        Param::Fixed(v) => at.finite(v),
+        Param::Random { lo, hi } => {
+            at.field("lo").finite(lo)?;
+            at.field("hi").finite(hi)?;
+            at.ensure(lo <= hi, || format!("the range {lo}..{hi} is empty"))
+        }
+        // Checked against the program in `trained`.
+        Param::Trained { .. } => Ok(()),
+    }
+}
+
+/// A script's steps: speeds in -1..1, channels in range, well-formed
+/// expressions, bounded steps.
+fn script(at: &At, sc: &Script) -> R {
+    for (i, st) in sc.steps.iter().enumerate() {
+        let at = at.field("steps").index(i);
+        let action = at.field("action");
+        match &st.action {
+            Action::Wheels { left, right } => {
+                action.field("left").within(*left, -1.0, 1.0)?;
+                action.field("right").within(*right, -1.0, 1.0)?;
+            }
+            Action::Toward { channels, speed } => {
+                action.field("channels").channels(channels)?;
+                action.field("speed").within(*speed, -1.0, 1.0)?;
+            }
+            Action::Reinforce(e) => expr(&action, e)?,
+            Action::Arm(_) | Action::Claw(_) | Action::Wait { .. } => {}
+        }
+        match &st.end {
+            StepEnd::Actions(n) => at.field("end").count(*n, 1, u32::MAX)?,
+            StepEnd::Until { cond, within } => {
+                expr(&at.field("end.cond"), cond)?;
+                at.field("end.within").count(*within, 1, u32::MAX)?;
+            }
+        }
+        if let Some(w) = &st.when {
+            expr(&at.field("when"), w)?;
+        }
+    }
+    Ok(())
+}
+
+/// An expression: well formed within the stack limit, channels and actuator
+/// slots in range, finite constants.
+fn expr(at: &At, e: &Expr) -> R {
+    for (i, op) in e.ops.iter().enumerate() {
+        let at = at.field("ops").index(i);
+        match *op {
+            Op::Chan(c) | Op::Prev(c) => at.channel(c)?,
+            Op::Act(a) => {
+                at.ensure((a as usize) < ACT_SLOTS, || format!("actuator slot {a} does not exist"))?
+            }
+            Op::Const(v) => at.finite(v)?,
+            _ => {}
+        }
+    }
+    at.ensure(e.is_valid(), || {
+        "malformed expression (stack underflow, leftover values or wrong depth)".into()
+    })
+}
+
+fn links(at: &At, s: &Stage) -> R {
+    let n = s.modules.len();
+    for (i, l) in s.links.iter().enumerate() {
+        let at = at.field("links").index(i);
+        at.field("from").ensure((l.from as usize) < n, || format!("module {} does not exist", l.from))?;
+        at.field("to").ensure((l.to as usize) < n, || format!("module {} does not exist", l.to))?;
+        param(&at.field("weight"), s, &l.weight)?;
+    }
+    Ok(())
+}
+
+fn fitness(at: &At, f: &Fitness) -> R {
+    if let Some(e) = &f.per_action {
+        expr(&at.field("per_action"), e)?;
+    }
+    for (i, b) in f.bonuses.iter().enumerate() {
+        at.field("bonuses").index(i).field("points").finite(b.points)?;
+    }
+    Ok(())
+}
+
+/// What the stage does: evolution settings within the limits, or a test.
+fn run(at: &At, s: &Stage) -> R {
+    match &s.run {
+        StageRun::Test { actions, .. } => {
+            at.field("test.actions").count(*actions, 1, MAX_ACTIONS)?;
+            at.ensure(s.parent.is_some(), || "a test stage must extend the stage it tests".into())
+        }
+        StageRun::Train { actions } => {
+            at.field("train.actions").count(*actions, 1, MAX_ACTIONS)?;
+            at.ensure(s.parent.is_none(), || "a training stage extends no stage".into())?;
+            at.field("layout").ensure(s.layout.genes.is_empty(), || "a training stage has no genes".into())
+        }
+        StageRun::Evolve(e) => {
+            let at = at.field("evolve");
+            at.field("population").count(e.population, 1, MAX_POPULATION)?;
+            at.field("generations").count(e.generations, 1, MAX_GENERATIONS)?;
+            at.field("actions").count(e.actions, 1, MAX_ACTIONS)?;
+            at.field("evaluations").count(e.evaluations, 1, MAX_EVALUATIONS)?;
+            at.field("elitism").count(e.elitism, 0, e.population)?;
+            if let Selection::Truncation { keep } = e.selection {
+                at.field("selection.keep").count(keep, 1, e.population)?;
+            }
+            at.field("crossover").within(e.crossover, 0.0, 1.0)?;
+            at.field("mutation").within(e.mutation, 0.0, 1.0)?;
+            let total = u64::from(e.population) * u64::from(s.layout.bits);
+            at.field("population").ensure(total <= MAX_POPULATION_BITS, || {
+                format!(
+                    "{} individuals of {} bits make {total} bits, more than the limit of {MAX_POPULATION_BITS}",
+                    e.population, s.layout.bits
+                )
+            })
+        }
+    }
+}
