@@ -185,16 +185,11 @@ fn compact_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
 /// life as `evolve::train_stage`'s (the same episode seed and genome).
 fn train_episode(stage: &Stage, index: usize, seed: u64, dir: &Path) -> Result<(), CliError> {
     let StageRun::Train { actions } = stage.run else { return Ok(()) };
-    let opts = EpisodeOptions { actions, learning: true, seed: train_episode_seed(seed, index) };
+    let opts = EpisodeOptions { actions, learning: true, seed: evolve::train::training_seed(seed, index) };
     let genome = Genome::zeros(stage.layout.bits as usize);
     let (_, _, ep) =
         episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
     write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
-}
-
-/// The episode seed of training stage `index`'s life.
-pub fn train_episode_seed(run_seed: u64, index: usize) -> u64 {
-    evolve::seed::episode_seed(run_seed, index, 0, 0, 0)
 }
 
 /// `episode.json` of an evolved stage: one recorded episode of its best
@@ -519,7 +514,8 @@ fn train_step(
     let mut trace = Trace::default();
     let trained = evolve::train_stage(program, index, seed, Some(&mut trace))
         .map_err(|e| CliError::io(format!("error: {e}")))?;
-    let scene = Sim::new(&stage.world, 0).scene();
+    let (sim_seed, _) = episode_rngs(evolve::train::training_seed(seed, index));
+    let scene = Sim::new(&stage.world, sim_seed).scene();
     report::episode_files(dir, &stage.name, stage, &trace, &scene, &[])?;
     write_atomic(&path, to_json(&trained)?.as_bytes())?;
     if args.json {

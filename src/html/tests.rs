@@ -316,7 +316,8 @@ fn a_training_stage_episode_is_the_training_life() {
     let StageRun::Train { actions } = stage.run else { unreachable!() };
     let mut trace = Trace::default();
     let trained = shaping_runtime::evolve::train_stage(&p, i, 5, Some(&mut trace)).unwrap();
-    let opts = EpisodeOptions { actions, learning: true, seed: crate::run::train_episode_seed(5, i) };
+    let opts =
+        EpisodeOptions { actions, learning: true, seed: shaping_runtime::evolve::train::training_seed(5, i) };
     let (result, recorded, ep) =
         run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts).unwrap();
     assert_eq!(result, trained.result);

@@ -34,6 +34,11 @@ pub fn training_fingerprint(stage: &crate::program::Stage) -> u64 {
     fnv1a(&serde_json::to_vec(stage).unwrap_or_default())
 }
 
+/// The episode seed of training stage `index`'s life in a run with `run_seed`.
+pub fn training_seed(run_seed: u64, index: usize) -> u64 {
+    seed::episode_seed(run_seed, index, 0, 0, 0)
+}
+
 /// Runs training stage `index` for one life of its declared length, with
 /// learning on, from an episode seed derived from `run_seed` and the stage.
 pub fn train_stage(
@@ -47,7 +52,7 @@ pub fn train_stage(
     let StageRun::Train { actions } = stage.run else {
         return Err(EvolveError::NotTrained { stage: stage.name.clone() });
     };
-    let episode = seed::episode_seed(run_seed, index, 0, 0, 0);
+    let episode = training_seed(run_seed, index);
     let (sim_seed, rng) = episode_rngs(episode);
     let genome = Genome::zeros(stage.layout.bits as usize);
     let mut ctl = Controller::new(stage, &genome, rng)
