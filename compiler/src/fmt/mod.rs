@@ -927,7 +927,7 @@ impl F<'_> {
             ExprKind::Unary(UnOp::Not, x) => format!("not {}", self.sub(x, 4)),
             ExprKind::Binary(op, a, b) => {
                 let p = level(e);
-                format!("{} {} {}", self.sub(a, p), op_text(*op), self.sub(b, p + 1))
+                format!("{} {} {}", self.sub(a, p), op.text(), self.sub(b, p + 1))
             }
             ExprKind::Cond(c, a, b) => format!("{} ? {} : {}", self.sub(c, 2), self.expr(a), self.sub(b, 1)),
         }
@@ -958,22 +958,5 @@ fn level(e: &Expr) -> u8 {
         ExprKind::Unary(UnOp::Not, _) => 4,
         ExprKind::Unary(..) => 8,
         ExprKind::Number(..) | ExprKind::Ref(..) | ExprKind::Call(..) => 9,
-    }
-}
-
-fn op_text(op: BinOp) -> &'static str {
-    match op {
-        BinOp::Add => "+",
-        BinOp::Sub => "-",
-        BinOp::Mul => "*",
-        BinOp::Div => "/",
-        BinOp::Lt => "<",
-        BinOp::Le => "<=",
-        BinOp::Gt => ">",
-        BinOp::Ge => ">=",
-        BinOp::Eq => "==",
-        BinOp::Ne => "!=",
-        BinOp::And => "and",
-        BinOp::Or => "or",
     }
 }

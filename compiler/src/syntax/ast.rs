@@ -418,20 +418,7 @@ impl Expr {
                 format!("({op} {})", e.sexpr())
             }
             ExprKind::Binary(op, a, b) => {
-                let op = match op {
-                    BinOp::Add => "+",
-                    BinOp::Sub => "-",
-                    BinOp::Mul => "*",
-                    BinOp::Div => "/",
-                    BinOp::Lt => "<",
-                    BinOp::Le => "<=",
-                    BinOp::Gt => ">",
-                    BinOp::Ge => ">=",
-                    BinOp::Eq => "==",
-                    BinOp::Ne => "!=",
-                    BinOp::And => "and",
-                    BinOp::Or => "or",
-                };
+                let op = op.text();
                 format!("({op} {} {})", a.sexpr(), b.sexpr())
             }
             ExprKind::Cond(c, a, b) => format!("(? {} {} {})", c.sexpr(), a.sexpr(), b.sexpr()),
@@ -460,6 +447,26 @@ pub enum BinOp {
     Ne,
     And,
     Or,
+}
+
+impl BinOp {
+    /// The operator as written in the language.
+    pub fn text(self) -> &'static str {
+        match self {
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::And => "and",
+            BinOp::Or => "or",
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -31,24 +31,7 @@ fn sources() -> Vec<(String, String)> {
 
 /// The ```bat blocks of `docs/language.md`.
 fn doc_examples() -> Vec<(String, String)> {
-    let text = std::fs::read_to_string(root().join("docs/language.md")).unwrap();
-    let mut out = Vec::new();
-    let mut lines = text.lines().enumerate();
-    while let Some((i, line)) = lines.next() {
-        if !line.trim_start().starts_with("```bat") {
-            continue;
-        }
-        let mut src = String::new();
-        for (_, l) in lines.by_ref() {
-            if l.trim_start().starts_with("```") {
-                break;
-            }
-            src.push_str(l);
-            src.push('\n');
-        }
-        out.push((format!("language.md:{}", i + 1), src));
-    }
-    out
+    crate::docs::blocks().into_iter().map(|(name, src, _)| (name, src)).collect()
 }
 
 /// The comments of a source, as written (trailing spaces aside).
