@@ -72,10 +72,12 @@ pub(super) fn recover(src: &str) -> (Option<String>, Vec<Error>) {
                 errors.sort_by_key(|e| e.0);
                 return (Some(text), errors.into_iter().map(|e| e.1).collect());
             }
-            Err(e) => match e.location {
-                InputLocation::Pos(p) => p,
-                InputLocation::Span((p, _)) => p,
-            },
+            // Over pest's call budget: what parses is too large to check again.
+            Err(e) if matches!(e.variant, pest::error::ErrorVariant::CustomError { .. }) => {
+                errors.push((0, syntax_error(src, e)));
+                break;
+            }
+            Err(e) => position(&e),
         };
         let Some(k) = parts.iter().position(|&(a, b)| a <= pos && (pos < b || b == src.len())) else { break };
         let (a, b) = parts[k];

@@ -138,3 +138,17 @@ fn many_broken_stages_are_recovered_in_linear_time() {
     assert_eq!(errors.len(), 10_000);
     assert_eq!(file.unwrap().stages.len(), 20_000);
 }
+
+#[test]
+fn recovery_keeps_the_call_budget_on_huge_files() {
+    // 200000 modules in one stage, and a syntax error before or after them:
+    // the answer comes (an error, not a hang), with every error found.
+    let modules = " module m { sense ir behavior forward }\n".repeat(200_000);
+    for (before, after) in [("robot q {\n", ""), ("", " module broken { sense }\n")] {
+        let src = format!("{ROBOT}{before}stage s {{\n fitness per action 1\n{modules}{after}}}\n");
+        let (_, errors) = parse_recovering(&src);
+        assert!(!errors.is_empty());
+        let first = errors[0].to_string();
+        assert!(first.contains("found `stage`") || first.contains("too complex"), "{first}");
+    }
+}
