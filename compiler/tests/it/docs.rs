@@ -99,6 +99,12 @@ mod world_facts {
         let back = sense(&w, 200.0, 600.0 - near, -FRAC_PI_2);
         assert!(back[CH_IR + 6] > 0.5 && back[CH_IR + 7] > 0.5, "ir[6..7] at the back: {back:?}");
         assert!(back[CH_IR..CH_IR + 6].iter().all(|&v| v < 0.01), "{back:?}");
+        // the back pair reaches farther
+        let behind = |gap: f32| {
+            let p = sense(&w, 200.0, 600.0 - RADIUS - gap, -FRAC_PI_2);
+            p[CH_IR + 6].max(p[CH_IR + 7])
+        };
+        assert!(behind(43.0) > 0.01 && behind(60.0) < 0.01, "{} {}", behind(43.0), behind(60.0));
         let ahead = facing_north(5.0);
         assert!(ahead[CH_IR + 2] > 0.99 && ahead[CH_IR + 3] > 0.99, "ir[2..3] ahead: {ahead:?}");
     }
