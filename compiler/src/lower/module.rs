@@ -9,6 +9,9 @@ use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
 use crate::syntax::Span;
 
+/// The words that start an action (`turn toward(...)` starts with `turn`).
+const ACTIONS: [&str; 8] = ["forward", "back", "turn", "stop", "toward", "wait", "recharge", "reinforce"];
+
 impl Lower<'_> {
     /// Declares a new module, or changes an inherited one.
     pub(super) fn module(&mut self, hw: &Hw, modules: &mut Vec<ModuleSt>, m: &ast::ModuleDecl, s: u16) {
@@ -288,7 +291,35 @@ impl Lower<'_> {
         false
     }
 
+    /// Reports a name in the place of an action that is neither an action
+    /// nor an actuator of the stage (`forwrd(1.0)`, `forwrd`, `turm left`).
+    fn unknown_action(&mut self, hw: &Hw, name: &ast::Name) {
+        if self.poisoned.contains(&name.text) || self.hw_origin.contains_key(&name.text) {
+            return self.unknown_hardware(hw, "actuator", name);
+        }
+        let actuators = hw.actuators.iter().map(|a| a.name.as_str());
+        let turn =
+            ["left", "right"].contains(&name.text.as_str()).then(|| format!("write `turn {}`", name.text));
+        self.errors.push(Error::Unknown {
+            span: name.span.into(),
+            what: "action",
+            name: name.text.clone(),
+            help: turn.or_else(|| did_you_mean(&name.text, ACTIONS.into_iter().chain(actuators))).or_else(|| {
+                Some(format!(
+                    "the actions are {}, and an actuator's name with a state or speeds (`arm down`, `wheels(0.5, 0.5)`)",
+                    super::expr::backticked(&ACTIONS)
+                ))
+            }),
+        });
+    }
+
     fn motion(&mut self, hw: &Hw, m: &Motion, span: Span) -> Option<[f32; 2]> {
+        if let Motion::Wheels(name, _) = m {
+            if !hw.actuators.iter().any(|a| a.name == name.text) {
+                self.unknown_action(hw, name);
+                return None;
+            }
+        }
         if !self.has_wheels(hw, span) {
             return None;
         }
@@ -310,7 +341,7 @@ impl Lower<'_> {
                 [v, -v]
             }
             Motion::Stop => [0.0, 0.0],
-            Motion::Wheels(name, l, r) => {
+            Motion::Wheels(name, speeds) => {
                 match hw.actuators.iter().find(|a| a.name == name.text) {
                     Some(a) if a.kind == ActuatorKind::Speed => {}
                     Some(a) => {
@@ -326,12 +357,18 @@ impl Lower<'_> {
                         );
                         return None;
                     }
-                    None => {
-                        self.unknown_hardware(hw, "actuator", name);
-                        return None;
-                    }
+                    None => return None,
                 }
-                [self.speed(Some(*l), span), self.speed(Some(*r), span)]
+                let &[l, r] = &speeds[..] else {
+                    self.value_error(
+                        span,
+                        format!("`{}(LEFT, RIGHT)` takes two speeds, not {}", name.text, speeds.len()),
+                        "two speeds",
+                        Some(format!("write `{}(0.5, -0.5)`, or `forward(0.5)`", name.text)),
+                    );
+                    return None;
+                };
+                [self.speed(Some(l), span), self.speed(Some(r), span)]
             }
         })
     }
@@ -387,7 +424,7 @@ impl Lower<'_> {
                             None,
                         );
                     } else {
-                        self.unknown_hardware(hw, "actuator", actuator);
+                        self.unknown_action(hw, actuator);
                     }
                     return None;
                 };
@@ -401,6 +438,15 @@ impl Lower<'_> {
                     );
                     return None;
                 }
+                let Some(state) = state else {
+                    self.value_error(
+                        *span,
+                        format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
+                        "no state",
+                        Some(format!("write `{} {}`", a.name, info.states[0])),
+                    );
+                    return None;
+                };
                 let Some(i) = info.states.iter().position(|s| *s == state.text) else {
                     self.errors.push(Error::Unknown {
                         span: state.span.into(),

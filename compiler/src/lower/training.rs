@@ -109,6 +109,24 @@ impl Lower<'_> {
                         keep_span = Some(q.span);
                     }
                 }
+                (ast::SettingValue::WordAndNumber(w, q), _) => {
+                    let message = match w.text.as_str() {
+                        "truncation" => "`selection truncation` takes its number after `keep`".to_string(),
+                        "roulette" => "`selection roulette` takes no number".to_string(),
+                        other => {
+                            self.errors.push(Error::Unknown {
+                                span: w.span.into(),
+                                what: "selection",
+                                name: other.to_string(),
+                                help: did_you_mean(other, ["truncation", "roulette"])
+                                    .map(|d| format!("{d} {}", evolve_help("selection")))
+                                    .or_else(|| Some(evolve_help("selection"))),
+                            });
+                            continue;
+                        }
+                    };
+                    self.value_error(q.span, message, "unexpected number", Some(evolve_help("selection")));
+                }
                 (ast::SettingValue::Word(w), "selection") => {
                     if w.text == "roulette" {
                         ev.selection = Selection::Roulette;
