@@ -4,7 +4,7 @@ use shaping_runtime::catalog::{self, ActuatorKind};
 use shaping_runtime::limits::MAX_HIDDEN;
 use shaping_runtime::program::*;
 
-use super::{expr::Scope, Hw, Lower, ModuleSt, Source, DEFAULT_RATES, DEFAULT_WINDOW};
+use super::{expr::Scope, Hw, Lower, ModuleSt, Source, TrainedShape, DEFAULT_RATES, DEFAULT_WINDOW};
 use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
 use crate::syntax::Span;
@@ -616,15 +616,7 @@ impl Lower<'_> {
         shape: (u16, u16, u16),
     ) -> Option<Vec<Param>> {
         let Some((stage, modules)) = self.trained.get(&by.text) else {
-            let help = did_you_mean(&by.text, self.trained.keys().map(String::as_str)).or_else(|| {
-                Some("name a training stage (`train for N actions`) declared before this one".into())
-            });
-            self.errors.push(Error::Unknown {
-                span: by.span.into(),
-                what: "training stage",
-                name: by.text.clone(),
-                help,
-            });
+            self.untrained(by);
             return None;
         };
         let stage = *stage;
@@ -637,11 +629,13 @@ impl Lower<'_> {
             );
             return None;
         };
-        if *found != Some(shape) {
-            let what = match found {
-                Some((i, h, o)) => format!("{i} inputs, {h} hidden and {o} outputs"),
-                None => "a scripted behavior".into(),
-            };
+        let what = match *found {
+            TrainedShape::Network(i, h, o) if (i, h, o) == shape => None,
+            TrainedShape::Failed => return None,
+            TrainedShape::Network(i, h, o) => Some(format!("{i} inputs, {h} hidden and {o} outputs")),
+            TrainedShape::Script => Some("a scripted behavior".to_string()),
+        };
+        if let Some(what) = what {
             self.value_error(
                 span,
                 format!(
@@ -655,6 +649,55 @@ impl Lower<'_> {
         }
         let count = Network::param_count(shape.0 as usize, shape.1 as usize, shape.2 as usize) as u32;
         Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
+    }
+
+    /// Reports `weights trained STAGE` where `STAGE` has trained nothing
+    /// before this stage: it is no stage, no training stage, this stage, or
+    /// a training stage that uses this one's weights in turn. A training
+    /// stage whose own declaration failed was reported already.
+    fn untrained(&mut self, by: &ast::Name) {
+        let file = self.file;
+        let is_training =
+            |s: &ast::StageDecl| s.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }));
+        let Some(decl) = file.stages.iter().find(|s| s.name.text == by.text) else {
+            let training = file.stages.iter().filter(|s| is_training(s)).map(|s| s.name.text.as_str());
+            self.errors.push(Error::Unknown {
+                span: by.span.into(),
+                what: "training stage",
+                name: by.text.clone(),
+                help: did_you_mean(&by.text, training)
+                    .or_else(|| Some("name a training stage (`train for N actions`)".into())),
+            });
+            return;
+        };
+        let current = self.stage_names.last().map(String::as_str);
+        let (message, label, other_label) = if !is_training(decl) {
+            (
+                format!("stage `{}` is not a training stage: it trains no weights", by.text),
+                "not a training stage",
+                "declared here without `train for N actions`",
+            )
+        } else if current == Some(by.text.as_str()) {
+            (format!("stage `{}` uses the weights it trains itself", by.text), "this stage", "declared here")
+        } else if self.stage_names.contains(&by.text) {
+            return;
+        } else {
+            (
+                format!(
+                    "training stage `{}` and this stage use each other's trained weights: neither can train first",
+                    by.text
+                ),
+                "used before it is trained",
+                "declared here",
+            )
+        };
+        self.errors.push(Error::Conflict {
+            span: by.span.into(),
+            other: decl.name.span.into(),
+            message,
+            label: label.into(),
+            other_label: other_label.into(),
+        });
     }
 
     fn learn(&mut self, l: &ast::LearnDecl) -> Option<Learning> {

@@ -15,6 +15,11 @@ impl Lower<'_> {
         use ast::StageItem as I;
         let mut evolve_span = None;
         let mut test_span: Option<Span> = None;
+        let evolve_settings = decl.items.iter().flat_map(|i| match i {
+            I::Evolve(settings, _) => settings.as_slice(),
+            _ => &[],
+        });
+        self.repeated("evolution setting", evolve_settings.map(|s| (s.name.text.clone(), s.span)));
         for item in &decl.items {
             match item {
                 I::Train { actions, span } => {
@@ -260,6 +265,7 @@ impl Lower<'_> {
             }
         }
         const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
+        self.repeated("bonus for the event", f.bonuses.iter().map(|b| (b.event.text.clone(), b.span)));
         for b in &f.bonuses {
             let event = match b.event.text.as_str() {
                 "grip" => Event::Grip,
