@@ -1,19 +1,38 @@
-//! `shaping emulate`: an emulated Khepera on a pseudo-terminal.
+//! `shaping emulate`: an emulated Khepera on a pseudo-terminal (Unix only;
+//! elsewhere the command says so).
 
+#[cfg(unix)]
 use std::io::Write as _;
+#[cfg(unix)]
 use std::os::fd::OwnedFd;
-use std::path::{Path, PathBuf};
+#[cfg(unix)]
+use std::path::Path;
+use std::path::PathBuf;
+#[cfg(unix)]
 use std::sync::atomic::Ordering;
+#[cfg(unix)]
 use std::time::{Duration, Instant};
 
+#[cfg(unix)]
+use rustix::event::{poll, PollFd, PollFlags, Timespec};
+#[cfg(unix)]
 use rustix::fs::{Mode, OFlags};
+#[cfg(unix)]
 use rustix::io::Errno;
+#[cfg(unix)]
 use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+#[cfg(unix)]
+use rustix::termios::{self, ControlModes, OptionalActions};
+#[cfg(unix)]
 use shaping_runtime::robot::protocol::LineBuffer;
+#[cfg(unix)]
 use shaping_runtime::robot::Emulator;
 
-use super::port::{interrupt_flag, make_raw, wait_readable};
-use crate::load::{self, CliError};
+#[cfg(unix)]
+use super::port::interrupt_flag;
+#[cfg(unix)]
+use crate::load;
+use crate::load::CliError;
 
 /// Bits on the wire per byte: start, 8 data, 2 stop bits.
 pub const BITS_PER_BYTE: u64 = 11;
@@ -57,17 +76,59 @@ pub struct EmulateArgs {
 }
 
 /// The paper's architecture, used when no file is given.
+#[cfg(unix)]
 const DEFAULT_FILE: &str = include_str!("../../examples/khepera.bat");
 
+/// Puts a terminal into raw mode at `baud` with 8 data bits and 2 stop bits
+/// (the Khepera's setting), no flow control.
+#[cfg(unix)]
+fn make_raw(fd: &OwnedFd, baud: u32) -> rustix::io::Result<()> {
+    let mut t = termios::tcgetattr(fd)?;
+    t.make_raw();
+    t.control_modes |= ControlModes::CSTOPB | ControlModes::CLOCAL | ControlModes::CREAD;
+    t.set_speed(baud)?;
+    termios::tcsetattr(fd, OptionalActions::Now, &t)
+}
+
+/// Waits until `fd` is readable or `deadline` passes; `Ok(false)` on timeout.
+#[cfg(unix)]
+fn wait_readable(fd: &OwnedFd, deadline: Instant) -> Result<bool, Errno> {
+    loop {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let ts = Timespec { tv_sec: left.as_secs() as _, tv_nsec: left.subsec_nanos() as _ };
+        let mut fds = [PollFd::new(fd, PollFlags::IN)];
+        match poll(&mut fds, Some(&ts)) {
+            Ok(0) => return Ok(false),
+            Ok(_) => {
+                let ev = fds[0].revents();
+                if ev.intersects(PollFlags::IN) {
+                    return Ok(true);
+                }
+                // Hang-up or error without data.
+                return Err(Errno::IO);
+            }
+            Err(Errno::INTR) => {
+                if Instant::now() >= deadline {
+                    return Ok(false);
+                }
+            }
+            Err(e) => return Err(e),
+        }
+    }
+}
+
 /// Removes the symlink at `path` when dropped.
+#[cfg(unix)]
 struct Symlink(PathBuf);
 
+#[cfg(unix)]
 impl Drop for Symlink {
     fn drop(&mut self) {
         let _ = std::fs::remove_file(&self.0);
     }
 }
 
+#[cfg(unix)]
 fn create_pty(port: &Path) -> Result<(OwnedFd, OwnedFd, Symlink), CliError> {
     let err = |e: Errno| CliError::io(format!("error: cannot create a pseudo-terminal: {e}"));
     let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).map_err(err)?;
@@ -97,6 +158,7 @@ fn create_pty(port: &Path) -> Result<(OwnedFd, OwnedFd, Symlink), CliError> {
     Ok((master, slave, Symlink(port.to_path_buf())))
 }
 
+#[cfg(unix)]
 fn write_all(fd: &OwnedFd, mut bytes: &[u8]) -> Result<(), Errno> {
     while !bytes.is_empty() {
         match rustix::io::write(fd, bytes) {
@@ -108,6 +170,17 @@ fn write_all(fd: &OwnedFd, mut bytes: &[u8]) -> Result<(), Errno> {
     Ok(())
 }
 
+/// The emulator needs a pseudo-terminal, which Windows does not have.
+#[cfg(not(unix))]
+pub fn emulate(args: EmulateArgs) -> Result<(), CliError> {
+    Err(CliError::io(format!(
+        "error: `shaping emulate` needs a Unix pseudo-terminal and cannot make `{}` here; \
+         drive a real robot's port, or run the emulator on Linux or macOS",
+        args.port.display()
+    )))
+}
+
+#[cfg(unix)]
 pub fn emulate(args: EmulateArgs) -> Result<(), CliError> {
     let program = match &args.file {
         Some(f) => load::load_program(f, args.error_format)?,
