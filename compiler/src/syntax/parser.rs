@@ -530,6 +530,29 @@ struct Builder {
 }
 
 impl Builder {
+    /// Reports an option given again in one block (`hidden 1 hidden 2`):
+    /// the AST keeps one of each, so the later one would silently win.
+    fn once(&mut self, seen: &mut Vec<(Rule, Span)>, what: &'static str, p: &Pair<Rule>) {
+        let name = match p.as_rule() {
+            Rule::weights_source | Rule::neural_weights => "weights",
+            Rule::hidden => "hidden",
+            Rule::range_setting => "range",
+            Rule::sense => "sense",
+            Rule::outputs => "outputs",
+            _ => return,
+        };
+        let key = if p.as_rule() == Rule::neural_weights { Rule::weights_source } else { p.as_rule() };
+        match seen.iter().find(|(r, _)| *r == key) {
+            Some((_, first)) => self.errors.push(Error::Duplicate {
+                span: span(p).into(),
+                first: (*first).into(),
+                what,
+                name: name.into(),
+            }),
+            None => seen.push((key, span(p))),
+        }
+    }
+
     fn file(&mut self, p: Pair<Rule>) -> File {
         let mut f = File { robots: vec![], genomes: vec![], stages: vec![] };
         for item in p.into_inner() {
@@ -648,7 +671,9 @@ impl Builder {
                 Rule::sense => items.push(ModuleItem::Sense(c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::activation => {
                     let mut a = ActivationDecl { source: None, hidden: None, range: None, span: csp };
+                    let mut seen = Vec::new();
                     for o in c.into_inner() {
+                        self.once(&mut seen, "activation option", &o);
                         match o.as_rule() {
                             Rule::weights_source => a.source = Some(weight_source(o)),
                             Rule::hidden => a.hidden = o.into_inner().nth(1).map(quantity),
@@ -730,8 +755,10 @@ impl Builder {
     fn neural(&mut self, p: Pair<Rule>) -> NeuralDecl {
         let sp = span(&p);
         let mut n = NeuralDecl { sense: None, hidden: None, outputs: None, weights: None, span: sp };
+        let mut seen = Vec::new();
         for c in p.into_inner() {
             let csp = span(&c);
+            self.once(&mut seen, "neural option", &c);
             match c.as_rule() {
                 Rule::sense => n.sense = Some((c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::hidden => n.hidden = c.into_inner().nth(1).map(quantity),
