@@ -18,7 +18,7 @@ use serde_json::Value;
 use shaping_compiler::fmt::{lex, Token, TokenKind};
 use shaping_compiler::lower::lower_partial;
 use shaping_compiler::syntax::{self, ast, parse_recovering};
-use shaping_compiler::{compile, render_layout, Program};
+use shaping_compiler::{render_layout, Program};
 
 use crate::load::CliError;
 
@@ -169,9 +169,10 @@ fn range(text: &str, start: usize, end: usize) -> lt::Range {
 
 // ------------------------------------------------------------------ diagnostics
 
-/// Every error of the document, with the related labels as related information.
+/// Every error and warning of the document, with the related labels as
+/// related information.
 pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
-    let Err(d) = compile(text, "document.bat") else { return vec![] };
+    let (_, d) = shaping_compiler::check(text, "document.bat");
     d.errors()
         .iter()
         .map(|e| {
@@ -195,7 +196,11 @@ pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
                 .collect();
             lt::Diagnostic {
                 range: r,
-                severity: Some(lt::DiagnosticSeverity::ERROR),
+                severity: Some(if e.is_warning() {
+                    lt::DiagnosticSeverity::WARNING
+                } else {
+                    lt::DiagnosticSeverity::ERROR
+                }),
                 source: Some("shaping".into()),
                 message,
                 related_information: (!related.is_empty()).then_some(related),

@@ -528,8 +528,14 @@ fn print_text(text: &str) {
 fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     let mut worst: Option<CliError> = None;
     for file in files {
-        match load::load_program(file, format) {
-            Ok(program) => {
+        match load::load_program_warnings(file, format) {
+            Ok((program, warnings)) => {
+                // Warnings do not change the exit code.
+                match warnings {
+                    Some(w) if format == ErrorFormat::Json => println!("{}", w.trim_end()),
+                    Some(w) => eprintln!("{}", w.trim_end()),
+                    None => {}
+                }
                 if format != ErrorFormat::Json {
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();

@@ -92,6 +92,30 @@ fn check_reports_diagnostics_with_exit_1() {
 }
 
 #[test]
+fn check_prints_warnings_and_exits_0() {
+    let dir = scratch("warn");
+    let file = dir.join("typo.bat");
+    std::fs::write(
+        &file,
+        "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+         stage s { fitness per action wheels[0]  module wander { sense ir  behavior forward } }\n\
+         stage t extends s { module wandr { sense ir  behavior back } }\n",
+    )
+    .unwrap();
+    let out = run(shaping().arg("check").arg(&file).arg("--error-format").arg("plain"));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    assert!(err.contains("new module `wandr` is one edit away from inherited module `wander`"), "{err}");
+    assert!(text(&out.stdout).contains("typo.bat: ok"), "{}", text(&out.stdout));
+
+    let json = run(shaping().arg("check").arg(&file).arg("--error-format").arg("json"));
+    assert_eq!(json.status.code(), Some(0));
+    let first = text(&json.stdout).lines().next().unwrap_or_default().to_string();
+    let v: serde_json::Value = serde_json::from_str(&first).unwrap();
+    assert_eq!(v["related"][0]["severity"], "warning", "{v}");
+}
+
+#[test]
 fn bad_inputs_give_an_error_never_a_panic() {
     let dir = scratch("bad-inputs");
     let cases: Vec<(&str, Vec<u8>)> = vec![

@@ -196,6 +196,21 @@ fn diagnostics_as_you_type_with_related_information() {
 }
 
 #[test]
+fn warnings_have_the_warning_severity() {
+    let mut c = Client::start();
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+               stage s { fitness per action wheels[0]  module wander { sense ir  behavior forward } }\n\
+               stage t extends s { module wandr { sense ir  behavior back } }\n";
+    let d = c.open(URI, src);
+    assert_eq!(d.len(), 1, "{d:?}");
+    // 2 is `DiagnosticSeverity::WARNING`
+    assert_eq!(d[0]["severity"], json!(2), "{d:?}");
+    assert!(d[0]["message"].as_str().unwrap().contains("`wandr`"), "{d:?}");
+    assert_eq!(d[0]["relatedInformation"][0]["message"], json!("inherited from stage `s`"));
+    c.stop();
+}
+
+#[test]
 fn hover_definition_references_completion_symbols_and_formatting() {
     let mut c = Client::start();
     let src = example("khepera.bat");

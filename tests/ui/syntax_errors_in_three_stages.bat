@@ -5,7 +5,7 @@ stage first {
   module go { sense ir[2..3]  behavior forward }
 }
 stage second extends first {
-  module turn { sense ir[0..1]  behavior turn }
+  module turn { sense ir[0..1]  behavior forward(0.5 }
   links all evolvable
 }
 stage third extends second {

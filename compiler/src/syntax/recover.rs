@@ -14,7 +14,7 @@
 use pest::error::InputLocation;
 use pest::Parser as _;
 
-use super::parser::{syntax_error, BatParser, Rule};
+use super::parser::{syntax_error, syntax_error_shifted, BatParser, Rule};
 use crate::diag::Error;
 use crate::fmt::{lex, Token, TokenKind};
 
@@ -276,9 +276,9 @@ fn located(src: &str, e: pest::error::Error<Rule>, a: usize, b: usize) -> Error 
 }
 
 /// A pest error placed at `pos` of the whole source.
-fn at(src: &str, mut e: pest::error::Error<Rule>, pos: usize) -> Error {
-    e.location = InputLocation::Pos(pos);
-    syntax_error(src, e)
+fn at(src: &str, e: pest::error::Error<Rule>, pos: usize) -> Error {
+    let shift = pos as isize - position(&e) as isize;
+    syntax_error_shifted(src, e, shift)
 }
 
 /// Replaces `a..b` by spaces, keeping line breaks (so every position keeps

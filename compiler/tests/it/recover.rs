@@ -36,7 +36,7 @@ fn lines(src: &str, errors: &[Error]) -> Vec<usize> {
 fn three_errors_in_three_stages_are_reported_at_once() {
     let src = format!(
         "{ROBOT}stage a {{\n  fitness per action wheels[0] +\n  module m {{ sense ir  behavior forward }}\n}}\n\
-         stage b extends a {{\n  module n {{ sense ir  behavior turn }}\n}}\n\
+         stage b extends a {{\n  module n {{ sense ir  behavior forward(0.5 }}\n}}\n\
          stage c extends b {{\n  link m -> n evolvable range 0..\n}}\n"
     );
     let d = compile(&src, "three.bat").unwrap_err();
