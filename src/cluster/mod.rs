@@ -70,4 +70,15 @@ impl Coordinator {
     pub fn set_context(&self, _: String, _: &std::path::Path) {
         match *self {}
     }
+    pub fn distributes(&self, _: usize) -> bool {
+        match *self {}
+    }
+    pub fn run_tasks(
+        &self,
+        _: &[(u32, u64)],
+        _: &(dyn Fn((u32, u64), usize) -> Result<(), crate::load::CliError> + Sync + '_),
+        _: &dyn Fn((u32, u64)) -> String,
+    ) -> Result<(), crate::load::CliError> {
+        match *self {}
+    }
 }

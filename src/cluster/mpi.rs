@@ -29,10 +29,14 @@ const POLL: Duration = Duration::from_micros(100);
 /// Initialises MPI and runs `body` on rank 0 with the coordinator; the other
 /// ranks serve batches until rank 0 is done. `jobs` is the rayon thread count
 /// of each rank (default: the node's cores shared among its ranks).
+///
+/// `tasks` runs a whole task (a seed of a sweep point) on a worker rank with
+/// the given threads, when rank 0 hands tasks out ([`Coordinator::run_tasks`]).
 pub fn with_mpi(
     jobs: Option<usize>,
     rank_timeout: u64,
     quiet: bool,
+    tasks: Option<&TaskRunner<'_>>,
     body: impl FnOnce(&Coordinator) -> Result<(), CliError>,
 ) -> Result<(), CliError> {
     let Some((universe, _)) = mpi::initialize_with_threading(Threading::Funneled) else {
@@ -48,7 +52,7 @@ pub fn with_mpi(
         .build()
         .map_err(|e| CliError::io(format!("error: rank {rank}: cannot start worker threads: {e}")))?;
     if rank != 0 {
-        return serve(&world, &pool);
+        return serve(&world, &pool, threads, tasks);
     }
     let term = Arc::new(AtomicBool::new(false));
     signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&term))
@@ -58,6 +62,7 @@ pub fn with_mpi(
         world,
         size,
         pool,
+        threads,
         timeout: Duration::from_secs(rank_timeout.max(1)),
         term,
         host,
@@ -71,11 +76,17 @@ pub fn with_mpi(
     result
 }
 
-/// Rank 0's side: spreads the episodes of a generation over the ranks.
+/// Runs one task (a point of a sweep and a seed) with this many threads.
+pub type TaskRunner<'a> = dyn Fn((u32, u64), usize) -> Result<(), CliError> + Sync + 'a;
+
+/// Rank 0's side: spreads the episodes of a generation, or whole tasks, over
+/// the ranks.
 pub struct Coordinator {
     world: SimpleCommunicator,
     size: usize,
     pool: rayon::ThreadPool,
+    /// Threads of each rank's pool (and of a task run on rank 0).
+    threads: usize,
     timeout: Duration,
     term: Arc<AtomicBool>,
     host: String,
@@ -105,6 +116,9 @@ struct Worker {
 
 #[derive(Default)]
 struct Stats {
+    /// Whole tasks run, and those run on other ranks.
+    tasks: u64,
+    remote_tasks: u64,
     rounds: u64,
     episodes: u64,
     remote_episodes: u64,
@@ -226,6 +240,9 @@ impl Coordinator {
                             done += 1;
                         }
                         Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
+                        Request::Done { .. } => {
+                            self.fatal(&st, format!("rank {rank} reported a task it was not given"))
+                        }
                     }
                     give(&mut st, rank, &mut outstanding);
                 }
@@ -270,6 +287,124 @@ impl Coordinator {
         st.stats.remote_episodes += remote;
         st.stats.wall += started.elapsed();
         results.into_iter().flatten().flatten().collect()
+    }
+
+    /// Whether an experiment of `tasks` tasks hands whole tasks to ranks
+    /// ([`wire::distribute_tasks`]).
+    pub fn distributes(&self, tasks: usize) -> bool {
+        wire::distribute_tasks(tasks, self.size)
+    }
+
+    /// Runs whole tasks over the ranks: each rank (rank 0 on a thread of its
+    /// own) runs a task at a time and writes its files, asking for the next
+    /// when it reports the last done; rank 0 only hands them out.
+    pub fn run_tasks(
+        &self,
+        tasks: &[(u32, u64)],
+        run: &TaskRunner<'_>,
+        describe: &dyn Fn((u32, u64)) -> String,
+    ) -> Result<(), CliError> {
+        let started = Instant::now();
+        let mut st = self.state.borrow_mut();
+        let count = tasks.len();
+        let next = AtomicUsize::new(0);
+        let mut done = 0;
+        let mut outstanding: HashMap<Rank, (usize, Instant)> = HashMap::new();
+        let mut remote = 0u64;
+        std::thread::scope(|s| {
+            let (tx, rx) = mpsc::channel();
+            let (next, threads) = (&next, self.threads);
+            s.spawn(move || loop {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                if k >= count {
+                    break;
+                }
+                let result = run(tasks[k], threads);
+                let failed = result.is_err();
+                if tx.send((k, result)).is_err() || failed {
+                    break;
+                }
+            });
+            let give = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
+                let k = next.fetch_add(1, Ordering::SeqCst);
+                if k < count {
+                    let (point, seed) = tasks[k];
+                    self.send(st, rank, &Reply::Task { point, seed }.encode());
+                    outstanding.insert(rank, (k, Instant::now()));
+                } else if !st.idle.contains(&rank) {
+                    st.idle.push(rank);
+                }
+            };
+            let waiting = std::mem::take(&mut st.idle);
+            for rank in waiting {
+                give(&mut st, rank, &mut outstanding);
+            }
+            while done < count {
+                let mut busy = false;
+                while let Some((rank, request)) = self.poll(&mut st) {
+                    busy = true;
+                    match request {
+                        Request::Hello { pid, host } => {
+                            st.workers.insert(rank, Worker { pid, host, version: 0 });
+                        }
+                        Request::Ready => {}
+                        Request::Done { point, seed } => {
+                            let Some((k, _)) = outstanding.remove(&rank) else {
+                                self.fatal(&st, format!("rank {rank} reported a task it was not given"));
+                            };
+                            if tasks[k] != (point, seed) {
+                                self.fatal(
+                                    &st,
+                                    format!("rank {rank} reported task ({point}, {seed}) for task {k}"),
+                                );
+                            }
+                            done += 1;
+                            remote += 1;
+                            eprintln!("{} done on rank {rank} ({done}/{count})", describe(tasks[k]));
+                        }
+                        Request::Results { .. } => {
+                            self.fatal(&st, format!("rank {rank} sent results it was not asked for"))
+                        }
+                        Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
+                    }
+                    give(&mut st, rank, &mut outstanding);
+                }
+                while let Ok((k, result)) = rx.try_recv() {
+                    busy = true;
+                    if let Err(e) = result {
+                        self.fatal(
+                            &st,
+                            format!(
+                                "rank 0, {}: {}",
+                                describe(tasks[k]),
+                                e.to_string().trim_start_matches("error: ")
+                            ),
+                        );
+                    }
+                    done += 1;
+                    eprintln!("{} done on rank 0 ({done}/{count})", describe(tasks[k]));
+                }
+                if let Some((&rank, &(k, _))) =
+                    outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout)
+                {
+                    let who = self.who(&st, rank);
+                    let msg = format!(
+                        "{who} did not report {} within {} s: it died or hangs (`--rank-timeout` sets the limit for a whole seed)",
+                        describe(tasks[k]),
+                        self.timeout.as_secs(),
+                    );
+                    self.fatal(&st, msg);
+                }
+                self.check_term(&st, &outstanding);
+                if !busy {
+                    std::thread::sleep(POLL);
+                }
+            }
+        });
+        st.stats.tasks += count as u64;
+        st.stats.remote_tasks += remote;
+        st.stats.wall += started.elapsed();
+        Ok(())
     }
 
     /// Makes `program` the one batches refer to (a new version when it changed).
@@ -337,7 +472,7 @@ impl Coordinator {
                         st.workers.insert(rank, Worker { pid, host, version: 0 });
                     }
                     Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
-                    Request::Ready | Request::Results { .. } => {}
+                    Request::Ready | Request::Results { .. } | Request::Done { .. } => {}
                 }
                 if !st.idle.contains(&rank) {
                     st.idle.push(rank);
@@ -369,6 +504,18 @@ impl Coordinator {
         let st = self.state.borrow();
         let s = &st.stats;
         let rounds = s.rounds.max(1) as f64;
+        if s.tasks > 0 {
+            eprintln!(
+                "mpi: {} ranks x {threads} threads; {} tasks (whole seeds), {} on other ranks, in {:.2} s; {} messages, {:.1} us each",
+                self.size,
+                s.tasks,
+                s.remote_tasks,
+                s.wall.as_secs_f64(),
+                s.messages,
+                s.in_mpi.as_secs_f64() * 1e6 / s.messages.max(1) as f64,
+            );
+            return;
+        }
         eprintln!(
             "mpi: {} ranks x {threads} threads; {} rounds, {} episodes ({} on other ranks), {:.0} episodes/s; {} messages, {:.2} MB, {:.1} us each; rank 0 spent {:.3} ms per round in sends and receives, {:.1} ms per round in all",
             self.size,
@@ -441,7 +588,12 @@ fn alive(pid: u32) -> bool {
 }
 
 /// A worker rank: evaluates the batches rank 0 sends until told to stop.
-fn serve(world: &SimpleCommunicator, pool: &rayon::ThreadPool) -> Result<(), CliError> {
+fn serve(
+    world: &SimpleCommunicator,
+    pool: &rayon::ThreadPool,
+    threads: usize,
+    tasks: Option<&TaskRunner<'_>>,
+) -> Result<(), CliError> {
     let root = world.process_at_rank(0);
     let send = |r: Request| root.send_with_tag(&r.encode()[..], TAG_REQUEST);
     let receive = || loop {
@@ -464,6 +616,13 @@ fn serve(world: &SimpleCommunicator, pool: &rayon::ThreadPool) -> Result<(), Cli
         match Reply::decode(&receive()) {
             Err(e) => fail(format!("cannot read a message from rank 0: {e}")),
             Ok(Reply::Stop) => return Ok(()),
+            Ok(Reply::Task { point, seed }) => {
+                let Some(run) = tasks else { fail("a task came to a rank that runs no experiment".into()) };
+                match run((point, seed), threads) {
+                    Ok(()) => send(Request::Done { point, seed }),
+                    Err(e) => fail(e.to_string().trim_start_matches("error: ").to_string()),
+                }
+            }
             Ok(Reply::Load { version, program: json }) => match serde_json::from_slice::<Program>(&json) {
                 Ok(p) => {
                     program = Some((version, p));
