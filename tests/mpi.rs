@@ -115,6 +115,37 @@ fn experiment_on_three_ranks_matches_one_process() {
     assert_same_files(&one, &three);
 }
 
+/// A sweep of 2 points over 2 seeds on 3 ranks: 4 tasks, so whole seeds go to
+/// ranks; every file is the single process's, byte for byte.
+#[test]
+fn a_sweep_on_three_ranks_hands_out_whole_seeds_and_matches_one_process() {
+    let dir = scratch("sweep");
+    let tiny = root().join("tests/cli/tiny.bat");
+    let args = |out: &Path| {
+        vec![
+            "experiment".into(),
+            tiny.clone().into_os_string(),
+            "--seeds".into(),
+            "2".into(),
+            "--set".into(),
+            "first.evolve.mutation=0.01,0.2".into(),
+            "--no-report".into(),
+            "--out".into(),
+            out.into(),
+        ]
+    };
+    let one = dir.join("one");
+    ok(single().args(args(&one)));
+    let three = dir.join("three");
+    let done = ok(mpirun(3).args(args(&three)));
+    let err = String::from_utf8_lossy(&done.stderr);
+    assert!(err.contains("mpi: 3 ranks") && err.contains("4 tasks (whole seeds)"), "no task summary:\n{err}");
+    assert!(err.contains("done on rank 1") || err.contains("done on rank 2"), "no task ran on another rank:\n{err}");
+    assert!(three.join("summary.json").exists());
+    assert!(three.join("first.evolve.mutation=0.2/seed-2/second/best.genome").exists());
+    assert_same_files(&one, &three);
+}
+
 /// The pid of rank `rank` among the children of `mpirun`.
 fn rank_pid(mpirun: u32, rank: usize) -> Option<u32> {
     let want = format!("OMPI_COMM_WORLD_RANK={rank}");
