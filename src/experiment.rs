@@ -220,6 +220,7 @@ impl Plan {
             let md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
             write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
             print!("{md}");
+            sweep_plot(&self.out.join("sweep"), &title, &table)?;
         }
         Ok(())
     }
@@ -251,6 +252,35 @@ pub fn experiment(plan: &Plan, cluster: Option<&crate::cluster::Coordinator>) ->
     plan.finish()
 }
 
+/// `sweep.svg`/`.png`: each evolved stage's chosen best per point.
+fn sweep_plot(
+    stem: &Path,
+    title: &str,
+    table: &[(Vec<Assignment>, Vec<serde_json::Value>)],
+) -> Result<(), CliError> {
+    let Some((_, first)) = table.first() else { return Ok(()) };
+    let series: Vec<plot::SweepSeries> = first
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s["kind"] == "evolve")
+        .map(|(k, s)| plot::SweepSeries {
+            stage: s["stage"].as_str().unwrap_or("").to_string(),
+            values: table
+                .iter()
+                .map(|(_, stages)| {
+                    let c = &stages[k]["chosen_best"];
+                    Some((c["median"].as_f64()?, c["min"].as_f64()?, c["max"].as_f64()?))
+                })
+                .collect(),
+        })
+        .collect();
+    if series.is_empty() {
+        return Ok(());
+    }
+    plot::sweep_points(stem, &format!("{title}: chosen best per point over the seeds"), &series)
+        .map_err(|e| CliError::io(format!("error: {e}")))
+}
+
 /// The sweep's `summary.md`: one row per point, the median (min .. max)
 /// over seeds of each evolved stage's final best, chosen best and the
 /// generation reaching its criterion.
@@ -270,7 +300,8 @@ fn sweep_table(
     );
     let _ =
         writeln!(md, "Median (min .. max) over seeds; each point's own `summary.md` is in its directory.\n");
-    let mut head: Vec<String> = sets.iter().map(|s| format!("`{}`", s.target)).collect();
+    let mut head: Vec<String> = vec!["point".to_string()];
+    head.extend(sets.iter().map(|s| format!("`{}`", s.target)));
     let evolved: Vec<(String, bool)> = table.first().map_or_else(Vec::new, |(_, stages)| {
         stages
             .iter()
@@ -295,8 +326,9 @@ fn sweep_table(
         (Some(m), Some(a), Some(b)) => fmt_spread(Some(Spread { median: m, min: a, max: b }), digits),
         _ => "-".to_string(),
     };
-    for (point, stages) in table {
-        let mut row: Vec<String> = point.iter().map(|(_, v)| v.clone()).collect();
+    for (i, (point, stages)) in table.iter().enumerate() {
+        let mut row: Vec<String> = vec![(i + 1).to_string()];
+        row.extend(point.iter().map(|(_, v)| v.clone()));
         for s in stages.iter().filter(|s| s["kind"] == "evolve") {
             row.push(cell(&s["final_best"], 3));
             row.push(cell(&s["chosen_best"], 3));
@@ -312,6 +344,8 @@ fn sweep_table(
         }
         let _ = writeln!(md, "| {} |", row.join(" | "));
     }
+    let _ =
+        writeln!(md, "\nPicture: `sweep.svg` / `sweep.png` (each evolved stage's chosen best per point).");
     md
 }
 

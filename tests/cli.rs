@@ -657,13 +657,12 @@ fn a_sweep_point_is_the_run_with_its_settings() {
     assert!((first["chosen_best"]["max"].as_f64().unwrap() - hi).abs() < 1e-6, "{first}");
     assert!((first["chosen_best"]["median"].as_f64().unwrap() - (lo + hi) / 2.0).abs() < 1e-6, "{first}");
     let md = std::fs::read_to_string(dir.join("sweep/summary.md")).unwrap();
-    assert!(
-        md.contains(
-            "| `first.evolve.mutation` | `first.world.battery` | first final best | first chosen best |"
-        ),
-        "{md}"
-    );
-    assert_eq!(md.lines().filter(|l| l.starts_with("| 0.")).count(), 4, "{md}");
+    let head =
+        "| point | `first.evolve.mutation` | `first.world.battery` | first final best | first chosen best |";
+    assert!(md.contains(head), "{md}");
+    assert!(md.contains("| 3 | 0.2 | 100 | "), "{md}");
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ") && l.contains(" | 0.")).count(), 4, "{md}");
+    assert!(dir.join("sweep/sweep.svg").exists() && dir.join("sweep/sweep.png").exists());
     assert!(dir.join("sweep").join(point).join("summary.md").exists(), "no summary of the point");
 }
 

@@ -140,7 +140,10 @@ fn a_sweep_on_three_ranks_hands_out_whole_seeds_and_matches_one_process() {
     let done = ok(mpirun(3).args(args(&three)));
     let err = String::from_utf8_lossy(&done.stderr);
     assert!(err.contains("mpi: 3 ranks") && err.contains("4 tasks (whole seeds)"), "no task summary:\n{err}");
-    assert!(err.contains("done on rank 1") || err.contains("done on rank 2"), "no task ran on another rank:\n{err}");
+    assert!(
+        err.contains("done on rank 1") || err.contains("done on rank 2"),
+        "no task ran on another rank:\n{err}"
+    );
     assert!(three.join("summary.json").exists());
     assert!(three.join("first.evolve.mutation=0.2/seed-2/second/best.genome").exists());
     assert_same_files(&one, &three);

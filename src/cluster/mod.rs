@@ -8,8 +8,13 @@
 //! simply takes fewer batches. Rank 0 evaluates too, on a second thread,
 //! while its main thread answers the others. Results are put back in episode
 //! order, and an episode's result depends only on its genome and seed, so
-//! the files are bit-identical for any number of ranks. The messages are in
-//! [`wire`]; the MPI side is in `mpi.rs` (only with the feature).
+//! the files are bit-identical for any number of ranks.
+//!
+//! An experiment with at least as many tasks (a seed of a sweep point) as
+//! ranks runs whole tasks instead: rank 0 hands one out per request, each
+//! rank runs the seed as a single process would and writes its files, and
+//! reports it done. The messages are in [`wire`]; the MPI side is in
+//! `mpi.rs` (only with the feature).
 
 #[cfg(feature = "mpi")]
 mod mpi;
