@@ -201,10 +201,6 @@ impl Plan {
                 serde_json::json!({ "name": name, "dir": dir_name, "settings": settings, "stages": stages }),
             );
             table.push((point.clone(), stages));
-            if !self.args.no_report {
-                let path = crate::html::write(&dir, None)?;
-                eprintln!("report: {}", path.display());
-            }
         }
         let sets: Vec<serde_json::Value> = self
             .args
@@ -221,6 +217,17 @@ impl Plan {
             write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
             print!("{md}");
             sweep_plot(&self.out.join("sweep"), &title, &table)?;
+        }
+        if !self.args.no_report {
+            // After `summary.json`: a point's report lists the sweep's points.
+            for i in 0..self.points.len() {
+                let path = crate::html::write(&self.point_dir(i), None)?;
+                eprintln!("report: {}", path.display());
+            }
+            if !self.args.sets.is_empty() {
+                let path = crate::html::write(&self.out, None)?;
+                eprintln!("report: {}", path.display());
+            }
         }
         Ok(())
     }

@@ -763,3 +763,38 @@ fn a_killed_sweep_resumes_to_the_same_result() {
         assert!(xa == xb, "{} differs after resuming", pa.display());
     }
 }
+
+/// The report of a sweep shows its best point and lists every point; a
+/// point's report lists them too, its own highlighted.
+#[test]
+fn the_report_of_a_sweep_lists_its_points() {
+    let dir = scratch("sweep-report");
+    let out = run(shaping()
+        .arg("experiment")
+        .arg(tiny())
+        .args(["--seeds", "2", "--set", "first.evolve.mutation=0.01,0.2"])
+        .arg("--out")
+        .arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let root = report_data(&dir.join("report.html"));
+    assert_eq!(root["kind"], "sweep");
+    let names: Vec<&str> =
+        root["sweep"]["points"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["first.evolve.mutation=0.01", "first.evolve.mutation=0.2"]);
+    // The point shown is the one with the highest median chosen best of the last evolved stage.
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+    let score = |i: usize| summary["points"][i]["stages"][1]["chosen_best"]["median"].as_f64().unwrap();
+    let best = if score(1) > score(0) { names[1] } else { names[0] };
+    assert_eq!(root["sweep_point"], best);
+    assert_eq!(root["seeds"], serde_json::json!([1, 2]));
+    let point = report_data(&dir.join("first.evolve.mutation=0.2/report.html"));
+    assert_eq!(point["kind"], "experiment");
+    assert_eq!(point["sweep_point"], "first.evolve.mutation=0.2");
+    assert_eq!(point["sweep"]["points"].as_array().unwrap().len(), 2);
+    // An experiment that is no sweep's point lists none.
+    let alone = scratch("exp-no-sweep");
+    let out = run(shaping().arg("experiment").arg(tiny()).args(["--seeds", "1"]).arg("--out").arg(&alone));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(report_data(&alone.join("report.html")).get("sweep").is_none());
+}
