@@ -82,7 +82,7 @@ impl Coordinator {
         &self,
         _: &[(u32, u64)],
         _: &(dyn Fn((u32, u64), usize) -> Result<(), crate::load::CliError> + Sync + '_),
-        _: &dyn Fn((u32, u64)) -> String,
+        _: &(dyn Fn((u32, u64)) -> String + Sync),
     ) -> Result<(), crate::load::CliError> {
         match *self {}
     }

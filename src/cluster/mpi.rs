@@ -160,133 +160,63 @@ impl Coordinator {
         }
         self.load(&mut st, program);
         let bounds = wire::batches(jobs.len(), self.size);
-        let count = bounds.len();
         let base = st.next_batch;
-        st.next_batch += count as u64;
-        let next = AtomicUsize::new(0);
-        let mut results: Vec<Option<Vec<Evaluation>>> = vec![None; count];
-        let mut done = 0;
-        let mut outstanding: HashMap<Rank, (usize, Instant)> = HashMap::new();
-        let mut remote = 0u64;
-        std::thread::scope(|s| {
-            let (tx, rx) = mpsc::channel();
-            let (next, bounds, pool) = (&next, &bounds, &self.pool);
-            s.spawn(move || loop {
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                if k >= count {
-                    break;
-                }
-                let (a, b) = bounds[k];
-                let out = pool.install(|| super::evaluate_local(stage, actions, &jobs[a..b]));
-                if tx.send((k, out)).is_err() {
-                    break;
-                }
-            });
-            let mut local_gone = false;
-            // Hands the next batch (or the program first) to a waiting worker.
-            let give = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
-                let version = st.version;
-                let known = st.workers.get(&rank).map_or(0, |w| w.version);
-                if known != version {
-                    let msg = Reply::Load { version, program: st.program.clone() }.encode();
-                    self.send(st, rank, &msg);
-                    if let Some(w) = st.workers.get_mut(&rank) {
-                        w.version = version;
-                    }
-                    return;
-                }
-                let k = next.fetch_add(1, Ordering::SeqCst);
-                if k < count {
-                    let (a, b) = bounds[k];
-                    let msg =
-                        Reply::encode_work(version, base + k as u64, index as u32, actions, &jobs[a..b]);
-                    self.send(st, rank, &msg);
-                    outstanding.insert(rank, (k, Instant::now()));
-                } else if !st.idle.contains(&rank) {
-                    st.idle.push(rank);
-                }
-            };
-            let waiting = std::mem::take(&mut st.idle);
-            for rank in waiting {
-                give(&mut st, rank, &mut outstanding);
+        st.next_batch += bounds.len() as u64;
+        let version = st.version;
+        let pool = &self.pool;
+        let local = |k: usize| {
+            let (a, b) = bounds[k];
+            Ok(pool.install(|| super::evaluate_local(stage, actions, &jobs[a..b])))
+        };
+        // A worker that has not loaded this program gets it first.
+        let prepare = |st: &mut State, rank: Rank| {
+            let known = st.workers.get(&rank).map_or(0, |w| w.version);
+            if known == version {
+                return false;
             }
-            while done < count {
-                let mut busy = false;
-                while let Some((rank, request)) = self.poll(&mut st) {
-                    busy = true;
-                    match request {
-                        Request::Hello { pid, host } => {
-                            st.workers.insert(rank, Worker { pid, host, version: 0 });
-                        }
-                        Request::Ready => {}
-                        Request::Results { batch, evaluations } => {
-                            let Some((k, _)) = outstanding.remove(&rank) else {
-                                self.fatal(&st, format!("rank {rank} sent results it was not asked for"));
-                            };
-                            let (a, b) = bounds[k];
-                            if batch != base + k as u64 || evaluations.len() != b - a {
-                                self.fatal(
-                                    &st,
-                                    format!(
-                                        "rank {rank} answered batch {} with {} results for batch {batch}, {} expected",
-                                        base + k as u64,
-                                        evaluations.len(),
-                                        b - a
-                                    ),
-                                );
-                            }
-                            remote += evaluations.len() as u64;
-                            results[k] = Some(evaluations);
-                            done += 1;
-                        }
-                        Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
-                        Request::Done { .. } => {
-                            self.fatal(&st, format!("rank {rank} reported a task it was not given"))
-                        }
-                    }
-                    give(&mut st, rank, &mut outstanding);
-                }
-                loop {
-                    match rx.try_recv() {
-                        Ok((k, out)) => {
-                            results[k] = Some(out);
-                            done += 1;
-                            busy = true;
-                        }
-                        Err(mpsc::TryRecvError::Empty) => break,
-                        Err(mpsc::TryRecvError::Disconnected) => {
-                            local_gone = true;
-                            break;
-                        }
-                    }
-                }
-                if local_gone
-                    && done < count
-                    && outstanding.is_empty()
-                    && next.load(Ordering::SeqCst) >= count
+            let msg = Reply::Load { version, program: st.program.clone() }.encode();
+            self.send(st, rank, &msg);
+            if let Some(w) = st.workers.get_mut(&rank) {
+                w.version = version;
+            }
+            true
+        };
+        let give = |k: usize| {
+            let (a, b) = bounds[k];
+            Reply::encode_work(version, base + k as u64, index as u32, actions, &jobs[a..b])
+        };
+        let take = |st: &State, rank: Rank, k: usize, request: Request| {
+            let (a, b) = bounds[k];
+            match request {
+                Request::Results { batch, evaluations }
+                    if batch == base + k as u64 && evaluations.len() == b - a =>
                 {
-                    self.fatal(&st, "an evaluation on rank 0 failed".into());
+                    evaluations
                 }
-                if let Some((&rank, _)) = outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout) {
-                    let who = self.who(&st, rank);
-                    let msg = format!(
-                        "{who} did not answer within {} s during {}: it died or hangs (`--rank-timeout` sets the limit)",
-                        self.timeout.as_secs(),
-                        st.context
-                    );
-                    self.fatal(&st, msg);
-                }
-                self.check_term(&st, &outstanding);
-                if !busy {
-                    std::thread::sleep(POLL);
-                }
+                Request::Results { batch, evaluations } => self.fatal(
+                    st,
+                    format!(
+                        "rank {rank} answered batch {} with {} results for batch {batch}, {} expected",
+                        base + k as u64,
+                        evaluations.len(),
+                        b - a
+                    ),
+                ),
+                _ => self
+                    .fatal(st, format!("rank {rank} did not answer batch {} with results", base + k as u64)),
             }
-        });
+        };
+        let late = |st: &State, _: usize| {
+            format!("answer within {} s during {}", self.timeout.as_secs(), st.context)
+        };
+        let (results, remote) =
+            self.hand_out(&mut st, bounds.len(), &local, &prepare, &give, &take, &late, &mut |_, _| {});
         st.stats.rounds += 1;
         st.stats.episodes += jobs.len() as u64;
-        st.stats.remote_episodes += remote;
+        st.stats.remote_episodes +=
+            results.iter().zip(&remote).filter(|(_, r)| **r).map(|(e, _)| e.len() as u64).sum::<u64>();
         st.stats.wall += started.elapsed();
-        results.into_iter().flatten().flatten().collect()
+        results.into_iter().flatten().collect()
     }
 
     /// Whether an experiment of `tasks` tasks hands whole tasks to ranks
@@ -302,34 +232,92 @@ impl Coordinator {
         &self,
         tasks: &[(u32, u64)],
         run: &TaskRunner<'_>,
-        describe: &dyn Fn((u32, u64)) -> String,
+        describe: &(dyn Fn((u32, u64)) -> String + Sync),
     ) -> Result<(), CliError> {
         let started = Instant::now();
         let mut st = self.state.borrow_mut();
+        let threads = self.threads;
+        let local = |k: usize| {
+            run(tasks[k], threads).map_err(|e| {
+                format!("rank 0, {}: {}", describe(tasks[k]), e.to_string().trim_start_matches("error: "))
+            })
+        };
+        let give = |k: usize| {
+            let (point, seed) = tasks[k];
+            Reply::Task { point, seed }.encode()
+        };
+        let take = |st: &State, rank: Rank, k: usize, request: Request| match request {
+            Request::Done { point, seed } if tasks[k] == (point, seed) => {}
+            _ => self.fatal(st, format!("rank {rank} did not report {} done", describe(tasks[k]))),
+        };
+        let late = |_: &State, k: usize| {
+            format!(
+                "report {} within {} s (`--rank-timeout` bounds a whole seed)",
+                describe(tasks[k]),
+                self.timeout.as_secs()
+            )
+        };
         let count = tasks.len();
+        let mut done = 0;
+        let mut progress = |k: usize, rank: Rank| {
+            done += 1;
+            eprintln!("{} done on rank {rank} ({done}/{count})", describe(tasks[k]));
+        };
+        let (_, remote) =
+            self.hand_out(&mut st, count, &local, &|_, _| false, &give, &take, &late, &mut progress);
+        st.stats.tasks += count as u64;
+        st.stats.remote_tasks += remote.iter().filter(|&&r| r).count() as u64;
+        st.stats.wall += started.elapsed();
+        Ok(())
+    }
+
+    /// Hands `count` items out, one per request, to the other ranks and to a
+    /// thread of rank 0 that runs `local`, until every item is done; returns
+    /// the results in item order and, per item, whether another rank did it.
+    /// `prepare` may first send a worker something else (then it takes no
+    /// item yet), `give` is the message giving item `k`, `take` reads the
+    /// answer to item `k` (ending the run on a wrong one), `late` says what a
+    /// rank did not do in time, `done` hears of every item done and where.
+    #[allow(clippy::too_many_arguments)]
+    fn hand_out<T: Send>(
+        &self,
+        st: &mut State,
+        count: usize,
+        local: &(dyn Fn(usize) -> Result<T, String> + Sync),
+        prepare: &dyn Fn(&mut State, Rank) -> bool,
+        give: &dyn Fn(usize) -> Vec<u8>,
+        take: &dyn Fn(&State, Rank, usize, Request) -> T,
+        late: &dyn Fn(&State, usize) -> String,
+        done_at: &mut dyn FnMut(usize, Rank),
+    ) -> (Vec<T>, Vec<bool>) {
         let next = AtomicUsize::new(0);
+        let mut results: Vec<Option<T>> = (0..count).map(|_| None).collect();
+        let mut remote = vec![false; count];
         let mut done = 0;
         let mut outstanding: HashMap<Rank, (usize, Instant)> = HashMap::new();
-        let mut remote = 0u64;
         std::thread::scope(|s| {
             let (tx, rx) = mpsc::channel();
-            let (next, threads) = (&next, self.threads);
+            let next = &next;
             s.spawn(move || loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 if k >= count {
                     break;
                 }
-                let result = run(tasks[k], threads);
-                let failed = result.is_err();
-                if tx.send((k, result)).is_err() || failed {
+                let out = local(k);
+                let failed = out.is_err();
+                if tx.send((k, out)).is_err() || failed {
                     break;
                 }
             });
-            let give = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
+            let mut local_gone = false;
+            // Hands the next item (or what must come first) to a waiting worker.
+            let hand = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
+                if prepare(st, rank) {
+                    return;
+                }
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 if k < count {
-                    let (point, seed) = tasks[k];
-                    self.send(st, rank, &Reply::Task { point, seed }.encode());
+                    self.send(st, rank, &give(k));
                     outstanding.insert(rank, (k, Instant::now()));
                 } else if !st.idle.contains(&rank) {
                     st.idle.push(rank);
@@ -337,74 +325,70 @@ impl Coordinator {
             };
             let waiting = std::mem::take(&mut st.idle);
             for rank in waiting {
-                give(&mut st, rank, &mut outstanding);
+                hand(st, rank, &mut outstanding);
             }
             while done < count {
                 let mut busy = false;
-                while let Some((rank, request)) = self.poll(&mut st) {
+                while let Some((rank, request)) = self.poll(st) {
                     busy = true;
                     match request {
                         Request::Hello { pid, host } => {
                             st.workers.insert(rank, Worker { pid, host, version: 0 });
                         }
                         Request::Ready => {}
-                        Request::Done { point, seed } => {
+                        Request::Failed { message } => self.fatal(st, format!("rank {rank}: {message}")),
+                        answer => {
                             let Some((k, _)) = outstanding.remove(&rank) else {
-                                self.fatal(&st, format!("rank {rank} reported a task it was not given"));
+                                self.fatal(st, format!("rank {rank} sent an answer it was not asked for"));
                             };
-                            if tasks[k] != (point, seed) {
-                                self.fatal(
-                                    &st,
-                                    format!("rank {rank} reported task ({point}, {seed}) for task {k}"),
-                                );
-                            }
+                            results[k] = Some(take(st, rank, k, answer));
+                            remote[k] = true;
                             done += 1;
-                            remote += 1;
-                            eprintln!("{} done on rank {rank} ({done}/{count})", describe(tasks[k]));
+                            done_at(k, rank);
                         }
-                        Request::Results { .. } => {
-                            self.fatal(&st, format!("rank {rank} sent results it was not asked for"))
-                        }
-                        Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
                     }
-                    give(&mut st, rank, &mut outstanding);
+                    hand(st, rank, &mut outstanding);
                 }
-                while let Ok((k, result)) = rx.try_recv() {
-                    busy = true;
-                    if let Err(e) = result {
-                        self.fatal(
-                            &st,
-                            format!(
-                                "rank 0, {}: {}",
-                                describe(tasks[k]),
-                                e.to_string().trim_start_matches("error: ")
-                            ),
-                        );
+                loop {
+                    match rx.try_recv() {
+                        Ok((k, Ok(out))) => {
+                            results[k] = Some(out);
+                            done += 1;
+                            busy = true;
+                            done_at(k, 0);
+                        }
+                        Ok((_, Err(message))) => self.fatal(st, message),
+                        Err(mpsc::TryRecvError::Empty) => break,
+                        Err(mpsc::TryRecvError::Disconnected) => {
+                            local_gone = true;
+                            break;
+                        }
                     }
-                    done += 1;
-                    eprintln!("{} done on rank 0 ({done}/{count})", describe(tasks[k]));
+                }
+                if local_gone
+                    && done < count
+                    && outstanding.is_empty()
+                    && next.load(Ordering::SeqCst) >= count
+                {
+                    self.fatal(st, "an evaluation on rank 0 failed".into());
                 }
                 if let Some((&rank, &(k, _))) =
                     outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout)
                 {
-                    let who = self.who(&st, rank);
                     let msg = format!(
-                        "{who} did not report {} within {} s: it died or hangs (`--rank-timeout` sets the limit for a whole seed)",
-                        describe(tasks[k]),
-                        self.timeout.as_secs(),
+                        "{} did not {}: it died or hangs (`--rank-timeout` sets the limit)",
+                        self.who(st, rank),
+                        late(st, k)
                     );
-                    self.fatal(&st, msg);
+                    self.fatal(st, msg);
                 }
-                self.check_term(&st, &outstanding);
+                self.check_term(st, &outstanding);
                 if !busy {
                     std::thread::sleep(POLL);
                 }
             }
         });
-        st.stats.tasks += count as u64;
-        st.stats.remote_tasks += remote;
-        st.stats.wall += started.elapsed();
-        Ok(())
+        (results.into_iter().flatten().collect(), remote)
     }
 
     /// Makes `program` the one batches refer to (a new version when it changed).
