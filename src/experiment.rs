@@ -115,6 +115,14 @@ impl Plan {
             Some(name) => run::chain(&program, load::stage_index(&program, Some(name))?),
             None => (0..program.stages.len()).collect(),
         };
+        if let Some((stage, _)) =
+            criteria.iter().find(|(c, _)| !stages.iter().any(|&i| program.stages[i].name == *c))
+        {
+            return Err(CliError::io(format!(
+                "error: `--criterion {stage}=...`: stage `{stage}` is not run with `--stage {}`",
+                args.stage.as_deref().unwrap_or_default()
+            )));
+        }
         let out = args.out.clone().unwrap_or_else(|| run::default_out(&args.file).join("experiment"));
         Ok(Plan { seeds: (args.first_seed..end).collect(), args, program, criteria, points, stages, out })
     }

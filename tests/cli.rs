@@ -713,6 +713,14 @@ fn bad_set_values_are_errors_naming_them() {
         }
         assert!(!dir.join("x").exists(), "--set {set}: files written before the error");
     }
+    let out =
+        run(shaping().arg("experiment").arg(tiny()).args(["--stage", "first", "--criterion", "second=0.5"]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("stage `second` is not run with `--stage first`"),
+        "{}",
+        text(&out.stderr)
+    );
     let out = run_tiny(&dir.join("y"), &["--set", "first.evolve.mutation=0.1,0.2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("`run` takes one value"), "{}", text(&out.stderr));
@@ -797,4 +805,21 @@ fn the_report_of_a_sweep_lists_its_points() {
     let out = run(shaping().arg("experiment").arg(tiny()).args(["--seeds", "1"]).arg("--out").arg(&alone));
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(report_data(&alone.join("report.html")).get("sweep").is_none());
+}
+
+/// `experiment --stage S` runs S and the stages it needs, and summarises them only.
+#[test]
+fn an_experiment_of_one_stage_runs_and_summarises_its_chain() {
+    let dir = scratch("exp-stage");
+    let out = run(shaping()
+        .arg("experiment")
+        .arg(tiny())
+        .args(["--seeds", "1", "--stage", "first", "--no-report"])
+        .arg("--out")
+        .arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(dir.join("seed-1/first/best.genome").exists());
+    assert!(!dir.join("seed-1/second").exists(), "the stage after `first` ran");
+    let md = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(md.contains("| first | 6 |") && !md.contains("| second |"), "{md}");
 }
