@@ -258,7 +258,7 @@ enum Command {
         criterion: Vec<String>,
         /// `STAGE.SECTION.FIELD=V1,V2,...`: sweep a setting; several `--set`
         /// sweep the cartesian product, every point over the seeds. Fields:
-        /// `evolve.{population,generations,actions,seed,crossover,mutation,
+        /// `evolve.{population,generations,actions,crossover,mutation,
         /// elitism,evaluations,keep,selection,inheritance}`, `world.{arena,
         /// charger,lamp,battery,recharge,objects,diameter}`,
         /// `world.body.{radius,wheel_base,v_max,action,wheel_noise,

@@ -146,7 +146,6 @@ const FIELDS: &[(&str, Kind)] = &[
     ("evolve.population", Kind::Count(None)),
     ("evolve.generations", Kind::Count(None)),
     ("evolve.actions", Kind::Count(Some("actions"))),
-    ("evolve.seed", Kind::Count(None)),
     ("evolve.crossover", Kind::Real(None)),
     ("evolve.mutation", Kind::Real(None)),
     ("evolve.elitism", Kind::Count(None)),
@@ -194,6 +193,12 @@ fn kind(path: &str) -> Option<Kind> {
 fn check_path(program: &Program, i: usize, path: &str) -> Result<(), String> {
     let stage = &program.stages[i];
     let module = |name: &str| stage.modules.iter().any(|m| m.name == name);
+    if path == "evolve.seed" {
+        return Err(
+            "`evolve.seed` only gives the run seed when none is given: use `--seed` (`run`) or `--seeds` and `--first-seed` (`experiment`)"
+                .into(),
+        );
+    }
     let known = match path.split_once('.') {
         Some((m, f)) if module(m) => MODULE_FIELDS.iter().any(|(p, _)| *p == f),
         _ => FIELDS.iter().any(|(p, _)| *p == path),
@@ -324,7 +329,6 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
         "evolve.population" => count(evolution(s)?.population),
         "evolve.generations" => count(evolution(s)?.generations),
         "evolve.actions" => count(evolution(s)?.actions),
-        "evolve.seed" => Ok(Value::Count(evolution(s)?.seed)),
         "evolve.crossover" => real(evolution(s)?.crossover),
         "evolve.mutation" => real(evolution(s)?.mutation),
         "evolve.elitism" => count(evolution(s)?.elitism),
@@ -430,7 +434,6 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
             }
             "generations" => e.generations = whole(n)?,
             "actions" => e.actions = whole(n)?,
-            "seed" => e.seed = n,
             "crossover" => e.crossover = r32,
             "mutation" => e.mutation = r32,
             "elitism" => e.elitism = whole(n)?,

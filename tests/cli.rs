@@ -684,7 +684,7 @@ fn a_set_value_is_inherited_like_a_written_one() {
 #[test]
 fn bad_set_values_are_errors_naming_them() {
     let dir = scratch("bad-set");
-    let cases: [(&str, &[&str]); 10] = [
+    let cases: [(&str, &[&str]); 11] = [
         ("frist.evolve.mutation=0.1", &["no stage `frist`", "did you mean `first`?"]),
         ("first.evolve.mutatoin=0.1", &["no setting `evolve.mutatoin`", "did you mean `evolve.mutation`?"]),
         (
@@ -698,6 +698,7 @@ fn bad_set_values_are_errors_naming_them() {
         ("second.wander.range=-2..2", &["introduced by stage `first`", "set `first.wander.range`"]),
         ("first.world.objects=3", &["the world of stage `first` has no objects"]),
         ("first.evolve.selection=random", &["`random` is not one of truncation, roulette"]),
+        ("first.evolve.seed=4", &["use `--seed` (`run`) or `--seeds`"]),
     ];
     for (set, wanted) in cases {
         let out = run(shaping()
