@@ -587,15 +587,16 @@ fn result_files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     out
 }
 
+/// `shaping experiment tiny.bat ARGS... --out OUT`.
+fn experiment_tiny(out: &Path, args: &[&str]) -> Output {
+    run(shaping().arg("experiment").arg(tiny()).args(args).arg("--out").arg(out))
+}
+
 fn sweep(out: &Path, extra: &[&str]) -> Output {
-    run(shaping()
-        .arg("experiment")
-        .arg(tiny())
-        .args(["--seeds", "2", "--no-report", "--set", "first.evolve.mutation=0.01,0.2"])
-        .args(["--set", "first.world.battery=100,300"])
-        .arg("--out")
-        .arg(out)
-        .args(extra))
+    let mut args = vec!["--seeds", "2", "--no-report", "--set", "first.evolve.mutation=0.01,0.2"];
+    args.extend(["--set", "first.world.battery=100,300"]);
+    args.extend(extra);
+    experiment_tiny(out, &args)
 }
 
 /// A sweep runs every point of the cartesian product over every seed, each
@@ -708,12 +709,7 @@ fn bad_set_values_are_errors_naming_them() {
         ("first.evolve.seed=4", &["use `--seed` (`run`) or `--seeds`"]),
     ];
     for (set, wanted) in cases {
-        let out = run(shaping()
-            .arg("experiment")
-            .arg(tiny())
-            .args(["--seeds", "1", "--set", set])
-            .arg("--out")
-            .arg(dir.join("x")));
+        let out = experiment_tiny(&dir.join("x"), &["--seeds", "1", "--set", set]);
         let err = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "--set {set}: {err}");
         for w in wanted {
@@ -785,12 +781,7 @@ fn a_killed_sweep_resumes_to_the_same_result() {
 #[test]
 fn the_report_of_a_sweep_lists_its_points() {
     let dir = scratch("sweep-report");
-    let out = run(shaping()
-        .arg("experiment")
-        .arg(tiny())
-        .args(["--seeds", "2", "--set", "first.evolve.mutation=0.01,0.2"])
-        .arg("--out")
-        .arg(&dir));
+    let out = experiment_tiny(&dir, &["--seeds", "2", "--set", "first.evolve.mutation=0.01,0.2"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let root = report_data(&dir.join("report.html"));
     assert_eq!(root["kind"], "sweep");
@@ -810,7 +801,7 @@ fn the_report_of_a_sweep_lists_its_points() {
     assert_eq!(point["sweep"]["points"].as_array().unwrap().len(), 2);
     // An experiment that is no sweep's point lists none.
     let alone = scratch("exp-no-sweep");
-    let out = run(shaping().arg("experiment").arg(tiny()).args(["--seeds", "1"]).arg("--out").arg(&alone));
+    let out = experiment_tiny(&alone, &["--seeds", "1"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(report_data(&alone.join("report.html")).get("sweep").is_none());
 }
@@ -819,12 +810,7 @@ fn the_report_of_a_sweep_lists_its_points() {
 #[test]
 fn an_experiment_of_one_stage_runs_and_summarises_its_chain() {
     let dir = scratch("exp-stage");
-    let out = run(shaping()
-        .arg("experiment")
-        .arg(tiny())
-        .args(["--seeds", "1", "--stage", "first", "--no-report"])
-        .arg("--out")
-        .arg(&dir));
+    let out = experiment_tiny(&dir, &["--seeds", "1", "--stage", "first", "--no-report"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(dir.join("seed-1/first/best.genome").exists());
     assert!(!dir.join("seed-1/second").exists(), "the stage after `first` ran");
