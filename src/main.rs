@@ -238,8 +238,9 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
-    /// Run every stage over several seeds and summarise (median and range):
-    /// `summary.md` and a multi-seed fitness picture.
+    /// Run every stage over several seeds, or a sweep of settings (`--set`),
+    /// and summarise (median and range): `summary.md`, `summary.json` and
+    /// pictures.
     Experiment {
         file: PathBuf,
         /// Number of seeds.
@@ -258,12 +259,12 @@ enum Command {
         criterion: Vec<String>,
         /// `STAGE.SECTION.FIELD=V1,V2,...`: sweep a setting; several `--set`
         /// sweep the cartesian product, every point over the seeds. Fields:
-        /// `evolve.{population,generations,actions,crossover,mutation,
-        /// elitism,evaluations,keep,selection,inheritance}`, `world.{arena,
-        /// charger,lamp,battery,recharge,objects,diameter}`,
-        /// `world.body.{radius,wheel_base,v_max,action,wheel_noise,
-        /// sensor_noise}`, `test.actions`, `train.actions`, and
-        /// `MODULE.{reward,punish,window,threshold,range}`; STAGE may be `*`.
+        /// `evolve.` population, generations, actions, crossover, mutation,
+        /// elitism, evaluations, keep, selection, inheritance; `world.`
+        /// arena, charger, lamp, battery, recharge, objects, diameter;
+        /// `world.body.` radius, wheel_base, v_max, action, wheel_noise,
+        /// sensor_noise; `test.actions`; `train.actions`; `MODULE.` reward,
+        /// punish, window, threshold, range. STAGE may be `*` (every stage).
         #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=V1,V2,...", value_parser = sweep::parse_set)]
         sets: Vec<sweep::Set>,
         /// Run only this stage and the stages it needs.
