@@ -24,7 +24,7 @@ pub struct ReportData {
     pub format: u32,
     /// The program's name.
     pub title: String,
-    /// `run`, `experiment`, `stage` or `replay`.
+    /// `run`, `experiment`, `sweep`, `stage` or `replay`.
     pub kind: &'static str,
     /// The directory the report was made from, as given.
     pub source: String,
@@ -39,6 +39,14 @@ pub struct ReportData {
     /// One series per evolved stage, in program order.
     pub fitness: Vec<FitnessSeries>,
     pub episodes: Vec<Episode>,
+    /// The `summary.json` of the sweep this experiment is a point of (or,
+    /// for a sweep's own directory, of the sweep): every point's settings
+    /// and figures, listed by the page.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<serde_json::Value>,
+    /// The name of the point shown (its settings).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_point: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -758,7 +766,55 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         stages: Vec::new(),
         fitness: Vec::new(),
         episodes: Vec::new(),
+        sweep: None,
+        sweep_point: None,
     }
+}
+
+/// The `summary.json` of a sweep in `dir`, if there is one (with points in
+/// directories of their own).
+fn sweep_summary(dir: &Path) -> Option<serde_json::Value> {
+    let bytes = std::fs::read(dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
+    let points = v["points"].as_array()?;
+    (!points.is_empty() && points.iter().all(|p| p["dir"].as_str().is_some_and(|d| d != "."))).then_some(v)
+}
+
+/// A sweep's directory: the experiment report of its best point (by the
+/// median chosen best of the last evolved stage), listing every point.
+fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, CliError> {
+    let points = summary["points"].as_array().cloned().unwrap_or_default();
+    let score = |p: &serde_json::Value| {
+        p["stages"]
+            .as_array()
+            .and_then(|s| s.iter().rev().find(|x| x["kind"] == "evolve"))
+            .and_then(|x| x["chosen_best"]["median"].as_f64())
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    // The first of the best, so ties go to the earlier point.
+    let best = points.iter().fold(None::<&serde_json::Value>, |b, p| match b {
+        Some(b) if score(b) >= score(p) => Some(b),
+        _ => Some(p),
+    });
+    let Some(best) = best else {
+        return Err(CliError::io(format!("error: the sweep in `{}` has no points", dir.display())));
+    };
+    let point_dir = dir.join(best["dir"].as_str().unwrap_or_default());
+    let seeds = seed_dirs(&point_dir);
+    if seeds.is_empty() {
+        return Err(CliError::io(format!(
+            "error: the point `{}` has no seed directories",
+            point_dir.display()
+        )));
+    }
+    let mut data = experiment(&point_dir, &seeds)?;
+    data.kind = "sweep";
+    data.source = dir.display().to_string();
+    let name = best["name"].as_str().unwrap_or_default().to_string();
+    data.episodes_note = format!("the best point, {name}: {}", data.episodes_note);
+    data.sweep_point = Some(name);
+    data.sweep = Some(summary);
+    Ok(data)
 }
 
 /// Gathers a report's data from a run, stage, experiment or replay directory.
@@ -797,7 +853,21 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
     }
     let seeds = seed_dirs(dir);
     if !seeds.is_empty() {
-        return experiment(dir, &seeds);
+        let mut data = experiment(dir, &seeds)?;
+        // A point of a sweep lists the sweep's points.
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
+        if let (Some(summary), Some(name)) = (dir.parent().and_then(sweep_summary), name) {
+            let listed =
+                summary["points"].as_array().is_some_and(|p| p.iter().any(|x| x["dir"] == name.as_str()));
+            if listed {
+                data.sweep_point = Some(name);
+                data.sweep = Some(summary);
+            }
+        }
+        return Ok(data);
+    }
+    if let Some(summary) = sweep_summary(dir) {
+        return sweep(dir, summary);
     }
     // A stage directory inside a run.
     let parent = dir.parent().filter(|p| p.join("program.json").exists());
@@ -814,7 +884,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
         }
     }
     Err(CliError::io(format!(
-        "error: `{}` is not a run, stage, experiment or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
+        "error: `{}` is not a run, stage, experiment, sweep or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
         dir.display()
     )))
 }

@@ -233,6 +233,8 @@ fn sample_data(title: &str) -> ReportData {
         stages: (0..p.stages.len()).map(|i| stage_view(&p, i, None)).collect(),
         fitness: Vec::new(),
         episodes: vec![ep],
+        sweep: None,
+        sweep_point: None,
     }
 }
 
