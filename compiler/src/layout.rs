@@ -39,6 +39,7 @@ pub fn role_text(stage: &Stage, gene: u32) -> String {
         GeneRole::Weight { input: i, hidden: Some(h) } => format!("weight {} -> h{h}", input(i)),
         GeneRole::HiddenBias { hidden } => format!("bias h{hidden}"),
         GeneRole::HiddenOut { hidden } => format!("weight h{hidden} -> out"),
+        GeneRole::Context { from, hidden } => format!("context h{from} -> h{hidden}"),
         GeneRole::Link { from } => format!("link {} -> {}", mname(from), mname(g.module)),
     };
     match neural {

@@ -47,7 +47,7 @@ use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LIGHT};
-use crate::program::{Wall, World};
+use crate::program::{Items, Wall, World};
 
 pub use scene::{ObjectState, Scene, SceneObject, SceneZone};
 
@@ -981,6 +981,35 @@ impl Sim {
             claw_closed: self.claw_closed,
         }
     }
+}
+
+/// What a disc overlaps among a world's declared items.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blocker {
+    /// `Items::walls[i]`.
+    Wall(usize),
+    /// `Items::cylinders[i]`.
+    Cylinder(usize),
+}
+
+/// The first inner wall or cylinder of `items` that a disc of `radius`
+/// centred at `at` overlaps (what the simulator's collision test finds).
+pub fn blocker(items: &Items, at: [f32; 2], radius: f32) -> Option<Blocker> {
+    let p = Point2::new(at[0], at[1]);
+    let pt = |q: [f32; 2]| Point2::new(q[0], q[1]);
+    if let Some(i) =
+        items.walls.iter().position(|w| segment_distance2(&p, &pt(w.from), &pt(w.to)) < radius * radius)
+    {
+        return Some(Blocker::Wall(i));
+    }
+    items
+        .cylinders
+        .iter()
+        .position(|c| {
+            let d = radius + c.diameter / 2.0;
+            (pt(c.at) - p).norm_squared() < d * d
+        })
+        .map(Blocker::Cylinder)
 }
 
 /// The bar's end points: centred on `wall`, flush with it.
