@@ -173,6 +173,7 @@ fn scene(by_module: bool) -> TrajectoryScene {
         marks: vec![(40, "grip 1".into()), (120, "release 1".into()), (260, "grip 2".into())],
         path_modules: by_module.then_some(modules),
         module_names: vec!["wander".into(), "avoid".into(), "light_follow".into()],
+        ..TrajectoryScene::default()
     }
 }
 
