@@ -24,12 +24,16 @@ stage homing {
     arena 400mm x 450mm
     zone charger_area from (0mm, 330mm) to (120mm, 450mm) grey 0 charger
     lamp tower at (40mm, 410mm) height 150mm
-    battery 50 actions, recharge 1 actions  // refilled at once on the area
+    battery 50 actions, recharge 1 actions      // refilled at once on the area
+    start from (150mm, 40mm) to (360mm, 300mm)  // away from the area
   }
   evolve { population 100  generations 240  actions 150  seed 1  mutation 0.02 }
   // V (1 - i), summed and divided by the maximal life of 150 actions; the
-  // battery is not in the fitness, but a life ends when it is empty.
-  fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) / 150
+  // battery is not in the fitness, but a life ends when it is empty. V
+  // counts forward motion only: with `abs(...)` the recurrent network
+  // learns to rock in place, one action forward and one back, which a
+  // simulator without inertia scores as full speed (EXPERIMENTS.md).
+  fitness per action max(wheels[0] + wheels[1], 0) / 2 * (1 - max(ir)) / 150
 
   module brain {
     sense ir, light[1], light[4], floor, battery
