@@ -82,7 +82,13 @@ pub fn module(name: &str, stage: u16, inputs: Vec<u16>, behavior: Behavior) -> M
     Module {
         name: name.to_string(),
         stage,
-        activation: Network { inputs: n as u16, hidden: 0, outputs: 1, recurrent: false, params: vec![EVOLVABLE; n + 1] },
+        activation: Network {
+            inputs: n as u16,
+            hidden: 0,
+            outputs: 1,
+            recurrent: false,
+            params: vec![EVOLVABLE; n + 1],
+        },
         inputs,
         behavior,
         learning: None,

@@ -284,10 +284,14 @@ fn world(at: &At, w: &World) -> R {
 fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
     let inside = |p: [f32; 2]| p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= arena[0] && p[1] <= arena[1];
     let at = at.field("items");
-    for (what, n) in
-        [("walls", it.walls.len()), ("cylinders", it.cylinders.len()), ("lamps", it.lamps.len()), ("zones", it.zones.len())]
-    {
-        at.field(what).ensure(n <= MAX_ITEMS, || format!("{n} {what}, more than the limit of {MAX_ITEMS}"))?;
+    for (what, n) in [
+        ("walls", it.walls.len()),
+        ("cylinders", it.cylinders.len()),
+        ("lamps", it.lamps.len()),
+        ("zones", it.zones.len()),
+    ] {
+        at.field(what)
+            .ensure(n <= MAX_ITEMS, || format!("{n} {what}, more than the limit of {MAX_ITEMS}"))?;
     }
     let point = |at: &At, p: [f32; 2]| -> R {
         at.index(0).within(p[0], -MAX_LENGTH_MM, MAX_LENGTH_MM)?;
@@ -316,8 +320,16 @@ fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
         point(&at.field("from"), z.from)?;
         point(&at.field("to"), z.to)?;
         at.field("grey").within(z.grey, 0.0, 1.0)?;
-        let (lo, hi) = ([z.from[0].min(z.to[0]), z.from[1].min(z.to[1])], [z.from[0].max(z.to[0]), z.from[1].max(z.to[1])]);
-        let overlaps = lo[0] < arena[0] && lo[1] < arena[1] && hi[0] > 0.0 && hi[1] > 0.0 && lo[0] < hi[0] && lo[1] < hi[1];
+        let (lo, hi) = (
+            [z.from[0].min(z.to[0]), z.from[1].min(z.to[1])],
+            [z.from[0].max(z.to[0]), z.from[1].max(z.to[1])],
+        );
+        let overlaps = lo[0] < arena[0]
+            && lo[1] < arena[1]
+            && hi[0] > 0.0
+            && hi[1] > 0.0
+            && lo[0] < hi[0]
+            && lo[1] < hi[1];
         at.ensure(overlaps, || "the zone does not overlap the arena".into())?;
     }
     if let Some(s) = &it.start {
@@ -327,7 +339,9 @@ fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
         if let Some(h) = s.heading {
             at.field("heading").within(h, -1e4, 1e4)?;
         }
-        let fits = |p: [f32; 2]| p[0] >= radius && p[1] >= radius && p[0] <= arena[0] - radius && p[1] <= arena[1] - radius;
+        let fits = |p: [f32; 2]| {
+            p[0] >= radius && p[1] >= radius && p[0] <= arena[0] - radius && p[1] <= arena[1] - radius
+        };
         at.ensure(fits(s.from) && fits(s.to), || "the start leaves the body outside the arena".into())?;
     }
     Ok(())

@@ -27,10 +27,7 @@ fn forward() -> Command {
 }
 
 fn wall_across(y: f32) -> Items {
-    Items {
-        walls: vec![InnerWall { name: None, from: [0.0, y], to: [400.0, y] }],
-        ..Items::default()
-    }
+    Items { walls: vec![InnerWall { name: None, from: [0.0, y], to: [400.0, y] }], ..Items::default() }
 }
 
 #[test]
@@ -58,8 +55,10 @@ fn an_inner_wall_blocks_the_body_and_is_seen_by_the_front_sensors() {
 
 #[test]
 fn a_cylinder_blocks_and_reflects() {
-    let items =
-        Items { cylinders: vec![Cylinder { name: None, at: [200.0, 300.0], diameter: 50.0 }], ..Items::default() };
+    let items = Items {
+        cylinders: vec![Cylinder { name: None, at: [200.0, 300.0], diameter: 50.0 }],
+        ..Items::default()
+    };
     let mut sim = Sim::new(&world(items.clone()), 1);
     assert!(!sim.set_pose(Pose { x: 200.0, y: 260.0, theta: 0.0 }));
     assert!(sim.set_pose(Pose { x: 200.0, y: 240.0, theta: std::f32::consts::FRAC_PI_2 }));
@@ -124,8 +123,10 @@ fn the_start_pose_is_fixed_or_drawn_in_its_region() {
         assert_eq!((p.x, p.y), (100.0, 150.0));
         assert!((p.theta - 1.0).abs() < 1e-6);
     }
-    let region =
-        Items { start: Some(Start { from: [50.0, 400.0], to: [350.0, 550.0], heading: None }), ..wall_across(470.0) };
+    let region = Items {
+        start: Some(Start { from: [50.0, 400.0], to: [350.0, 550.0], heading: None }),
+        ..wall_across(470.0)
+    };
     let mut headings = Vec::new();
     for seed in 0..30 {
         let p = Sim::new(&world(region.clone()), seed).pose();

@@ -413,6 +413,7 @@ fn a_bouncing_path_with_repeated_points_stays_inside_the_arena() {
         marks: vec![],
         path_modules: Some(vec![0; n]),
         module_names: vec!["a".into()],
+        ..TrajectoryScene::default()
     };
     let fig = Arena::new("", &sc);
     let (w, h) = fig.size(false);

@@ -694,7 +694,12 @@ impl F<'_> {
                 format!("wall{} from {} to {}", self.item_name(name), self.point(from), self.point(to))
             }
             WorldItem::Cylinder { name, at, diameter, .. } => {
-                format!("cylinder{} at {} diameter {}", self.item_name(name), self.point(at), self.qty(diameter))
+                format!(
+                    "cylinder{} at {} diameter {}",
+                    self.item_name(name),
+                    self.point(at),
+                    self.qty(diameter)
+                )
             }
             WorldItem::Lamp { name, at, height, intensity, .. } => {
                 let mut t = format!("lamp{} at {}", self.item_name(name), self.point(at));
@@ -707,7 +712,8 @@ impl F<'_> {
                 t
             }
             WorldItem::Zone { name, from, to, grey, charger, .. } => {
-                let mut t = format!("zone{} from {} to {}", self.item_name(name), self.point(from), self.point(to));
+                let mut t =
+                    format!("zone{} from {} to {}", self.item_name(name), self.point(from), self.point(to));
                 if let Some(g) = grey {
                     t += &format!(" grey {}", self.qty(g));
                 }
@@ -853,7 +859,9 @@ impl F<'_> {
                 }
                 if let Some(h) = &n.hidden {
                     let rec = if n.recurrent { " recurrent" } else { "" };
-                    items.push(self.item_after_keyword(h.span, Doc::Text(format!("hidden {}{rec}", self.qty(h)))));
+                    items.push(
+                        self.item_after_keyword(h.span, Doc::Text(format!("hidden {}{rec}", self.qty(h)))),
+                    );
                 }
                 if let Some(o) = &n.outputs {
                     let (t, span) = match o {

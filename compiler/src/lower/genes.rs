@@ -140,8 +140,12 @@ impl Lower<'_> {
             }
             if m.behavior_stage == s {
                 if let (Some(range), Some(Behavior::Neural(nb))) = (m.behavior_genes, m.behavior.as_mut()) {
-                    let roles =
-                        network_roles(nb.inputs.len(), nb.net.hidden as usize, nb.net.outputs as usize, nb.net.recurrent);
+                    let roles = network_roles(
+                        nb.inputs.len(),
+                        nb.net.hidden as usize,
+                        nb.net.outputs as usize,
+                        nb.net.recurrent,
+                    );
                     nb.net.params = roles
                         .into_iter()
                         .map(|role| {

@@ -868,7 +868,8 @@ impl<'a> Lower<'a> {
             stage: sname.clone(),
             sensors: st.sensors.clone(),
             actuators: st.actuators.clone(),
-            has_charger: st.world.world.charger.is_some() || st.world.world.items.zones.iter().any(|z| z.charger),
+            has_charger: st.world.world.charger.is_some()
+                || st.world.world.items.zones.iter().any(|z| z.charger),
         };
         // Modules.
         let mut declared_here: HashMap<String, Span> = HashMap::new();

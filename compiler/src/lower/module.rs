@@ -436,7 +436,10 @@ impl Lower<'_> {
                 stage: hw.stage.clone(),
                 what: "world item",
                 name: "charger".into(),
-                help: Some("declare `charger LENGTH on WALL wall` or a `zone ... charger` in the stage's `world`".into()),
+                help: Some(
+                    "declare `charger LENGTH on WALL wall` or a `zone ... charger` in the stage's `world`"
+                        .into(),
+                ),
             });
         }
         // Lowered first, so its errors are reported even when `end` fails.
@@ -611,7 +614,8 @@ impl Lower<'_> {
             );
             return None;
         }
-        let count = Network::param_count_of(shape.0 as usize, shape.1 as usize, shape.2 as usize, shape.3) as u32;
+        let count =
+            Network::param_count_of(shape.0 as usize, shape.1 as usize, shape.2 as usize, shape.3) as u32;
         Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
     }
 

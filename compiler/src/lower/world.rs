@@ -208,8 +208,13 @@ impl Lower<'_> {
                         None => Some(0.0),
                     };
                     let (Some(from), Some(to), Some(grey)) = (a, b, g) else { continue };
-                    let zone =
-                        Zone { name: name.as_ref().map(|n| n.text.clone()), from, to, grey, charger: *charger };
+                    let zone = Zone {
+                        name: name.as_ref().map(|n| n.text.clone()),
+                        from,
+                        to,
+                        grey,
+                        charger: *charger,
+                    };
                     let place = self.place(ws, block, stage, "zone", name.as_ref(), *span);
                     put(&mut ws.world.items.zones, place, zone);
                 }
@@ -220,7 +225,9 @@ impl Lower<'_> {
                         None => a,
                     };
                     let h = match heading {
-                        Some(q) => self.plain(q, "the heading (degrees)", -360.0, 360.0).map(|d| Some(d.to_radians())),
+                        Some(q) => self
+                            .plain(q, "the heading (degrees)", -360.0, 360.0)
+                            .map(|d| Some(d.to_radians())),
                         None => Some(None),
                     };
                     let (Some(from), Some(to), Some(heading)) = (a, b, h) else { continue };
@@ -358,7 +365,10 @@ impl Lower<'_> {
             if here(&sp) && !(x0 < x1 && y0 < y1) {
                 self.value_error(
                     sp,
-                    format!("the zone{} overlaps nothing: no part of it is on the arena's floor ({w} x {d} mm)", item_name(&z.name)),
+                    format!(
+                        "the zone{} overlaps nothing: no part of it is on the arena's floor ({w} x {d} mm)",
+                        item_name(&z.name)
+                    ),
                     "covers no floor",
                     Some("give two opposite corners inside the arena".into()),
                 );
@@ -384,10 +394,13 @@ impl Lower<'_> {
         }
         let (what, other) = match blocker(items, s.from, r) {
             None => return,
-            Some(Blocker::Wall(i)) => (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied()),
-            Some(Blocker::Cylinder(i)) => {
-                (format!("the cylinder{}", item_name(&items.cylinders[i].name)), spans("cylinder").get(i).copied())
+            Some(Blocker::Wall(i)) => {
+                (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied())
             }
+            Some(Blocker::Cylinder(i)) => (
+                format!("the cylinder{}", item_name(&items.cylinders[i].name)),
+                spans("cylinder").get(i).copied(),
+            ),
         };
         self.errors.push(Error::Conflict {
             span: (*sp).into(),

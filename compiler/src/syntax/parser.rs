@@ -606,7 +606,13 @@ impl Builder {
             match c.as_rule() {
                 Rule::sense => items.push(ModuleItem::Sense(c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::activation => {
-                    let mut a = ActivationDecl { source: None, hidden: None, recurrent: false, range: None, span: csp };
+                    let mut a = ActivationDecl {
+                        source: None,
+                        hidden: None,
+                        recurrent: false,
+                        range: None,
+                        span: csp,
+                    };
                     for o in c.into_inner() {
                         match o.as_rule() {
                             Rule::weights_source => a.source = Some(weight_source(o)),
@@ -692,7 +698,14 @@ impl Builder {
 
     fn neural(&mut self, p: Pair<Rule>) -> NeuralDecl {
         let sp = span(&p);
-        let mut n = NeuralDecl { sense: None, hidden: None, recurrent: false, outputs: None, weights: None, span: sp };
+        let mut n = NeuralDecl {
+            sense: None,
+            hidden: None,
+            recurrent: false,
+            outputs: None,
+            weights: None,
+            span: sp,
+        };
         for c in p.into_inner() {
             let csp = span(&c);
             match c.as_rule() {
@@ -961,7 +974,8 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 let rule = c.as_rule();
                 let mut name_ = None;
                 let mut points = Vec::new();
-                let (mut diameter, mut height, mut intensity, mut grey, mut heading) = (None, None, None, None, None);
+                let (mut diameter, mut height, mut intensity, mut grey, mut heading) =
+                    (None, None, None, None, None);
                 let mut charger = false;
                 for o in c.into_inner() {
                     match o.as_rule() {
@@ -991,10 +1005,15 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                     Rule::inner_wall => {
                         WorldItem::Wall { name: name_, from: first, to: second.unwrap_or(p0), span: csp }
                     }
-                    Rule::cylinder => {
-                        WorldItem::Cylinder { name: name_, at: first, diameter: diameter.unwrap_or(q0), span: csp }
+                    Rule::cylinder => WorldItem::Cylinder {
+                        name: name_,
+                        at: first,
+                        diameter: diameter.unwrap_or(q0),
+                        span: csp,
+                    },
+                    Rule::lamp_item => {
+                        WorldItem::Lamp { name: name_, at: first, height, intensity, span: csp }
                     }
-                    Rule::lamp_item => WorldItem::Lamp { name: name_, at: first, height, intensity, span: csp },
                     Rule::zone => WorldItem::Zone {
                         name: name_,
                         from: first,

@@ -552,31 +552,41 @@ impl Sim {
 
     /// Adds the walls' noise-free IR readings to `out`.
     fn ir_walls(&self, out: &mut [f32; ir::SENSORS]) {
-        let wt = &ir::tables().0;
         let centre = self.centre();
-        let rot = &self.pose.rotation;
-        let g = &self.geo;
         let reach = self.radius + ir::RANGE;
-        let mut add = |dist: f32, normal: Vector2<f32>| {
-            // With `n` the normal in the body frame, each sensor is `pos . n`
-            // nearer the wall than the centre, and its axis makes an angle
-            // of cosine `ray . n` with the normal: all eight at once.
-            let n = rot.inverse_transform_vector(&normal);
-            let nearer = g.pos * n;
-            let cos_a = g.rays * n;
-            for k in 0..ir::SENSORS {
-                out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
-            }
-        };
         for (dist, normal) in self.walls(&centre) {
             if dist <= reach {
-                add(dist, normal);
+                self.wall_ir(out, dist, &normal);
             }
         }
-        // An inner wall reads as a flat wall through its point nearest the
-        // centre, facing the body.
+        if !self.inner.is_empty() {
+            self.ir_inner_walls(out, &centre, reach);
+        }
+    }
+
+    /// Adds one flat wall's readings: `dist` from the body centre, `normal`
+    /// its unit normal toward the wall (world frame).
+    #[inline(always)]
+    fn wall_ir(&self, out: &mut [f32; ir::SENSORS], dist: f32, normal: &Vector2<f32>) {
+        let wt = &ir::tables().0;
+        let g = &self.geo;
+        // With `n` the normal in the body frame, each sensor is `pos . n`
+        // nearer the wall than the centre, and its axis makes an angle
+        // of cosine `ray . n` with the normal: all eight at once.
+        let n = self.pose.rotation.inverse_transform_vector(normal);
+        let nearer = g.pos * n;
+        let cos_a = g.rays * n;
+        for k in 0..ir::SENSORS {
+            out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
+        }
+    }
+
+    /// An inner wall reads as a flat wall through its point nearest the
+    /// centre, facing the body.
+    #[inline(never)]
+    fn ir_inner_walls(&self, out: &mut [f32; ir::SENSORS], centre: &Point2<f32>, reach: f32) {
         for [a, b] in &self.inner {
-            let d2 = segment_distance2(&centre, a, b);
+            let d2 = segment_distance2(centre, a, b);
             if d2 > reach * reach || d2 <= 0.0 {
                 continue;
             }
@@ -585,7 +595,7 @@ impl Sim {
             let len2 = ab.norm_squared();
             let t = if len2 > 0.0 { ((centre - a).dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
             let nearest = a + ab * t;
-            add(dist, (nearest - centre) / dist);
+            self.wall_ir(out, dist, &((nearest - centre) / dist));
         }
     }
 
@@ -659,6 +669,7 @@ impl Sim {
     }
 
     /// Adds one lamp's readings to `out` (unclamped).
+    #[inline(always)]
     fn add_lamp(&self, lamp: &Lamp, out: &mut [f32; ir::SENSORS]) {
         // The lamp in the body frame.
         let rel = self.pose.inverse_transform_point(&lamp.at).coords;
