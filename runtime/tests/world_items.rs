@@ -33,10 +33,10 @@ fn wall_across(y: f32) -> Items {
 #[test]
 fn an_inner_wall_blocks_the_body_and_is_seen_by_the_front_sensors() {
     let mut sim = Sim::new(&world(wall_across(300.0)), 1);
-    // Facing north, 60 mm below the wall: front sensors read it, back do not.
-    assert!(sim.set_pose(Pose { x: 200.0, y: 240.0, theta: std::f32::consts::FRAC_PI_2 }));
+    // Facing north, 17.5 mm from the wall: front sensors read it, back do not.
+    assert!(sim.set_pose(Pose { x: 200.0, y: 255.0, theta: std::f32::consts::FRAC_PI_2 }));
     let p = percept(&mut sim);
-    assert!(p[CH_IR + 2] > 0.05 && p[CH_IR + 3] > 0.05, "{p:?}");
+    assert!(p[CH_IR + 2] > 0.3 && p[CH_IR + 3] > 0.3, "{p:?}");
     assert!(p[CH_IR + 6] < 0.01, "{p:?}");
     // Driving on ends against it.
     let mut collided = false;
@@ -49,7 +49,7 @@ fn an_inner_wall_blocks_the_body_and_is_seen_by_the_front_sensors() {
     assert!(!sim.set_pose(Pose { x: 200.0, y: 310.0, theta: 0.0 }));
     // Without the wall the same place reads nothing ahead.
     let mut open = Sim::new(&world(Items::default()), 1);
-    assert!(open.set_pose(Pose { x: 200.0, y: 240.0, theta: std::f32::consts::FRAC_PI_2 }));
+    assert!(open.set_pose(Pose { x: 200.0, y: 255.0, theta: std::f32::consts::FRAC_PI_2 }));
     assert!(percept(&mut open)[CH_IR + 2] < 0.01);
 }
 
