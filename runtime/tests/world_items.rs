@@ -136,3 +136,28 @@ fn the_start_pose_is_fixed_or_drawn_in_its_region() {
     }
     assert!(headings.iter().any(|&h| (h - headings[0]).abs() > 0.1));
 }
+
+#[test]
+fn the_validation_refuses_items_outside_the_arena_and_a_start_where_the_body_does_not_fit() {
+    use shaping_runtime::testkit;
+    let check = |items: Items| {
+        let mut s = testkit::navigation();
+        s.world.items = items;
+        shaping_runtime::validate::stage(&s).err().map(|e| e.to_string())
+    };
+    assert_eq!(check(wall_across(300.0)), None);
+    let e = check(wall_across(700.0)).unwrap();
+    assert!(e.contains("`world.items.walls[0]`") && e.contains("not inside the arena"), "{e}");
+    let zone = |from, to| Items {
+        zones: vec![Zone { name: None, from, to, grey: 0.0, charger: false }],
+        ..Items::default()
+    };
+    assert_eq!(check(zone([0.0, 0.0], [50.0, 50.0])), None);
+    let e = check(zone([500.0, 0.0], [600.0, 50.0])).unwrap();
+    assert!(e.contains("does not overlap the arena"), "{e}");
+    let start =
+        |at: [f32; 2]| Items { start: Some(Start { from: at, to: at, heading: None }), ..Items::default() };
+    assert_eq!(check(start([100.0, 100.0])), None);
+    let e = check(start([10.0, 100.0])).unwrap();
+    assert!(e.contains("`world.items.start`"), "{e}");
+}
