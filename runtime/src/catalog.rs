@@ -10,7 +10,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Number of percept channels the simulator fills each action.
-pub const CHANNELS: usize = 19;
+pub const CHANNELS: usize = 20;
 /// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`, arm, claw).
 pub const ACT_SLOTS: usize = 4;
 
@@ -24,6 +24,8 @@ pub const CH_BATTERY: usize = 16;
 pub const CH_BARRIER: usize = 17;
 /// Channel index of the ground (floor) sensor.
 pub const CH_FLOOR: usize = 18;
+/// Channel index of the distance to the nearest lamp.
+pub const CH_LAMP_DISTANCE: usize = 19;
 
 /// Actuator slot of the left wheel's commanded speed (normalised to -1..1).
 pub const ACT_LEFT: usize = 0;
@@ -52,6 +54,9 @@ pub enum SensorKind {
     /// Ground sensor under the body centre: the floor's grey level, 0
     /// black .. 1 white.
     Ground,
+    /// The distance from the body centre to the nearest lamp, 0 .. 1 (1 m
+    /// or more, or no lamp): the simulator's knowledge, for fitness terms.
+    LampDistance,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -92,7 +97,7 @@ pub struct ActuatorInfo {
     pub doc: &'static str,
 }
 
-pub const SENSORS: [SensorInfo; 5] = [
+pub const SENSORS: [SensorInfo; 6] = [
     SensorInfo {
         kind: SensorKind::Proximity,
         keyword: "proximity",
@@ -127,6 +132,13 @@ pub const SENSORS: [SensorInfo; 5] = [
         max_count: 1,
         channel: CH_FLOOR,
         doc: "ground sensor under the body: the floor's grey level, 0 black .. 1 white",
+    },
+    SensorInfo {
+        kind: SensorKind::LampDistance,
+        keyword: "lamp_distance",
+        max_count: 1,
+        channel: CH_LAMP_DISTANCE,
+        doc: "distance to the nearest lamp in m, 0 .. 1 (1 m or more, or no lamp); simulated only",
     },
 ];
 

@@ -161,3 +161,15 @@ fn the_validation_refuses_items_outside_the_arena_and_a_start_where_the_body_doe
     let e = check(start([10.0, 100.0])).unwrap();
     assert!(e.contains("`world.items.start`"), "{e}");
 }
+
+#[test]
+fn the_lamp_distance_channel_reads_metres_to_the_nearest_lamp() {
+    use shaping_runtime::catalog::CH_LAMP_DISTANCE;
+    let lamp = |at| Lamp { name: None, at, height: 150.0, intensity: 1.0 };
+    let items = Items { lamps: vec![lamp([200.0, 500.0]), lamp([200.0, 0.0])], ..Items::default() };
+    let mut sim = Sim::new(&world(items), 1);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 350.0, theta: 0.0 }));
+    assert!((percept(&mut sim)[CH_LAMP_DISTANCE] - 0.15).abs() < 1e-6);
+    let mut dark = Sim::new(&world(Items::default()), 1);
+    assert_eq!(percept(&mut dark)[CH_LAMP_DISTANCE], 1.0);
+}

@@ -46,7 +46,7 @@ use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LIGHT};
+use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT};
 use crate::program::{Items, Wall, World};
 
 pub use scene::{ObjectState, Scene, SceneObject, SceneZone};
@@ -528,6 +528,7 @@ impl Sim {
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
         out[CH_FLOOR] = self.floor();
+        out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
     }
 
     /// What a ground sensor under the body centre reads: the grey level of
@@ -922,6 +923,7 @@ impl Sim {
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
         out[CH_FLOOR] = self.floor();
+        out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
     }
 
     /// Battery level 0..1 (1 forever without a battery).
