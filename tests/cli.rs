@@ -450,6 +450,13 @@ fn run_writes_a_report_of_every_stage_and_report_reads_any_directory() {
     let stages: Vec<&str> =
         data["stages"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
     assert_eq!(stages, ["navigation", "collect", "bigger"]);
+    // The frozen genes of `collect` are traced to an individual of `navigation`'s final population.
+    let from = data["stages"][1]["frozen_from"].as_str().unwrap_or_default();
+    assert!(
+        from.contains("come from individual #") && from.contains("stage `navigation`'s final population"),
+        "{from}"
+    );
+    assert!(data["stages"][0]["frozen_from"].is_null() && data["stages"][2]["frozen_from"].is_null());
     // One episode per stage, the test stage's in two worlds as long as its trace.
     let eps = data["episodes"].as_array().unwrap();
     assert_eq!(eps.len(), 3);

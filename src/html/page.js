@@ -750,7 +750,8 @@
     const frozen = genes.filter((g) => g.frozen);
     const fbits = frozen.reduce((s, g) => s + g.bits, 0);
     $('gen-summary').textContent = st.name + ': ' + genes.length + ' genes, ' + bits + ' bits; frozen ' + frozen.length + ' genes (' + fbits + ' bits), evolvable ' + (genes.length - frozen.length) + ' (' + (bits - fbits) + ' bits)' +
-      (st.genome ? '; values decoded from ' + st.genome : '; no genome found, so no values') + '. The strip shows the bit string, one block per gene, coloured by the stage that added it (faded: frozen); click a block to find its gene.';
+      (st.genome ? '; values decoded from ' + st.genome : '; no genome found, so no values') + '. The strip shows the bit string, one block per gene, coloured by the stage that added it (faded: frozen); click a block to find its gene.' +
+      (st.frozen_from ? ' ' + st.frozen_from : '');
     const strip = $('gen-strip');
     strip.textContent = '';
     const stageIndex = (name) => D.stages.findIndex((s) => s.name === name);
@@ -768,7 +769,8 @@
         el('td', { cls: 'num', text: String(g.index) }), el('td', { cls: 'num', text: String(g.offset) }), el('td', { cls: 'num', text: String(g.bits) }),
         el('td', { text: g.stage }), el('td', { text: g.module }), el('td', { text: g.role }),
         el('td', { text: fmt(g.lo, 2) + '..' + fmt(g.hi, 2) }), el('td', { text: g.frozen ? 'frozen' : 'evolvable' }),
-        el('td', { cls: 'code', text: g.code || '' }), el('td', { cls: 'num', text: fmt(g.value, 3) }));
+        el('td', { cls: 'code', text: g.code || '' }),
+        el('td', { cls: 'num', text: fmt(g.value, 3) + (g.parent_value === null || g.parent_value === undefined ? '' : ' (parent best: ' + fmt(g.parent_value, 3) + ')'), title: g.parent_value === null || g.parent_value === undefined ? null : "differs from the parent stage's best.genome" }));
       tr.dataset.search = ('#' + g.index + ' ' + g.stage + ' ' + g.module + ' ' + g.role + ' ' + (g.frozen ? 'frozen' : 'evolvable')).toLowerCase();
       body.append(tr);
     }

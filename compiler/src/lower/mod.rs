@@ -193,7 +193,6 @@ fn default_evolution() -> Evolution {
     }
 }
 
-/// Lowers a parsed file to a [`Program`], or every error found.
 /// Whether an error of a stage whose parent is unknown stands without the
 /// parent: a sensor or actuator that no stage declares, an index out of
 /// range, a bad range, unit or gene size, an unknown function or event.
@@ -208,7 +207,18 @@ fn checkable_without_parent(e: &Error) -> bool {
     )
 }
 
+/// Lowers a parsed file to a [`Program`], or every error found.
 pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
+    match lower_partial(file, file_name) {
+        (program, errors) if errors.is_empty() => Ok(program),
+        (_, errors) => Err(errors),
+    }
+}
+
+/// Lowers what a file declares even where it has errors: the program, with
+/// placeholders where an error stands (never to be run), beside every error.
+/// For the language server, which describes the parts that stand.
+pub fn lower_partial(file: &ast::File, file_name: &str) -> (Program, Vec<Error>) {
     let mut lw = Lower {
         errors: Vec::new(),
         file,
@@ -219,16 +229,12 @@ pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
         trained: HashMap::new(),
     };
     let program = lw.program(file_name);
-    if lw.errors.is_empty() {
-        Ok(program)
-    } else {
-        let mut errors = lw.errors;
-        errors.sort_by_key(|e| {
-            use miette::Diagnostic;
-            e.labels().and_then(|mut l| l.next()).map(|l| l.offset()).unwrap_or(0)
-        });
-        Err(errors)
-    }
+    let mut errors = lw.errors;
+    errors.sort_by_key(|e| {
+        use miette::Diagnostic;
+        e.labels().and_then(|mut l| l.next()).map(|l| l.offset()).unwrap_or(0)
+    });
+    (program, errors)
 }
 
 impl<'a> Lower<'a> {

@@ -10,7 +10,7 @@ use crate::diag::Error;
 
 #[derive(pest_derive::Parser)]
 #[grammar = "../../grammar/shaping.pest"]
-struct BatParser;
+pub(super) struct BatParser;
 
 /// The reserved words of the grammar's `keyword` rule.
 pub const RESERVED: [&str; 29] = [
@@ -55,32 +55,61 @@ const MAX_LINE: usize = 4096;
 /// Budget of pest rule calls for one file.
 const CALL_LIMIT: usize = 20_000_000;
 
-/// Parses a file. On a syntax error, returns that one error (the checker
-/// reports every error of a file that parses).
+/// Parses a file. On syntax errors, returns every one of them (each part
+/// that does not parse gives its own, see [`parse_recovering`]).
 pub fn parse(src: &str) -> Result<File, Vec<Error>> {
+    match parse_with_limit(src, CALL_LIMIT) {
+        (Some(file), errors) if errors.is_empty() => Ok(file),
+        (_, errors) => Err(errors),
+    }
+}
+
+/// Parses a file as far as it can: on syntax errors, the AST of the parts
+/// that parse (top-level items, and the items of a stage) beside every
+/// syntax error, each at its place. `None` for a file refused before
+/// parsing (the limits on line length, nesting and pest's call budget).
+pub fn parse_recovering(src: &str) -> (Option<File>, Vec<Error>) {
     parse_with_limit(src, CALL_LIMIT)
 }
 
-fn parse_with_limit(src: &str, call_limit: usize) -> Result<File, Vec<Error>> {
+fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) {
     if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
-        return Err(vec![err]);
+        return (None, vec![err]);
     }
     pest::set_call_limit(std::num::NonZeroUsize::new(call_limit));
-    let mut pairs = match BatParser::parse(Rule::file, src) {
-        Ok(p) => p,
-        Err(e) => return Err(vec![syntax_error(src, e)]),
+    let (masked, mut errors) = match BatParser::parse(Rule::file, src) {
+        Ok(pairs) => return build(pairs, Vec::new()),
+        Err(e) if matches!(e.variant, pest::error::ErrorVariant::CustomError { .. }) => {
+            return (None, vec![syntax_error(src, e)])
+        }
+        Err(e) => {
+            let (masked, mut errors) = super::recover::recover(src);
+            if errors.is_empty() {
+                errors.push(syntax_error(src, e));
+            }
+            (masked, errors)
+        }
     };
+    match masked.as_deref().map(|m| BatParser::parse(Rule::file, m)) {
+        Some(Ok(pairs)) => build(pairs, errors),
+        _ => {
+            errors.dedup_by_key(|e| e.to_string());
+            (None, errors)
+        }
+    }
+}
+
+/// The AST of a parsed file, with the errors found building it after the
+/// syntax errors already found.
+fn build(mut pairs: pest::iterators::Pairs<Rule>, mut errors: Vec<Error>) -> (Option<File>, Vec<Error>) {
     if let Some(err) = check_numbers(&pairs) {
-        return Err(vec![err]);
+        errors.push(err);
     }
     let mut b = Builder { pratt: pratt(), errors: Vec::new() };
     let file =
         pairs.next().map(|p| b.file(p)).unwrap_or(File { robots: vec![], genomes: vec![], stages: vec![] });
-    if b.errors.is_empty() {
-        Ok(file)
-    } else {
-        Err(b.errors)
-    }
+    errors.extend(b.errors);
+    (Some(file), errors)
 }
 
 fn pratt() -> PrattParser<Rule> {
@@ -301,7 +330,7 @@ fn token_at(src: &str, pos: usize) -> (Span, String) {
     (Span::new(pos, pos + len), found)
 }
 
-fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
+pub(super) fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
     let pos = match e.location {
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((a, _)) => a,
@@ -1071,10 +1100,10 @@ mod tests {
     #[test]
     fn exceeding_the_call_limit_is_a_diagnostic() {
         let src = "robot r { sensor ir[8] proximity }\nstage s { module m { sense ir behavior stop } }";
-        let errors = parse_with_limit(src, 50).unwrap_err();
+        let errors = parse_with_limit(src, 50).1;
         assert!(matches!(&errors[..], [Error::TooComplex { .. }]), "{errors:?}");
         assert!(errors[0].to_string().starts_with("the file is too complex to parse"));
-        assert!(parse_with_limit(src, CALL_LIMIT).is_ok());
+        assert!(parse_with_limit(src, CALL_LIMIT).1.is_empty());
     }
 
     #[test]

@@ -9,6 +9,7 @@ mod layout;
 mod limits;
 mod parse;
 mod props;
+mod recover;
 mod ui;
 
 use std::path::Path;
