@@ -418,6 +418,15 @@ const WORDS: &[&str] = &[
     "battery",
     "objects",
     "body",
+    "wall",
+    "cylinder",
+    "lamp",
+    "zone",
+    "start",
+    "heading",
+    "grey",
+    "intensity",
+    "recurrent",
     "population",
     "generations",
     "actions",
@@ -429,6 +438,8 @@ const WORDS: &[&str] = &[
     "ambient",
     "level",
     "optical",
+    "ground",
+    "lamp_distance",
     "speed",
     "lift",
     "grip",
@@ -438,6 +449,7 @@ const WORDS: &[&str] = &[
     "mean",
     "abs",
     "sign",
+    "sqrt",
 ];
 
 /// Where the cursor is, as completion sees it.
