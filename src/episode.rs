@@ -103,6 +103,18 @@ pub struct EpisodeWorld {
     pub arena: [f32; 2],
     pub bar: Option<[[f32; 2]; 2]>,
     pub lamp: Option<[f32; 2]>,
+    /// Inner walls' end points.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<[[f32; 2]; 2]>,
+    /// Cylinders: `[x, y, radius]`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cylinders: Vec<[f32; 3]>,
+    /// Declared lamps (the charger's is `lamp`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lamps: Vec<[f32; 2]>,
+    /// Floor zones.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub zones: Vec<shaping_runtime::sim::SceneZone>,
     pub body_radius: f32,
     /// Pose before the first action: `[x, y, theta]`.
     pub start: [f32; 3],
@@ -229,6 +241,10 @@ pub fn episode(
             arena: part.scene.arena,
             bar: part.scene.bar,
             lamp: part.scene.lamp,
+            walls: part.scene.walls.clone(),
+            cylinders: part.scene.cylinders.clone(),
+            lamps: part.scene.lamps.clone(),
+            zones: part.scene.zones.clone(),
             body_radius: part.scene.body_radius,
             start: [round(p.x, 2), round(p.y, 2), round(p.theta, 4)],
             objects: start.map_or_else(|| object_rows(&part.scene), |f| f.objects.clone()),

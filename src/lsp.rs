@@ -423,6 +423,15 @@ const WORDS: &[&str] = &[
     "battery",
     "objects",
     "body",
+    "wall",
+    "cylinder",
+    "lamp",
+    "zone",
+    "start",
+    "heading",
+    "grey",
+    "intensity",
+    "recurrent",
     "population",
     "generations",
     "actions",
@@ -434,6 +443,8 @@ const WORDS: &[&str] = &[
     "ambient",
     "level",
     "optical",
+    "ground",
+    "lamp_distance",
     "speed",
     "lift",
     "grip",
@@ -443,6 +454,7 @@ const WORDS: &[&str] = &[
     "mean",
     "abs",
     "sign",
+    "sqrt",
 ];
 
 /// Where the cursor is, as completion sees it.

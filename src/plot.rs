@@ -83,6 +83,15 @@ pub struct TrajectoryScene {
     pub bar: Option<([f32; 2], [f32; 2])>,
     /// Position of the lamp, mm.
     pub lamp: Option<[f32; 2]>,
+    /// Inner walls' end points, mm.
+    pub walls: Vec<([f32; 2], [f32; 2])>,
+    /// Cylinders: centre x, y and radius, mm.
+    pub cylinders: Vec<[f32; 3]>,
+    /// Declared lamps' positions, mm.
+    pub lamps: Vec<[f32; 2]>,
+    /// Floor zones: south-west and north-east corners, grey level (0 black
+    /// .. 1 white) and whether the zone is a charger.
+    pub zones: Vec<([f32; 2], [f32; 2], f32, bool)>,
     /// Objects to draw.
     pub objects: Vec<SceneObject>,
     /// Pose `[x, y, theta]` after every action.

@@ -217,6 +217,10 @@ fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
         arena: scene.arena,
         bar: scene.bar.map(|[a, b]| (a, b)),
         lamp: scene.lamp,
+        walls: scene.walls.iter().map(|&[a, b]| (a, b)).collect(),
+        cylinders: scene.cylinders.clone(),
+        lamps: scene.lamps.clone(),
+        zones: scene.zones.iter().map(|z| (z.from, z.to, z.grey, z.charger)).collect(),
         objects: scene
             .objects
             .iter()

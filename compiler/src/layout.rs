@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use shaping_runtime::program::{Behavior, GeneRole, Param, Program, Stage, StageRun};
+use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Program, Stage, StageRun};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
 fn channel_name(stage: &Stage, c: u16) -> String {
@@ -39,6 +39,7 @@ pub fn role_text(stage: &Stage, gene: u32) -> String {
         GeneRole::Weight { input: i, hidden: Some(h) } => format!("weight {} -> h{h}", input(i)),
         GeneRole::HiddenBias { hidden } => format!("bias h{hidden}"),
         GeneRole::HiddenOut { hidden } => format!("weight h{hidden} -> out"),
+        GeneRole::Context { from, hidden } => format!("context h{from} -> h{hidden}"),
         GeneRole::Link { from } => format!("link {} -> {}", mname(from), mname(g.module)),
     };
     match neural {
@@ -46,8 +47,9 @@ pub fn role_text(stage: &Stage, gene: u32) -> String {
             let pos = nb.net.params.iter().position(|p| *p == Param::Gene(gene)).unwrap_or(0);
             let per_out =
                 if nb.net.hidden == 0 { nb.net.inputs as usize + 1 } else { nb.net.hidden as usize + 1 };
-            let before =
-                if nb.net.hidden == 0 { 0 } else { nb.net.hidden as usize * (nb.net.inputs as usize + 1) };
+            // The hidden units' parameters (with their context weights).
+            let (i, h) = (nb.net.inputs as usize, nb.net.hidden as usize);
+            let before = if h == 0 { 0 } else { Network::param_count_of(i, h, 0, nb.net.recurrent) };
             if pos >= before {
                 format!("behavior out{} {text}", (pos - before) / per_out)
             } else {

@@ -29,6 +29,12 @@ $B experiment examples/scratch-full.bat --seeds $SEEDS --out $R/scratch-full --f
 $B experiment examples/khepera.bat --stage navigation --seeds $SEEDS --out $R/mutation --fresh --no-report \
   --set navigation.evolve.mutation=0.01,0.02,0.03,0.05 --criterion navigation=0.7 > /dev/null
 
+# Floreano & Mondada 1994 (obstacle avoidance) and 1996 (homing for
+# battery recharge), both evolved from scratch; the 1996 one against
+# khepera.bat's navigation is the paper's "almost one order of magnitude".
+$B experiment examples/floreano-mondada-1994.bat --seeds $SEEDS --out $R/fm1994 --fresh > /dev/null
+$B experiment examples/floreano-mondada-1996.bat --seeds $SEEDS --out $R/fm1996 --fresh > /dev/null
+
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
 # to learning within the life).
@@ -52,7 +58,10 @@ done
 # Figure 11: the collect best of seed 1 over 225 actions.
 $B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 > /dev/null
 
-for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement \
+# The F&M 1996 best of seed 1 over its 150 actions, for the picture.
+$B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed-1 --seed 101 --out $R/fm1996-replay > /dev/null
+
+for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
   figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done

@@ -25,6 +25,7 @@ fn world(virtual_: bool) -> World {
         // Large enough that the robot never dies during a measurement.
         battery: Some(Battery { capacity: u32::MAX, recharge: 20 }),
         objects: Some(Objects { count: 8, diameter: 25.0, virtual_ }),
+        items: Default::default(),
     }
 }
 

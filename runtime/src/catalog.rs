@@ -10,7 +10,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Number of percept channels the simulator fills each action.
-pub const CHANNELS: usize = 18;
+pub const CHANNELS: usize = 20;
 /// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`, arm, claw).
 pub const ACT_SLOTS: usize = 4;
 
@@ -22,6 +22,10 @@ pub const CH_LIGHT: usize = 8;
 pub const CH_BATTERY: usize = 16;
 /// Channel index of the gripper's optical barrier.
 pub const CH_BARRIER: usize = 17;
+/// Channel index of the ground (floor) sensor.
+pub const CH_FLOOR: usize = 18;
+/// Channel index of the distance to the nearest lamp.
+pub const CH_LAMP_DISTANCE: usize = 19;
 
 /// Actuator slot of the left wheel's commanded speed (normalised to -1..1).
 pub const ACT_LEFT: usize = 0;
@@ -47,6 +51,12 @@ pub enum SensorKind {
     Level,
     /// Optical barrier between the gripper's arms, 0 or 1.
     Optical,
+    /// Ground sensor under the body centre: the floor's grey level, 0
+    /// black .. 1 white.
+    Ground,
+    /// The distance from the body centre to the nearest lamp, 0 .. 1 (1 m
+    /// or more, or no lamp): the simulator's knowledge, for fitness terms.
+    LampDistance,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -87,7 +97,7 @@ pub struct ActuatorInfo {
     pub doc: &'static str,
 }
 
-pub const SENSORS: [SensorInfo; 4] = [
+pub const SENSORS: [SensorInfo; 6] = [
     SensorInfo {
         kind: SensorKind::Proximity,
         keyword: "proximity",
@@ -115,6 +125,20 @@ pub const SENSORS: [SensorInfo; 4] = [
         max_count: 1,
         channel: CH_BARRIER,
         doc: "optical barrier between the gripper's arms, 0 or 1",
+    },
+    SensorInfo {
+        kind: SensorKind::Ground,
+        keyword: "ground",
+        max_count: 1,
+        channel: CH_FLOOR,
+        doc: "ground sensor under the body: the floor's grey level, 0 black .. 1 white",
+    },
+    SensorInfo {
+        kind: SensorKind::LampDistance,
+        keyword: "lamp_distance",
+        max_count: 1,
+        channel: CH_LAMP_DISTANCE,
+        doc: "distance to the nearest lamp in m, 0 .. 1 (1 m or more, or no lamp); simulated only",
     },
 ];
 

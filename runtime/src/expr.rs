@@ -24,6 +24,8 @@ pub enum Op {
     Not,
     Abs,
     Sign,
+    /// Square root of the value, 0 for a negative one.
+    Sqrt,
     Add,
     Sub,
     Mul,
@@ -81,7 +83,7 @@ impl Expr {
         for op in ops {
             let (pop, push) = match *op {
                 Op::Const(_) | Op::Chan(_) | Op::Prev(_) | Op::Act(_) => (0, 1),
-                Op::Neg | Op::Not | Op::Abs | Op::Sign => (1, 1),
+                Op::Neg | Op::Not | Op::Abs | Op::Sign | Op::Sqrt => (1, 1),
                 Op::Select => (3, 1),
                 Op::Max(n) | Op::Min(n) | Op::Sum(n) | Op::Mean(n) => {
                     if n == 0 {
@@ -176,6 +178,7 @@ pub fn apply(op: Op, stack: &mut [f32; MAX_STACK], mut sp: usize, env: &Env) -> 
         Op::Not => stack[sp - 1] = truth(stack[sp - 1] == 0.0),
         Op::Abs => stack[sp - 1] = stack[sp - 1].abs(),
         Op::Sign => stack[sp - 1] = sign(stack[sp - 1]),
+        Op::Sqrt => stack[sp - 1] = stack[sp - 1].max(0.0).sqrt(),
         Op::Select => {
             let (c, t, e) = (stack[sp - 3], stack[sp - 2], stack[sp - 1]);
             sp -= 2;

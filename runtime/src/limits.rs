@@ -20,6 +20,8 @@ pub const MAX_ACTIONS: u32 = 10_000_000;
 pub const MAX_EVALUATIONS: u32 = 1_000;
 /// Most objects in a world (the simulator checks every object at every action).
 pub const MAX_OBJECTS: u32 = 1_024;
+/// Most inner walls, cylinders, lamps or floor zones a world may have (each).
+pub const MAX_ITEMS: usize = 1_024;
 /// Longest genome of a stage, in bits.
 pub const MAX_GENOME_BITS: u32 = 1 << 20;
 /// Most bits of a whole population (population times genome bits).

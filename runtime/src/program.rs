@@ -74,6 +74,85 @@ pub struct World {
     pub charger: Option<Charger>,
     pub battery: Option<Battery>,
     pub objects: Option<Objects>,
+    /// Inner walls, cylinders, lamps, floor zones and the start pose.
+    #[serde(default, skip_serializing_if = "Items::is_empty")]
+    pub items: Items,
+}
+
+/// The items a world may have any number of (and the start pose), in
+/// declaration order. Coordinates are mm from the arena's south-west corner
+/// (x east, y north).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Items {
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<InnerWall>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cylinders: Vec<Cylinder>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lamps: Vec<Lamp>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub zones: Vec<Zone>,
+    /// Where the robot starts; `None`: anywhere free, at a random heading.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<Start>,
+}
+
+impl Items {
+    pub fn is_empty(&self) -> bool {
+        self == &Items::default()
+    }
+}
+
+/// A thin wall segment inside the arena: blocks the body, reflects IR.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InnerWall {
+    pub name: Option<String>,
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+}
+
+/// A physical cylinder standing on the floor: blocks the body, reflects IR.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Cylinder {
+    pub name: Option<String>,
+    pub at: [f32; 2],
+    /// Diameter, mm.
+    pub diameter: f32,
+}
+
+/// A lamp anywhere (also outside the arena): ambient light sensors read it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Lamp {
+    pub name: Option<String>,
+    pub at: [f32; 2],
+    /// Height above the floor, mm.
+    pub height: f32,
+    /// 1: a sensor facing it from 100 mm (horizontally) reads 1, as under
+    /// the charger's lamp; the irradiance scales with it.
+    pub intensity: f32,
+}
+
+/// A rectangle of the floor with a grey level (what a ground sensor reads
+/// above it), optionally a charger: the battery refills there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Zone {
+    pub name: Option<String>,
+    /// South-west and north-east corners.
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+    /// 0 black .. 1 white (the arena floor is white, 1).
+    pub grey: f32,
+    pub charger: bool,
+}
+
+/// The start pose: a fixed point, or uniformly random in a rectangle; a
+/// fixed heading (radians, counter-clockwise from east) or a random one.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Start {
+    pub from: [f32; 2],
+    /// Equal to `from` for a fixed point.
+    pub to: [f32; 2],
+    pub heading: Option<f32>,
 }
 
 /// The robot's body and motion parameters.
@@ -166,23 +245,37 @@ pub struct Module {
 ///
 /// Parameter order in `params`:
 /// - `hidden == 0`: for each output `o`: `bias_o, w_o0, w_o1, ..., w_o(n-1)`;
-/// - `hidden > 0`: for each hidden unit `h`: `bias_h, w_h0 .. w_h(n-1)`; then
+/// - `hidden > 0`: for each hidden unit `h`: `bias_h, w_h0 .. w_h(n-1)`
+///   (and, `recurrent`, `c_h0 .. c_h(hidden-1)` from the context); then
 ///   for each output `o`: `bias_o, w_o,h0 .. w_o,h(hidden-1)`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Network {
     pub inputs: u16,
     pub hidden: u16,
     pub outputs: u16,
+    /// Elman-style context: each hidden unit also reads every hidden unit's
+    /// activation of the previous forward pass (0 at the start of an
+    /// episode); its weights follow the unit's input weights.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub recurrent: bool,
     pub params: Vec<Param>,
 }
 
 impl Network {
-    /// Number of parameters a network of this shape has.
+    /// Number of parameters a feed-forward network of this shape has.
     pub fn param_count(inputs: usize, hidden: usize, outputs: usize) -> usize {
+        Network::param_count_of(inputs, hidden, outputs, false)
+    }
+
+    /// Number of parameters of a network of this shape, recurrent or not:
+    /// per hidden unit a bias, `inputs` weights and (recurrent) `hidden`
+    /// context weights; per output a bias and `hidden` weights.
+    pub fn param_count_of(inputs: usize, hidden: usize, outputs: usize, recurrent: bool) -> usize {
         if hidden == 0 {
             outputs * (inputs + 1)
         } else {
-            hidden * (inputs + 1) + outputs * (hidden + 1)
+            let context = if recurrent { hidden } else { 0 };
+            hidden * (inputs + 1 + context) + outputs * (hidden + 1)
         }
     }
 }
@@ -379,6 +472,9 @@ pub enum GeneRole {
     HiddenBias { hidden: u16 },
     /// Weight from hidden unit `hidden` to the output.
     HiddenOut { hidden: u16 },
+    /// Weight from the context (hidden unit `from` at the previous forward
+    /// pass) into hidden unit `hidden` of a recurrent network.
+    Context { from: u16, hidden: u16 },
     /// Link weight from module `from` into the gene's module.
     Link { from: u16 },
 }

@@ -82,7 +82,13 @@ pub fn module(name: &str, stage: u16, inputs: Vec<u16>, behavior: Behavior) -> M
     Module {
         name: name.to_string(),
         stage,
-        activation: Network { inputs: n as u16, hidden: 0, outputs: 1, params: vec![EVOLVABLE; n + 1] },
+        activation: Network {
+            inputs: n as u16,
+            hidden: 0,
+            outputs: 1,
+            recurrent: false,
+            params: vec![EVOLVABLE; n + 1],
+        },
         inputs,
         behavior,
         learning: None,
@@ -103,7 +109,7 @@ pub fn avoid_behavior(init: f32, speed: f32) -> Behavior {
     let params = vec![Param::Random { lo: -init, hi: init }; Network::param_count(8, 0, 2)];
     Behavior::Neural(NeuralBehavior {
         inputs: chans(CH_IR, 8),
-        net: Network { inputs: 8, hidden: 0, outputs: 2, params },
+        net: Network { inputs: 8, hidden: 0, outputs: 2, recurrent: false, params },
         decode: Decode::Table(vec![[-speed, -speed], [-speed, speed], [speed, -speed], [speed, speed]]),
     })
 }
@@ -194,6 +200,7 @@ pub fn arena_world() -> World {
         charger: Some(Charger { wall: Wall::North, length: 200.0, lamp_height: Some(100.0) }),
         battery: Some(Battery { capacity: 200, recharge: 20 }),
         objects: None,
+        items: Default::default(),
     }
 }
 

@@ -276,6 +276,74 @@ fn world(at: &At, w: &World) -> R {
         at.field("count").count(o.count, 0, MAX_OBJECTS)?;
         at.field("diameter").length(o.diameter)?;
     }
+    items(at, &w.items, [width, depth], w.body.radius)
+}
+
+/// The world's items: within the limits, finite, walls and cylinders inside
+/// the arena, zones overlapping it, a start region where the body fits.
+fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
+    let inside = |p: [f32; 2]| p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= arena[0] && p[1] <= arena[1];
+    let at = at.field("items");
+    for (what, n) in [
+        ("walls", it.walls.len()),
+        ("cylinders", it.cylinders.len()),
+        ("lamps", it.lamps.len()),
+        ("zones", it.zones.len()),
+    ] {
+        at.field(what)
+            .ensure(n <= MAX_ITEMS, || format!("{n} {what}, more than the limit of {MAX_ITEMS}"))?;
+    }
+    let point = |at: &At, p: [f32; 2]| -> R {
+        at.index(0).within(p[0], -MAX_LENGTH_MM, MAX_LENGTH_MM)?;
+        at.index(1).within(p[1], -MAX_LENGTH_MM, MAX_LENGTH_MM)
+    };
+    for (i, w) in it.walls.iter().enumerate() {
+        let at = at.field("walls").index(i);
+        point(&at.field("from"), w.from)?;
+        point(&at.field("to"), w.to)?;
+        at.ensure(inside(w.from) && inside(w.to), || "the wall is not inside the arena".into())?;
+    }
+    for (i, c) in it.cylinders.iter().enumerate() {
+        let at = at.field("cylinders").index(i);
+        point(&at.field("at"), c.at)?;
+        at.field("diameter").length(c.diameter)?;
+        at.ensure(inside(c.at), || "the cylinder is not inside the arena".into())?;
+    }
+    for (i, l) in it.lamps.iter().enumerate() {
+        let at = at.field("lamps").index(i);
+        point(&at.field("at"), l.at)?;
+        at.field("height").length(l.height)?;
+        at.field("intensity").within(l.intensity, 0.0, 1e6)?;
+    }
+    for (i, z) in it.zones.iter().enumerate() {
+        let at = at.field("zones").index(i);
+        point(&at.field("from"), z.from)?;
+        point(&at.field("to"), z.to)?;
+        at.field("grey").within(z.grey, 0.0, 1.0)?;
+        let (lo, hi) = (
+            [z.from[0].min(z.to[0]), z.from[1].min(z.to[1])],
+            [z.from[0].max(z.to[0]), z.from[1].max(z.to[1])],
+        );
+        let overlaps = lo[0] < arena[0]
+            && lo[1] < arena[1]
+            && hi[0] > 0.0
+            && hi[1] > 0.0
+            && lo[0] < hi[0]
+            && lo[1] < hi[1];
+        at.ensure(overlaps, || "the zone does not overlap the arena".into())?;
+    }
+    if let Some(s) = &it.start {
+        let at = at.field("start");
+        point(&at.field("from"), s.from)?;
+        point(&at.field("to"), s.to)?;
+        if let Some(h) = s.heading {
+            at.field("heading").within(h, -1e4, 1e4)?;
+        }
+        let fits = |p: [f32; 2]| {
+            p[0] >= radius && p[1] >= radius && p[0] <= arena[0] - radius && p[1] <= arena[1] - radius
+        };
+        at.ensure(fits(s.from) && fits(s.to), || "the start leaves the body outside the arena".into())?;
+    }
     Ok(())
 }
 
@@ -388,7 +456,7 @@ fn network(at: &At, s: &Stage, n: &Network, inputs: usize) -> R {
         format!("{} hidden units, more than the limit of {MAX_HIDDEN}", n.hidden)
     })?;
     at.field("outputs").ensure(n.outputs >= 1, || "a network has at least one output".into())?;
-    let want = Network::param_count(inputs, n.hidden as usize, n.outputs as usize);
+    let want = Network::param_count_of(inputs, n.hidden as usize, n.outputs as usize, n.recurrent);
     at.field("params").ensure(n.params.len() == want, || {
         format!("{} parameters, but its shape has {want}", n.params.len())
     })?;

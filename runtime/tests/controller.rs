@@ -34,7 +34,7 @@ impl Robot for Puppet {
 }
 
 fn bias_only(bias: f32) -> Network {
-    Network { inputs: 0, hidden: 0, outputs: 1, params: vec![Param::Fixed(bias)] }
+    Network { inputs: 0, hidden: 0, outputs: 1, recurrent: false, params: vec![Param::Fixed(bias)] }
 }
 
 /// A module whose activation is the constant `sigmoid(bias)` (plus links)
@@ -156,6 +156,7 @@ fn script_stage() -> Stage {
             inputs: 1,
             hidden: 0,
             outputs: 1,
+            recurrent: false,
             params: vec![Param::Fixed(-10.0), Param::Fixed(20.0)],
         },
         behavior: testkit::script(Action::Wheels { left: 9.0, right: 9.0 }),
@@ -268,7 +269,7 @@ fn neural_stage(reinforce: Expr, learning: Option<Learning>, params: Vec<Param>)
         activation: bias_only(0.0),
         behavior: Behavior::Neural(NeuralBehavior {
             inputs: vec![0, 1],
-            net: Network { inputs: 2, hidden: 0, outputs: 2, params },
+            net: Network { inputs: 2, hidden: 0, outputs: 2, recurrent: false, params },
             decode: Decode::Table(vec![[-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0], [1.0, 1.0]]),
         }),
         learning,
@@ -367,7 +368,13 @@ fn activation_learning_stage() -> Stage {
         name: "grip".into(),
         stage: 0,
         inputs: vec![0, 1],
-        activation: Network { inputs: 2, hidden: 0, outputs: 1, params: vec![Param::Fixed(0.0); 3] },
+        activation: Network {
+            inputs: 2,
+            hidden: 0,
+            outputs: 1,
+            recurrent: false,
+            params: vec![Param::Fixed(0.0); 3],
+        },
         behavior: testkit::script(Action::Wheels { left: 0.0, right: 0.0 }),
         learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
         reinforce: Some(r),
@@ -407,7 +414,13 @@ fn a_reinforce_step_late_in_a_script_trains_the_pattern_the_script_started_on() 
         name: "grip".into(),
         stage: 0,
         inputs: vec![0, 1],
-        activation: Network { inputs: 2, hidden: 0, outputs: 1, params: vec![Param::Fixed(0.0); 3] },
+        activation: Network {
+            inputs: 2,
+            hidden: 0,
+            outputs: 1,
+            recurrent: false,
+            params: vec![Param::Fixed(0.0); 3],
+        },
         behavior: Behavior::Script(Script { steps, commit: true }),
         learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
         reinforce: Some(expr(vec![Op::Const(1.0)])),

@@ -26,7 +26,7 @@ fn avoid_stage(alone: bool, rates: (f32, f32), error: CrbpError) -> Stage {
     let mut avoid = testkit::module("avoid", 0, chans(CH_IR, 8), testkit::avoid_behavior(0.5, 1.0));
     let mut act = vec![Param::Fixed(1.0); 9];
     act[0] = Param::Fixed(-0.3);
-    avoid.activation = Network { inputs: 8, hidden: 0, outputs: 1, params: act };
+    avoid.activation = Network { inputs: 8, hidden: 0, outputs: 1, recurrent: false, params: act };
     let mut learning = testkit::crbp(LearnTarget::Behavior, rates.0, rates.1, 30);
     learning.error = error;
     avoid.learning = Some(learning);
@@ -103,7 +103,7 @@ fn fixed_activation(bias: f32, w: f32, sensors: &[usize]) -> Network {
     for &k in sensors {
         p[1 + k] = Param::Fixed(w);
     }
-    Network { inputs: 9, hidden: 0, outputs: 1, params: p }
+    Network { inputs: 9, hidden: 0, outputs: 1, recurrent: false, params: p }
 }
 
 /// Wander (forward, constant activation `sigmoid(wander_bias)`) and grip (the

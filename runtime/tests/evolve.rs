@@ -57,6 +57,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, run: StageRun)
             charger: None,
             battery: None,
             objects: None,
+            items: Default::default(),
         },
         modules: vec![],
         links: vec![],

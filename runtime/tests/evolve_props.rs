@@ -73,6 +73,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, evo: Evolution
             charger: None,
             battery: None,
             objects: None,
+            items: Default::default(),
         },
         modules: vec![],
         links: vec![],

@@ -96,6 +96,7 @@ fn test_world(objects: Option<Objects>) -> World {
         charger: None,
         battery: None,
         objects,
+        items: Default::default(),
     }
 }
 

@@ -9,13 +9,15 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use shaping_runtime::catalog::CHANNELS;
 use shaping_runtime::controller::{run_episode, EpisodeOptions};
-use shaping_runtime::program::Stage;
+use shaping_runtime::program::{
+    Behavior, Cylinder, InnerWall, Items, Lamp, Network, Param, Stage, Start, Zone,
+};
 use shaping_runtime::sim::{Command, Sim};
 use shaping_runtime::testkit;
 
 #[test]
 fn the_simulator_step_never_allocates() {
-    for stage in [testkit::navigation(), testkit::collect()] {
+    for stage in [testkit::navigation(), testkit::collect(), with_items()] {
         let mut world = stage.world.clone();
         world.battery = None;
         let mut sim = Sim::new(&world, 5);
@@ -37,6 +39,34 @@ fn the_simulator_step_never_allocates() {
     }
 }
 
+/// Navigation in a world with every kind of declared item, its neural
+/// behaviors recurrent (hidden 3).
+fn with_items() -> Stage {
+    let mut stage = testkit::navigation();
+    stage.name = "items".into();
+    stage.world.items = Items {
+        walls: vec![InnerWall { name: None, from: [100.0, 200.0], to: [300.0, 200.0] }],
+        cylinders: vec![Cylinder { name: None, at: [100.0, 450.0], diameter: 40.0 }],
+        lamps: vec![Lamp { name: None, at: [300.0, 100.0], height: 100.0, intensity: 1.0 }],
+        zones: vec![Zone { name: None, from: [0.0, 0.0], to: [120.0, 120.0], grey: 0.0, charger: true }],
+        start: Some(Start { from: [150.0, 300.0], to: [250.0, 400.0], heading: None }),
+    };
+    for m in &mut stage.modules {
+        if let Behavior::Neural(nb) = &mut m.behavior {
+            let n = nb.inputs.len();
+            let count = Network::param_count_of(n, 3, nb.net.outputs as usize, true);
+            nb.net = Network {
+                inputs: n as u16,
+                hidden: 3,
+                outputs: nb.net.outputs,
+                recurrent: true,
+                params: vec![Param::Random { lo: -1.0, hi: 1.0 }; count],
+            };
+        }
+    }
+    stage
+}
+
 /// Allocations of one untraced episode of `actions` actions.
 fn episode_allocations(stage: &Stage, actions: u32) -> (u64, u32) {
     let genome = testkit::random_genome(stage, &mut ChaCha8Rng::seed_from_u64(9));
@@ -51,7 +81,7 @@ fn an_episode_allocates_the_same_whatever_its_length() {
     // Navigation (CRBP on a behavior network) and collect (scripts, gripper,
     // CRBP on activation networks), without a battery so every episode
     // lasts as long as asked.
-    for mut stage in [testkit::navigation(), testkit::collect()] {
+    for mut stage in [testkit::navigation(), testkit::collect(), with_items()] {
         stage.world.battery = None;
         let (short, n_short) = episode_allocations(&stage, 10);
         let (long, n_long) = episode_allocations(&stage, 3_000);

@@ -13,6 +13,7 @@ fn world() -> World {
         charger: Some(Charger { wall: Wall::North, length: 200.0, lamp_height: Some(150.0) }),
         battery: Some(Battery { capacity: 200, recharge: 20 }),
         objects: None,
+        items: Default::default(),
     }
 }
 
@@ -534,6 +535,7 @@ fn arb_world() -> impl Strategy<Value = World> {
             battery: battery
                 .map(|(capacity, recharge)| Battery { capacity: capacity % 1000, recharge: recharge % 100 }),
             objects: objects.map(|(count, virtual_)| Objects { count: count % 64, diameter: diam, virtual_ }),
+            items: Default::default(),
         })
 }
 

@@ -127,9 +127,24 @@
     // Floor and walls.
     g.fillStyle = '#fbfaf6'; g.fillRect(X(0), Y(w.arena[1]), w.arena[0] * s, w.arena[1] * s);
     g.strokeStyle = '#38414d'; g.lineWidth = 3; g.strokeRect(X(0), Y(w.arena[1]), w.arena[0] * s, w.arena[1] * s);
-    // Lamp and charger.
-    if (w.lamp) {
-      const [lx, ly] = w.lamp;
+    // Floor zones at their grey level (a charger outlined), inner walls, cylinders.
+    for (const z of w.zones || []) {
+      const v = Math.round(155 + 100 * z.grey);
+      const zx = X(Math.min(z.from[0], z.to[0])), zy = Y(Math.max(z.from[1], z.to[1]));
+      const zw = Math.abs(z.to[0] - z.from[0]) * s, zh = Math.abs(z.to[1] - z.from[1]) * s;
+      g.fillStyle = 'rgb(' + v + ',' + v + ',' + v + ')'; g.fillRect(zx, zy, zw, zh);
+      if (z.charger) { g.strokeStyle = '#e8741c'; g.lineWidth = 2; g.strokeRect(zx, zy, zw, zh); }
+    }
+    g.strokeStyle = '#38414d'; g.lineWidth = 3; g.lineCap = 'round';
+    for (const [p, q] of w.walls || []) {
+      g.beginPath(); g.moveTo(X(p[0]), Y(p[1])); g.lineTo(X(q[0]), Y(q[1])); g.stroke();
+    }
+    g.fillStyle = '#5a5a5a';
+    for (const [cx, cy, r] of w.cylinders || []) {
+      g.beginPath(); g.arc(X(cx), Y(cy), Math.max(r * s, 2), 0, 2 * Math.PI); g.fill();
+    }
+    // Lamps and charger.
+    for (const [lx, ly] of (w.lamp ? [w.lamp] : []).concat(w.lamps || [])) {
       const grd = g.createRadialGradient(X(lx), Y(ly), 0, X(lx), Y(ly), 90 * s);
       grd.addColorStop(0, 'rgba(255, 210, 40, 0.55)'); grd.addColorStop(1, 'rgba(255, 210, 40, 0)');
       g.fillStyle = grd; g.beginPath(); g.arc(X(lx), Y(ly), 90 * s, 0, 2 * Math.PI); g.fill();

@@ -19,6 +19,7 @@ const PAD_MM: f64 = 12.0;
 
 const FLOOR: RGBColor = RGBColor(252, 251, 246);
 const BAR: RGBColor = RGBColor(70, 90, 115);
+const CYLINDER: RGBColor = RGBColor(90, 90, 90);
 const LAMP: RGBColor = RGBColor(255, 200, 0);
 const OBJECT: RGBColor = RGBColor(200, 80, 40);
 const VIRTUAL: RGBColor = RGBColor(148, 103, 189);
@@ -41,8 +42,17 @@ pub(super) fn check(s: &TrajectoryScene) -> Result<(), String> {
             return Err("the charger bar has a non-finite end".into());
         }
     }
-    if s.lamp.is_some_and(|l| !finite(&l)) {
-        return Err("the lamp has a non-finite position".into());
+    if s.lamp.is_some_and(|l| !finite(&l)) || s.lamps.iter().any(|l| !finite(l)) {
+        return Err("a lamp has a non-finite position".into());
+    }
+    if s.walls.iter().any(|(a, b)| !finite(a) || !finite(b)) {
+        return Err("an inner wall has a non-finite end".into());
+    }
+    if s.cylinders.iter().any(|c| !finite(c) || c[2] < 0.0) {
+        return Err("a cylinder has a non-finite position or a bad radius".into());
+    }
+    if s.zones.iter().any(|(a, b, g, _)| !finite(a) || !finite(b) || !(0.0..=1.0).contains(g)) {
+        return Err("a floor zone has a non-finite corner or a grey level outside 0..1".into());
     }
     if let Some(i) = s.objects.iter().position(|o| !finite(&[o.x, o.y, o.radius]) || o.radius < 0.0) {
         return Err(format!("object {i} has a non-finite position or a bad radius"));
@@ -92,6 +102,9 @@ impl<'a> Arena<'a> {
             cover(f64::from(b[0]), f64::from(b[1]), 0.0);
         }
         if let Some(l) = s.lamp {
+            cover(f64::from(l[0]), f64::from(l[1]), 10.0);
+        }
+        for l in &s.lamps {
             cover(f64::from(l[0]), f64::from(l[1]), 10.0);
         }
         let view = [v[0] - PAD_MM, v[1] + PAD_MM, v[2] - PAD_MM, v[3] + PAD_MM];
@@ -170,11 +183,27 @@ impl Figure for Arena<'_> {
         let (w, h) = (f64::from(s.arena[0]), f64::from(s.arena[1]));
         chart.draw_series(std::iter::once(Rectangle::new([(0.0, 0.0), (w, h)], FLOOR.filled())))?;
         chart.draw_series(std::iter::once(Rectangle::new([(0.0, 0.0), (w, h)], INK.stroke_width(3))))?;
+        let xy = |p: [f32; 2]| (f64::from(p[0]), f64::from(p[1]));
+        for &(a, b, grey, charger) in &s.zones {
+            // The floor is white (grey 1); a zone is drawn at its grey level.
+            let v = (155.0 + 100.0 * grey).round() as u8;
+            chart.draw_series(std::iter::once(Rectangle::new([xy(a), xy(b)], RGBColor(v, v, v).filled())))?;
+            if charger {
+                chart.draw_series(std::iter::once(Rectangle::new([xy(a), xy(b)], BAR.stroke_width(3))))?;
+            }
+        }
+        for &(a, b) in &s.walls {
+            chart.draw_series(std::iter::once(PathElement::new(vec![xy(a), xy(b)], INK.stroke_width(4))))?;
+        }
+        for c in &s.cylinders {
+            let at = (f64::from(c[0]), f64::from(c[1]));
+            chart.draw_series(std::iter::once(Circle::new(at, px(c[2]), CYLINDER.filled())))?;
+        }
         if let Some((a, b)) = s.bar {
             let line = vec![(f64::from(a[0]), f64::from(a[1])), (f64::from(b[0]), f64::from(b[1]))];
             chart.draw_series(std::iter::once(PathElement::new(line, BAR.stroke_width(7))))?;
         }
-        if let Some(l) = s.lamp {
+        for l in s.lamp.iter().chain(&s.lamps) {
             draw_lamp(chart.plotting_area(), (f64::from(l[0]), f64::from(l[1])))?;
         }
         for o in &s.objects {

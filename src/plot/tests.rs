@@ -173,6 +173,7 @@ fn scene(by_module: bool) -> TrajectoryScene {
         marks: vec![(40, "grip 1".into()), (120, "release 1".into()), (260, "grip 2".into())],
         path_modules: by_module.then_some(modules),
         module_names: vec!["wander".into(), "avoid".into(), "light_follow".into()],
+        ..TrajectoryScene::default()
     }
 }
 
@@ -412,6 +413,7 @@ fn a_bouncing_path_with_repeated_points_stays_inside_the_arena() {
         marks: vec![],
         path_modules: Some(vec![0; n]),
         module_names: vec!["a".into()],
+        ..TrajectoryScene::default()
     };
     let fig = Arena::new("", &sc);
     let (w, h) = fig.size(false);
@@ -453,4 +455,27 @@ fn polylines_are_cut_at_reversals_and_repeated_points_dropped() {
     );
     assert_eq!(unmitered(&[(3.0, 4.0)]), vec![vec![(3.0, 4.0), (3.0, 4.0)]]);
     assert_eq!(unmitered(&[(3.0, 4.0), (3.0, 4.0)]), vec![vec![(3.0, 4.0), (3.0, 4.0)]]);
+}
+
+#[test]
+fn declared_world_items_are_drawn() {
+    let d = Dir::new("items");
+    let plain = scene(false);
+    let items = TrajectoryScene {
+        walls: vec![([100.0, 100.0], [300.0, 100.0])],
+        cylinders: vec![[200.0, 400.0, 25.0]],
+        lamps: vec![[350.0, 550.0]],
+        zones: vec![([0.0, 500.0], [100.0, 600.0], 0.0, true)],
+        ..scene(false)
+    };
+    trajectory(&d.stem("plain"), "", &plain).unwrap();
+    trajectory(&d.stem("items"), "", &items).unwrap();
+    let svg = |name: &str| fs::read_to_string(d.0.join(format!("{name}.svg"))).unwrap();
+    let (a, b) = (svg("plain"), svg("items"));
+    // The cylinder's grey and the black (grey 0) zone appear only with the items.
+    for colour in ["#5A5A5A", "#9B9B9B"] {
+        assert!(!a.contains(colour) && b.contains(colour), "{colour}");
+    }
+    let bad = TrajectoryScene { zones: vec![([0.0, 0.0], [1.0, 1.0], 2.0, false)], ..scene(false) };
+    assert!(trajectory(&d.stem("bad"), "", &bad).is_err());
 }

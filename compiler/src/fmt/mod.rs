@@ -690,12 +690,62 @@ impl F<'_> {
                 }
                 t
             }
+            WorldItem::Wall { name, from, to, .. } => {
+                format!("wall{} from {} to {}", self.item_name(name), self.point(from), self.point(to))
+            }
+            WorldItem::Cylinder { name, at, diameter, .. } => {
+                format!(
+                    "cylinder{} at {} diameter {}",
+                    self.item_name(name),
+                    self.point(at),
+                    self.qty(diameter)
+                )
+            }
+            WorldItem::Lamp { name, at, height, intensity, .. } => {
+                let mut t = format!("lamp{} at {}", self.item_name(name), self.point(at));
+                if let Some(h) = height {
+                    t += &format!(" height {}", self.qty(h));
+                }
+                if let Some(k) = intensity {
+                    t += &format!(" intensity {}", self.qty(k));
+                }
+                t
+            }
+            WorldItem::Zone { name, from, to, grey, charger, .. } => {
+                let mut t =
+                    format!("zone{} from {} to {}", self.item_name(name), self.point(from), self.point(to));
+                if let Some(g) = grey {
+                    t += &format!(" grey {}", self.qty(g));
+                }
+                if *charger {
+                    t += " charger";
+                }
+                t
+            }
+            WorldItem::Start { from, to, heading, .. } => {
+                let mut t = match to {
+                    None => format!("start at {}", self.point(from)),
+                    Some(to) => format!("start from {} to {}", self.point(from), self.point(to)),
+                };
+                if let Some(h) = heading {
+                    t += &format!(" heading {}", self.qty(h));
+                }
+                t
+            }
             WorldItem::Body(settings, span) => {
                 let items = settings.iter().map(|s| self.item(s.span, Doc::Text(self.setting(s)))).collect();
                 return self.item(*span, self.block("body".into(), *span, items));
             }
         };
         self.item(x.span(), Doc::Text(t))
+    }
+
+    fn point(&self, p: &Point) -> String {
+        format!("({}, {})", self.qty(&p.x), self.qty(&p.y))
+    }
+
+    fn item_name(&self, n: &Option<Name>) -> String {
+        n.as_ref().map_or(String::new(), |n| format!(" {}", n.text))
     }
 
     fn setting(&self, s: &Setting) -> String {
@@ -740,7 +790,8 @@ impl F<'_> {
                     parts.push((s.span().start, self.weights(s)));
                 }
                 if let Some(h) = &a.hidden {
-                    parts.push((h.span.start, format!("hidden {}", self.qty(h))));
+                    let rec = if a.recurrent { " recurrent" } else { "" };
+                    parts.push((h.span.start, format!("hidden {}{rec}", self.qty(h))));
                 }
                 if let Some(r) = &a.range {
                     parts.push((r.span.start, format!("range {}", self.range(r))));
@@ -808,7 +859,10 @@ impl F<'_> {
                     items.push(self.item(*span, Doc::Text(format!("sense {}", Self::sensor_refs(refs)))));
                 }
                 if let Some(h) = &n.hidden {
-                    items.push(self.item_after_keyword(h.span, Doc::Text(format!("hidden {}", self.qty(h)))));
+                    let rec = if n.recurrent { " recurrent" } else { "" };
+                    items.push(
+                        self.item_after_keyword(h.span, Doc::Text(format!("hidden {}{rec}", self.qty(h)))),
+                    );
                 }
                 if let Some(o) = &n.outputs {
                     let (t, span) = match o {

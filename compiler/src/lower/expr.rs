@@ -27,7 +27,7 @@ enum Val {
     Err,
 }
 
-const FUNCTIONS: [&str; 6] = ["max", "min", "sum", "mean", "abs", "sign"];
+const FUNCTIONS: [&str; 7] = ["max", "min", "sum", "mean", "abs", "sign", "sqrt"];
 
 impl Lower<'_> {
     /// Lowers an expression that must give a number; `None` after an error.
@@ -150,7 +150,7 @@ impl Lower<'_> {
         ops: &mut Vec<Op>,
     ) -> Val {
         match f.text.as_str() {
-            "abs" | "sign" => {
+            "abs" | "sign" | "sqrt" => {
                 if args.len() != 1 {
                     self.errors.push(Error::Value {
                         span: span.into(),
@@ -164,7 +164,11 @@ impl Lower<'_> {
                 if !self.expect_num(v, args[0].span, ops) {
                     return Val::Err;
                 }
-                ops.push(if f.text == "abs" { Op::Abs } else { Op::Sign });
+                ops.push(match f.text.as_str() {
+                    "abs" => Op::Abs,
+                    "sqrt" => Op::Sqrt,
+                    _ => Op::Sign,
+                });
                 Val::Num
             }
             "max" | "min" | "sum" | "mean" => {

@@ -128,7 +128,7 @@ impl Lower<'_> {
             let m = &mut st.modules[mi];
             if m.stage == s {
                 if let Source::Evolvable(range) = m.source.clone() {
-                    let roles = network_roles(m.inputs.len(), m.hidden as usize, 1);
+                    let roles = network_roles(m.inputs.len(), m.hidden as usize, 1, m.recurrent);
                     m.act_params = roles
                         .into_iter()
                         .map(|role| {
@@ -140,8 +140,12 @@ impl Lower<'_> {
             }
             if m.behavior_stage == s {
                 if let (Some(range), Some(Behavior::Neural(nb))) = (m.behavior_genes, m.behavior.as_mut()) {
-                    let roles =
-                        network_roles(nb.inputs.len(), nb.net.hidden as usize, nb.net.outputs as usize);
+                    let roles = network_roles(
+                        nb.inputs.len(),
+                        nb.net.hidden as usize,
+                        nb.net.outputs as usize,
+                        nb.net.recurrent,
+                    );
                     nb.net.params = roles
                         .into_iter()
                         .map(|role| {
@@ -169,8 +173,8 @@ pub(super) fn is_bias(role: GeneRole) -> bool {
 }
 
 /// The roles of a network's parameters, in `Network::params` order.
-pub(crate) fn network_roles(inputs: usize, hidden: usize, outputs: usize) -> Vec<GeneRole> {
-    let mut roles = Vec::with_capacity(Network::param_count(inputs, hidden, outputs));
+pub(crate) fn network_roles(inputs: usize, hidden: usize, outputs: usize, recurrent: bool) -> Vec<GeneRole> {
+    let mut roles = Vec::with_capacity(Network::param_count_of(inputs, hidden, outputs, recurrent));
     if hidden == 0 {
         for _ in 0..outputs {
             roles.push(GeneRole::Bias);
@@ -180,6 +184,9 @@ pub(crate) fn network_roles(inputs: usize, hidden: usize, outputs: usize) -> Vec
         for h in 0..hidden {
             roles.push(GeneRole::HiddenBias { hidden: h as u16 });
             roles.extend((0..inputs).map(|i| GeneRole::Weight { input: i as u16, hidden: Some(h as u16) }));
+            if recurrent {
+                roles.extend((0..hidden).map(|f| GeneRole::Context { from: f as u16, hidden: h as u16 }));
+            }
         }
         for _ in 0..outputs {
             roles.push(GeneRole::Bias);

@@ -87,6 +87,8 @@ pub(crate) struct ModuleSt {
     pub inputs: Vec<u16>,
     pub inputs_span: Option<Span>,
     pub hidden: u16,
+    /// The activation network's hidden units are recurrent.
+    pub recurrent: bool,
     pub source: Source,
     pub act_span: Option<Span>,
     pub act_params: Vec<Param>,
@@ -118,6 +120,9 @@ struct WorldSt {
     world: World,
     /// Where each optional item was declared: charger, battery, objects.
     spans: HashMap<&'static str, Span>,
+    /// Where each list item was declared, by kind, parallel to the lists of
+    /// `world.items` (`wall`, `cylinder`, `lamp`, `zone`).
+    item_spans: HashMap<&'static str, Vec<Span>>,
 }
 
 #[derive(Clone, Debug)]
@@ -164,12 +169,14 @@ pub(crate) struct Lower<'a> {
 /// A module of a training stage: its name and its behavior's shape.
 pub(crate) type TrainedModule = (String, TrainedShape);
 
+/// A network's shape: inputs, hidden units, outputs, recurrent.
+pub(crate) type Shape = (u16, u16, u16, bool);
+
 /// The behavior of a module of a training stage.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum TrainedShape {
     Script,
-    /// A network: inputs, hidden, outputs.
-    Network(u16, u16, u16),
+    Network(Shape),
     /// The behavior did not compile (reported there): nothing to say about its shape.
     Failed,
 }
@@ -347,6 +354,16 @@ impl<'a> Lower<'a> {
 
     /// A length in mm (`mm`, `cm` or no unit), positive.
     fn length(&mut self, q: &Quantity, what: &str) -> Option<f32> {
+        self.millimetres(q, what, false)
+    }
+
+    /// A coordinate in mm (`mm`, `cm` or no unit): 0 and negative values
+    /// allowed, at most [`MAX_LENGTH_MM`] in magnitude.
+    fn coordinate(&mut self, q: &Quantity, what: &str) -> Option<f32> {
+        self.millimetres(q, what, true)
+    }
+
+    fn millimetres(&mut self, q: &Quantity, what: &str, coordinate: bool) -> Option<f32> {
         let factor = match q.unit {
             None | Some(Unit::Mm) => 1.0,
             Some(Unit::Cm) => 10.0,
@@ -361,6 +378,18 @@ impl<'a> Lower<'a> {
             }
         };
         let mm = q.value * factor;
+        if coordinate {
+            if !(q.value.is_finite() && mm.abs() <= MAX_LENGTH_MM as f64) {
+                self.value_error(
+                    q.span,
+                    format!("{what} must be within {MAX_LENGTH_MM} mm of the arena's corner"),
+                    "too far",
+                    None,
+                );
+                return None;
+            }
+            return Some(mm as f32);
+        }
         // Checked as the runtime will hold it: `1e-46` is 0 in f32.
         if !(q.value.is_finite() && mm as f32 > 0.0) {
             self.value_error(q.span, format!("{what} must be positive"), "not positive", None);
@@ -640,9 +669,12 @@ impl<'a> Lower<'a> {
                     .iter()
                     .map(|m| {
                         let shape = match &m.behavior {
-                            Behavior::Neural(nb) => {
-                                TrainedShape::Network(nb.net.inputs, nb.net.hidden, nb.net.outputs)
-                            }
+                            Behavior::Neural(nb) => TrainedShape::Network((
+                                nb.net.inputs,
+                                nb.net.hidden,
+                                nb.net.outputs,
+                                nb.net.recurrent,
+                            )),
                             // A script has a step: none is the placeholder of a failed behavior.
                             Behavior::Script(sc) if sc.steps.is_empty() => TrainedShape::Failed,
                             Behavior::Script(_) => TrainedShape::Script,
@@ -670,8 +702,10 @@ impl<'a> Lower<'a> {
                     charger: None,
                     battery: None,
                     objects: None,
+                    items: Default::default(),
                 },
                 spans: HashMap::new(),
+                item_spans: HashMap::new(),
             },
             genome: GenomeSt { links: spec, weights: spec, biases: spec },
             evolution: default_evolution(),
@@ -895,12 +929,14 @@ impl<'a> Lower<'a> {
         }
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span);
+        self.check_items(&st.world, decl.span);
         self.run(&mut st, decl, parent.is_some());
         let hw = Hw {
             stage: sname.clone(),
             sensors: st.sensors.clone(),
             actuators: st.actuators.clone(),
-            has_charger: st.world.world.charger.is_some(),
+            has_charger: st.world.world.charger.is_some()
+                || st.world.world.items.zones.iter().any(|z| z.charger),
         };
         // Modules.
         let mut declared_here: HashMap<String, Span> = HashMap::new();
@@ -1059,6 +1095,7 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
                 inputs: m.inputs.len() as u16,
                 hidden: m.hidden,
                 outputs: 1,
+                recurrent: m.recurrent && m.hidden > 0,
                 params: m.act_params.clone(),
             },
             behavior: m.behavior.clone().unwrap_or(Behavior::Script(Script { steps: vec![], commit: false })),
@@ -1146,11 +1183,22 @@ mod tests {
     #[test]
     fn network_roles_follow_the_parameter_order_of_network() {
         for (i, h, o) in [(0, 0, 1), (3, 0, 1), (8, 0, 2), (2, 3, 1), (4, 2, 3)] {
-            let roles = network_roles(i, h, o);
+            let roles = network_roles(i, h, o, false);
             assert_eq!(roles.len(), Network::param_count(i, h, o));
+            let roles = network_roles(i, h, o, true);
+            assert_eq!(roles.len(), Network::param_count_of(i, h, o, true));
         }
         assert_eq!(
-            network_roles(2, 0, 1),
+            network_roles(1, 2, 1, true)[..4],
+            [
+                GeneRole::HiddenBias { hidden: 0 },
+                GeneRole::Weight { input: 0, hidden: Some(0) },
+                GeneRole::Context { from: 0, hidden: 0 },
+                GeneRole::Context { from: 1, hidden: 0 },
+            ]
+        );
+        assert_eq!(
+            network_roles(2, 0, 1, false),
             [
                 GeneRole::Bias,
                 GeneRole::Weight { input: 0, hidden: None },
@@ -1158,7 +1206,7 @@ mod tests {
             ]
         );
         assert_eq!(
-            network_roles(1, 2, 1),
+            network_roles(1, 2, 1, false),
             [
                 GeneRole::HiddenBias { hidden: 0 },
                 GeneRole::Weight { input: 0, hidden: Some(0) },

@@ -4,7 +4,7 @@ use shaping_runtime::catalog::{self, ActuatorKind};
 use shaping_runtime::limits::MAX_HIDDEN;
 use shaping_runtime::program::*;
 
-use super::{expr::Scope, Hw, Lower, ModuleSt, Source, TrainedShape, DEFAULT_RATES, DEFAULT_WINDOW};
+use super::{expr::Scope, Hw, Lower, ModuleSt, Shape, Source, TrainedShape, DEFAULT_RATES, DEFAULT_WINDOW};
 use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
 use crate::syntax::Span;
@@ -39,6 +39,7 @@ impl Lower<'_> {
                 inputs: Vec::new(),
                 inputs_span: None,
                 hidden: 0,
+                recurrent: false,
                 source: Source::Evolvable(None),
                 act_span: None,
                 act_params: Vec::new(),
@@ -76,8 +77,9 @@ impl Lower<'_> {
                 }
                 ModuleItem::Activation(a) => {
                     let Some((hidden, source)) = self.activation(a) else { continue };
+                    let recurrent = a.recurrent && hidden > 0;
                     if inherited {
-                        if hidden != st.hidden || source != st.source {
+                        if hidden != st.hidden || recurrent != st.recurrent || source != st.source {
                             self.errors.push(Error::Frozen {
                                 span: a.span.into(),
                                 frozen: st.act_span.unwrap_or(st.span).into(),
@@ -89,6 +91,7 @@ impl Lower<'_> {
                         continue;
                     }
                     st.hidden = hidden;
+                    st.recurrent = recurrent;
                     st.source = source;
                     st.act_span = Some(a.span);
                 }
@@ -99,11 +102,11 @@ impl Lower<'_> {
             st.act_params = match &st.source {
                 Source::Evolvable(_) => Vec::new(), // genes, allocated with the stage
                 Source::Fixed(vals) => {
-                    let n = Network::param_count(st.inputs.len(), st.hidden as usize, 1);
+                    let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
                     self.fixed_params(vals, n, st.act_span.unwrap_or(st.span))
                 }
                 Source::Random(lo, hi) => {
-                    let n = Network::param_count(st.inputs.len(), st.hidden as usize, 1);
+                    let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
                     vec![Param::Random { lo: *lo, hi: *hi }; n]
                 }
             };
@@ -482,7 +485,10 @@ impl Lower<'_> {
                 stage: hw.stage.clone(),
                 what: "world item",
                 name: "charger".into(),
-                help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
+                help: Some(
+                    "declare `charger LENGTH on WALL wall` or a `zone ... charger` in the stage's `world`"
+                        .into(),
+                ),
             });
         }
         // Lowered first, so its errors are reported even when `end` fails.
@@ -585,7 +591,8 @@ impl Lower<'_> {
                 (k as u16, Decode::Table(rows))
             }
         };
-        let count = Network::param_count(inputs.len(), hidden as usize, outputs as usize);
+        let recurrent = n.recurrent && hidden > 0;
+        let count = Network::param_count_of(inputs.len(), hidden as usize, outputs as usize, recurrent);
         let (params, genes) = match &n.weights {
             None => (vec![Param::Random { lo: -1.0, hi: 1.0 }; count], None),
             Some(ast::WeightSource::Random(r, _)) => match self.range(r) {
@@ -598,14 +605,14 @@ impl Lower<'_> {
             }
             Some(ast::WeightSource::Evolvable(_)) => (Vec::new(), Some(None)),
             Some(ast::WeightSource::Trained(by, sp)) => {
-                let shape = (inputs.len() as u16, hidden, outputs);
+                let shape = (inputs.len() as u16, hidden, outputs, recurrent);
                 match self.trained_params(by, *sp, module, shape) {
                     Some(p) => (p, None),
                     None => return (None, None),
                 }
             }
         };
-        let net = Network { inputs: inputs.len() as u16, hidden, outputs, params };
+        let net = Network { inputs: inputs.len() as u16, hidden, outputs, recurrent, params };
         (Some(NeuralBehavior { inputs, net, decode }), genes)
     }
 
@@ -616,7 +623,7 @@ impl Lower<'_> {
         by: &ast::Name,
         span: Span,
         module: &str,
-        shape: (u16, u16, u16),
+        shape: Shape,
     ) -> Option<Vec<Param>> {
         let Some((stage, modules)) = self.trained.get(&by.text) else {
             self.untrained(by);
@@ -633,24 +640,27 @@ impl Lower<'_> {
             return None;
         };
         let what = match *found {
-            TrainedShape::Network(i, h, o) if (i, h, o) == shape => None,
+            TrainedShape::Network(s) if s == shape => None,
             TrainedShape::Failed => return None,
-            TrainedShape::Network(i, h, o) => Some(format!("{i} inputs, {h} hidden and {o} outputs")),
+            TrainedShape::Network((i, h, o, r)) => {
+                Some(format!("{i} inputs, {h} {}hidden and {o} outputs", recurrent_word(r)))
+            }
             TrainedShape::Script => Some("a scripted behavior".to_string()),
         };
         if let Some(what) = what {
             self.value_error(
                 span,
                 format!(
-                    "module `{module}` of `{}` has {what}, but this network has {} inputs, {} hidden and {} outputs",
-                    by.text, shape.0, shape.1, shape.2
+                    "module `{module}` of `{}` has {what}, but this network has {} inputs, {} {}hidden and {} outputs",
+                    by.text, shape.0, shape.1, recurrent_word(shape.3), shape.2
                 ),
                 "another shape",
                 Some("sense the same inputs and declare the same `hidden` and `outputs`".into()),
             );
             return None;
         }
-        let count = Network::param_count(shape.0 as usize, shape.1 as usize, shape.2 as usize) as u32;
+        let count =
+            Network::param_count_of(shape.0 as usize, shape.1 as usize, shape.2 as usize, shape.3) as u32;
         Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
     }
 
@@ -752,5 +762,14 @@ impl Lower<'_> {
             None => DEFAULT_WINDOW,
         };
         Some(Learning { target, rate_reward, rate_punish, when, window, error })
+    }
+}
+
+/// `"recurrent "` for a recurrent network, else nothing.
+fn recurrent_word(recurrent: bool) -> &'static str {
+    if recurrent {
+        "recurrent "
+    } else {
+        ""
     }
 }

@@ -301,7 +301,7 @@ impl Lower<'_> {
                     stage: hw.stage.clone(),
                     what: "world item",
                     name: "charger".into(),
-                    help: Some("declare `charger LENGTH on WALL wall` in the stage's `world`".into()),
+                    help: Some("declare `charger LENGTH on WALL wall` or a `zone ... charger` in the stage's `world`".into()),
                 });
             }
             if !b.points.is_finite() {

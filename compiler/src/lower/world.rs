@@ -1,8 +1,10 @@
-//! The world: arena, charger, battery, objects and body, with `world adds` and
-//! `world changes` checked against the inherited world.
+//! The world: arena, charger, battery, objects, body and start pose (one of
+//! each), inner walls, cylinders, lamps and floor zones (any number), with
+//! `world adds` and `world changes` checked against the inherited world.
 
-use shaping_runtime::limits::MAX_OBJECTS;
+use shaping_runtime::limits::{MAX_ITEMS, MAX_OBJECTS};
 use shaping_runtime::program::*;
+use shaping_runtime::sim::{blocker, Blocker};
 
 use super::*;
 use crate::diag::{did_you_mean, Error};
@@ -11,17 +13,43 @@ use crate::syntax::ast::{self, Unit};
 impl Lower<'_> {
     pub(super) fn world(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str) {
         use ast::WorldItem as W;
+        // Settings that are not lists: once per block.
+        let mut seen: HashMap<&'static str, Span> = HashMap::new();
         for item in &block.items {
+            let single = match item {
+                W::Arena { .. } => Some("arena"),
+                W::Charger { .. } => Some("charger"),
+                W::Battery(..) => Some("battery"),
+                W::Recharge(..) => Some("recharge"),
+                W::Objects { .. } => Some("objects"),
+                W::Body(..) => Some("body"),
+                W::Start { .. } => Some("start"),
+                _ => None,
+            };
+            if let Some(key) = single {
+                if let Some(first) = seen.get(key) {
+                    self.errors.push(Error::Duplicate {
+                        span: item.span().into(),
+                        first: (*first).into(),
+                        what: "world setting",
+                        name: key.into(),
+                    });
+                    continue;
+                }
+                seen.insert(key, item.span());
+            }
             let key = match item {
                 W::Charger { .. } => Some("charger"),
                 W::Battery(..) | W::Recharge(..) => Some("battery"),
                 W::Objects { .. } => Some("objects"),
+                W::Start { .. } => Some("start"),
                 _ => None,
             };
             if let Some(key) = key {
                 let exists = match key {
                     "charger" => ws.world.charger.is_some(),
                     "battery" => ws.world.battery.is_some(),
+                    "start" => ws.world.items.start.is_some(),
                     _ => ws.world.objects.is_some(),
                 };
                 match block.mode {
@@ -143,8 +171,244 @@ impl Lower<'_> {
                     self.body(&mut ws.world.body, settings);
                     ws.spans.insert("body", *span);
                 }
+                W::Wall { name, from, to, span } => {
+                    let (a, b) = (self.point(from, "a wall's end"), self.point(to, "a wall's end"));
+                    let (Some(from), Some(to)) = (a, b) else { continue };
+                    let wall = InnerWall { name: name.as_ref().map(|n| n.text.clone()), from, to };
+                    let place = self.place(ws, block, stage, "wall", name.as_ref(), *span);
+                    put(&mut ws.world.items.walls, place, wall);
+                }
+                W::Cylinder { name, at, diameter, span } => {
+                    let at = self.point(at, "a cylinder's centre");
+                    let d = self.length(diameter, "the cylinder diameter");
+                    let (Some(at), Some(diameter)) = (at, d) else { continue };
+                    let cyl = Cylinder { name: name.as_ref().map(|n| n.text.clone()), at, diameter };
+                    let place = self.place(ws, block, stage, "cylinder", name.as_ref(), *span);
+                    put(&mut ws.world.items.cylinders, place, cyl);
+                }
+                W::Lamp { name, at, height, intensity, span } => {
+                    let at = self.point(at, "a lamp's position");
+                    let h = match height {
+                        Some(q) => self.length(q, "the lamp height"),
+                        None => Some(DEFAULT_LAMP_HEIGHT),
+                    };
+                    let k = match intensity {
+                        Some(q) => self.plain(q, "the lamp intensity", 1e-6, 1e6),
+                        None => Some(1.0),
+                    };
+                    let (Some(at), Some(height), Some(intensity)) = (at, h, k) else { continue };
+                    let lamp = Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity };
+                    let place = self.place(ws, block, stage, "lamp", name.as_ref(), *span);
+                    put(&mut ws.world.items.lamps, place, lamp);
+                }
+                W::Zone { name, from, to, grey, charger, span } => {
+                    let (a, b) = (self.point(from, "a zone's corner"), self.point(to, "a zone's corner"));
+                    let g = match grey {
+                        Some(q) => self.plain(q, "the grey level", 0.0, 1.0),
+                        None => Some(0.0),
+                    };
+                    let (Some(from), Some(to), Some(grey)) = (a, b, g) else { continue };
+                    let zone = Zone {
+                        name: name.as_ref().map(|n| n.text.clone()),
+                        from,
+                        to,
+                        grey,
+                        charger: *charger,
+                    };
+                    let place = self.place(ws, block, stage, "zone", name.as_ref(), *span);
+                    put(&mut ws.world.items.zones, place, zone);
+                }
+                W::Start { from, to, heading, span } => {
+                    let a = self.point(from, "the start position");
+                    let b = match to {
+                        Some(p) => self.point(p, "the start region's corner"),
+                        None => a,
+                    };
+                    let h = match heading {
+                        Some(q) => self
+                            .plain(q, "the heading (degrees)", -360.0, 360.0)
+                            .map(|d| Some(d.to_radians())),
+                        None => Some(None),
+                    };
+                    let (Some(from), Some(to), Some(heading)) = (a, b, h) else { continue };
+                    ws.world.items.start = Some(Start { from, to, heading });
+                    ws.spans.insert("start", *span);
+                }
             }
         }
+    }
+
+    /// `X Y` in mm.
+    fn point(&mut self, p: &ast::Point, what: &str) -> Option<[f32; 2]> {
+        let x = self.coordinate(&p.x, what);
+        let y = self.coordinate(&p.y, what);
+        Some([x?, y?])
+    }
+
+    /// Where a list item of kind `kind` goes: `Some(i)` replaces item `i`
+    /// (the item of that name), `None` appends, `Err` after an error
+    /// (nothing changes). Records the item's span.
+    fn place(
+        &mut self,
+        ws: &mut WorldSt,
+        block: &ast::WorldBlock,
+        stage: &str,
+        kind: &'static str,
+        name: Option<&ast::Name>,
+        span: Span,
+    ) -> Result<Option<usize>, ()> {
+        let names: Vec<Option<&str>> = match kind {
+            "wall" => ws.world.items.walls.iter().map(|x| x.name.as_deref()).collect(),
+            "cylinder" => ws.world.items.cylinders.iter().map(|x| x.name.as_deref()).collect(),
+            "lamp" => ws.world.items.lamps.iter().map(|x| x.name.as_deref()).collect(),
+            _ => ws.world.items.zones.iter().map(|x| x.name.as_deref()).collect(),
+        };
+        let spans = ws.item_spans.entry(kind).or_default();
+        let existing = name.and_then(|n| names.iter().position(|m| *m == Some(n.text.as_str())));
+        let here = |sp: Span| block.span.start <= sp.start && sp.end <= block.span.end;
+        match (block.mode, existing) {
+            (ast::WorldMode::Changes, None) => {
+                let help = match name {
+                    Some(n) => did_you_mean(&n.text, names.iter().flatten().copied())
+                        .or_else(|| Some(format!("use `world adds {{ {kind} ... }}` to add one"))),
+                    None => Some(format!("name the {kind} when you declare it and when you change it")),
+                };
+                let what = match name {
+                    Some(n) => format!("a {kind} `{}`", n.text),
+                    None => format!("an unnamed {kind}"),
+                };
+                self.value_error(
+                    span,
+                    format!("stage `{stage}` changes {what}, but its world has none"),
+                    "nothing to change",
+                    help,
+                );
+                Err(())
+            }
+            (ast::WorldMode::Adds, Some(i)) => {
+                let other = spans.get(i).copied().unwrap_or(span);
+                self.errors.push(Error::Conflict {
+                    span: span.into(),
+                    other: other.into(),
+                    message: format!(
+                        "stage `{stage}` adds a {kind} `{}`, but its world has one already",
+                        name.map_or("", |n| n.text.as_str())
+                    ),
+                    label: "added here".into(),
+                    other_label: "already declared here".into(),
+                });
+                Err(())
+            }
+            (_, Some(i)) if spans.get(i).is_some_and(|&sp| here(sp)) => {
+                self.errors.push(Error::Duplicate {
+                    span: span.into(),
+                    first: spans[i].into(),
+                    what: kind,
+                    name: name.map_or(String::new(), |n| n.text.clone()),
+                });
+                Err(())
+            }
+            (_, Some(i)) => {
+                if let Some(sp) = spans.get_mut(i) {
+                    *sp = span;
+                }
+                Ok(Some(i))
+            }
+            (_, None) => {
+                if names.len() >= MAX_ITEMS {
+                    self.value_error(
+                        span,
+                        format!("a world has at most {MAX_ITEMS} items of a kind ({kind})"),
+                        "one too many",
+                        None,
+                    );
+                    return Err(());
+                }
+                spans.push(span);
+                Ok(None)
+            }
+        }
+    }
+
+    /// Walls and cylinders inside the arena, zones overlapping it, a start
+    /// pose where the body fits; only for the items declared in `stage`
+    /// (`decl` its span), so an error is reported once.
+    pub(super) fn check_items(&mut self, ws: &WorldSt, decl: Span) {
+        let [w, d] = ws.world.arena;
+        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
+        let inside = |p: [f32; 2]| p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= w && p[1] <= d;
+        let spans = |kind: &str| ws.item_spans.get(kind).cloned().unwrap_or_default();
+        let items = &ws.world.items;
+        for (wall, sp) in items.walls.iter().zip(spans("wall")) {
+            if here(&sp) && !(inside(wall.from) && inside(wall.to)) {
+                self.value_error(
+                    sp,
+                    format!("the wall{} is not inside the arena ({w} x {d} mm)", item_name(&wall.name)),
+                    "outside the arena",
+                    Some("coordinates are mm east and north of the arena's south-west corner".into()),
+                );
+            }
+        }
+        for (c, sp) in items.cylinders.iter().zip(spans("cylinder")) {
+            if here(&sp) && !inside(c.at) {
+                self.value_error(
+                    sp,
+                    format!("the cylinder{} stands outside the arena ({w} x {d} mm)", item_name(&c.name)),
+                    "outside the arena",
+                    Some("coordinates are mm east and north of the arena's south-west corner".into()),
+                );
+            }
+        }
+        for (z, sp) in items.zones.iter().zip(spans("zone")) {
+            let (x0, x1) = (z.from[0].min(z.to[0]).max(0.0), z.from[0].max(z.to[0]).min(w));
+            let (y0, y1) = (z.from[1].min(z.to[1]).max(0.0), z.from[1].max(z.to[1]).min(d));
+            if here(&sp) && !(x0 < x1 && y0 < y1) {
+                self.value_error(
+                    sp,
+                    format!(
+                        "the zone{} overlaps nothing: no part of it is on the arena's floor ({w} x {d} mm)",
+                        item_name(&z.name)
+                    ),
+                    "covers no floor",
+                    Some("give two opposite corners inside the arena".into()),
+                );
+            }
+        }
+        let (Some(s), Some(sp)) = (&items.start, ws.spans.get("start")) else { return };
+        if !here(sp) {
+            return;
+        }
+        let r = ws.world.body.radius;
+        let fits = |p: [f32; 2]| p[0] >= r && p[1] >= r && p[0] <= w - r && p[1] <= d - r;
+        if !(fits(s.from) && fits(s.to)) {
+            self.value_error(
+                *sp,
+                format!("the start puts the body (radius {r} mm) across the arena's walls ({w} x {d} mm)"),
+                "the robot does not fit here",
+                Some(format!("keep the start at least {r} mm from every wall")),
+            );
+            return;
+        }
+        if s.from != s.to {
+            return;
+        }
+        let (what, other) = match blocker(items, s.from, r) {
+            None => return,
+            Some(Blocker::Wall(i)) => {
+                (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied())
+            }
+            Some(Blocker::Cylinder(i)) => (
+                format!("the cylinder{}", item_name(&items.cylinders[i].name)),
+                spans("cylinder").get(i).copied(),
+            ),
+        };
+        self.errors.push(Error::Conflict {
+            span: (*sp).into(),
+            other: other.unwrap_or(*sp).into(),
+            message: format!("the start puts the body inside {what}"),
+            label: "the body overlaps it here".into(),
+            other_label: "declared here".into(),
+        });
     }
 
     /// The charger must fit on its wall.
@@ -231,10 +495,25 @@ impl Lower<'_> {
     }
 }
 
+/// Puts a list item where [`Lower::place`] said.
+fn put<T>(list: &mut Vec<T>, place: Result<Option<usize>, ()>, item: T) {
+    match place {
+        Ok(Some(i)) => list[i] = item,
+        Ok(None) => list.push(item),
+        Err(()) => {}
+    }
+}
+
+/// ` `name`` for a named item, else nothing.
+fn item_name(name: &Option<String>) -> String {
+    name.as_ref().map_or(String::new(), |n| format!(" `{n}`"))
+}
+
 pub(super) fn key_desc(key: &str) -> &'static str {
     match key {
         "charger" => "a charger",
         "battery" => "a battery",
+        "start" => "a start pose",
         _ => "a set of objects",
     }
 }

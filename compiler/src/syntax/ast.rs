@@ -134,6 +134,18 @@ pub enum WorldItem {
     Recharge(Quantity, Span),
     Objects { count: Option<Quantity>, diameter: Option<Quantity>, virtual_: Option<bool>, span: Span },
     Body(Vec<Setting>, Span),
+    Wall { name: Option<Name>, from: Point, to: Point, span: Span },
+    Cylinder { name: Option<Name>, at: Point, diameter: Quantity, span: Span },
+    Lamp { name: Option<Name>, at: Point, height: Option<Quantity>, intensity: Option<Quantity>, span: Span },
+    Zone { name: Option<Name>, from: Point, to: Point, grey: Option<Quantity>, charger: bool, span: Span },
+    Start { from: Point, to: Option<Point>, heading: Option<Quantity>, span: Span },
+}
+
+/// `(X, Y)` in a world item.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Point {
+    pub x: Quantity,
+    pub y: Quantity,
 }
 
 impl WorldItem {
@@ -144,7 +156,12 @@ impl WorldItem {
             | WorldItem::Battery(_, span)
             | WorldItem::Recharge(_, span)
             | WorldItem::Objects { span, .. }
-            | WorldItem::Body(_, span) => *span,
+            | WorldItem::Body(_, span)
+            | WorldItem::Wall { span, .. }
+            | WorldItem::Cylinder { span, .. }
+            | WorldItem::Lamp { span, .. }
+            | WorldItem::Zone { span, .. }
+            | WorldItem::Start { span, .. } => *span,
         }
     }
 }
@@ -262,6 +279,8 @@ impl WeightSource {
 pub struct ActivationDecl {
     pub source: Option<WeightSource>,
     pub hidden: Option<Quantity>,
+    /// `hidden N recurrent`
+    pub recurrent: bool,
     pub range: Option<Range>,
     pub span: Span,
 }
@@ -348,6 +367,8 @@ impl ActionDecl {
 pub struct NeuralDecl {
     pub sense: Option<(Vec<SensorRef>, Span)>,
     pub hidden: Option<Quantity>,
+    /// `hidden N recurrent`
+    pub recurrent: bool,
     pub outputs: Option<OutputsDecl>,
     pub weights: Option<WeightSource>,
     pub span: Span,

@@ -245,6 +245,20 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::diameter => "`diameter`",
         Rule::object_kind => "`physical` or `virtual`",
         Rule::body => "`body`",
+        Rule::inner_wall | Rule::k_wall => "`wall`",
+        Rule::cylinder | Rule::k_cylinder => "`cylinder`",
+        Rule::lamp_item | Rule::k_lamp => "`lamp`",
+        Rule::zone | Rule::k_zone => "`zone`",
+        Rule::start | Rule::k_start => "`start`",
+        Rule::item_name => "a name",
+        Rule::k_from => "`from`",
+        Rule::k_at => "`at`",
+        Rule::point => "a point `(X, Y)`",
+        Rule::lamp_height => "`height`",
+        Rule::lamp_intensity => "`intensity`",
+        Rule::zone_grey => "`grey`",
+        Rule::zone_charger => "`charger`",
+        Rule::heading => "`heading`",
         Rule::setting => "a setting",
         Rule::evolve => "`evolve`",
         Rule::selection => "`selection`",
@@ -268,6 +282,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::k_random => "`random`",
         Rule::number_list => "`[`",
         Rule::hidden | Rule::k_hidden => "`hidden`",
+        Rule::k_recurrent => "`recurrent`",
         Rule::behavior => "`behavior`",
         Rule::script => "`{`",
         Rule::commit => "`commit`",
@@ -707,13 +722,23 @@ impl Builder {
             match c.as_rule() {
                 Rule::sense => items.push(ModuleItem::Sense(c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::activation => {
-                    let mut a = ActivationDecl { source: None, hidden: None, range: None, span: csp };
+                    let mut a = ActivationDecl {
+                        source: None,
+                        hidden: None,
+                        recurrent: false,
+                        range: None,
+                        span: csp,
+                    };
                     let mut seen = Vec::new();
                     for o in c.into_inner() {
                         self.once(&mut seen, "activation option", &o);
                         match o.as_rule() {
                             Rule::weights_source => a.source = Some(weight_source(o)),
-                            Rule::hidden => a.hidden = o.into_inner().nth(1).map(quantity),
+                            Rule::hidden => {
+                                let mut h = o.into_inner();
+                                a.hidden = h.nth(1).map(quantity);
+                                a.recurrent = h.next().is_some();
+                            }
                             Rule::range_setting => a.range = o.into_inner().nth(1).map(range),
                             _ => {}
                         }
@@ -791,14 +816,25 @@ impl Builder {
 
     fn neural(&mut self, p: Pair<Rule>) -> NeuralDecl {
         let sp = span(&p);
-        let mut n = NeuralDecl { sense: None, hidden: None, outputs: None, weights: None, span: sp };
+        let mut n = NeuralDecl {
+            sense: None,
+            hidden: None,
+            recurrent: false,
+            outputs: None,
+            weights: None,
+            span: sp,
+        };
         let mut seen = Vec::new();
         for c in p.into_inner() {
             let csp = span(&c);
             self.once(&mut seen, "neural option", &c);
             match c.as_rule() {
                 Rule::sense => n.sense = Some((c.into_inner().map(sensor_ref).collect(), csp)),
-                Rule::hidden => n.hidden = c.into_inner().nth(1).map(quantity),
+                Rule::hidden => {
+                    let mut h = c.into_inner();
+                    n.hidden = h.nth(1).map(quantity);
+                    n.recurrent = h.next().is_some();
+                }
                 Rule::neural_weights => n.weights = c.into_inner().next().map(weight_source),
                 Rule::outputs => {
                     if let Some(o) = c.into_inner().next() {
@@ -1054,6 +1090,61 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 items.push(WorldItem::Objects { count, diameter, virtual_, span: csp });
             }
             Rule::body => items.push(WorldItem::Body(c.into_inner().map(setting).collect(), csp)),
+            Rule::inner_wall | Rule::cylinder | Rule::lamp_item | Rule::zone | Rule::start => {
+                let rule = c.as_rule();
+                let mut name_ = None;
+                let mut points = Vec::new();
+                let (mut diameter, mut height, mut intensity, mut grey, mut heading) =
+                    (None, None, None, None, None);
+                let mut charger = false;
+                for o in c.into_inner() {
+                    match o.as_rule() {
+                        Rule::item_name => name_ = o.into_inner().next().map(name),
+                        Rule::point => {
+                            let mut q = o.into_inner().map(quantity);
+                            let q0 = Quantity { value: 0.0, unit: None, span: csp };
+                            let x = q.next().unwrap_or(q0.clone());
+                            let y = q.next().unwrap_or(q0);
+                            points.push(Point { x, y });
+                        }
+                        Rule::diameter => diameter = o.into_inner().next().map(quantity),
+                        Rule::lamp_height => height = o.into_inner().next().map(quantity),
+                        Rule::lamp_intensity => intensity = o.into_inner().next().map(quantity),
+                        Rule::zone_grey => grey = o.into_inner().next().map(quantity),
+                        Rule::zone_charger => charger = true,
+                        Rule::heading => heading = o.into_inner().next().map(quantity),
+                        _ => {}
+                    }
+                }
+                let q0 = Quantity { value: 0.0, unit: None, span: csp };
+                let p0 = Point { x: q0.clone(), y: q0.clone() };
+                let mut points = points.into_iter();
+                let first = points.next().unwrap_or(p0.clone());
+                let second = points.next();
+                items.push(match rule {
+                    Rule::inner_wall => {
+                        WorldItem::Wall { name: name_, from: first, to: second.unwrap_or(p0), span: csp }
+                    }
+                    Rule::cylinder => WorldItem::Cylinder {
+                        name: name_,
+                        at: first,
+                        diameter: diameter.unwrap_or(q0),
+                        span: csp,
+                    },
+                    Rule::lamp_item => {
+                        WorldItem::Lamp { name: name_, at: first, height, intensity, span: csp }
+                    }
+                    Rule::zone => WorldItem::Zone {
+                        name: name_,
+                        from: first,
+                        to: second.unwrap_or(p0),
+                        grey,
+                        charger,
+                        span: csp,
+                    },
+                    _ => WorldItem::Start { from: first, to: second, heading, span: csp },
+                });
+            }
             _ => {}
         }
     }

@@ -57,6 +57,7 @@ mod world_facts {
             charger: Some(Charger { wall: Wall::North, length: 200.0, lamp_height: Some(150.0) }),
             battery: Some(Battery { capacity: 200, recharge: 20 }),
             objects: None,
+            items: Default::default(),
         }
     }
 

@@ -338,19 +338,21 @@ impl<'s> Controller<'s> {
         let mut mods = Vec::with_capacity(stage.modules.len());
         for m in &stage.modules {
             let a = &m.activation;
-            let activation = Net::new(
+            let activation = Net::with_context(
                 m.inputs.clone(),
                 a.hidden as usize,
                 a.outputs as usize,
+                a.recurrent,
                 a.params.iter().map(&mut value).collect(),
             );
             let gen = match &m.behavior {
                 Behavior::Script(s) => Gen::Script(ScriptRun::new(s)),
                 Behavior::Neural(nb) => Gen::Neural {
-                    net: Net::new(
+                    net: Net::with_context(
                         nb.inputs.clone(),
                         nb.net.hidden as usize,
                         nb.net.outputs as usize,
+                        nb.net.recurrent,
                         nb.net.params.iter().map(&mut value).collect(),
                     ),
                     decode: &nb.decode,

@@ -29,6 +29,9 @@ pub struct Net {
     x: Vec<f32>,
     /// Hidden activations of the last forward pass.
     h: Vec<f32>,
+    /// The context of the last forward pass: the hidden activations of the
+    /// one before (0 at first; empty unless recurrent).
+    ctx: Vec<f32>,
     /// Outputs of the last forward pass.
     y: Vec<f32>,
     /// Net inputs of the output units in the last forward pass (what the
@@ -62,8 +65,15 @@ impl Net {
     /// A network over the given channels; `w` must hold
     /// `Network::param_count(chans.len(), hidden, outputs)` weights.
     pub fn new(chans: Vec<u16>, hidden: usize, outputs: usize, w: Vec<f32>) -> Net {
+        Net::with_context(chans, hidden, outputs, false, w)
+    }
+
+    /// A network, recurrent (Elman) or not; `w` must hold
+    /// `Network::param_count_of(chans.len(), hidden, outputs, recurrent)` weights.
+    pub fn with_context(chans: Vec<u16>, hidden: usize, outputs: usize, recurrent: bool, w: Vec<f32>) -> Net {
         let n = chans.len();
-        debug_assert_eq!(w.len(), crate::program::Network::param_count(n, hidden, outputs));
+        let recurrent = recurrent && hidden > 0;
+        debug_assert_eq!(w.len(), crate::program::Network::param_count_of(n, hidden, outputs, recurrent));
         let run = match chans.first() {
             Some(&c0) if chans.iter().enumerate().all(|(i, &c)| c as usize == c0 as usize + i) => {
                 Some(c0 as usize)
@@ -79,6 +89,7 @@ impl Net {
             w,
             x: vec![0.0; n],
             h: vec![0.0; hidden],
+            ctx: vec![0.0; if recurrent { hidden } else { 0 }],
             y: vec![0.0; outputs],
             z: vec![0.0; outputs],
             dy: vec![0.0; outputs],
@@ -98,10 +109,26 @@ impl Net {
     /// input (the link term of an activation network).
     #[inline]
     pub fn forward(&mut self, percept: &[f32; CHANNELS], extra: f32) -> &[f32] {
-        let Net { chans, run, hidden, w, x, h, y, z, .. } = self;
+        let Net { chans, run, hidden, w, x, h, ctx, y, z, .. } = self;
         let x = inputs(chans, *run, x, percept);
         let n = x.len();
-        if *hidden == 0 {
+        if !ctx.is_empty() {
+            // Elman: the context is the previous pass's hidden layer.
+            ctx.copy_from_slice(h);
+            let c = ctx.len();
+            let u = n + 1 + c;
+            for (j, h) in h.iter_mut().enumerate() {
+                let row = &w[j * u..(j + 1) * u];
+                *h = sigmoid(row[0] + dot(&row[1..n + 1], x) + dot(&row[n + 1..], ctx));
+            }
+            let base = *hidden * u;
+            let m = *hidden + 1;
+            for (o, (y, z)) in y.iter_mut().zip(z.iter_mut()).enumerate() {
+                let row = &w[base + o * m..base + (o + 1) * m];
+                *z = row[0] + dot(&row[1..], h) + extra;
+                *y = sigmoid(*z);
+            }
+        } else if *hidden == 0 {
             for (o, (y, z)) in y.iter_mut().zip(z.iter_mut()).enumerate() {
                 let row = &w[o * (n + 1)..(o + 1) * (n + 1)];
                 *z = row[0] + dot(&row[1..], x) + extra;
@@ -136,7 +163,7 @@ impl Net {
         rate: f32,
         error: CrbpError,
     ) {
-        let Net { chans, run, hidden, outputs, w, x, h, y, dy, .. } = self;
+        let Net { chans, run, hidden, outputs, w, x, h, ctx, y, dy, .. } = self;
         let x = inputs(chans, *run, x, percept);
         let n = x.len();
         for (o, (d, &y)) in dy.iter_mut().zip(y.iter()).enumerate() {
@@ -156,16 +183,20 @@ impl Net {
             }
             return;
         }
-        let base = *hidden * (n + 1);
+        // A hidden unit's row: bias, inputs, then the context (recurrent);
+        // the context is an input like the others (one step back, no
+        // propagation through time).
+        let u = n + 1 + ctx.len();
+        let base = *hidden * u;
         let m = *hidden + 1;
         // Hidden deltas from the weights before this update.
         for j in 0..*hidden {
             let back: f32 = (0..*outputs).map(|o| w[base + o * m + 1 + j] * dy[o]).sum();
             let hj = h[j];
             let g = rate * back * hj * (1.0 - hj);
-            let row = &mut w[j * (n + 1)..(j + 1) * (n + 1)];
+            let row = &mut w[j * u..(j + 1) * u];
             row[0] += g;
-            for (w, &x) in row[1..].iter_mut().zip(x) {
+            for (w, &x) in row[1..].iter_mut().zip(x.iter().chain(ctx.iter())) {
                 *w += g * x;
             }
         }
@@ -217,6 +248,26 @@ mod tests {
         let after = net.forward(&p, 0.0).to_vec();
         assert!(after[0] > before[0] + 0.05, "{before:?} -> {after:?}");
         assert!(after[1] < before[1] - 0.05, "{before:?} -> {after:?}");
+    }
+
+    #[test]
+    fn recurrent_hidden_units_read_the_previous_pass() {
+        // 1 input, 1 recurrent hidden unit, 1 output: h = s(0 + 1 x + 2 c),
+        // y = s(0 + 1 h).
+        let mut net = Net::with_context(vec![0], 1, 1, true, vec![0.0, 1.0, 2.0, 0.0, 1.0]);
+        assert_eq!(Network::param_count_of(1, 1, 1, true), 5);
+        let p = [0.0; CHANNELS];
+        let y1 = net.forward(&p, 0.0)[0];
+        let h1 = sigmoid(0.0);
+        assert!((y1 - sigmoid(h1)).abs() < 1e-6);
+        // Same input, but the context is now h1: the output changes.
+        let y2 = net.forward(&p, 0.0)[0];
+        let h2 = sigmoid(2.0 * h1);
+        assert!((y2 - sigmoid(h2)).abs() < 1e-6, "{y2} vs {}", sigmoid(h2));
+        assert!(y2 > y1);
+        // A fresh network starts from a zero context again.
+        let mut fresh = Net::with_context(vec![0], 1, 1, true, vec![0.0, 1.0, 2.0, 0.0, 1.0]);
+        assert_eq!(fresh.forward(&p, 0.0)[0], y1);
     }
 
     use crate::program::Network;

@@ -122,7 +122,7 @@ mod tests {
             testkit::module("avoid", 0, testkit::chans(CH_IR, 8), testkit::avoid_behavior(0.5, 1.0));
         let mut act = vec![Param::Fixed(1.0); 9];
         act[0] = Param::Fixed(-0.3);
-        avoid.activation = Network { inputs: 8, hidden: 0, outputs: 1, params: act };
+        avoid.activation = Network { inputs: 8, hidden: 0, outputs: 1, recurrent: false, params: act };
         avoid.learning = Some(testkit::crbp(LearnTarget::Behavior, 0.5, 0.1, 30));
         avoid.reinforce = Some(testkit::ir_decrease());
         train.modules = vec![wander, avoid.clone()];

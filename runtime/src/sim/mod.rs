@@ -46,10 +46,10 @@ use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_IR, CH_LIGHT};
-use crate::program::{Wall, World};
+use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT};
+use crate::program::{Items, Wall, World};
 
-pub use scene::{ObjectState, Scene, SceneObject};
+pub use scene::{ObjectState, Scene, SceneObject, SceneZone};
 
 /// What the controller asks of the robot for one action.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -166,6 +166,12 @@ pub struct Sim {
     obj_radius: f32,
     obj_virtual: bool,
     objects: Vec<Obj>,
+    /// Inner wall segments' end points.
+    inner: Vec<[Point2<f32>; 2]>,
+    cylinders: Vec<Cyl>,
+    /// Declared lamps (the charger's is `lamp`).
+    lamps: Vec<Lamp>,
+    zones: Vec<FloorZone>,
     // precomputed IR
     geo: ir::Geometry,
     wall_k: ir::Coeffs,
@@ -180,7 +186,30 @@ pub struct Sim {
     held: Option<usize>,
 }
 
-/// The lamp above the charger.
+/// A physical cylinder with its IR constants.
+#[derive(Clone, Copy, Debug)]
+struct Cyl {
+    at: Point2<f32>,
+    radius: f32,
+    k: ir::Coeffs,
+}
+
+/// A rectangle of the floor.
+#[derive(Clone, Copy, Debug)]
+struct FloorZone {
+    min: Point2<f32>,
+    max: Point2<f32>,
+    grey: f32,
+    charger: bool,
+}
+
+impl FloorZone {
+    fn contains(&self, p: &Point2<f32>) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+}
+
+/// A lamp: the one above the charger, or a declared one.
 #[derive(Clone, Copy, Debug)]
 struct Lamp {
     /// Where it is, seen from above.
@@ -275,6 +304,40 @@ impl Sim {
             None => (0, 5.0, true),
         };
         let model = &ir::KHEPERA;
+        let items = &world.items;
+        let pt = |p: [f32; 2]| Point2::new(finite_or(p[0], 0.0), finite_or(p[1], 0.0));
+        let inner = items.walls.iter().map(|w| [pt(w.from), pt(w.to)]).collect();
+        let cylinders = items
+            .cylinders
+            .iter()
+            .map(|c| {
+                let radius = finite_or(c.diameter, 0.0).max(0.2) / 2.0;
+                let k = ir::Coeffs::new(&model.cylinder_reach(radius), &model.cylinder);
+                Cyl { at: pt(c.at), radius, k }
+            })
+            .collect();
+        let lamps = items
+            .lamps
+            .iter()
+            .map(|l| {
+                let h = finite_or(l.height, 0.0).max(0.0);
+                let k = (LAMP_FULL * LAMP_FULL + h * h) * finite_or(l.intensity, 0.0).max(0.0);
+                Lamp { at: pt(l.at), height: h, k }
+            })
+            .collect();
+        let zones = items
+            .zones
+            .iter()
+            .map(|z| {
+                let (a, b) = (pt(z.from), pt(z.to));
+                FloorZone {
+                    min: Point2::new(a.x.min(b.x), a.y.min(b.y)),
+                    max: Point2::new(a.x.max(b.x), a.y.max(b.y)),
+                    grey: finite_or(z.grey, 1.0).clamp(0.0, 1.0),
+                    charger: z.charger,
+                }
+            })
+            .collect();
         let mut sim = Sim {
             rng: ChaCha8Rng::seed_from_u64(0),
             width,
@@ -291,6 +354,10 @@ impl Sim {
             obj_radius,
             obj_virtual,
             objects: Vec::with_capacity(count),
+            inner,
+            cylinders,
+            lamps,
+            zones,
             geo: ir::Geometry::new(model, radius),
             wall_k: ir::Coeffs::new(&model.wall.reach, &model.wall),
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
@@ -308,17 +375,29 @@ impl Sim {
             sim.objects.push(Obj { at, state: ObjectState::Floor, gripped: false });
         }
         let margin = radius + START_CLEARANCE;
+        let (lo, hi) = match &items.start {
+            Some(s) => {
+                let (a, b) = (pt(s.from), pt(s.to));
+                (Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)))
+            }
+            None => (Point2::new(margin, margin), Point2::new(width - margin, depth - margin)),
+        };
         let mut centre = Point2::new(width / 2.0, depth / 2.0);
         for _ in 0..PLACE_TRIES {
-            let x = uniform(&mut rng, margin, width - margin);
-            let y = uniform(&mut rng, margin, depth - margin);
+            let x = uniform(&mut rng, lo.x, hi.x);
+            let y = uniform(&mut rng, lo.y, hi.y);
             centre = Point2::new(x, y);
             let d = radius + sim.obj_radius + 2.0;
-            if sim.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d) {
+            if sim.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d)
+                && sim.clear_of_items(&centre, radius + 2.0)
+            {
                 break;
             }
         }
-        let theta = uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI);
+        let theta = match items.start.as_ref().and_then(|s| s.heading) {
+            Some(h) => finite_or(h, 0.0),
+            None => uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI),
+        };
         sim.set_pose_unchecked(Pose { x: centre.x, y: centre.y, theta });
         sim.rng = rng;
         sim
@@ -347,7 +426,7 @@ impl Sim {
                 let d = self.radius + r + 2.0;
                 (p - spot).norm_squared() >= d * d
             });
-            if clear_objects && clear_robot {
+            if clear_objects && clear_robot && self.clear_of_items(&spot, r + 2.0) {
                 break;
             }
         }
@@ -392,11 +471,21 @@ impl Sim {
         }
     }
 
-    /// True when the body centred at `p` overlaps no wall and no physical
-    /// object on the floor.
+    /// True when a disc of radius `r` centred at `p` overlaps no inner wall
+    /// and no cylinder (true at once in a world without them).
+    fn clear_of_items(&self, p: &Point2<f32>, r: f32) -> bool {
+        self.inner.iter().all(|[a, b]| segment_distance2(p, a, b) >= r * r)
+            && self.cylinders.iter().all(|c| (c.at - p).norm_squared() >= (r + c.radius) * (r + c.radius))
+    }
+
+    /// True when the body centred at `p` overlaps no wall, no cylinder and
+    /// no physical object on the floor.
     fn free(&self, p: &Point2<f32>) -> bool {
         let r = self.radius;
         if !(p.x >= r && p.x <= self.width - r && p.y >= r && p.y <= self.depth - r) {
+            return false;
+        }
+        if !self.clear_of_items(p, r) {
             return false;
         }
         if self.obj_virtual {
@@ -438,6 +527,22 @@ impl Sim {
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
+        out[CH_FLOOR] = self.floor();
+        out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
+    }
+
+    /// What a ground sensor under the body centre reads: the grey level of
+    /// the last declared floor zone there, else the white floor's 1.
+    pub fn floor(&self) -> f32 {
+        let c = self.centre();
+        self.zones.iter().rev().find(|z| z.contains(&c)).map_or(1.0, |z| z.grey)
+    }
+
+    /// Distance from the body centre to the nearest lamp, seen from above
+    /// (the charger's lamp included), mm; `None` without lamps.
+    pub fn lamp_distance(&self) -> Option<f32> {
+        let c = self.centre();
+        self.lamp.iter().chain(&self.lamps).map(|l| (l.at - c).norm()).reduce(f32::min)
     }
 
     /// Noise-free IR readings of the current state.
@@ -448,24 +553,50 @@ impl Sim {
 
     /// Adds the walls' noise-free IR readings to `out`.
     fn ir_walls(&self, out: &mut [f32; ir::SENSORS]) {
-        let wt = &ir::tables().0;
         let centre = self.centre();
-        let rot = &self.pose.rotation;
-        let g = &self.geo;
         let reach = self.radius + ir::RANGE;
         for (dist, normal) in self.walls(&centre) {
-            if dist > reach {
+            if dist <= reach {
+                self.wall_ir(out, dist, &normal);
+            }
+        }
+        if !self.inner.is_empty() {
+            self.ir_inner_walls(out, &centre, reach);
+        }
+    }
+
+    /// Adds one flat wall's readings: `dist` from the body centre, `normal`
+    /// its unit normal toward the wall (world frame).
+    #[inline(always)]
+    fn wall_ir(&self, out: &mut [f32; ir::SENSORS], dist: f32, normal: &Vector2<f32>) {
+        let wt = &ir::tables().0;
+        let g = &self.geo;
+        // With `n` the normal in the body frame, each sensor is `pos . n`
+        // nearer the wall than the centre, and its axis makes an angle
+        // of cosine `ray . n` with the normal: all eight at once.
+        let n = self.pose.rotation.inverse_transform_vector(normal);
+        let nearer = g.pos * n;
+        let cos_a = g.rays * n;
+        for k in 0..ir::SENSORS {
+            out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
+        }
+    }
+
+    /// An inner wall reads as a flat wall through its point nearest the
+    /// centre, facing the body.
+    #[inline(never)]
+    fn ir_inner_walls(&self, out: &mut [f32; ir::SENSORS], centre: &Point2<f32>, reach: f32) {
+        for [a, b] in &self.inner {
+            let d2 = segment_distance2(centre, a, b);
+            if d2 > reach * reach || d2 <= 0.0 {
                 continue;
             }
-            // With `n` the normal in the body frame, each sensor is `pos . n`
-            // nearer the wall than the centre, and its axis makes an angle
-            // of cosine `ray . n` with the normal: all eight at once.
-            let n = rot.inverse_transform_vector(&normal);
-            let nearer = g.pos * n;
-            let cos_a = g.rays * n;
-            for k in 0..ir::SENSORS {
-                out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
-            }
+            let dist = d2.sqrt();
+            let ab = b - a;
+            let len2 = ab.norm_squared();
+            let t = if len2 > 0.0 { ((centre - a).dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+            let nearest = a + ab * t;
+            self.wall_ir(out, dist, &((nearest - centre) / dist));
         }
     }
 
@@ -479,6 +610,20 @@ impl Sim {
         let r = self.obj_radius;
         let reach = reach + r;
         let reach2 = reach * reach;
+        for c in &self.cylinders {
+            let offset = c.at - centre;
+            let far = reach - r + c.radius;
+            if offset.norm_squared() > far * far {
+                continue;
+            }
+            let at = Point2::from(rot.inverse_transform_vector(&offset));
+            for k in 0..ir::SENSORS {
+                let v = at - g.position(k);
+                let dist = v.norm().max(1e-3);
+                let cos_a = g.axis(k).dot(&v) / dist;
+                out[k] += ct.get(c.k.z(k, dist - c.radius, cos_a));
+            }
+        }
         for o in &self.objects {
             if o.state != ObjectState::Floor {
                 continue;
@@ -513,9 +658,20 @@ impl Sim {
     /// times the lobe `cos(1.5 a)` for a horizontal bearing `|a| < 60` degrees
     /// off the sensor's axis (0 beyond), clamped at 1.
     fn sense_light(&self, out: &mut [f32; ir::SENSORS]) {
-        let Some(lamp) = self.lamp else {
-            return;
-        };
+        if let Some(lamp) = &self.lamp {
+            self.add_lamp(lamp, out);
+        }
+        for lamp in &self.lamps {
+            self.add_lamp(lamp, out);
+        }
+        for v in out.iter_mut() {
+            *v = v.min(1.0);
+        }
+    }
+
+    /// Adds one lamp's readings to `out` (unclamped).
+    #[inline(always)]
+    fn add_lamp(&self, lamp: &Lamp, out: &mut [f32; ir::SENSORS]) {
         // The lamp in the body frame.
         let rel = self.pose.inverse_transform_point(&lamp.at).coords;
         let rho2 = rel.norm_squared();
@@ -529,7 +685,7 @@ impl Sim {
             // cos(1.5 a) = 4 q^3 - 3 q with q = cos(a / 2).
             let q = ((1.0 + cos_a) * 0.5).max(0.0).sqrt();
             let lobe = (4.0 * q * q * q - 3.0 * q).max(0.0);
-            out[i] = (intensity * lobe).min(1.0);
+            out[i] += intensity * lobe;
         }
     }
 
@@ -606,7 +762,7 @@ impl Sim {
             return false;
         };
         let full = cap * rech;
-        if charge && self.in_contact() {
+        if (charge && self.in_contact()) || self.on_charging_zone() {
             if self.charge < full {
                 self.charge = (self.charge + cap).min(full);
                 return self.charge == full;
@@ -665,6 +821,13 @@ impl Sim {
         };
         let reach = self.radius + CONTACT;
         segment_distance2(&self.centre(), &a, &b) <= reach * reach
+    }
+
+    /// The body centre on a floor zone that is a charger (these charge
+    /// without being asked to).
+    fn on_charging_zone(&self) -> bool {
+        let c = self.centre();
+        self.zones.iter().any(|z| z.charger && z.contains(&c))
     }
 
     /// Moves the body for one action; returns true on a collision. The exact
@@ -746,8 +909,8 @@ impl Sim {
 
     /// The part of the percept a host simulates for a real robot: the IR
     /// readings of the virtual objects alone (no walls, no noise: the robot
-    /// senses those), the battery and the optical barrier. Light channels
-    /// are 0.
+    /// senses those), the battery, the optical barrier and the floor zone
+    /// under the body. Light channels are 0.
     pub fn sense_virtual(&self, out: &mut [f32; CHANNELS]) {
         let mut irv = [0.0f32; ir::SENSORS];
         if self.obj_virtual {
@@ -759,6 +922,8 @@ impl Sim {
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
+        out[CH_FLOOR] = self.floor();
+        out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
     }
 
     /// Battery level 0..1 (1 forever without a battery).
@@ -872,12 +1037,49 @@ impl Sim {
                     }
                 })
                 .collect(),
+            walls: self.inner.iter().map(|&[a, b]| [xy(a), xy(b)]).collect(),
+            cylinders: self.cylinders.iter().map(|c| [c.at.x, c.at.y, c.radius]).collect(),
+            lamps: self.lamps.iter().map(|l| xy(l.at)).collect(),
+            zones: self
+                .zones
+                .iter()
+                .map(|z| SceneZone { from: xy(z.min), to: xy(z.max), grey: z.grey, charger: z.charger })
+                .collect(),
             pose: self.pose(),
             body_radius: self.radius,
             arm_down: self.arm_down,
             claw_closed: self.claw_closed,
         }
     }
+}
+
+/// What a disc overlaps among a world's declared items.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blocker {
+    /// `Items::walls[i]`.
+    Wall(usize),
+    /// `Items::cylinders[i]`.
+    Cylinder(usize),
+}
+
+/// The first inner wall or cylinder of `items` that a disc of `radius`
+/// centred at `at` overlaps (what the simulator's collision test finds).
+pub fn blocker(items: &Items, at: [f32; 2], radius: f32) -> Option<Blocker> {
+    let p = Point2::new(at[0], at[1]);
+    let pt = |q: [f32; 2]| Point2::new(q[0], q[1]);
+    if let Some(i) =
+        items.walls.iter().position(|w| segment_distance2(&p, &pt(w.from), &pt(w.to)) < radius * radius)
+    {
+        return Some(Blocker::Wall(i));
+    }
+    items
+        .cylinders
+        .iter()
+        .position(|c| {
+            let d = radius + c.diameter / 2.0;
+            (pt(c.at) - p).norm_squared() < d * d
+        })
+        .map(Blocker::Cylinder)
 }
 
 /// The bar's end points: centred on `wall`, flush with it.

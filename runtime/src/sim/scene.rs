@@ -35,8 +35,28 @@ pub struct Scene {
     /// The lamp's position (above the bar's middle), if there is one.
     pub lamp: Option<[f32; 2]>,
     pub objects: Vec<SceneObject>,
+    /// Inner walls' end points.
+    #[serde(default)]
+    pub walls: Vec<[[f32; 2]; 2]>,
+    /// Cylinders: centre x, y and radius.
+    #[serde(default)]
+    pub cylinders: Vec<[f32; 3]>,
+    /// Declared lamps (the charger's is `lamp`).
+    #[serde(default)]
+    pub lamps: Vec<[f32; 2]>,
+    #[serde(default)]
+    pub zones: Vec<SceneZone>,
     pub pose: Pose,
     pub body_radius: f32,
     pub arm_down: bool,
     pub claw_closed: bool,
+}
+
+/// A floor zone: south-west and north-east corners, grey level, charger.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneZone {
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+    pub grey: f32,
+    pub charger: bool,
 }

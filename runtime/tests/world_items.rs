@@ -1,0 +1,175 @@
+//! The world's declared items in the simulator: inner walls, cylinders,
+//! lamps, floor zones (the ground sensor, charging zones) and the start pose.
+
+use shaping_runtime::catalog::{CHANNELS, CH_FLOOR, CH_IR, CH_LIGHT};
+use shaping_runtime::program::{Battery, Body, Cylinder, InnerWall, Items, Lamp, Start, World, Zone};
+use shaping_runtime::sim::{blocker, Blocker, Command, Pose, Sim};
+
+fn world(items: Items) -> World {
+    World {
+        arena: [400.0, 600.0],
+        body: Body { wheel_noise: 0.0, sensor_noise: 0.0, ..Body::default() },
+        charger: None,
+        battery: None,
+        objects: None,
+        items,
+    }
+}
+
+fn percept(sim: &mut Sim) -> [f32; CHANNELS] {
+    let mut p = [0.0; CHANNELS];
+    sim.sense(&mut p);
+    p
+}
+
+fn forward() -> Command {
+    Command { wheels: [1.0, 1.0], ..Command::default() }
+}
+
+fn wall_across(y: f32) -> Items {
+    Items { walls: vec![InnerWall { name: None, from: [0.0, y], to: [400.0, y] }], ..Items::default() }
+}
+
+#[test]
+fn an_inner_wall_blocks_the_body_and_is_seen_by_the_front_sensors() {
+    let mut sim = Sim::new(&world(wall_across(300.0)), 1);
+    // Facing north, 17.5 mm from the wall: front sensors read it, back do not.
+    assert!(sim.set_pose(Pose { x: 200.0, y: 255.0, theta: std::f32::consts::FRAC_PI_2 }));
+    let p = percept(&mut sim);
+    assert!(p[CH_IR + 2] > 0.3 && p[CH_IR + 3] > 0.3, "{p:?}");
+    assert!(p[CH_IR + 6] < 0.01, "{p:?}");
+    // Driving on ends against it.
+    let mut collided = false;
+    for _ in 0..10 {
+        collided |= sim.step(&forward()).collided;
+    }
+    assert!(collided);
+    assert!(sim.pose().y <= 300.0 - 27.5 + 1e-3, "{:?}", sim.pose());
+    // The body cannot be put across it.
+    assert!(!sim.set_pose(Pose { x: 200.0, y: 310.0, theta: 0.0 }));
+    // Without the wall the same place reads nothing ahead.
+    let mut open = Sim::new(&world(Items::default()), 1);
+    assert!(open.set_pose(Pose { x: 200.0, y: 255.0, theta: std::f32::consts::FRAC_PI_2 }));
+    assert!(percept(&mut open)[CH_IR + 2] < 0.01);
+}
+
+#[test]
+fn a_cylinder_blocks_and_reflects() {
+    let items = Items {
+        cylinders: vec![Cylinder { name: None, at: [200.0, 300.0], diameter: 50.0 }],
+        ..Items::default()
+    };
+    let mut sim = Sim::new(&world(items.clone()), 1);
+    assert!(!sim.set_pose(Pose { x: 200.0, y: 260.0, theta: 0.0 }));
+    assert!(sim.set_pose(Pose { x: 200.0, y: 240.0, theta: std::f32::consts::FRAC_PI_2 }));
+    let p = percept(&mut sim);
+    assert!(p[CH_IR + 2] > 0.05, "{p:?}");
+    assert_eq!(blocker(&items, [200.0, 260.0], 27.5), Some(Blocker::Cylinder(0)));
+    assert_eq!(blocker(&items, [200.0, 200.0], 27.5), None);
+}
+
+#[test]
+fn lamps_add_up_and_scale_with_intensity() {
+    let lamp = |intensity: f32| Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity };
+    let read = |lamps: Vec<Lamp>| {
+        let mut sim = Sim::new(&world(Items { lamps, ..Items::default() }), 1);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 100.0, theta: std::f32::consts::FRAC_PI_2 }));
+        percept(&mut sim)[CH_LIGHT + 2]
+    };
+    let one = read(vec![lamp(1.0)]);
+    assert!(one > 0.0 && one < 0.5, "{one}");
+    assert!((read(vec![lamp(2.0)]) - 2.0 * one).abs() < 1e-5);
+    assert!((read(vec![lamp(1.0), lamp(1.0)]) - 2.0 * one).abs() < 1e-5);
+    assert_eq!(read(vec![]), 0.0);
+}
+
+#[test]
+fn the_ground_sensor_reads_the_zone_under_the_body_and_a_charging_zone_refills() {
+    let items = Items {
+        zones: vec![
+            Zone { name: None, from: [0.0, 0.0], to: [100.0, 100.0], grey: 0.5, charger: false },
+            Zone { name: None, from: [300.0, 500.0], to: [400.0, 600.0], grey: 0.0, charger: true },
+        ],
+        ..Items::default()
+    };
+    let w = World { battery: Some(Battery { capacity: 10, recharge: 2 }), ..world(items) };
+    let mut sim = Sim::new(&w, 1);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    assert_eq!(percept(&mut sim)[CH_FLOOR], 1.0);
+    assert!(sim.set_pose(Pose { x: 50.0, y: 50.0, theta: 0.0 }));
+    assert_eq!(percept(&mut sim)[CH_FLOOR], 0.5);
+    // Drain eight actions standing still, then on the charging zone: two
+    // actions (half a battery each) refill it, without a charge command.
+    for _ in 0..8 {
+        sim.step(&Command::default());
+    }
+    assert!((sim.battery() - 0.2).abs() < 1e-6);
+    assert!(sim.set_pose(Pose { x: 350.0, y: 550.0, theta: 0.0 }));
+    assert_eq!(percept(&mut sim)[CH_FLOOR], 0.0);
+    assert!(!sim.step(&Command::default()).recharged);
+    assert!((sim.battery() - 0.7).abs() < 1e-6);
+    assert!(sim.step(&Command::default()).recharged);
+    assert_eq!(sim.battery(), 1.0);
+}
+
+#[test]
+fn the_start_pose_is_fixed_or_drawn_in_its_region() {
+    let fixed = Items {
+        start: Some(Start { from: [100.0, 150.0], to: [100.0, 150.0], heading: Some(1.0) }),
+        ..Items::default()
+    };
+    for seed in 0..5 {
+        let p = Sim::new(&world(fixed.clone()), seed).pose();
+        assert_eq!((p.x, p.y), (100.0, 150.0));
+        assert!((p.theta - 1.0).abs() < 1e-6);
+    }
+    let region = Items {
+        start: Some(Start { from: [50.0, 400.0], to: [350.0, 550.0], heading: None }),
+        ..wall_across(470.0)
+    };
+    let mut headings = Vec::new();
+    for seed in 0..30 {
+        let p = Sim::new(&world(region.clone()), seed).pose();
+        assert!((50.0..=350.0).contains(&p.x) && (400.0..=550.0).contains(&p.y), "{p:?}");
+        assert!((p.y - 470.0).abs() >= 27.5, "{p:?} overlaps the wall");
+        headings.push(p.theta);
+    }
+    assert!(headings.iter().any(|&h| (h - headings[0]).abs() > 0.1));
+}
+
+#[test]
+fn the_validation_refuses_items_outside_the_arena_and_a_start_where_the_body_does_not_fit() {
+    use shaping_runtime::testkit;
+    let check = |items: Items| {
+        let mut s = testkit::navigation();
+        s.world.items = items;
+        shaping_runtime::validate::stage(&s).err().map(|e| e.to_string())
+    };
+    assert_eq!(check(wall_across(300.0)), None);
+    let e = check(wall_across(700.0)).unwrap();
+    assert!(e.contains("`world.items.walls[0]`") && e.contains("not inside the arena"), "{e}");
+    let zone = |from, to| Items {
+        zones: vec![Zone { name: None, from, to, grey: 0.0, charger: false }],
+        ..Items::default()
+    };
+    assert_eq!(check(zone([0.0, 0.0], [50.0, 50.0])), None);
+    let e = check(zone([500.0, 0.0], [600.0, 50.0])).unwrap();
+    assert!(e.contains("does not overlap the arena"), "{e}");
+    let start =
+        |at: [f32; 2]| Items { start: Some(Start { from: at, to: at, heading: None }), ..Items::default() };
+    assert_eq!(check(start([100.0, 100.0])), None);
+    let e = check(start([10.0, 100.0])).unwrap();
+    assert!(e.contains("`world.items.start`"), "{e}");
+}
+
+#[test]
+fn the_lamp_distance_channel_reads_metres_to_the_nearest_lamp() {
+    use shaping_runtime::catalog::CH_LAMP_DISTANCE;
+    let lamp = |at| Lamp { name: None, at, height: 150.0, intensity: 1.0 };
+    let items = Items { lamps: vec![lamp([200.0, 500.0]), lamp([200.0, 0.0])], ..Items::default() };
+    let mut sim = Sim::new(&world(items), 1);
+    assert!(sim.set_pose(Pose { x: 200.0, y: 350.0, theta: 0.0 }));
+    assert!((percept(&mut sim)[CH_LAMP_DISTANCE] - 0.15).abs() < 1e-6);
+    let mut dark = Sim::new(&world(Items::default()), 1);
+    assert_eq!(percept(&mut dark)[CH_LAMP_DISTANCE], 1.0);
+}
