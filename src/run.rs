@@ -3,6 +3,8 @@
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -86,6 +88,37 @@ pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evalua
     }
 }
 
+/// The error for a saved result (checkpoint or trained weights) that does
+/// not belong to the program as it is now.
+fn stale(path: &Path, e: &evolve::EvolveError) -> CliError {
+    let hint = match e {
+        evolve::EvolveError::TooManyGenerations { done, .. } => {
+            format!("declare at least {done} generations, pass `--fresh` to start again, or choose another `--out`")
+        }
+        _ => "pass `--fresh` to start again, or choose another `--out`".to_string(),
+    };
+    CliError::io(format!("error: cannot resume from `{}`: {e}; {hint}", path.display()))
+}
+
+/// Ctrl-C (or SIGTERM) during a run in one process: the generation under
+/// way finishes and is saved, then the run stops saying where; a second
+/// Ctrl-C ends it at once. (On a robot the robot's own handler stops the
+/// motors first, so there the second one does not end the process.)
+fn interrupt_flag(exit_on_second: bool) -> Option<Arc<AtomicBool>> {
+    static FLAG: OnceLock<Option<Arc<AtomicBool>>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            if exit_on_second {
+                signal_hook::flag::register_conditional_shutdown(sig, 2, Arc::clone(&flag)).ok()?;
+            }
+            signal_hook::flag::register(sig, Arc::clone(&flag)).ok()?;
+        }
+        Some(flag)
+    })
+    .clone()
+}
+
 fn ckpt_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.json")
 }
@@ -128,6 +161,7 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
         .build()
         .map_err(|e| CliError::io(format!("error: cannot start worker threads: {e}")))?;
     create_dir(&out)?;
+    let interrupted = if cluster.is_none() { interrupt_flag(args.robot.is_none()) } else { None };
     // The compiled program, for `shaping report` (and `shaping run program.json`).
     write_atomic(&out.join("program.json"), compact_json(&program)?.as_bytes())?;
     let started = Instant::now();
@@ -149,11 +183,11 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
             StageRun::Evolve(_) => {
                 let parent = evolved_parent(&program, index, &finals)?;
                 let cp = match cluster {
-                    None => {
-                        pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args, None))?
-                    }
+                    None => pool.install(|| {
+                        evolve_stage(&program, index, seed, parent, &dir, &args, None, interrupted.as_deref())
+                    })?,
                     // The coordinator's loop calls MPI, so it stays on this thread.
-                    Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c))?,
+                    Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c), None)?,
                 };
                 best_episode(stage, &cp, seed, &dir)?;
                 finals[index] = Some(cp);
@@ -222,6 +256,7 @@ fn evolved_parent<'a>(
     Ok(None)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn evolve_stage(
     program: &Program,
     index: usize,
@@ -230,26 +265,34 @@ fn evolve_stage(
     dir: &Path,
     args: &RunArgs,
     cluster: Option<&Coordinator>,
+    interrupted: Option<&AtomicBool>,
 ) -> Result<Checkpoint, CliError> {
     let stage = &program.stages[index];
     let StageRun::Evolve(evo) = &stage.run else { unreachable!("evolve_stage is called for evolved stages") };
     let path = ckpt_path(dir);
     let existing = if args.fresh { None } else { read_checkpoint(&path)? };
     let mut cp = match existing {
-        Some(cp) => {
-            evolve::check_resume(program, &cp).map_err(|e| {
-                CliError::io(format!(
-                    "error: cannot resume from `{}`: {e}; pass `--fresh` (or another `--out`) to start again",
-                    path.display()
-                ))
-            })?;
-            if cp.stage != index || cp.seed != seed {
+        Some(mut cp) => {
+            if cp.seed != seed {
                 return Err(CliError::io(format!(
-                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it or `--fresh` to start again",
+                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it, `--fresh` to start again, or another `--out`",
                     path.display(),
                     cp.seed,
                     cp.seed
                 )));
+            }
+            evolve::resume(program, index, &mut cp).map_err(|e| stale(&path, &e))?;
+            if !args.quiet && !args.json {
+                if evolve::is_finished(program, &cp) && cp.validated {
+                    eprintln!(
+                        "stage {:<12} all {} generations done before, from {}",
+                        stage.name,
+                        cp.generation,
+                        path.display()
+                    );
+                } else {
+                    eprintln!("resuming `{}` at generation {} of {}", stage.name, cp.generation, evo.generations);
+                }
             }
             cp
         }
@@ -286,6 +329,16 @@ fn evolve_stage(
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats);
+        if interrupted.is_some_and(|f| f.load(Ordering::Relaxed)) && !evolve::is_finished(program, &cp) {
+            bar.abandon();
+            return Err(CliError::io(format!(
+                "interrupted: stage `{}` stopped after generation {} of {}, saved in `{}`; the same command resumes it",
+                stage.name,
+                cp.generation,
+                evo.generations,
+                path.display()
+            )));
+        }
     }
     bar.finish_and_clear();
     if !cp.validated {
@@ -503,12 +556,19 @@ fn train_step(
     let path = dir.join("trained.json");
     if !args.fresh {
         if let Some(t) = read_trained(&path)? {
-            if t.fingerprint == evolve::train::training_fingerprint(stage) && t.run_seed == seed {
-                if !args.quiet && !args.json {
-                    eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
-                }
-                return Ok(t);
+            if t.run_seed != seed {
+                return Err(CliError::io(format!(
+                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it, `--fresh` to start again, or another `--out`",
+                    path.display(),
+                    t.run_seed,
+                    t.run_seed
+                )));
             }
+            evolve::train::check(program, index, &t).map_err(|e| stale(&path, &e))?;
+            if !args.quiet && !args.json {
+                eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
+            }
+            return Ok(t);
         }
     }
     let mut trace = Trace::default();
@@ -558,17 +618,35 @@ fn read_trained(path: &Path) -> Result<Option<evolve::Trained>, CliError> {
 }
 
 /// Binds the weights of every training stage into `program`: from the
-/// `trained.json` files of run directory `run_dir` where they exist and fit,
-/// else by training again from `seed` (training is deterministic by seed).
-pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -> Result<(), CliError> {
+/// `trained.json` files of run directory `run_dir` where they exist and fit
+/// (a stale one is said and not used), else by training again from `seed`
+/// (training is deterministic by seed). Returns what each training stage
+/// learned. Every command that runs a stage of a file binds through here
+/// (`run` binds each training stage as it runs it).
+pub fn bind_training(
+    program: &mut Program,
+    run_dir: Option<&Path>,
+    seed: u64,
+) -> Result<Vec<(usize, evolve::Trained)>, CliError> {
+    let mut all = Vec::new();
     for i in 0..program.stages.len() {
         if !matches!(program.stages[i].run, StageRun::Train { .. }) {
             continue;
         }
-        let stage = &program.stages[i];
         let saved = match run_dir {
-            Some(d) => read_trained(&d.join(&stage.name).join("trained.json"))?
-                .filter(|t| t.fingerprint == evolve::train::training_fingerprint(stage)),
+            Some(d) => {
+                let path = d.join(&program.stages[i].name).join("trained.json");
+                match read_trained(&path)? {
+                    Some(t) => match evolve::train::check(program, i, &t) {
+                        Ok(()) => Some(t),
+                        Err(e) => {
+                            eprintln!("note: not using `{}`: {e}; training the stage again", path.display());
+                            None
+                        }
+                    },
+                    None => None,
+                }
+            }
             None => None,
         };
         let trained = match saved {
@@ -577,8 +655,9 @@ pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -
                 .map_err(|e| CliError::io(format!("error: {e}")))?,
         };
         evolve::train::bind(program, i, &trained).map_err(|e| CliError::io(format!("error: {e}")))?;
+        all.push((i, trained));
     }
-    Ok(())
+    Ok(all)
 }
 
 #[cfg(test)]
