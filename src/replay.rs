@@ -158,8 +158,13 @@ pub(crate) fn evolved_source(program: &Program, index: usize) -> usize {
 }
 
 pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
-    let chosen =
-        choose(&args.file, args.stage.as_deref(), args.genome.as_deref(), args.run.as_deref(), args.error_format)?;
+    let chosen = choose(
+        &args.file,
+        args.stage.as_deref(),
+        args.genome.as_deref(),
+        args.run.as_deref(),
+        args.error_format,
+    )?;
     let Chosen { program, index, genome, training_seed } = chosen;
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let stage = &program.stages[index];
@@ -180,7 +185,7 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     create_dir(&out)?;
     let scene = Sim::new(&stage.world, seed).scene();
-    report::episode_files(&out, &stage.name, stage, &trace, &scene, &[])?;
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[])?;
     let err = |e: serde_json::Error| CliError::io(format!("error: cannot serialise: {e}"));
     write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).map_err(err)?.as_bytes())?;
     write_atomic(&out.join("program.json"), serde_json::to_string(&program).map_err(err)?.as_bytes())?;

@@ -3,11 +3,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT};
 use shaping_runtime::controller::Trace;
 use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
+use crate::episode::{Episode, EpisodeColumns};
 use crate::load::{write_atomic, CliError};
 use crate::plot;
 
@@ -49,8 +51,60 @@ pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(),
         .map_err(|e| CliError::io(format!("error: {e}")))
 }
 
-/// `trace.csv`: one row per action.
-pub fn trace_csv(trace: &Trace) -> String {
+/// One declared sensor or actuator element as a column of `trace.csv`:
+/// its name (`ir[0]`, `battery[0]`, `wheels[1]`) and its value at an action
+/// of a recorded episode.
+type Column = (String, Box<dyn Fn(&EpisodeColumns, usize) -> f32>);
+
+/// The columns of the robot's declared sensors and actuators, one per
+/// element, named `NAME[i]` after the declaration (also a single-valued one:
+/// `battery[0]`, so no name can be one of the fixed columns).
+fn declared_columns(stage: &Stage) -> Vec<Column> {
+    let at =
+        |v: &[[f32; 8]], k: usize, i: usize| v.get(k).and_then(|r| r.get(i)).copied().unwrap_or(f32::NAN);
+    let mut out: Vec<Column> = Vec::new();
+    for s in &stage.sensors {
+        for i in 0..s.count as usize {
+            let name = format!("{}[{i}]", s.name);
+            let ch = s.channel as usize + i;
+            let value: Box<dyn Fn(&EpisodeColumns, usize) -> f32> = match s.kind {
+                SensorKind::Proximity => Box::new(move |c, k| at(&c.ir, k, ch - CH_IR)),
+                SensorKind::Ambient => Box::new(move |c, k| at(&c.light, k, ch - CH_LIGHT)),
+                SensorKind::Level => Box::new(|c, k| c.battery.get(k).copied().unwrap_or(f32::NAN)),
+                SensorKind::Optical => Box::new(|c, k| c.barrier.get(k).map_or(f32::NAN, |&b| b as f32)),
+            };
+            out.push((name, value));
+        }
+    }
+    for a in &stage.actuators {
+        let flag = |v: &[u8], k: usize| v.get(k).map_or(f32::NAN, |&b| b as f32);
+        match a.kind {
+            ActuatorKind::Speed => {
+                for i in 0..2 {
+                    let value = move |c: &EpisodeColumns, k: usize| {
+                        c.wheels.get(k).map_or(f32::NAN, |w: &[f32; 2]| w[i])
+                    };
+                    out.push((format!("{}[{i}]", a.name), Box::new(value)));
+                }
+            }
+            ActuatorKind::Lift => {
+                out.push((format!("{}[0]", a.name), Box::new(move |c, k| flag(&c.arm_down, k))));
+            }
+            ActuatorKind::Grip => {
+                out.push((format!("{}[0]", a.name), Box::new(move |c, k| flag(&c.claw_closed, k))));
+            }
+        }
+    }
+    out
+}
+
+/// `trace.csv`: one row per action: what the controller did (the winner,
+/// activations, reinforcements, performance indicators), where the robot
+/// went, and, named after the robot's declarations, what each sensor read
+/// after the action and what each actuator was set to (from the recorded
+/// `episode`, `NaN` where it has no value).
+pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
+    let declared = declared_columns(stage);
     let mut s =
         String::from("action,winner,battery,holding,grips,releases_outside,recharged,collided,x,y,theta");
     for m in &trace.modules {
@@ -62,8 +116,11 @@ pub fn trace_csv(trace: &Trace) -> String {
     for m in &trace.modules {
         let _ = write!(s, ",perf_{m}");
     }
+    for (name, _) in &declared {
+        let _ = write!(s, ",{name}");
+    }
     s.push('\n');
-    for r in &trace.rows {
+    for (k, r) in trace.rows.iter().enumerate() {
         let winner = trace.modules.get(r.winner as usize).map_or("", |m| m.as_str());
         let _ = write!(
             s,
@@ -83,6 +140,9 @@ pub fn trace_csv(trace: &Trace) -> String {
         for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
             let _ = write!(s, ",{v:.4}");
         }
+        for (_, value) in &declared {
+            let _ = write!(s, ",{:.4}", value(&episode.actions, k));
+        }
         s.push('\n');
     }
     s
@@ -91,16 +151,18 @@ pub fn trace_csv(trace: &Trace) -> String {
 /// Writes `trace.csv` and the pictures of one episode into `dir`:
 /// `activations` (figure 11), `reinforcement` (figures 5, 10, 13) for every
 /// learning module, and `trajectory`.
+#[allow(clippy::too_many_arguments)]
 pub fn episode_files(
     dir: &Path,
     title: &str,
     stage: &Stage,
     trace: &Trace,
+    episode: &Episode,
     scene: &Scene,
     marks: &[(u32, String)],
 ) -> Result<(), CliError> {
     let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
-    write_atomic(&dir.join("trace.csv"), trace_csv(trace).as_bytes())?;
+    write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());
     }

@@ -166,14 +166,19 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
     write_atomic(&out.join("program.json"), compact_json(&program)?.as_bytes())?;
     let started = Instant::now();
     let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
+    // What each stage ended with, for the last line of `--json`.
+    let mut results = Vec::new();
     for &index in &stages {
         if let StageRun::Train { .. } = program.stages[index].run {
             let dir = out.join(&program.stages[index].name);
             create_dir(&dir)?;
             let trained = train_step(&program, index, seed, &dir, &args)?;
-            train_episode(&program.stages[index], index, seed, &dir)?;
             evolve::train::bind(&mut program, index, &trained)
                 .map_err(|e| CliError::io(format!("error: {e}")))?;
+            results.push(serde_json::json!({
+                "stage": program.stages[index].name, "kind": "train",
+                "actions": trained.result.actions, "performance": trained.performance,
+            }));
             continue;
         }
         let stage = &program.stages[index];
@@ -190,18 +195,33 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
                     Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c), None)?,
                 };
                 best_episode(stage, &cp, seed, &dir)?;
+                if let Some((genome, fitness)) = evolve::best_of(&cp) {
+                    results.push(serde_json::json!({
+                        "stage": stage.name, "kind": "evolve", "generations": cp.generation,
+                        "best": fitness, "genome": genome.to_bitstring(),
+                    }));
+                }
                 finals[index] = Some(cp);
             }
             StageRun::Test { actions, learning } => {
                 let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
                     CliError::io(format!("error: test stage `{}` extends no evolved stage", stage.name))
                 })?;
-                test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+                let summary = test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+                results.push(serde_json::json!({"kind": "test", "summary": summary, "stage": stage.name}));
             }
             StageRun::Train { .. } => unreachable!("training stages run above"),
         }
     }
     let report = if args.no_report { None } else { Some(html::write(&out, None)?) };
+    if args.json {
+        let line = serde_json::json!({
+            "done": true, "out": out.display().to_string(), "seed": seed,
+            "seconds": started.elapsed().as_secs_f64(), "stages": results,
+            "report": report.as_ref().map(|p| p.display().to_string()),
+        });
+        println!("{line}");
+    }
     if !args.quiet && !args.json {
         eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), out.display());
         if let Some(path) = report {
@@ -213,17 +233,6 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
 
 fn compact_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
     serde_json::to_string(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
-}
-
-/// `episode.json` of a training stage: its life recorded again, the same
-/// life as `evolve::train_stage`'s (the same episode seed and genome).
-fn train_episode(stage: &Stage, index: usize, seed: u64, dir: &Path) -> Result<(), CliError> {
-    let StageRun::Train { actions } = stage.run else { return Ok(()) };
-    let opts = EpisodeOptions { actions, learning: true, seed: evolve::train::training_seed(seed, index) };
-    let genome = Genome::zeros(stage.layout.bits as usize);
-    let (_, _, ep) =
-        episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
-    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
 }
 
 /// `episode.json` of an evolved stage: one recorded episode of its best
@@ -291,7 +300,10 @@ fn evolve_stage(
                         path.display()
                     );
                 } else {
-                    eprintln!("resuming `{}` at generation {} of {}", stage.name, cp.generation, evo.generations);
+                    eprintln!(
+                        "resuming `{}` at generation {} of {}",
+                        stage.name, cp.generation, evo.generations
+                    );
                 }
             }
             cp
@@ -441,7 +453,7 @@ fn test_stage(
     learning: bool,
     dir: &Path,
     args: &RunArgs,
-) -> Result<(), CliError> {
+) -> Result<serde_json::Value, CliError> {
     let stage = &program.stages[index];
     let eval = |genome: &Genome, episode: u64| {
         let r = run_episode(stage, genome, &EpisodeOptions { actions, learning, seed: episode }, None);
@@ -453,7 +465,7 @@ fn test_stage(
     let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
     let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
     let mark = [(ba.switch, format!("world of `{}`", stage.name))];
-    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.scene, &mark)?;
+    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.episode, &ba.scene, &mark)?;
     write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
     let perf = |r: &EpisodeResult| {
@@ -486,7 +498,7 @@ fn test_stage(
             dir.display()
         );
     }
-    Ok(())
+    Ok(summary)
 }
 
 /// Mean reinforcement of each learning module over the life before the world
@@ -571,12 +583,18 @@ fn train_step(
             return Ok(t);
         }
     }
-    let mut trace = Trace::default();
-    let trained = evolve::train_stage(program, index, seed, Some(&mut trace))
+    let trained =
+        evolve::train_stage(program, index, seed, None).map_err(|e| CliError::io(format!("error: {e}")))?;
+    // The same life recorded again (the same episode seed and genome), for
+    // `trace.csv`, the pictures and `episode.json`.
+    let StageRun::Train { actions } = stage.run else { unreachable!("train_step runs training stages") };
+    let episode_seed = evolve::train::training_seed(seed, index);
+    let opts = EpisodeOptions { actions, learning: true, seed: episode_seed };
+    let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
-    let (sim_seed, _) = episode_rngs(evolve::train::training_seed(seed, index));
-    let scene = Sim::new(&stage.world, sim_seed).scene();
-    report::episode_files(dir, &stage.name, stage, &trace, &scene, &[])?;
+    let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
+    report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
     write_atomic(&path, to_json(&trained)?.as_bytes())?;
     if args.json {
         println!(

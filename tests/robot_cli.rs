@@ -326,3 +326,47 @@ fn bad_robot_arguments_are_errors() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("unknown fault"), "{}", text(&out.stderr));
 }
+
+/// `drive` binds trained weights as `replay` does (it used to refuse every
+/// stage using a training stage's weights): every stage of every example is
+/// driven for a few actions, its training stages trained on the fly, and
+/// with `--run` a run's training stage is driven through its own life.
+#[test]
+fn drive_runs_every_stage_of_every_example() {
+    let dir = scratch("every-stage");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let emu = Emulator::start(&dir, &[]);
+    let built = dir.join("program.json");
+    for example in std::fs::read_dir(root.join("examples")).unwrap() {
+        let file = example.unwrap().path();
+        if file.extension().is_none_or(|e| e != "bat") {
+            continue;
+        }
+        let out = shaping().arg("build").arg(&file).arg("-o").arg(&built).output().unwrap();
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let program: serde_json::Value = serde_json::from_slice(&std::fs::read(&built).unwrap()).unwrap();
+        for stage in program["stages"].as_array().unwrap() {
+            let name = stage["name"].as_str().unwrap();
+            let bits = stage["layout"]["bits"].as_u64().unwrap() as usize;
+            let physical = stage["world"]["objects"].as_object().is_some_and(|o| o["virtual_"] == false);
+            // In an empty directory: no `runs/` of an earlier run is used.
+            let out = shaping()
+                .current_dir(&dir)
+                .arg("drive")
+                .arg(&file)
+                .args(["--stage", name, "--actions", "3", "--period", "0", "--genome", &"0".repeat(bits)])
+                .arg("--port")
+                .arg(&emu.port)
+                .arg("--out")
+                .arg(dir.join("d"))
+                .output()
+                .unwrap();
+            let err = text(&out.stderr);
+            if physical {
+                assert!(err.contains("the objects must be `virtual`"), "{} {name}: {err}", file.display());
+            } else {
+                assert!(out.status.success(), "{} {name}: {err}", file.display());
+            }
+        }
+    }
+}

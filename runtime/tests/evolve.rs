@@ -348,7 +348,10 @@ fn a_checkpoint_is_refused_when_anything_it_depends_on_changed_saying_what() {
     assert!(err.contains("the position of `second`; the position of `first`, which"), "{err}");
 
     // A stage removed.
-    assert!(matches!(check_resume(&one_stage(10, 2), &cp1), Err(EvolveError::StageIndex { index: 1, count: 1 })));
+    assert!(matches!(
+        check_resume(&one_stage(10, 2), &cp1),
+        Err(EvolveError::StageIndex { index: 1, count: 1 })
+    ));
 
     // A checkpoint of another format.
     let mut old = cp1.clone();

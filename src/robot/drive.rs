@@ -11,6 +11,7 @@ use shaping_runtime::program::Stage;
 use shaping_runtime::robot::{RobotError, SerialRobot};
 
 use super::port::{interrupt_flag, SerialPort};
+use crate::episode::{self, Part, Recorder};
 use crate::load::{create_dir, write_atomic, CliError};
 use crate::{replay, report, run};
 
@@ -107,8 +108,16 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let scene = robot.host().scene();
     let started = Instant::now();
     let mut trace = Trace::default();
+    let mut frames = Vec::new();
     let result = match robot.connect() {
-        Ok(()) => Some(ctl.run(&mut robot, &EpisodeOptions { actions, learning, seed }, Some(&mut trace))),
+        Ok(()) => {
+            // Recorded as `replay` records the simulator: what the robot sensed, for
+            // `trace.csv` and `episode.json`.
+            let mut rec = Recorder::new(&mut robot);
+            let r = ctl.run(&mut rec, &EpisodeOptions { actions, learning, seed }, Some(&mut trace));
+            frames = rec.frames;
+            Some(r)
+        }
         Err(_) => None,
     };
     // Whatever happened, the wheels stop before anything else.
@@ -120,7 +129,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
 
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
     create_dir(&out)?;
-    report::episode_files(&out, &stage.name, stage, &trace, &scene, &[])?;
+    let parts = [Part { stage: &stage.name, scene: scene.clone(), frames }];
+    let ep = episode::episode(stage, seed, learning, &trace, &parts);
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).unwrap_or_default().as_bytes())?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     let done = trace.rows.len();
     let rate = if elapsed > 0.0 { done as f64 / elapsed } else { 0.0 };

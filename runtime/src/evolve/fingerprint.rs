@@ -70,19 +70,8 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
     let Some(stage) = program.stages.get(index) else {
         return StagePrint { stage: format!("#{index}"), parts: BTreeMap::new() };
     };
-    let Stage {
-        name,
-        parent,
-        sensors,
-        actuators,
-        world,
-        modules,
-        links,
-        layout,
-        fitness,
-        run,
-        inheritance,
-    } = stage;
+    let Stage { name, parent, sensors, actuators, world, modules, links, layout, fitness, run, inheritance } =
+        stage;
     let parent = parent.and_then(|p| program.stages.get(p)).map(|p| p.name.as_str());
     let (settings, generations) = match run {
         StageRun::Evolve(evo) => {
@@ -132,10 +121,7 @@ fn evolved_ancestors(program: &Program, index: usize) -> Vec<usize> {
 /// The fingerprint of a result of stage `index`: the stage, then the evolved
 /// stages it extends, nearest first.
 pub fn fingerprint(program: &Program, index: usize) -> Fingerprint {
-    std::iter::once(index)
-        .chain(evolved_ancestors(program, index))
-        .map(|i| stage_print(program, i))
-        .collect()
+    std::iter::once(index).chain(evolved_ancestors(program, index)).map(|i| stage_print(program, i)).collect()
 }
 
 /// What differs between a saved fingerprint and the program's, in words:
