@@ -15,12 +15,23 @@ use crate::plot;
 
 /// `generations.csv`: one row per generation of the stage and its ancestors.
 pub fn generations_csv(history: &[GenStats]) -> String {
-    let mut s = String::from("stage,generation,stage_generation,best,mean,worst,best_index\n");
+    let mut s = String::from(
+        "stage,generation,stage_generation,best,mean,worst,best_index,best_recharges,best_grips,best_releases_outside\n",
+    );
     for h in history {
         let _ = writeln!(
             s,
-            "{},{},{},{:.6},{:.6},{:.6},{}",
-            h.stage, h.generation, h.stage_generation, h.best, h.mean, h.worst, h.best_index
+            "{},{},{},{:.6},{:.6},{:.6},{},{},{},{}",
+            h.stage,
+            h.generation,
+            h.stage_generation,
+            h.best,
+            h.mean,
+            h.worst,
+            h.best_index,
+            h.best_recharges,
+            h.best_grips,
+            h.best_releases_outside
         );
     }
     s

@@ -83,8 +83,12 @@ pub fn chain(program: &Program, target: usize) -> Vec<usize> {
 /// Evaluation of one genome in an evolved stage: one episode with local learning on.
 pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evaluation + Sync + '_ {
     move |genome: &Genome, seed: u64| {
-        let r = run_episode(stage, genome, &EpisodeOptions { actions, learning: true, seed }, None);
-        Evaluation { fitness: r.fitness, learned: r.learned }
+        Evaluation::of_episode(run_episode(
+            stage,
+            genome,
+            &EpisodeOptions { actions, learning: true, seed },
+            None,
+        ))
     }
 }
 
@@ -456,8 +460,12 @@ fn test_stage(
 ) -> Result<serde_json::Value, CliError> {
     let stage = &program.stages[index];
     let eval = |genome: &Genome, episode: u64| {
-        let r = run_episode(stage, genome, &EpisodeOptions { actions, learning, seed: episode }, None);
-        Evaluation { fitness: r.fitness, learned: r.learned }
+        Evaluation::of_episode(run_episode(
+            stage,
+            genome,
+            &EpisodeOptions { actions, learning, seed: episode },
+            None,
+        ))
     };
     // Checks that the parent fits and picks its best individual and the episode seed.
     let outcome = evolve::test_best(program, index, seed, parent, &eval)

@@ -249,6 +249,14 @@ fn run_writes_statistics_genomes_and_plots_and_is_deterministic() {
     }
     let csv = std::fs::read_to_string(a.join("second/generations.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 10, "{csv}");
+    // The best individual's events close every row, as counts.
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(header[header.len() - 3..], ["best_recharges", "best_grips", "best_releases_outside"]);
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells.len(), header.len(), "{line}");
+        assert!(cells[cells.len() - 3..].iter().all(|c| c.parse::<u32>().is_ok()), "{line}");
+    }
 }
 
 #[test]

@@ -92,7 +92,7 @@ fn onemax(mask: Vec<bool>) -> impl Fn(&Genome, u64) -> Evaluation + Sync {
         let free = mask.iter().filter(|&&m| !m).count().max(1);
         let ones = g.bits.iter().zip(&mask).filter(|(&b, &m)| b == 1 && !m).count();
         let noise = (seed::splitmix64(episode) >> 40) as f32 / (1u64 << 24) as f32 * 0.01;
-        Evaluation { fitness: ones as f32 / free as f32 + noise, learned: None }
+        Evaluation { fitness: ones as f32 / free as f32 + noise, learned: None, ..Default::default() }
     }
 }
 
@@ -100,7 +100,7 @@ fn onemax(mask: Vec<bool>) -> impl Fn(&Genome, u64) -> Evaluation + Sync {
 fn ones(g: &Genome, _episode: u64) -> Evaluation {
     Evaluation {
         fitness: g.bits.iter().filter(|&&b| b == 1).count() as f32 / g.bits.len() as f32,
-        learned: None,
+        ..Default::default()
     }
 }
 
@@ -455,6 +455,7 @@ fn lamarckian_write_back_changes_only_evolvable_bits() {
     let learn = |g: &Genome, _: u64| Evaluation {
         fitness: 0.5,
         learned: Some(Genome { bits: vec![1; g.bits.len()] }),
+        ..Default::default()
     };
     step_generation(&program, &mut cp1, &learn).unwrap();
     for (after, before) in cp1.population.iter().zip(&before) {
@@ -472,7 +473,11 @@ fn lamarckian_write_back_changes_only_evolvable_bits() {
 
     // A learned genome of the wrong length is an error, not a panic.
     program.stages[1].inheritance = Inheritance::Lamarckian;
-    let bad = |_: &Genome, _: u64| Evaluation { fitness: 0.5, learned: Some(Genome { bits: vec![1; 3] }) };
+    let bad = |_: &Genome, _: u64| Evaluation {
+        fitness: 0.5,
+        learned: Some(Genome { bits: vec![1; 3] }),
+        ..Default::default()
+    };
     let mut cp1 = start_stage(&program, 1, 2, Some(&cp0)).unwrap();
     assert!(matches!(
         step_generation(&program, &mut cp1, &bad),
@@ -489,7 +494,7 @@ fn evaluations_average_episodes_with_distinct_seeds() {
     let seen = std::sync::Mutex::new(Vec::new());
     let eval = |_: &Genome, s: u64| {
         seen.lock().unwrap().push(s);
-        Evaluation { fitness: (s % 7) as f32, learned: None }
+        Evaluation { fitness: (s % 7) as f32, learned: None, ..Default::default() }
     };
     let mut cp = start_stage(&program, 0, 4, None).unwrap();
     step_generation(&program, &mut cp, &eval).unwrap();
@@ -561,7 +566,7 @@ fn bad_input_is_an_error_not_a_panic() {
     run_stage(&not_extension, &mut cp0, &ones);
     assert!(matches!(start_stage(&not_extension, 1, 1, Some(&cp0)), Err(EvolveError::NotAnExtension { .. })));
 
-    let nan = |_: &Genome, _: u64| Evaluation { fitness: f32::NAN, learned: None };
+    let nan = |_: &Genome, _: u64| Evaluation { fitness: f32::NAN, learned: None, ..Default::default() };
     let mut cp = start_stage(&program, 0, 1, None).unwrap();
     let err = step_generation(&program, &mut cp, &nan).unwrap_err();
     assert!(matches!(err, EvolveError::NonFiniteFitness { index: 0, generation: 0, .. }), "{err}");
@@ -616,4 +621,34 @@ fn validate_best_prefers_the_best_mean_over_a_lucky_evaluation() {
     seeds.sort_unstable();
     seeds.dedup();
     assert_eq!(seeds.len(), 3, "the candidates share the 3 episode seeds");
+}
+
+#[test]
+fn generation_stats_carry_the_best_individuals_events_summed_over_its_episodes() {
+    let mut program = one_stage(8, 1);
+    if let StageRun::Evolve(evo) = &mut program.stages[0].run {
+        evo.evaluations = 2;
+    }
+    // Events that identify the individual (its count of ones) and the episode.
+    let eval = |g: &Genome, s: u64| {
+        let ones = g.bits.iter().filter(|&&b| b == 1).count() as u32;
+        Evaluation {
+            fitness: ones as f32,
+            events: evolve::Events { grips: ones, releases_outside: (s % 3) as u32, recharges: 1 },
+            ..Default::default()
+        }
+    };
+    let mut cp = start_stage(&program, 0, 9, None).unwrap();
+    for _ in 0..3 {
+        let st = step_generation(&program, &mut cp, &eval).unwrap();
+        let best = &cp.population[st.best_index as usize];
+        let ones = best.bits.iter().filter(|&&b| b == 1).count() as u32;
+        let g = st.stage_generation;
+        let releases: u32 =
+            (0..2).map(|e| (seed::episode_seed(9, 0, g, st.best_index as usize, e) % 3) as u32).sum();
+        assert_eq!(st.best_grips, 2 * ones, "generation {g}");
+        assert_eq!(st.best_releases_outside, releases, "generation {g}");
+        assert_eq!(st.best_recharges, 2, "generation {g}");
+        assert_eq!(cp.history.last(), Some(&st));
+    }
 }

@@ -163,7 +163,7 @@ proptest! {
         };
         // Fitness counts every bit, frozen ones too: selection would favour
         // changing them if the GA could.
-        let eval = |g: &Genome, _: u64| Evaluation { fitness: g.bits.iter().map(|&b| b as f32).sum(), learned: None };
+        let eval = |g: &Genome, _: u64| Evaluation { fitness: g.bits.iter().map(|&b| b as f32).sum(), learned: None, ..Default::default() };
         let mut cp0 = start_stage(&program, 0, seed, None).unwrap();
         for _ in 0..3 {
             step_generation(&program, &mut cp0, &eval).unwrap();

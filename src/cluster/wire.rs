@@ -2,7 +2,7 @@
 //! then little-endian integers and length-prefixed byte strings. Fitness
 //! travels as its bit pattern, so a result is the same on every rank.
 
-use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::evolve::{Evaluation, Events};
 use shaping_runtime::genome::Genome;
 
 /// From a worker rank to rank 0: each is also a request for the next reply.
@@ -108,6 +108,9 @@ impl Request {
                 w.u32(evaluations.len() as u32);
                 for ev in evaluations {
                     w.u32(ev.fitness.to_bits());
+                    w.u32(ev.events.grips);
+                    w.u32(ev.events.releases_outside);
+                    w.u32(ev.events.recharges);
                     match &ev.learned {
                         Some(g) => {
                             w.u8(1);
@@ -136,12 +139,13 @@ impl Request {
                 let mut evaluations = Vec::with_capacity(n.min(data.len()));
                 for _ in 0..n {
                     let fitness = f32::from_bits(r.u32()?);
+                    let events = Events { grips: r.u32()?, releases_outside: r.u32()?, recharges: r.u32()? };
                     let learned = match r.u8()? {
                         0 => None,
                         1 => Some(Genome { bits: r.bytes()?.to_vec() }),
                         k => return Err(format!("unknown learned-genome flag {k}")),
                     };
-                    evaluations.push(Evaluation { fitness, learned });
+                    evaluations.push(Evaluation { fitness, learned, events });
                 }
                 Request::Results { batch, evaluations }
             }
@@ -247,8 +251,12 @@ mod tests {
             Request::Results {
                 batch: u64::MAX - 3,
                 evaluations: vec![
-                    Evaluation { fitness: -0.0, learned: None },
-                    Evaluation { fitness: odd, learned: Some(Genome { bits: vec![1, 0, 1, 1] }) },
+                    Evaluation { fitness: -0.0, learned: None, events: Events::default() },
+                    Evaluation {
+                        fitness: odd,
+                        learned: Some(Genome { bits: vec![1, 0, 1, 1] }),
+                        events: Events { grips: 3, releases_outside: 2, recharges: 1 },
+                    },
                 ],
             },
             Request::Failed { message: "stage 9 does not exist".into() },

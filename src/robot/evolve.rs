@@ -14,7 +14,7 @@ use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
 use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions};
-use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::evolve::{Evaluation, Events};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Inheritance, Stage};
 use shaping_runtime::robot::SerialRobot;
@@ -32,6 +32,10 @@ struct Episode {
     learned: Option<String>,
     /// The robot's pose at the end of the episode (odometry).
     pose: [f32; 3],
+    /// Grips, releases outside and recharges (logs written before these
+    /// were recorded read as none).
+    #[serde(default)]
+    events: Events,
 }
 
 struct State {
@@ -100,7 +104,7 @@ impl RobotRun {
                 for line in bytes.split(|&b| b == b'\n') {
                     if let Ok(e) = serde_json::from_slice::<Episode>(line) {
                         let learned = e.learned.as_deref().and_then(Genome::from_bitstring);
-                        st.done.insert(e.seed, Evaluation { fitness: e.fitness, learned });
+                        st.done.insert(e.seed, Evaluation { fitness: e.fitness, learned, events: e.events });
                         st.pose = Some(Pose { x: e.pose[0], y: e.pose[1], theta: e.pose[2] });
                     }
                 }
@@ -119,7 +123,7 @@ impl RobotRun {
     }
 
     fn evaluate(&self, stage: &Stage, actions: u32, genome: &Genome, seed: u64) -> Evaluation {
-        let nan = Evaluation { fitness: f32::NAN, learned: None };
+        let nan = Evaluation { fitness: f32::NAN, ..Evaluation::default() };
         let mut st = self.lock();
         if st.error.is_some() {
             return nan;
@@ -168,11 +172,13 @@ impl RobotRun {
         st.port = Some(robot.into_link());
         let Some(r) = result else { return nan };
         let learned = (stage.inheritance == Inheritance::Lamarckian).then(|| ctl.write_back(genome));
+        let ev = Evaluation { learned, ..Evaluation::of_episode(r) };
         let line = Episode {
             seed,
-            fitness: r.fitness,
-            learned: learned.as_ref().map(Genome::to_bitstring),
+            fitness: ev.fitness,
+            learned: ev.learned.as_ref().map(Genome::to_bitstring),
             pose: [pose.x, pose.y, pose.theta],
+            events: ev.events,
         };
         if let Some(log) = st.log.clone() {
             if let Err(e) = append_line(&log, &line) {
@@ -181,7 +187,6 @@ impl RobotRun {
             }
         }
         st.pose = Some(pose);
-        let ev = Evaluation { fitness: r.fitness, learned };
         st.done.insert(seed, ev.clone());
         ev
     }

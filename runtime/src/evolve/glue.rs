@@ -40,7 +40,6 @@ pub fn evaluate_with_controller(
     controller::validate(stage, &Genome::zeros(stage.layout.bits as usize))?;
     Ok(move |genome: &Genome, seed: u64| {
         let episode = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed };
-        let result = controller::run_episode(stage, genome, &episode, None);
-        Evaluation { fitness: result.fitness, learned: result.learned }
+        Evaluation::of_episode(controller::run_episode(stage, genome, &episode, None))
     })
 }

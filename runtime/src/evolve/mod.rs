@@ -78,13 +78,52 @@ pub fn evaluate_many(evaluate: Evaluate, jobs: &[(&Genome, u64)]) -> Vec<Evaluat
 }
 
 /// The result of one episode.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Evaluation {
     pub fitness: f32,
     /// The genome with learned values re-encoded. In a stage with
     /// `inheritance: lamarckian` its evolvable bits replace the individual's
     /// in the population; otherwise it is ignored.
     pub learned: Option<Genome>,
+    /// What happened in the episode (for the statistics only: the GA
+    /// selects on `fitness`).
+    #[serde(default)]
+    pub events: Events,
+}
+
+impl Evaluation {
+    /// The evaluation of one controller episode.
+    pub fn of_episode(result: crate::controller::EpisodeResult) -> Evaluation {
+        Evaluation {
+            fitness: result.fitness,
+            events: Events {
+                grips: result.grips,
+                releases_outside: result.releases_outside,
+                recharges: result.recharges,
+            },
+            learned: result.learned,
+        }
+    }
+}
+
+/// Counts of the events of an episode (or, summed, of an individual's
+/// episodes in one generation).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Events {
+    /// Objects gripped.
+    pub grips: u32,
+    /// Objects released outside the arena.
+    pub releases_outside: u32,
+    /// Times the battery was recharged.
+    pub recharges: u32,
+}
+
+impl Events {
+    fn add(&mut self, other: Events) {
+        self.grips = self.grips.saturating_add(other.grips);
+        self.releases_outside = self.releases_outside.saturating_add(other.releases_outside);
+        self.recharges = self.recharges.saturating_add(other.recharges);
+    }
 }
 
 /// Statistics of one evaluated generation.
@@ -101,6 +140,15 @@ pub struct GenStats {
     pub worst: f32,
     /// Index of the best individual in the evaluated population.
     pub best_index: u32,
+    /// The best individual's events in its evaluation (summed over its
+    /// episodes when the stage evaluates each individual more than once).
+    /// Checkpoints written before these existed read as zero.
+    #[serde(default)]
+    pub best_recharges: u32,
+    #[serde(default)]
+    pub best_grips: u32,
+    #[serde(default)]
+    pub best_releases_outside: u32,
 }
 
 /// Everything needed to continue a run: plain data, serde (JSON) friendly.
@@ -287,21 +335,24 @@ pub fn step_generation_with(
         });
     }
     let mut evaluations = evaluations.into_iter();
-    let results: Vec<(f32, Option<Genome>)> = (0..population.len())
+    let results: Vec<(f32, Option<Genome>, Events)> = (0..population.len())
         .map(|_| {
             let mut sum = 0.0f64;
             let mut learned = None;
+            let mut events = Events::default();
             for ev in evaluations.by_ref().take(episodes as usize) {
                 sum += ev.fitness as f64;
                 learned = ev.learned;
+                events.add(ev.events);
             }
-            ((sum / episodes as f64) as f32, learned)
+            ((sum / episodes as f64) as f32, learned, events)
         })
         .collect();
 
     let mut fitness = Vec::with_capacity(results.len());
     let mut learned_all = Vec::with_capacity(results.len());
-    for (i, (f, learned)) in results.into_iter().enumerate() {
+    let mut events_all = Vec::with_capacity(results.len());
+    for (i, (f, learned, events)) in results.into_iter().enumerate() {
         if !f.is_finite() {
             return Err(EvolveError::NonFiniteFitness {
                 stage: st.name.clone(),
@@ -323,6 +374,7 @@ pub fn step_generation_with(
         }
         fitness.push(f);
         learned_all.push(learned);
+        events_all.push(events);
     }
 
     let ranked = ranking(&fitness);
@@ -351,6 +403,9 @@ pub fn step_generation_with(
         mean: (fitness.iter().map(|&f| f as f64).sum::<f64>() / fitness.len() as f64) as f32,
         worst: fitness[worst_index],
         best_index: best_index as u32,
+        best_recharges: events_all[best_index].recharges,
+        best_grips: events_all[best_index].grips,
+        best_releases_outside: events_all[best_index].releases_outside,
     };
     cp.population = population;
     cp.fitness = fitness;
