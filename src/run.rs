@@ -322,7 +322,10 @@ fn evolve_stage(
         .map_err(|e| CliError::io(format!("error: stage `{}` cannot run: {e}", stage.name)))?;
     let bar = progress_bar(args, stage, evo.generations, cp.generation);
     let sim_eval = evaluator(stage, evo.actions);
-    let robot_eval = args.robot.as_ref().map(|r| r.evaluator(stage, evo.actions, dir)).transpose()?;
+    // The robot's episode log is tied to the stage as the checkpoint is.
+    let digest = evolve::fingerprint::digest(&cp.fingerprint);
+    let robot_eval =
+        args.robot.as_ref().map(|r| r.evaluator(stage, evo.actions, dir, digest, args.fresh)).transpose()?;
     let eval: &(dyn Fn(&Genome, u64) -> Evaluation + Sync) = match &robot_eval {
         Some(e) => e,
         None => &sim_eval,

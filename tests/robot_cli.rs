@@ -370,3 +370,37 @@ fn drive_runs_every_stage_of_every_example() {
         }
     }
 }
+
+/// The robot's episode log is tied to the stage like a checkpoint: episodes
+/// of another version are not reused (the run refuses), and `--fresh` moves
+/// the log aside and starts again.
+#[test]
+fn robot_episodes_of_another_version_of_the_stage_are_not_reused() {
+    let dir = scratch("stale-log");
+    let emu = Emulator::start(&dir, &[]);
+    let out = dir.join("runs");
+    std::fs::create_dir_all(out.join("roam")).unwrap();
+    let log = out.join("roam/robot-episodes.jsonl");
+    std::fs::write(&log, "{\"seed\":1,\"fitness\":0.5,\"learned\":null,\"pose\":[0,0,0]}\n").unwrap();
+    let run = |extra: &[&str]| {
+        shaping()
+            .arg("run")
+            .arg(file())
+            .args(["--stage", "roam", "--quiet", "--period", "0", "--robot"])
+            .arg(&emu.port)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let stale = run(&[]);
+    assert_eq!(stale.status.code(), Some(2));
+    let err = text(&stale.stderr);
+    assert!(err.contains("line 1 of") && err.contains("another version of stage `roam`"), "{err}");
+    let fresh = run(&["--fresh"]);
+    assert!(fresh.status.success(), "{}", text(&fresh.stderr));
+    assert!(out.join("roam/robot-episodes.jsonl.old").exists());
+    let lines = std::fs::read_to_string(&log).unwrap();
+    assert!(lines.lines().all(|l| l.contains("\"program\":")), "{lines}");
+}

@@ -124,6 +124,17 @@ pub fn fingerprint(program: &Program, index: usize) -> Fingerprint {
     std::iter::once(index).chain(evolved_ancestors(program, index)).map(|i| stage_print(program, i)).collect()
 }
 
+/// One number for a fingerprint, its own `generations` left out (they may
+/// grow): for files that hold many results of one stage, one per line (the
+/// episodes of `run --robot`).
+pub fn digest(print: &[StagePrint]) -> u64 {
+    let mut print = print.to_vec();
+    if let Some(own) = print.first_mut() {
+        own.parts.remove(OWN_FREE);
+    }
+    hash(&print)
+}
+
 /// What differs between a saved fingerprint and the program's, in words:
 /// empty when the saved result still belongs to the program. The result's
 /// own `generations` is not compared.
