@@ -62,49 +62,61 @@ pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(),
         .map_err(|e| CliError::io(format!("error: {e}")))
 }
 
-/// One declared sensor or actuator element as a column of `trace.csv`:
-/// its name (`ir[0]`, `battery[0]`, `wheels[1]`) and its value at an action
-/// of a recorded episode.
-type Column = (String, Box<dyn Fn(&EpisodeColumns, usize) -> f32>);
+/// Where the value of one declared sensor or actuator element comes from in
+/// a recorded episode.
+#[derive(Clone, Copy)]
+enum Source {
+    Ir(usize),
+    Light(usize),
+    Battery,
+    Barrier,
+    Wheel(usize),
+    Arm,
+    Claw,
+}
+
+impl Source {
+    /// The value at action `k` (`NaN` where the episode has none).
+    fn at(self, c: &EpisodeColumns, k: usize) -> f32 {
+        let channel = |v: &[[f32; 8]], i: usize| v.get(k).and_then(|r| r.get(i)).copied();
+        let flag = |v: &[u8]| v.get(k).map(|&b| f32::from(b));
+        match self {
+            Source::Ir(i) => channel(&c.ir, i),
+            Source::Light(i) => channel(&c.light, i),
+            Source::Battery => c.battery.get(k).copied(),
+            Source::Barrier => flag(&c.barrier),
+            Source::Wheel(i) => c.wheels.get(k).map(|w| w[i.min(1)]),
+            Source::Arm => flag(&c.arm_down),
+            Source::Claw => flag(&c.claw_closed),
+        }
+        .unwrap_or(f32::NAN)
+    }
+}
 
 /// The columns of the robot's declared sensors and actuators, one per
 /// element, named `NAME[i]` after the declaration (also a single-valued one:
 /// `battery[0]`, so no name can be one of the fixed columns).
-fn declared_columns(stage: &Stage) -> Vec<Column> {
-    let at =
-        |v: &[[f32; 8]], k: usize, i: usize| v.get(k).and_then(|r| r.get(i)).copied().unwrap_or(f32::NAN);
-    let mut out: Vec<Column> = Vec::new();
+fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
+    let mut out = Vec::new();
     for s in &stage.sensors {
         for i in 0..s.count as usize {
-            let name = format!("{}[{i}]", s.name);
             let ch = s.channel as usize + i;
-            let value: Box<dyn Fn(&EpisodeColumns, usize) -> f32> = match s.kind {
-                SensorKind::Proximity => Box::new(move |c, k| at(&c.ir, k, ch - CH_IR)),
-                SensorKind::Ambient => Box::new(move |c, k| at(&c.light, k, ch - CH_LIGHT)),
-                SensorKind::Level => Box::new(|c, k| c.battery.get(k).copied().unwrap_or(f32::NAN)),
-                SensorKind::Optical => Box::new(|c, k| c.barrier.get(k).map_or(f32::NAN, |&b| b as f32)),
+            let source = match s.kind {
+                SensorKind::Proximity => Source::Ir(ch.saturating_sub(CH_IR)),
+                SensorKind::Ambient => Source::Light(ch.saturating_sub(CH_LIGHT)),
+                SensorKind::Level => Source::Battery,
+                SensorKind::Optical => Source::Barrier,
             };
-            out.push((name, value));
+            out.push((format!("{}[{i}]", s.name), source));
         }
     }
     for a in &stage.actuators {
-        let flag = |v: &[u8], k: usize| v.get(k).map_or(f32::NAN, |&b| b as f32);
-        match a.kind {
-            ActuatorKind::Speed => {
-                for i in 0..2 {
-                    let value = move |c: &EpisodeColumns, k: usize| {
-                        c.wheels.get(k).map_or(f32::NAN, |w: &[f32; 2]| w[i])
-                    };
-                    out.push((format!("{}[{i}]", a.name), Box::new(value)));
-                }
-            }
-            ActuatorKind::Lift => {
-                out.push((format!("{}[0]", a.name), Box::new(move |c, k| flag(&c.arm_down, k))));
-            }
-            ActuatorKind::Grip => {
-                out.push((format!("{}[0]", a.name), Box::new(move |c, k| flag(&c.claw_closed, k))));
-            }
-        }
+        let sources: &[Source] = match a.kind {
+            ActuatorKind::Speed => &[Source::Wheel(0), Source::Wheel(1)],
+            ActuatorKind::Lift => &[Source::Arm],
+            ActuatorKind::Grip => &[Source::Claw],
+        };
+        out.extend(sources.iter().enumerate().map(|(i, &src)| (format!("{}[{i}]", a.name), src)));
     }
     out
 }
@@ -151,8 +163,8 @@ pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
         for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
             let _ = write!(s, ",{v:.4}");
         }
-        for (_, value) in &declared {
-            let _ = write!(s, ",{:.4}", value(&episode.actions, k));
+        for (_, source) in &declared {
+            let _ = write!(s, ",{:.4}", source.at(&episode.actions, k));
         }
         s.push('\n');
     }
