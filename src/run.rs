@@ -173,6 +173,15 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
     // What each stage ended with, for the last line of `--json`.
     let mut results = Vec::new();
     for &index in &stages {
+        // Ctrl-C during a training life, a test or the choice of a best: the
+        // step under way finished and is saved; stop before the next.
+        if interrupted.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            return Err(CliError::io(format!(
+                "interrupted: stopped before stage `{}`; what ran is saved in `{}`, and the same command resumes",
+                program.stages[index].name,
+                out.display()
+            )));
+        }
         if let StageRun::Train { .. } = program.stages[index].run {
             let dir = out.join(&program.stages[index].name);
             create_dir(&dir)?;

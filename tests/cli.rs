@@ -611,6 +611,12 @@ fn an_edited_file_is_not_resumed_from_its_old_checkpoint() {
         assert!(err.contains("cannot resume from") && err.contains("checkpoint.json"), "{err}");
         assert!(err.contains(what) && err.contains("`--fresh`") && err.contains("`--out`"), "{err}");
     }
+    // Nor does `replay` take the run's best for the edited stage.
+    let replay =
+        run(shaping().arg("replay").arg(&file).arg("--run").arg(&out).arg("--out").arg(dir.join("r")));
+    assert_eq!(replay.status.code(), Some(2));
+    let err = text(&replay.stderr);
+    assert!(err.contains("is not of this program") && err.contains("the world of `s` changed"), "{err}");
     // The last edit, started again: the fitness is that of the edited file.
     std::fs::write(&file, EDITED.replace("per action wheels[0]", "per action wheels[0] * 0.5 + 7")).unwrap();
     let fresh = run_file(&file, &out, &["--fresh", "--json"]);
