@@ -28,7 +28,7 @@ stage mono {
   module recharge {
     sense ir[0..5], battery
     behavior script commit {
-      forward(0.6) for 2 actions
+      forward(1.0) for 3 actions
       wait until battery >= 1 or battery <= prev battery within 25 actions uses charger
     }
   }

@@ -52,11 +52,20 @@ for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforc
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
 
+# What the world allows in the collect stage: a blind search with perfect
+# gripping, releasing and recharging, and each seed's collect best with
+# perfect grip and release decisions (docs/experiments/oracle.rs).
+cargo build --release --quiet --example oracle
+target/release/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
+
 for f in khepera pretrained forward-only scratch-full; do
   echo "== $f"
   cat $R/$f/summary.md
 done
 python3 docs/experiments/analyse.py "$R" "$SEEDS"
+echo "== the ceiling of the collect stage (oracle)"
+grep -E '^(search|decisions|evolved) (random|even): ' $R/oracle.txt
+grep '^decisions random, ' $R/oracle.txt
 
 # Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.
 times=""

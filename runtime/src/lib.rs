@@ -19,6 +19,7 @@ pub mod evolve;
 pub mod expr;
 pub mod genome;
 pub mod limits;
+pub mod oracle;
 pub mod program;
 pub mod robot;
 pub mod sim;

@@ -168,6 +168,9 @@ pub enum ControllerError {
     GenomeTooShort { have: usize, need: usize },
     #[error("{0}")]
     Invalid(#[from] crate::validate::Invalid),
+    /// A measurement's setup does not fit the stage ([`crate::oracle`]).
+    #[error("{0}")]
+    Setup(String),
 }
 
 // ------------------------------------------------------------------ robot
@@ -297,6 +300,10 @@ pub struct Controller<'s> {
     /// Actuator slots of the last executed command.
     slots: [f32; ACT_SLOTS],
     last_winner: Option<usize>,
+    /// A winner imposed on the next action (see [`Controller::force_winner`]).
+    forced: Option<usize>,
+    /// Modules that cannot win the next action ([`Controller::forbid`]).
+    forbidden: Vec<bool>,
     holding: bool,
     fitness: Option<FastExpr>,
 }
@@ -382,6 +389,8 @@ impl<'s> Controller<'s> {
             next: [0.0; CHANNELS],
             slots: [0.0; ACT_SLOTS],
             last_winner: None,
+            forced: None,
+            forbidden: vec![false; n],
             holding: false,
             fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
         })
@@ -477,7 +486,7 @@ impl<'s> Controller<'s> {
             let link: f32 = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
             self.act[m] = module.activation.forward(&self.now, link)[0];
             let z = module.activation.net_inputs()[0];
-            if z > best {
+            if z > best && !self.forbidden[m] {
                 best = z;
                 winner = m;
             }
@@ -496,6 +505,10 @@ impl<'s> Controller<'s> {
                 fitness: 0.0,
             };
         }
+        if let Some(f) = self.forced.take() {
+            winner = f.min(self.mods.len() - 1);
+        }
+        self.forbidden.fill(false);
         // A committed script that has started keeps control until it ends.
         if let Some(l) = self.last_winner {
             if matches!(&self.mods[l].gen, Gen::Script(s) if s.holds_control()) {
@@ -617,12 +630,43 @@ impl<'s> Controller<'s> {
         ActionReport { winner, command: cmd, outcome, reinforcement: r, fitness }
     }
 
+    /// Imposes module `m` as the winner of the next [`Controller::act`] in
+    /// place of the arbitration (activations are still computed and traced;
+    /// a committed script that has started still keeps control). For
+    /// measurements with an arbiter outside the architecture, such as
+    /// [`crate::oracle`]; evolution never uses it.
+    pub fn force_winner(&mut self, m: usize) {
+        self.forced = Some(m);
+    }
+
+    /// Keeps module `m` from winning the next [`Controller::act`]: the
+    /// highest activation among the others wins (if every module is
+    /// forbidden, the first). Same use as [`Controller::force_winner`].
+    pub fn forbid(&mut self, m: usize) {
+        if let Some(f) = self.forbidden.get_mut(m) {
+            *f = true;
+        }
+    }
+
     /// Runs a whole episode on `sim` (which must be fresh) and returns its result.
     pub fn run<R: Robot>(
         &mut self,
         sim: &mut R,
         opts: &EpisodeOptions,
+        trace: Option<&mut Trace>,
+    ) -> EpisodeResult {
+        self.run_with(sim, opts, trace, |_, _| {})
+    }
+
+    /// [`Controller::run`] with `before` called before every action, with
+    /// the controller and the robot as they are then (e.g. to
+    /// [`Controller::force_winner`]).
+    pub fn run_with<R: Robot>(
+        &mut self,
+        sim: &mut R,
+        opts: &EpisodeOptions,
         mut trace: Option<&mut Trace>,
+        mut before: impl FnMut(&mut Self, &R),
     ) -> EpisodeResult {
         self.set_learning(opts.learning);
         if let Some(t) = trace.as_deref_mut() {
@@ -636,6 +680,7 @@ impl<'s> Controller<'s> {
             if !sim.alive() {
                 break;
             }
+            before(self, sim);
             let rep = self.act(sim);
             fitness += rep.fitness as f64;
             res.actions += 1;
@@ -660,15 +705,7 @@ impl<'s> Controller<'s> {
                 });
             }
         }
-        for b in &self.stage.fitness.bonuses {
-            let n = match b.event {
-                Event::Grip => res.grips,
-                Event::ReleaseOutside => res.releases_outside,
-                Event::Recharge => res.recharges,
-                Event::Collision => res.collisions,
-            };
-            fitness += (b.points * n as f32) as f64;
-        }
+        add_bonuses(self.stage, &res, &mut fitness);
         res.fitness = fitness as f32;
         res
     }
@@ -725,6 +762,19 @@ pub fn episode_rngs(seed: u64) -> (u64, ChaCha8Rng) {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     rng.set_stream(1);
     (seed, rng)
+}
+
+/// Adds to `fitness` the stage's bonuses for the events counted in `res`.
+pub fn add_bonuses(stage: &Stage, res: &EpisodeResult, fitness: &mut f64) {
+    for b in &stage.fitness.bonuses {
+        let n = match b.event {
+            Event::Grip => res.grips,
+            Event::ReleaseOutside => res.releases_outside,
+            Event::Recharge => res.recharges,
+            Event::Collision => res.collisions,
+        };
+        *fitness += (b.points * n as f32) as f64;
+    }
 }
 
 /// Runs one episode of `genome` on `stage`, which must have passed

@@ -655,10 +655,7 @@ impl Sim {
     /// A wall within [`RELEASE_REACH`] of the body surface, within
     /// [`RELEASE_ANGLE_DEG`] of the heading.
     fn wall_ahead(&self) -> bool {
-        let reach = self.radius + RELEASE_REACH;
-        let cos_max = RELEASE_ANGLE_DEG.to_radians().cos();
-        let heading = self.heading();
-        self.walls(&self.centre()).iter().any(|(dist, n)| *dist <= reach && n.dot(&heading) >= cos_max)
+        self.wall_ahead_within(RELEASE_REACH)
     }
 
     /// The body surface within [`CONTACT`] of the charger bar.
@@ -788,6 +785,66 @@ impl Sim {
 
     pub fn claw_closed(&self) -> bool {
         self.claw_closed
+    }
+
+    /// True when a floor object's centre lies in the gripper's catch zone
+    /// (whatever the arm and claw): what an arbiter that knows the world
+    /// ([`crate::oracle`]) reads as "an object is in reach".
+    pub fn object_in_reach(&self) -> bool {
+        self.catchable().is_some()
+    }
+
+    /// True when a wall lies within `reach` mm of the body surface, within
+    /// [`RELEASE_ANGLE_DEG`] of the heading (opening the claw there, within
+    /// [`RELEASE_REACH`], throws a held object out).
+    pub fn wall_ahead_within(&self, reach: f32) -> bool {
+        let reach = self.radius + reach;
+        let cos_max = RELEASE_ANGLE_DEG.to_radians().cos();
+        let heading = self.heading();
+        self.walls(&self.centre()).iter().any(|(dist, n)| *dist <= reach && n.dot(&heading) >= cos_max)
+    }
+
+    /// The nearest floor object in the body frame: its centre's distance
+    /// ahead of the body surface along the heading, to the left of the
+    /// heading, and from the body surface, mm (`None` without one).
+    pub fn nearest_object(&self) -> Option<(f32, f32, f32)> {
+        let mut best: Option<(f32, f32, f32)> = None;
+        for o in self.objects.iter().filter(|o| o.state == ObjectState::Floor) {
+            let at = self.pose.inverse_transform_point(&o.at);
+            let gap = at.coords.norm() - self.radius;
+            if best.is_none_or(|(_, _, g)| gap < g) {
+                best = Some((at.x - self.radius, at.y, gap));
+            }
+        }
+        best
+    }
+
+    /// The nearest wall: its distance from the body surface, mm, and the
+    /// bearing of its outward normal from the heading, radians (0: facing it
+    /// squarely; positive: to the left).
+    pub fn nearest_wall(&self) -> (f32, f32) {
+        let centre = self.centre();
+        let walls = self.walls(&centre);
+        let (dist, n) = walls.iter().fold(walls[0], |a, b| if b.0 < a.0 { *b } else { a });
+        let local = self.pose.rotation.inverse() * n;
+        (dist - self.radius, local.y.atan2(local.x))
+    }
+
+    /// The body's radius, mm.
+    pub fn body_radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// The charger bar's end points, mm (`None` without a charger).
+    pub fn bar(&self) -> Option<[[f32; 2]; 2]> {
+        self.bar.map(|[a, b]| [[a.x, a.y], [b.x, b.y]])
+    }
+
+    /// Distance from the body surface to the charger bar, mm (`None` without
+    /// a charger).
+    pub fn bar_distance(&self) -> Option<f32> {
+        let [a, b] = self.bar?;
+        Some(segment_distance2(&self.centre(), &a, &b).sqrt() - self.radius)
     }
 
     /// Plain data describing the current state, for pictures.
