@@ -171,7 +171,8 @@ fn run_on_the_robot_evolves_and_resumes_after_being_killed() {
     // 164 requests: in the seventh), and the first run waits a minute for
     // it: it is killed there, whatever the machine's load, not in a race with
     // its own end.
-    let emu = Emulator::start(&dir, &["--fault", "drop@1000"]);
+    let mut emu = Emulator::start(&dir, &["--fault", "drop@1000"]);
+    let mut said = std::io::BufReader::new(emu.child.stderr.take().unwrap());
     let out = dir.join("runs");
     let run = || {
         let mut c = shaping();
@@ -185,17 +186,16 @@ fn run_on_the_robot_evolves_and_resumes_after_being_killed() {
     let log = out.join("roam/robot-episodes.jsonl");
     let mut first =
         run().args(["--timeout", "60000"]).stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
-    // Killed once it has evaluated a few individuals, in the second generation.
-    let t = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&log).map_or(0, |s| s.lines().count());
-        if n >= 6 {
-            break;
-        }
-        assert!(first.try_wait().unwrap().is_none(), "the run ended before it was killed");
-        assert!(t.elapsed() < Duration::from_secs(50), "no episodes logged");
-        std::thread::sleep(Duration::from_millis(20));
+    // Killed once the emulator has dropped that answer (the run waits for it),
+    // having evaluated a few individuals, in the second generation.
+    let mut line = String::new();
+    while !line.contains("fault: no answer to request 1000") {
+        line.clear();
+        let n = std::io::BufRead::read_line(&mut said, &mut line).unwrap();
+        assert!(n > 0, "the emulator ended before the fault");
     }
+    assert!(first.try_wait().unwrap().is_none(), "the run ended before it was killed");
+    assert!(std::fs::read_to_string(&log).unwrap().lines().count() >= 5, "few episodes logged");
     first.kill().unwrap();
     first.wait().unwrap();
     let before = std::fs::read_to_string(&log).unwrap().lines().count();
