@@ -85,20 +85,36 @@ pub fn read_bytes(path: &Path) -> Result<Vec<u8>, CliError> {
 }
 
 /// Reads and compiles a `.bat` file, or loads a built `Program` (`.json`).
+/// Warnings go to standard error.
 pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliError> {
+    let (program, warnings) = load_program_warnings(path, format)?;
+    if let Some(w) = warnings {
+        eprintln!("{}", w.trim_end());
+    }
+    Ok(program)
+}
+
+/// Like [`load_program`], with the warnings rendered and returned.
+pub fn load_program_warnings(
+    path: &Path,
+    format: ErrorFormat,
+) -> Result<(Program, Option<String>), CliError> {
     if path.extension().is_some_and(|e| e == "json") {
-        return load_built(path);
+        return Ok((load_built(path)?, None));
     }
     let source = read_source(path, format)?;
     let name = path.display().to_string();
-    let program = shaping_compiler::compile(&source, &name)
-        .map_err(|d| CliError::Diagnostics(diag::render(&d, format)))?;
+    let (program, diagnostics) = shaping_compiler::check(&source, &name);
+    let Some(program) = program else {
+        return Err(CliError::Diagnostics(diag::render(&diagnostics, format)));
+    };
+    let warnings = (!diagnostics.is_empty()).then(|| diag::render(&diagnostics, format));
     // The compiler's output always validates (a property test checks it);
     // validating here too makes every command run only validated programs.
     program.validate().map_err(|e| {
         CliError::io(format!("error: internal error: `{name}` compiled to an invalid program: {e}"))
     })?;
-    Ok(program)
+    Ok((program, warnings))
 }
 
 /// Reads a `.bat` source; a file that is not UTF-8 is a diagnostic that

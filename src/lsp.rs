@@ -2,7 +2,10 @@
 //!
 //! Documents are synchronised whole. Every change recompiles the document
 //! and publishes its diagnostics; requests (hover, definition, references,
-//! completion, document symbols, formatting) work from the last text. Every
+//! completion, document symbols, formatting) work from the last text. A file
+//! with syntax errors still has the AST of the parts that parse (the
+//! parser's recovery) and the program lowered from them, so hover,
+//! definitions, references, symbols and completion go on working there. Every
 //! request handler runs under `catch_unwind`: a bug answers an error, it
 //! never stops the server.
 
@@ -12,9 +15,10 @@ use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::{self as lt, Uri};
 use miette::Diagnostic as _;
 use serde_json::Value;
-use shaping_compiler::fmt::{lex, TokenKind};
-use shaping_compiler::syntax::{self, ast};
-use shaping_compiler::{compile, render_layout, Program};
+use shaping_compiler::fmt::{lex, Token, TokenKind};
+use shaping_compiler::lower::lower_partial;
+use shaping_compiler::syntax::{self, ast, parse_recovering};
+use shaping_compiler::{render_layout, Program};
 
 use crate::load::CliError;
 
@@ -117,7 +121,7 @@ fn request(docs: &HashMap<String, (Uri, String)>, req: &Request) -> Result<Value
         "textDocument/hover" => json(pos().and_then(|o| hover(text, o))),
         "textDocument/definition" => json(pos().map(|o| locations(uri, text, o, false))),
         "textDocument/references" => json(pos().map(|o| locations(uri, text, o, true))),
-        "textDocument/completion" => json(Some(completion(text))),
+        "textDocument/completion" => json(pos().map(|o| completion(text, o))),
         "textDocument/documentSymbol" => json(Some(symbols(text))),
         "textDocument/formatting" => json(formatting(text)),
         m => Err(format!("`{m}` is not supported")),
@@ -165,9 +169,10 @@ fn range(text: &str, start: usize, end: usize) -> lt::Range {
 
 // ------------------------------------------------------------------ diagnostics
 
-/// Every error of the document, with the related labels as related information.
+/// Every error and warning of the document, with the related labels as
+/// related information.
 pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
-    let Err(d) = compile(text, "document.bat") else { return vec![] };
+    let (_, d) = shaping_compiler::check(text, "document.bat");
     d.errors()
         .iter()
         .map(|e| {
@@ -191,7 +196,11 @@ pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
                 .collect();
             lt::Diagnostic {
                 range: r,
-                severity: Some(lt::DiagnosticSeverity::ERROR),
+                severity: Some(if e.is_warning() {
+                    lt::DiagnosticSeverity::WARNING
+                } else {
+                    lt::DiagnosticSeverity::ERROR
+                }),
                 source: Some("shaping".into()),
                 message,
                 related_information: (!related.is_empty()).then_some(related),
@@ -252,7 +261,7 @@ fn word_at(text: &str, offset: usize) -> Option<(usize, usize)> {
 fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
     let Some((a, b)) = word_at(text, offset) else { return Value::Null };
     let word = &text[a..b];
-    let Ok(file) = syntax::parse(text) else { return Value::Null };
+    let Some(file) = parse_recovering(text).0 else { return Value::Null };
     let decls: Vec<_> = declarations(&file).into_iter().filter(|d| d.0 == word).collect();
     if decls.is_empty() {
         return Value::Null;
@@ -278,83 +287,88 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
 fn hover(text: &str, offset: usize) -> Option<Value> {
     let (a, b) = word_at(text, offset)?;
     let word = &text[a..b];
-    let file = syntax::parse(text).ok()?;
+    let file = parse_recovering(text).0?;
     let decls = declarations(&file);
     let (_, kind, _, _) = decls.iter().find(|d| d.0 == word)?;
     // The stage the cursor is in (else the last one).
     let here = file.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end);
-    let program = compile(text, "document.bat").ok();
-    let md = match (kind, &program) {
-        (Kind::Stage, Some(p)) => {
-            let (i, st) = p.stage(word)?;
-            let table = render_layout(p, i);
-            let totals = table.lines().find(|l| l.starts_with("genes:")).unwrap_or("");
-            let added: Vec<&str> =
-                st.modules.iter().filter(|m| m.stage as usize == i).map(|m| m.name.as_str()).collect();
-            let parent = st.parent.map(|j| format!(", extends `{}`", p.stages[j].name)).unwrap_or_default();
-            format!(
-                "**stage `{word}`** ({} of {}{parent})\n\nadds modules: {}\n\n{totals}",
-                i + 1,
-                p.stages.len(),
-                if added.is_empty() { "none".to_string() } else { added.join(", ") }
-            )
-        }
-        (Kind::Module, Some(p)) => {
-            let stage_name = here.map(|s| s.name.text.as_str());
-            let (i, st) = match stage_name.and_then(|n| p.stage(n)) {
-                Some((i, st)) if st.modules.iter().any(|m| m.name == word) => (i, st),
-                _ => p
-                    .stages
-                    .iter()
-                    .enumerate()
-                    .rev()
-                    .find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
-            };
-            let m = st.modules.iter().find(|m| m.name == word)?;
-            let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
-            let table = render_layout(p, i);
-            let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
-            rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(word)));
-            // Weights that are not genes: what a training stage learned.
-            let trained = format!("trained: `{word}` ");
-            let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
-            let genes = if rows.len() > 1 {
-                format!("```text\n{}\n```", rows.join("\n"))
-            } else {
-                "no genes in this stage".to_string()
-            };
-            let extra = if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
-            format!(
-                "**module `{word}`** in stage `{}`\n\nsenses: {}\n\n{genes}{extra}",
-                st.name,
-                if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
-            )
-        }
-        (Kind::Sensor, Some(p)) => {
-            let s = p.stages.iter().find_map(|st| st.sensors.iter().find(|s| s.name == word))?;
-            let chans = if s.count == 1 {
-                format!("channel {}", s.channel)
-            } else {
-                format!("{} elements, channels {}..{}", s.count, s.channel, s.channel + s.count - 1)
-            };
-            let kind = format!("{:?}", s.kind).to_lowercase();
-            format!("**sensor `{word}`**: `{kind}`, {chans}")
-        }
-        (Kind::Actuator, Some(p)) => {
-            let a = p.stages.iter().find_map(|st| st.actuators.iter().find(|a| a.name == word))?;
-            let kind = format!("{:?}", a.kind).to_lowercase();
-            let slots = match kind.as_str() {
-                "speed" => "two wheel speeds, -1..1 of v_max: `[0]` left, `[1]` right",
-                "lift" => "states `up`, `down`",
-                _ => "states `open`, `closed`",
-            };
-            format!("**actuator `{word}`**: `{kind}`, {slots}")
-        }
-        (k, None) => format!(
-            "{} `{word}` (the file has errors: fix them for details)",
-            format!("{k:?}").to_lowercase()
-        ),
+    // What stands of the program, errors or not (the parts with errors show
+    // their placeholders; their diagnostics say what is wrong).
+    let program = lower_partial(&file, "document.bat").0;
+    let p = &program;
+    let md = || -> Option<String> {
+        Some(match kind {
+            Kind::Stage => {
+                let (i, st) = p.stage(word)?;
+                let table = render_layout(p, i);
+                let totals = table.lines().find(|l| l.starts_with("genes:")).unwrap_or("");
+                let added: Vec<&str> =
+                    st.modules.iter().filter(|m| m.stage as usize == i).map(|m| m.name.as_str()).collect();
+                let parent =
+                    st.parent.map(|j| format!(", extends `{}`", p.stages[j].name)).unwrap_or_default();
+                format!(
+                    "**stage `{word}`** ({} of {}{parent})\n\nadds modules: {}\n\n{totals}",
+                    i + 1,
+                    p.stages.len(),
+                    if added.is_empty() { "none".to_string() } else { added.join(", ") }
+                )
+            }
+            Kind::Module => {
+                let stage_name = here.map(|s| s.name.text.as_str());
+                let (i, st) = match stage_name.and_then(|n| p.stage(n)) {
+                    Some((i, st)) if st.modules.iter().any(|m| m.name == word) => (i, st),
+                    _ => p
+                        .stages
+                        .iter()
+                        .enumerate()
+                        .rev()
+                        .find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
+                };
+                let m = st.modules.iter().find(|m| m.name == word)?;
+                let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
+                let table = render_layout(p, i);
+                let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
+                rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(word)));
+                // Weights that are not genes: what a training stage learned.
+                let trained = format!("trained: `{word}` ");
+                let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
+                let genes = if rows.len() > 1 {
+                    format!("```text\n{}\n```", rows.join("\n"))
+                } else {
+                    "no genes in this stage".to_string()
+                };
+                let extra =
+                    if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
+                format!(
+                    "**module `{word}`** in stage `{}`\n\nsenses: {}\n\n{genes}{extra}",
+                    st.name,
+                    if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
+                )
+            }
+            Kind::Sensor => {
+                let s = p.stages.iter().find_map(|st| st.sensors.iter().find(|s| s.name == word))?;
+                let chans = if s.count == 1 {
+                    format!("channel {}", s.channel)
+                } else {
+                    format!("{} elements, channels {}..{}", s.count, s.channel, s.channel + s.count - 1)
+                };
+                let kind = format!("{:?}", s.kind).to_lowercase();
+                format!("**sensor `{word}`**: `{kind}`, {chans}")
+            }
+            Kind::Actuator => {
+                let a = p.stages.iter().find_map(|st| st.actuators.iter().find(|a| a.name == word))?;
+                let kind = format!("{:?}", a.kind).to_lowercase();
+                let slots = match kind.as_str() {
+                    "speed" => "two wheel speeds, -1..1 of v_max: `[0]` left, `[1]` right",
+                    "lift" => "states `up`, `down`",
+                    _ => "states `open`, `closed`",
+                };
+                format!("**actuator `{word}`**: `{kind}`, {slots}")
+            }
+        })
     };
+    // What the program does not hold (a stage in an `extends` cycle, say) is named only.
+    let md = md().unwrap_or_else(|| format!("**{} `{word}`**", format!("{kind:?}").to_lowercase()));
     let h = lt::Hover {
         contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value: md }),
         range: Some(range(text, a, b)),
@@ -431,44 +445,238 @@ const WORDS: &[&str] = &[
     "sign",
 ];
 
-fn completion(text: &str) -> Value {
-    let mut items: Vec<lt::CompletionItem> = syntax::RESERVED
-        .iter()
-        .chain(WORDS)
-        .map(|k| lt::CompletionItem {
-            label: k.to_string(),
-            kind: Some(lt::CompletionItemKind::KEYWORD),
-            ..Default::default()
-        })
-        .collect();
-    if let Ok(file) = syntax::parse(text) {
-        let mut seen = std::collections::HashSet::new();
-        for (name, kind, _, _) in declarations(&file) {
-            if seen.insert(name.clone()) {
-                let k = match kind {
-                    Kind::Stage => lt::CompletionItemKind::CLASS,
-                    Kind::Module => lt::CompletionItemKind::MODULE,
-                    Kind::Sensor | Kind::Actuator => lt::CompletionItemKind::VARIABLE,
-                };
-                items.push(lt::CompletionItem {
-                    label: name,
-                    kind: Some(k),
-                    detail: Some(format!("{kind:?}").to_lowercase()),
-                    ..Default::default()
-                });
-            }
+/// Where the cursor is, as completion sees it.
+#[derive(Debug, PartialEq, Eq)]
+enum Context {
+    /// After `sense` (or in its list), in `toward(`: the robot's sensors.
+    Sensors,
+    /// After `link` or `link A ->`: the modules of the stage.
+    Modules,
+    /// After `extends`: the other stages.
+    Stages,
+    /// After `trained`: the training stages.
+    TrainingStages,
+    /// In a `world { }` block: its items.
+    World,
+    /// After `on` in a world: the walls.
+    Walls,
+    /// After `behavior`, `->` or `|` of a decoding table: the motions.
+    Motions,
+    /// Anywhere else: keywords and names.
+    Anywhere,
+}
+
+/// The words that start a world item, from the grammar's `world_item` rule
+/// (each item's first keyword), so that they follow the grammar.
+fn world_items() -> Vec<String> {
+    const GRAMMAR: &str = include_str!("../grammar/shaping.pest");
+    // The first quoted word of a rule's definition, through `k_...` rules.
+    fn first_word(rule: &str, depth: usize) -> Option<String> {
+        let line = GRAMMAR.lines().find(|l| l.split_whitespace().next() == Some(rule) && l.contains('='))?;
+        let body = &line[line.find('=')? + 1..];
+        let body = body.trim_start_matches([' ', '_', '@', '{']);
+        if let Some(rest) = body.strip_prefix('"') {
+            return rest.split('"').next().map(str::to_string);
         }
-    } else {
-        // A half-typed file: offer the words already written.
-        let mut seen = std::collections::HashSet::new();
-        for t in lex(text).tokens.iter().filter(|t| t.kind == TokenKind::Word) {
-            let w = &text[t.span.start..t.span.end];
-            if !syntax::RESERVED.contains(&w) && !WORDS.contains(&w) && seen.insert(w) {
-                items.push(lt::CompletionItem { label: w.to_string(), ..Default::default() });
+        let head: String = body.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+        (depth < 4).then(|| first_word(&head, depth + 1)).flatten()
+    }
+    let Some(line) = GRAMMAR.lines().find(|l| l.starts_with("world_item")) else { return vec![] };
+    let alts = line.split_once('{').map_or("", |x| x.1).trim_end().trim_end_matches('}');
+    alts.split('|').filter_map(|r| first_word(r.trim(), 0)).collect()
+}
+
+/// The kind of the innermost block open at `offset` (`stage`, `module`,
+/// `world`, ...: the keyword before its `{`), `None` at top level.
+fn block_at<'t>(text: &'t str, tokens: &[Token]) -> Option<&'t str> {
+    let mut stack: Vec<Option<&str>> = Vec::new();
+    for (i, t) in tokens.iter().enumerate() {
+        match &text[t.span.start..t.span.end] {
+            "{" => {
+                let head = tokens[i.saturating_sub(4)..i]
+                    .iter()
+                    .rev()
+                    .map(|t| &text[t.span.start..t.span.end])
+                    .find(|w| {
+                        matches!(
+                            *w,
+                            "stage"
+                                | "module"
+                                | "world"
+                                | "robot"
+                                | "genome"
+                                | "evolve"
+                                | "body"
+                                | "neural"
+                                | "script"
+                                | "behavior"
+                        )
+                    });
+                stack.push(head);
+            }
+            "}" => {
+                stack.pop();
+            }
+            _ => {}
+        }
+    }
+    stack.pop().flatten()
+}
+
+/// The completion context at `offset`.
+fn context(text: &str, offset: usize) -> Context {
+    let all = lex(text).tokens;
+    // The tokens before the word being typed.
+    let before: Vec<Token> = all
+        .into_iter()
+        .take_while(|t| t.span.end < offset || (t.span.start < offset && t.kind != TokenKind::Word))
+        .collect();
+    let w = |k: usize| -> &str {
+        before.len().checked_sub(k + 1).map_or("", |i| &text[before[i].span.start..before[i].span.end])
+    };
+    match (w(0), w(1)) {
+        ("sense", _) | ("(", "toward") => return Context::Sensors,
+        ("link", _) => return Context::Modules,
+        (">", "-") if w(3) == "link" => return Context::Modules,
+        (">", "-") | ("|", _) | ("behavior", _) => return Context::Motions,
+        ("extends", _) => return Context::Stages,
+        ("trained", _) => return Context::TrainingStages,
+        _ => {}
+    }
+    // In a list of sensors: `sense ir, light[2..5], `.
+    if w(0) == "," {
+        for k in 1..before.len() {
+            match w(k) {
+                "sense" => return Context::Sensors,
+                "toward" => return Context::Sensors,
+                "," | "[" | "]" | "." | "(" => {}
+                x if x.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') => {}
+                _ => break,
             }
         }
     }
+    match block_at(text, &before) {
+        Some("world") if w(0) == "on" => Context::Walls,
+        Some("world") => Context::World,
+        _ => Context::Anywhere,
+    }
+}
+
+/// The stage declared around `offset`, and its ancestors by `extends`.
+fn lineage(file: &ast::File, offset: usize) -> Vec<&ast::StageDecl> {
+    let mut out: Vec<&ast::StageDecl> = Vec::new();
+    let mut cur = file.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end);
+    while let Some(s) = cur {
+        if out.iter().any(|o| std::ptr::eq(*o, s)) {
+            break;
+        }
+        out.push(s);
+        cur = s.extends.as_ref().and_then(|e| file.stages.iter().find(|p| p.name.text == e.text));
+    }
+    out
+}
+
+fn item(label: &str, kind: lt::CompletionItemKind, detail: &str) -> lt::CompletionItem {
+    lt::CompletionItem {
+        label: label.to_string(),
+        kind: Some(kind),
+        detail: (!detail.is_empty()).then(|| detail.to_string()),
+        ..Default::default()
+    }
+}
+
+/// The motions of scripts and decoding tables.
+const MOTIONS: &[&str] = &["forward", "back", "turn left", "turn right", "left", "right", "stop"];
+
+fn completion(text: &str, offset: usize) -> Value {
+    use lt::CompletionItemKind as K;
+    let ctx = context(text, offset);
+    let file = parse_recovering(text).0;
+    let file = file.as_ref();
+    let stages = lineage_or_all(file, offset);
+    let hardware = |sensor: bool| -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        let robots = file.iter().flat_map(|f| f.robots.iter()).flat_map(|r| r.hardware.iter());
+        let added = stages.iter().flat_map(|s| s.items.iter()).flat_map(|i| match i {
+            ast::StageItem::RobotAdds(h, _) => h.iter().collect(),
+            _ => Vec::new(),
+        });
+        for h in robots.chain(added) {
+            if h.is_sensor == sensor && !names.contains(&h.name.text) {
+                names.push(h.name.text.clone());
+            }
+        }
+        names
+    };
+    let items: Vec<lt::CompletionItem> = match ctx {
+        Context::Sensors => hardware(true).iter().map(|n| item(n, K::VARIABLE, "sensor")).collect(),
+        Context::Modules => {
+            let mut names: Vec<&str> = Vec::new();
+            for s in stages.iter().rev() {
+                for i in &s.items {
+                    if let ast::StageItem::Module(m) = i {
+                        if !names.contains(&m.name.text.as_str()) {
+                            names.push(&m.name.text);
+                        }
+                    }
+                }
+            }
+            names.iter().map(|n| item(n, K::MODULE, "module")).collect()
+        }
+        Context::Stages | Context::TrainingStages => {
+            let here =
+                file.and_then(|f| f.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end));
+            file.iter()
+                .flat_map(|f| f.stages.iter())
+                .filter(|s| here.is_none_or(|h| h.name.text != s.name.text))
+                .filter(|s| {
+                    ctx == Context::Stages
+                        || s.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }))
+                })
+                .map(|s| item(&s.name.text, K::CLASS, "stage"))
+                .collect()
+        }
+        Context::World => world_items().iter().map(|w| item(w, K::KEYWORD, "world item")).collect(),
+        Context::Walls => {
+            ["north", "south", "east", "west"].iter().map(|w| item(w, K::KEYWORD, "wall")).collect()
+        }
+        Context::Motions => {
+            let mut out: Vec<lt::CompletionItem> =
+                MOTIONS.iter().map(|m| item(m, K::KEYWORD, "motion")).collect();
+            for a in hardware(false) {
+                out.push(item(&format!("{a}(0.5, 0.5)"), K::FUNCTION, "wheel speeds"));
+            }
+            out
+        }
+        Context::Anywhere => {
+            let mut out: Vec<lt::CompletionItem> =
+                syntax::RESERVED.iter().chain(WORDS).map(|k| item(k, K::KEYWORD, "")).collect();
+            let mut seen = std::collections::HashSet::new();
+            for (name, kind, _, _) in file.map(declarations).unwrap_or_default() {
+                if seen.insert(name.clone()) {
+                    let k = match kind {
+                        Kind::Stage => K::CLASS,
+                        Kind::Module => K::MODULE,
+                        Kind::Sensor | Kind::Actuator => K::VARIABLE,
+                    };
+                    out.push(item(&name, k, &format!("{kind:?}").to_lowercase()));
+                }
+            }
+            out
+        }
+    };
     serde_json::to_value(items).unwrap_or(Value::Null)
+}
+
+/// The stage at `offset` and its ancestors; outside any stage, every stage.
+fn lineage_or_all(file: Option<&ast::File>, offset: usize) -> Vec<&ast::StageDecl> {
+    let Some(f) = file else { return Vec::new() };
+    let l = lineage(f, offset);
+    if l.is_empty() {
+        f.stages.iter().collect()
+    } else {
+        l
+    }
 }
 
 #[allow(deprecated)] // `DocumentSymbol::deprecated` must be given
@@ -491,7 +699,7 @@ fn symbol(
 }
 
 fn symbols(text: &str) -> Value {
-    let Ok(file) = syntax::parse(text) else { return Value::Null };
+    let Some(file) = parse_recovering(text).0 else { return Value::Null };
     let mut out = Vec::new();
     for r in &file.robots {
         let hw = r.hardware.iter().map(|h| symbol(text, &h.name, lt::SymbolKind::FIELD, vec![])).collect();

@@ -14,6 +14,7 @@ mod replay;
 mod report;
 mod robot;
 mod run;
+mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -124,6 +125,10 @@ enum Command {
         /// serial port (see `docs/robot.md`); every episode is saved as it ends.
         #[arg(long)]
         robot: Option<PathBuf>,
+        /// `STAGE.SECTION.FIELD=VALUE`: change a setting of the program
+        /// (the settings `experiment --set` sweeps; one value here).
+        #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
+        sets: Vec<sweep::Set>,
         /// Baud rate of `--robot`.
         #[arg(long, default_value_t = 9600, requires = "robot")]
         baud: u32,
@@ -233,8 +238,9 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         error_format: ErrorFormat,
     },
-    /// Run every stage over several seeds and summarise (median and range):
-    /// `summary.md` and a multi-seed fitness picture.
+    /// Run every stage over several seeds, or a sweep of settings (`--set`),
+    /// and summarise (median and range): `summary.md`, `summary.json` and
+    /// pictures.
     Experiment {
         file: PathBuf,
         /// Number of seeds.
@@ -251,6 +257,19 @@ enum Command {
         /// `STAGE=FITNESS`: report the generation at which the best reaches it.
         #[arg(long)]
         criterion: Vec<String>,
+        /// `STAGE.SECTION.FIELD=V1,V2,...`: sweep a setting; several `--set`
+        /// sweep the cartesian product, every point over the seeds. Fields:
+        /// `evolve.` population, generations, actions, crossover, mutation,
+        /// elitism, evaluations, keep, selection, inheritance; `world.`
+        /// arena, charger, lamp, battery, recharge, objects, diameter;
+        /// `world.body.` radius, wheel_base, v_max, action, wheel_noise,
+        /// sensor_noise; `test.actions`; `train.actions`; `MODULE.` reward,
+        /// punish, window, threshold, range. STAGE may be `*` (every stage).
+        #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=V1,V2,...", value_parser = sweep::parse_set)]
+        sets: Vec<sweep::Set>,
+        /// Run only this stage and the stages it needs.
+        #[arg(long)]
+        stage: Option<String>,
         /// Ignore existing checkpoints.
         #[arg(long)]
         fresh: bool,
@@ -347,6 +366,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             no_report,
             rank_timeout,
             robot,
+            sets,
             baud,
             period,
             timeout,
@@ -367,6 +387,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 no_report,
                 error_format,
                 robot,
+                sets: single_values(sets)?,
             };
             #[cfg(feature = "mpi")]
             if cluster::launcher().is_some() {
@@ -375,7 +396,9 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                         "error: `--robot` evaluates on one robot; run it without `mpirun`",
                     ));
                 }
-                return cluster::with_mpi(jobs, rank_timeout, quiet || json, |c| run::run(args, Some(c)));
+                return cluster::with_mpi(jobs, rank_timeout, quiet || json, None, |c| {
+                    run::run(args, Some(c))
+                });
             }
             let _ = rank_timeout;
             run::run(args, None)
@@ -451,30 +474,35 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             out,
             jobs,
             criterion,
+            sets,
+            stage,
             fresh,
             no_report,
             rank_timeout,
             error_format,
         } => {
-            let args = experiment::ExperimentArgs {
+            let plan = experiment::Plan::new(experiment::ExperimentArgs {
                 file,
                 seeds,
                 first_seed,
                 out,
                 jobs,
                 criterion,
+                sets,
+                stage,
                 fresh,
                 no_report,
                 error_format,
-            };
+            })?;
             #[cfg(feature = "mpi")]
             if cluster::launcher().is_some() {
-                return cluster::with_mpi(jobs, rank_timeout, false, |c| {
-                    experiment::experiment(args, Some(c))
+                let task = |task, threads| plan.run_task(task, Some(threads), true, None);
+                return cluster::with_mpi(jobs, rank_timeout, false, Some(&task), |c| {
+                    experiment::experiment(&plan, Some(c))
                 });
             }
             let _ = rank_timeout;
-            experiment::experiment(args, None)
+            experiment::experiment(&plan, None)
         }
         Command::Report { dir, output } => {
             let path = html::write(&dir, output.as_deref())?;
@@ -515,6 +543,21 @@ fn refuse_without_mpi(command: &Command) -> Result<(), CliError> {
     }
 }
 
+/// `run --set`: one value each, no setting twice.
+fn single_values(sets: Vec<sweep::Set>) -> Result<Vec<sweep::Assignment>, CliError> {
+    sweep::check_sets(&sets)?;
+    sets.into_iter()
+        .map(|s| match <[String; 1]>::try_from(s.values) {
+            Ok([v]) => Ok((s.target, v)),
+            Err(values) => Err(CliError::io(format!(
+                "error: `--set {}={}`: `run` takes one value (`experiment` sweeps several)",
+                s.target,
+                values.join(",")
+            ))),
+        })
+        .collect()
+}
+
 /// Prints text to stdout, ending it with a newline.
 fn print_text(text: &str) {
     if text.ends_with('\n') {
@@ -529,13 +572,17 @@ fn print_text(text: &str) {
 fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     let mut worst: Option<CliError> = None;
     for file in files {
-        let result = load::load_program(file, format);
+        let result = load::load_program_warnings(file, format);
         if format == ErrorFormat::Json {
             println!("{}", check_json(file, &result));
         }
         match result {
-            Ok(program) => {
+            Ok((program, warnings)) => {
                 if format != ErrorFormat::Json {
+                    // Warnings do not change the exit code.
+                    if let Some(w) = warnings {
+                        eprintln!("{}", w.trim_end());
+                    }
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();
                     println!("{}: ok ({})", file.display(), genes.join(", "));
@@ -565,17 +612,23 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
 /// bad one the diagnostic (`message`, `severity`, `labels`, `related`, ...).
 fn check_json(
     file: &std::path::Path,
-    result: &Result<shaping_runtime::program::Program, CliError>,
+    result: &Result<(shaping_runtime::program::Program, Option<String>), CliError>,
 ) -> String {
     let name = file.display().to_string();
     let value = match result {
-        Ok(program) => {
+        Ok((program, warnings)) => {
             let stages: Vec<serde_json::Value> = program
                 .stages
                 .iter()
                 .map(|s| serde_json::json!({"name": s.name, "bits": s.layout.bits}))
                 .collect();
-            serde_json::json!({"file": name, "ok": true, "stages": stages})
+            let mut v = serde_json::json!({"file": name, "ok": true, "stages": stages});
+            // A good file's warnings: the diagnostic object of the warnings.
+            if let Some(w) = warnings {
+                v["warnings"] =
+                    serde_json::from_str(w).unwrap_or_else(|_| serde_json::Value::String(w.trim().into()));
+            }
+            v
         }
         Err(CliError::Diagnostics(text)) => match serde_json::from_str::<serde_json::Value>(text) {
             Ok(serde_json::Value::Object(mut diagnostic)) => {

@@ -12,6 +12,7 @@
 
 mod arena;
 mod fitness;
+mod points;
 mod render;
 mod series;
 mod trace;
@@ -169,6 +170,24 @@ pub fn multi_seed_fitness(
         return Err(PlotError::input(stem, "no generations to plot"));
     }
     render::render(stem, &fitness::Multi { title, runs, stages: stage_starts })
+}
+
+/// One stage's figures over the points of a sweep: per point, the median,
+/// minimum and maximum over the seeds (`None` where it has none).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSeries {
+    pub stage: String,
+    pub values: Vec<Option<(f64, f64, f64)>>,
+}
+
+/// The points of a sweep along x (1, 2, ...), one marker per stage at the
+/// median with a bar from minimum to maximum.
+pub fn sweep_points(stem: &Path, title: &str, series: &[SweepSeries]) -> Result<(), PlotError> {
+    let points = series.iter().map(|s| s.values.len()).max().unwrap_or(0);
+    if points == 0 || series.iter().all(|s| s.values.iter().all(Option::is_none)) {
+        return Err(PlotError::input(stem, "no points to plot"));
+    }
+    render::render(stem, &points::Points { title, points, series })
 }
 
 /// Trailing rolling mean (over `window` actions) of reinforcement values in

@@ -35,6 +35,8 @@ pub struct RunArgs {
     pub error_format: crate::diag::ErrorFormat,
     /// Evaluate on a robot (`--robot`) instead of the simulator.
     pub robot: Option<crate::robot::RobotRun>,
+    /// Settings changed from the command line (`--set`, one value each).
+    pub sets: Vec<crate::sweep::Assignment>,
 }
 
 /// The directory a run of `file` writes to by default: `runs/<file stem>`.
@@ -148,6 +150,7 @@ fn to_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
 /// each generation are spread over the ranks.
 pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError> {
     let mut program = load::load_program(&args.file, args.error_format)?;
+    crate::sweep::apply(&mut program, &args.sets)?;
     let target = match args.stage.as_deref() {
         Some(_) => load::stage_index(&program, args.stage.as_deref())?,
         None => program.stages.len().saturating_sub(1),

@@ -92,6 +92,33 @@ fn check_reports_diagnostics_with_exit_1() {
 }
 
 #[test]
+fn check_prints_warnings_and_exits_0() {
+    let dir = scratch("warn");
+    let file = dir.join("typo.bat");
+    std::fs::write(
+        &file,
+        "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+         stage s { fitness per action wheels[0]  module wander { sense ir  behavior forward } }\n\
+         stage t extends s { module wandr { sense ir  behavior back } }\n",
+    )
+    .unwrap();
+    let out = run(shaping().arg("check").arg(&file).arg("--error-format").arg("plain"));
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    assert!(err.contains("new module `wandr` is one edit away from inherited module `wander`"), "{err}");
+    assert!(text(&out.stdout).contains("typo.bat: ok"), "{}", text(&out.stdout));
+
+    let json = run(shaping().arg("check").arg(&file).arg("--error-format").arg("json"));
+    assert_eq!(json.status.code(), Some(0));
+    let first = text(&json.stdout).lines().next().unwrap_or_default().to_string();
+    // One object per file: the good file's, its warnings inside.
+    let v: serde_json::Value = serde_json::from_str(&first).unwrap();
+    assert_eq!(text(&json.stdout).lines().count(), 1, "{}", text(&json.stdout));
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["warnings"]["related"][0]["severity"], "warning", "{v}");
+}
+
+#[test]
 fn bad_inputs_give_an_error_never_a_panic() {
     let dir = scratch("bad-inputs");
     let cases: Vec<(&str, Vec<u8>)> = vec![
@@ -451,6 +478,13 @@ fn run_writes_a_report_of_every_stage_and_report_reads_any_directory() {
     let stages: Vec<&str> =
         data["stages"].as_array().unwrap().iter().map(|s| s["name"].as_str().unwrap()).collect();
     assert_eq!(stages, ["navigation", "collect", "bigger"]);
+    // The frozen genes of `collect` are traced to an individual of `navigation`'s final population.
+    let from = data["stages"][1]["frozen_from"].as_str().unwrap_or_default();
+    assert!(
+        from.contains("come from individual #") && from.contains("stage `navigation`'s final population"),
+        "{from}"
+    );
+    assert!(data["stages"][0]["frozen_from"].is_null() && data["stages"][2]["frozen_from"].is_null());
     // One episode per stage, the test stage's in two worlds as long as its trace.
     let eps = data["episodes"].as_array().unwrap();
     assert_eq!(eps.len(), 3);
@@ -890,4 +924,255 @@ fn the_trace_has_what_the_robot_sensed_and_did() {
     // The lamp lights the arena: the light readings are not all zero.
     assert!(rows.iter().any(|r| r[col("light[0]")] > 0.0));
     assert!(rows.iter().any(|r| r[col("wheels[0]")] != 0.0));
+}
+
+/// Every regular file under `dir`, relative to it, sorted, with its bytes
+/// (`report.html` and pictures aside: they are not the run's results).
+fn result_files(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let ext = p.extension().and_then(|e| e.to_str()).unwrap_or("");
+            if p.is_dir() {
+                stack.push(p);
+            } else if ["csv", "json", "genome", "md"].contains(&ext) {
+                out.push((p.strip_prefix(dir).unwrap().to_path_buf(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `shaping experiment tiny.bat ARGS... --out OUT`.
+fn experiment_tiny(out: &Path, args: &[&str]) -> Output {
+    run(shaping().arg("experiment").arg(tiny()).args(args).arg("--out").arg(out))
+}
+
+fn sweep(out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["--seeds", "2", "--no-report", "--set", "first.evolve.mutation=0.01,0.2"];
+    args.extend(["--set", "first.world.battery=100,300"]);
+    args.extend(extra);
+    experiment_tiny(out, &args)
+}
+
+/// A sweep runs every point of the cartesian product over every seed, each
+/// point's seed writing what `shaping run` with the same `--set` writes, and
+/// tables every point in `summary.md` and `summary.json`.
+#[test]
+fn a_sweep_point_is_the_run_with_its_settings() {
+    let dir = scratch("sweep");
+    let out = sweep(&dir.join("sweep"), &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let point = "first.evolve.mutation=0.2,first.world.battery=100";
+    let alone = dir.join("alone");
+    let single = run_tiny(
+        &alone,
+        &[
+            "--seed",
+            "2",
+            "--no-report",
+            "--set",
+            "first.evolve.mutation=0.2",
+            "--set",
+            "first.world.battery=100",
+        ],
+    );
+    assert!(single.status.success(), "{}", text(&single.stderr));
+    let in_sweep = result_files(&dir.join("sweep").join(point).join("seed-2"));
+    assert!(in_sweep.len() >= 6, "{in_sweep:?}");
+    let names = |v: &[(PathBuf, Vec<u8>)]| v.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&in_sweep), names(&result_files(&alone)));
+    assert!(in_sweep == result_files(&alone), "the sweep's point differs from the run with its settings");
+    // The settings reach the program: both stages (the second inherits the mutation).
+    let program: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(alone.join("program.json")).unwrap()).unwrap();
+    for stage in 0..2 {
+        let s = &program["stages"][stage];
+        assert!((s["run"]["Evolve"]["mutation"].as_f64().unwrap() - 0.2).abs() < 1e-6, "{}", s["name"]);
+        assert_eq!(s["world"]["battery"]["capacity"], 100);
+    }
+    // And they change the results: another mutation rate evolves otherwise.
+    let other =
+        dir.join("sweep/first.evolve.mutation=0.01,first.world.battery=100/seed-2/first/generations.csv");
+    let this = dir.join("sweep").join(point).join("seed-2/first/generations.csv");
+    assert_ne!(std::fs::read(other).unwrap(), std::fs::read(this).unwrap());
+
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("sweep/summary.json")).unwrap()).unwrap();
+    let points = summary["points"].as_array().unwrap();
+    assert_eq!(points.len(), 4);
+    assert_eq!(points[2]["name"], point);
+    assert_eq!(points[2]["settings"]["first.world.battery"], "100");
+    let first = &points[2]["stages"][0];
+    assert_eq!(first["stage"], "first");
+    // The chosen best of each seed is the one in its checkpoint.
+    let chosen: Vec<f64> = (1..=2)
+        .map(|s| {
+            let cp: serde_json::Value = serde_json::from_slice(
+                &std::fs::read(dir.join("sweep").join(point).join(format!("seed-{s}/first/checkpoint.json")))
+                    .unwrap(),
+            )
+            .unwrap();
+            cp["best"][1].as_f64().unwrap()
+        })
+        .collect();
+    let (lo, hi) = (chosen[0].min(chosen[1]), chosen[0].max(chosen[1]));
+    assert!((first["chosen_best"]["min"].as_f64().unwrap() - lo).abs() < 1e-6, "{first}");
+    assert!((first["chosen_best"]["max"].as_f64().unwrap() - hi).abs() < 1e-6, "{first}");
+    assert!((first["chosen_best"]["median"].as_f64().unwrap() - (lo + hi) / 2.0).abs() < 1e-6, "{first}");
+    let md = std::fs::read_to_string(dir.join("sweep/summary.md")).unwrap();
+    let head =
+        "| point | `first.evolve.mutation` | `first.world.battery` | first final best | first chosen best |";
+    assert!(md.contains(head), "{md}");
+    assert!(md.contains("| 3 | 0.2 | 100 | "), "{md}");
+    assert_eq!(md.lines().filter(|l| l.starts_with("| ") && l.contains(" | 0.")).count(), 4, "{md}");
+    assert!(dir.join("sweep/sweep.svg").exists() && dir.join("sweep/sweep.png").exists());
+    assert!(dir.join("sweep").join(point).join("summary.md").exists(), "no summary of the point");
+}
+
+/// A value set on a stage goes to the stages extending it that had the same
+/// value (inherited), not to one that sets its own.
+#[test]
+fn a_set_value_is_inherited_like_a_written_one() {
+    let dir = scratch("inherit");
+    let out = run_tiny(&dir, &["--no-report", "--set", "first.evolve.generations=3"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let program: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("program.json")).unwrap()).unwrap();
+    assert_eq!(program["stages"][0]["run"]["Evolve"]["generations"], 3);
+    assert_eq!(program["stages"][1]["run"]["Evolve"]["generations"], 4, "`second` sets its own");
+    let csv = std::fs::read_to_string(dir.join("first/generations.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "a header and 3 generations:\n{csv}");
+}
+
+#[test]
+fn bad_set_values_are_errors_naming_them() {
+    let dir = scratch("bad-set");
+    let cases: [(&str, &[&str]); 11] = [
+        ("frist.evolve.mutation=0.1", &["no stage `frist`", "did you mean `first`?"]),
+        ("first.evolve.mutatoin=0.1", &["no setting `evolve.mutatoin`", "did you mean `evolve.mutation`?"]),
+        (
+            "first.evolve.mutation=0.1,1.5",
+            &["`--set first.evolve.mutation=1.5`", "1.5 is not between 0 and 1"],
+        ),
+        ("first.evolve.population=many", &["`many` is not a whole number"]),
+        ("first.evolve.keep=40", &["selection.keep", "40 is not between 1 and 12"]),
+        ("first.wandr.reward=0.5", &["no module `wandr`", "did you mean `wander`?"]),
+        ("first.wander.reward=0.5", &["module `wander` of stage `first` does not learn"]),
+        ("second.wander.range=-2..2", &["introduced by stage `first`", "set `first.wander.range`"]),
+        ("first.world.objects=3", &["the world of stage `first` has no objects"]),
+        ("first.evolve.selection=random", &["`random` is not one of truncation, roulette"]),
+        ("first.evolve.seed=4", &["use `--seed` (`run`) or `--seeds`"]),
+    ];
+    for (set, wanted) in cases {
+        let out = experiment_tiny(&dir.join("x"), &["--seeds", "1", "--set", set]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--set {set}: {err}");
+        for w in wanted {
+            assert!(err.contains(w), "--set {set}: `{w}` missing from:\n{err}");
+        }
+        assert!(!dir.join("x").exists(), "--set {set}: files written before the error");
+    }
+    let out =
+        run(shaping().arg("experiment").arg(tiny()).args(["--stage", "first", "--criterion", "second=0.5"]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("stage `second` is not run with `--stage first`"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = run_tiny(&dir.join("y"), &["--set", "first.evolve.mutation=0.1,0.2"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("`run` takes one value"), "{}", text(&out.stderr));
+    let out = run(shaping().arg("experiment").arg(tiny()).args([
+        "--set",
+        "first.evolve.seed=1",
+        "--set",
+        "first.evolve.seed=2",
+    ]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("given twice"), "{}", text(&out.stderr));
+}
+
+/// A sweep killed with SIGKILL and started again ends with the files of
+/// one that was never interrupted.
+#[test]
+fn a_killed_sweep_resumes_to_the_same_result() {
+    let dir = scratch("sweep-kill");
+    let straight = dir.join("straight");
+    assert!(sweep(&straight, &["--jobs", "1"]).status.success());
+    let killed = dir.join("killed");
+    let mut child = shaping()
+        .arg("experiment")
+        .arg(tiny())
+        .args(["--seeds", "2", "--no-report", "--set", "first.evolve.mutation=0.01,0.2"])
+        .args(["--set", "first.world.battery=100,300", "--jobs", "1"])
+        .arg("--out")
+        .arg(&killed)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Kill in the middle of the second point.
+    let mid = killed.join("first.evolve.mutation=0.01,first.world.battery=300/seed-1/first/checkpoint.json");
+    let start = Instant::now();
+    while !mid.exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(!killed.join("summary.json").exists(), "the sweep ended before it was killed");
+    let out = sweep(&killed, &["--jobs", "1"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (a, b) = (result_files(&straight), result_files(&killed));
+    assert_eq!(a.len(), b.len());
+    for ((pa, xa), (pb, xb)) in a.iter().zip(&b) {
+        assert_eq!(pa, pb);
+        assert!(xa == xb, "{} differs after resuming", pa.display());
+    }
+}
+
+/// The report of a sweep shows its best point and lists every point; a
+/// point's report lists them too, its own highlighted.
+#[test]
+fn the_report_of_a_sweep_lists_its_points() {
+    let dir = scratch("sweep-report");
+    let out = experiment_tiny(&dir, &["--seeds", "2", "--set", "first.evolve.mutation=0.01,0.2"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let root = report_data(&dir.join("report.html"));
+    assert_eq!(root["kind"], "sweep");
+    let names: Vec<&str> =
+        root["sweep"]["points"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["first.evolve.mutation=0.01", "first.evolve.mutation=0.2"]);
+    // The point shown is the one with the highest median chosen best of the last evolved stage.
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+    let score = |i: usize| summary["points"][i]["stages"][1]["chosen_best"]["median"].as_f64().unwrap();
+    let best = if score(1) > score(0) { names[1] } else { names[0] };
+    assert_eq!(root["sweep_point"], best);
+    assert_eq!(root["seeds"], serde_json::json!([1, 2]));
+    let point = report_data(&dir.join("first.evolve.mutation=0.2/report.html"));
+    assert_eq!(point["kind"], "experiment");
+    assert_eq!(point["sweep_point"], "first.evolve.mutation=0.2");
+    assert_eq!(point["sweep"]["points"].as_array().unwrap().len(), 2);
+    // An experiment that is no sweep's point lists none.
+    let alone = scratch("exp-no-sweep");
+    let out = experiment_tiny(&alone, &["--seeds", "1"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(report_data(&alone.join("report.html")).get("sweep").is_none());
+}
+
+/// `experiment --stage S` runs S and the stages it needs, and summarises them only.
+#[test]
+fn an_experiment_of_one_stage_runs_and_summarises_its_chain() {
+    let dir = scratch("exp-stage");
+    let out = experiment_tiny(&dir, &["--seeds", "1", "--stage", "first", "--no-report"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(dir.join("seed-1/first/best.genome").exists());
+    assert!(!dir.join("seed-1/second").exists(), "the stage after `first` ran");
+    let md = std::fs::read_to_string(dir.join("summary.md")).unwrap();
+    assert!(md.contains("| first | 6 |") && !md.contains("| second |"), "{md}");
 }

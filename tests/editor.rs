@@ -196,6 +196,21 @@ fn diagnostics_as_you_type_with_related_information() {
 }
 
 #[test]
+fn warnings_have_the_warning_severity() {
+    let mut c = Client::start();
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+               stage s { fitness per action wheels[0]  module wander { sense ir  behavior forward } }\n\
+               stage t extends s { module wandr { sense ir  behavior back } }\n";
+    let d = c.open(URI, src);
+    assert_eq!(d.len(), 1, "{d:?}");
+    // 2 is `DiagnosticSeverity::WARNING`
+    assert_eq!(d[0]["severity"], json!(2), "{d:?}");
+    assert!(d[0]["message"].as_str().unwrap().contains("`wandr`"), "{d:?}");
+    assert_eq!(d[0]["relatedInformation"][0]["message"], json!("inherited from stage `s`"));
+    c.stop();
+}
+
+#[test]
 fn hover_definition_references_completion_symbols_and_formatting() {
     let mut c = Client::start();
     let src = example("khepera.bat");
@@ -255,8 +270,9 @@ fn hover_definition_references_completion_symbols_and_formatting() {
     c.stop();
 }
 
-/// A thousand random edits of an example: every one gets diagnostics and a
-/// response to a request, and the server survives.
+/// A thousand random edits of an example, mended every 20: every one gets
+/// diagnostics and a response to a request, hover answers on the modules of
+/// the stages the edits left alone, and the server survives.
 #[test]
 fn random_edits_never_crash_the_server() {
     let mut c = Client::start();
@@ -279,6 +295,18 @@ fn random_edits_never_crash_the_server() {
         "é",
         "0.5",
     ];
+    // Each stage of the example, and its first module: while the stage's
+    // text stands untouched (and outside a comment), hover on that module
+    // answers whatever the edits did elsewhere.
+    let stages: Vec<(String, String)> = split_stages(&text)
+        .into_iter()
+        .filter_map(|st| {
+            let m = st.split("module ").nth(1)?.split_whitespace().next()?.to_string();
+            Some((st, m))
+        })
+        .collect();
+    assert_eq!(stages.len(), 3, "the stages with modules");
+    let mut hovered = 0;
     let mut rng: u64 = 0x5eed;
     let mut next = |n: usize| {
         rng ^= rng << 13;
@@ -286,7 +314,12 @@ fn random_edits_never_crash_the_server() {
         rng ^= rng << 17;
         (rng % n as u64) as usize
     };
+    let original = text.clone();
     for version in 2..1002 {
+        // Every 20 edits, the file is mended (the example again).
+        if version % 20 == 0 {
+            text = original.clone();
+        }
         let mut at = next(text.len() + 1);
         while !text.is_char_boundary(at) {
             at -= 1;
@@ -309,6 +342,193 @@ fn random_edits_never_crash_the_server() {
         ][next(4)];
         let r = c.at(method, URI, &text, "", next(text.len() + 1));
         assert!(r.get("result").is_some(), "{method} after edit {version}: {r}");
+        let (stage, module) = &stages[next(stages.len())];
+        if let Some(at) = text.find(stage.as_str()).filter(|&at| !commented(&text, at)) {
+            let needle = format!("module {module}");
+            let off = at + stage.find(&needle).unwrap() + 7;
+            let h = c.at("textDocument/hover", URI, &text, "", off);
+            let md = h["result"]["contents"]["value"].as_str().unwrap_or_default();
+            assert!(
+                md.contains(&format!("module `{module}`")),
+                "hover on `{module}` after edit {version}: {h}"
+            );
+            hovered += 1;
+        }
+    }
+    assert!(hovered > 200, "only {hovered} hovers on untouched modules");
+    c.stop();
+}
+
+/// The stages of a file: from each `stage` at the start of a line to the
+/// `}` alone on a line that closes it.
+fn split_stages(text: &str) -> Vec<String> {
+    text.split("\nstage ").skip(1).map(|s| format!("stage {}\n}}", s.split("\n}").next().unwrap())).collect()
+}
+
+/// Whether `at` is inside a comment (a `//` line or a `/* */` block,
+/// unterminated ones included).
+fn commented(text: &str, at: usize) -> bool {
+    let b = text.as_bytes();
+    let mut i = 0;
+    while i < at {
+        if b[i] == b'/' && b.get(i + 1) == Some(&b'/') {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+            if i > at {
+                return true;
+            }
+        } else if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+            i += 2;
+            while i < b.len() && !(b[i] == b'*' && b.get(i + 1) == Some(&b'/')) {
+                i += 1;
+            }
+            if i >= at {
+                return true;
+            }
+            i += 2;
+        } else {
+            i += 1;
+        }
+    }
+    false
+}
+
+/// A file with syntax errors in two stages: the other stages keep hover
+/// (with their genes), definition, references and symbols; every syntax
+/// error is published.
+#[test]
+fn a_broken_file_keeps_its_intact_parts() {
+    let mut c = Client::start();
+    let src = example("khepera.bat");
+    c.open(URI, &src);
+    let bad = src
+        .replacen("behavior forward(1.0)\n  }\n\n  // Starts", "behavior forward(\n  }\n\n  // Starts", 1)
+        .replacen("world adds { objects 8 diameter 10mm virtual }", "world adds { objects 8 diameter }", 1);
+    let d = c.change(URI, 2, &bad);
+    assert_eq!(d.len(), 2, "{d:?}");
+    let line_of = |needle: &str| bad[..bad.find(needle).unwrap()].matches('\n').count();
+    assert_eq!(d[0]["range"]["start"]["line"], json!(line_of("behavior forward(\n") + 1));
+    assert_eq!(d[1]["range"]["start"]["line"], json!(line_of("diameter }")));
+    // hover on a module of the intact stage `navigation`: its genes
+    let h = c.at("textDocument/hover", URI, &bad, "module follow", 8);
+    let md = h["result"]["contents"]["value"].as_str().unwrap();
+    assert!(md.contains("module `follow`") && md.contains("bias") && md.contains("senses: light[0]"), "{md}");
+    // and on a module of the broken stage `collect` that parses
+    let h = c.at("textDocument/hover", URI, &bad, "module grip", 8);
+    assert!(h["result"]["contents"]["value"].as_str().unwrap().contains("module `grip`"), "{h}");
+    // definition of a stage, references of a module
+    let d = c.at("textDocument/definition", URI, &bad, "extends navigation", 9);
+    assert_eq!(d["result"][0]["range"]["start"]["line"], json!(line_of("stage navigation")), "{d}");
+    let r = c.at("textDocument/references", URI, &bad, "module avoid", 8);
+    assert_eq!(r["result"].as_array().unwrap().len(), 2, "{r}");
+    // symbols: every stage; `navigation` without the module that broke
+    let s = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": URI } }));
+    let names: Vec<&str> =
+        s["result"].as_array().unwrap().iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(names, ["khepera", "avoidance", "navigation", "collect", "bigger"]);
+    let modules: Vec<&str> =
+        s["result"][2]["children"].as_array().unwrap().iter().filter_map(|s| s["name"].as_str()).collect();
+    assert_eq!(modules, ["avoid", "follow", "recharge"]);
+    c.stop();
+}
+
+/// The labels completion offers at the end of `needle` in `text`.
+fn completions(c: &mut Client, text: &str, needle: &str) -> Vec<String> {
+    c.change(URI, 2, text);
+    let r = c.at("textDocument/completion", URI, text, needle, needle.len());
+    r["result"].as_array().unwrap().iter().filter_map(|i| i["label"].as_str().map(str::to_string)).collect()
+}
+
+const TUTOR: &str = "robot r {
+  sensor ir[8]       proximity
+  sensor light[8]    ambient
+  actuator wheels[2] speed
+}
+stage practice {
+  train for 100 actions
+  module avoid { sense ir  activation fixed 0  behavior stop }
+}
+stage first {
+  fitness per action wheels[0]
+  module go { sense ir[2..3]  behavior forward }
+}
+stage second extends first {
+  robot adds { sensor battery level }
+  world { arena 400mm x 600mm  charger 200mm on north wall }
+  module turn { sense ir  behavior turn left }
+  module steer {
+    sense ir
+    behavior neural { outputs sign(1) -> forward | back  weights trained practice }
+  }
+  link turn -> go evolvable
+}
+";
+
+#[test]
+fn completion_after_sense_offers_the_sensors() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    // in `second`, which adds the battery
+    let text = TUTOR.replacen("module turn { sense ir", "module turn { sense ", 1);
+    let labels = completions(&mut c, &text, "module turn { sense ");
+    assert_eq!(labels, ["ir", "light", "battery"]);
+    // in a list, and while typing a name
+    let text = TUTOR.replacen("module go { sense ir[2..3]", "module go { sense ir[2..3], li", 1);
+    assert_eq!(completions(&mut c, &text, "ir[2..3], li"), ["ir", "light"], "`first` has no battery");
+    c.stop();
+}
+
+#[test]
+fn completion_after_link_and_arrow_offers_the_stages_modules() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    let text = TUTOR.replacen("link turn -> go", "link ", 1);
+    assert_eq!(completions(&mut c, &text, "link "), ["go", "turn", "steer"]);
+    let text = TUTOR.replacen("link turn -> go", "link turn -> ", 1);
+    assert_eq!(completions(&mut c, &text, "link turn -> "), ["go", "turn", "steer"]);
+    c.stop();
+}
+
+#[test]
+fn completion_after_extends_and_trained_offers_the_stages() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    let text = TUTOR.replacen("stage second extends first", "stage second extends ", 1);
+    assert_eq!(completions(&mut c, &text, "stage second extends "), ["practice", "first"]);
+    let text = TUTOR.replacen("weights trained practice", "weights trained ", 1);
+    assert_eq!(completions(&mut c, &text, "weights trained "), ["practice"], "training stages only");
+    c.stop();
+}
+
+#[test]
+fn completion_in_a_world_offers_its_items() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    let labels = completions(&mut c, TUTOR, "world { arena 400mm x 600mm ");
+    for want in ["arena", "charger", "battery", "recharge", "objects", "body"] {
+        assert!(labels.contains(&want.to_string()), "{want} missing from {labels:?}");
+    }
+    assert!(!labels.contains(&"module".to_string()), "{labels:?}");
+    assert_eq!(completions(&mut c, TUTOR, "charger 200mm on "), ["north", "south", "east", "west"]);
+    c.stop();
+}
+
+#[test]
+fn completion_after_a_motion_offers_the_motions() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    for needle in ["sign(1) -> ", "sign(1) -> forward | ", "module go { sense ir[2..3]  behavior "] {
+        let labels = completions(&mut c, TUTOR, needle);
+        for want in ["forward", "back", "turn left", "stop", "wheels(0.5, 0.5)"] {
+            assert!(labels.contains(&want.to_string()), "after `{needle}`: {want} missing from {labels:?}");
+        }
+        assert!(!labels.contains(&"ir".to_string()), "{labels:?}");
+    }
+    // elsewhere: keywords and every name
+    let labels = completions(&mut c, TUTOR, "stage first {\n");
+    for want in ["module", "fitness", "go", "practice", "light"] {
+        assert!(labels.contains(&want.to_string()), "{want} missing from {labels:?}");
     }
     c.stop();
 }

@@ -93,26 +93,45 @@ fn any_number_of_ranks_writes_the_single_process_files() {
     }
 }
 
-#[test]
-fn experiment_on_three_ranks_matches_one_process() {
-    let dir = scratch("experiment");
+/// `shaping experiment tiny.bat --seeds 2 EXTRA... --out OUT`, on one process
+/// and on 3 ranks: the files must be the same; returns rank 0's stderr and
+/// the directory of the 3 ranks.
+fn experiment_on_three_ranks(name: &str, extra: &[&str]) -> (String, PathBuf) {
+    let dir = scratch(name);
     let tiny = root().join("tests/cli/tiny.bat");
-    let args = |out: &Path| {
-        vec![
-            "experiment".into(),
-            tiny.clone().into_os_string(),
-            "--seeds".into(),
-            "2".into(),
-            "--out".into(),
-            out.into(),
-        ]
+    let run = |mut cmd: Command, out: &Path| {
+        ok(cmd.arg("experiment").arg(&tiny).args(["--seeds", "2"]).args(extra).arg("--out").arg(out))
     };
     let one = dir.join("one");
-    ok(single().args(args(&one)));
+    run(single(), &one);
     let three = dir.join("three");
-    ok(mpirun(3).args(args(&three)));
-    assert!(three.join("summary.md").exists() && three.join("seed-2/second/best.genome").exists());
+    let done = run(mpirun(3), &three);
     assert_same_files(&one, &three);
+    (String::from_utf8_lossy(&done.stderr).into_owned(), three)
+}
+
+/// 2 seeds on 3 ranks: fewer tasks than ranks, so each generation's
+/// episodes go out in batches.
+#[test]
+fn experiment_on_three_ranks_matches_one_process() {
+    let (err, three) = experiment_on_three_ranks("experiment", &[]);
+    assert!(err.contains("mpi: 3 ranks") && err.contains("rounds"), "no batch summary:\n{err}");
+    assert!(three.join("summary.md").exists() && three.join("seed-2/second/best.genome").exists());
+}
+
+/// A sweep of 2 points over 2 seeds on 3 ranks: 4 tasks, so whole seeds go to
+/// ranks; every file is the single process's, byte for byte.
+#[test]
+fn a_sweep_on_three_ranks_hands_out_whole_seeds_and_matches_one_process() {
+    let (err, three) =
+        experiment_on_three_ranks("sweep", &["--set", "first.evolve.mutation=0.01,0.2", "--no-report"]);
+    assert!(err.contains("mpi: 3 ranks") && err.contains("4 tasks (whole seeds)"), "no task summary:\n{err}");
+    assert!(
+        err.contains("done on rank 1") || err.contains("done on rank 2"),
+        "no task ran on another rank:\n{err}"
+    );
+    assert!(three.join("summary.json").exists());
+    assert!(three.join("first.evolve.mutation=0.2/seed-2/second/best.genome").exists());
 }
 
 /// The pid of rank `rank` among the children of `mpirun`.

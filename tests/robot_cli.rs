@@ -309,6 +309,35 @@ fn ctrl_c_stops_the_motors() {
 }
 
 #[test]
+fn a_port_in_use_is_refused() {
+    let dir = scratch("busy");
+    let emu = Emulator::start(&dir, &[]);
+    let genome = "1".repeat(80);
+    let drive_genome = |out: &str| {
+        let mut c = shaping();
+        c.arg("drive")
+            .arg(file())
+            .args(["--stage", "roam", "--period", "20", "--actions", "300", "--genome", &genome])
+            .arg("--port")
+            .arg(&emu.port)
+            .arg("--out")
+            .arg(dir.join(out));
+        c
+    };
+    let mut first = drive_genome("first").stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    let mut err = std::io::BufReader::new(first.stderr.take().unwrap());
+    let mut line = String::new();
+    std::io::BufRead::read_line(&mut err, &mut line).unwrap();
+    assert!(line.contains("driving"), "{line}");
+    // A second driver on the same port would interleave its commands.
+    let second = drive_genome("second").output().unwrap();
+    let _ = Command::new("kill").args(["-INT", &first.id().to_string()]).status();
+    let _ = first.wait();
+    assert_eq!(second.status.code(), Some(2), "{}", text(&second.stderr));
+    assert!(text(&second.stderr).contains("is in use by another program"), "{}", text(&second.stderr));
+}
+
+#[test]
 fn bad_robot_arguments_are_errors() {
     let dir = scratch("bad");
     let out = shaping()

@@ -193,6 +193,21 @@ pub enum Error {
         max: usize,
     },
 
+    /// A warning: the file compiles, but a name looks like a typo.
+    #[error("new module `{name}` is one edit away from inherited module `{similar}`")]
+    #[diagnostic(severity(Warning))]
+    SimilarName {
+        #[label("a new module")]
+        span: SourceSpan,
+        #[label("inherited from stage `{stage}`")]
+        similar_span: SourceSpan,
+        name: String,
+        similar: String,
+        stage: String,
+        #[help]
+        help: Option<String>,
+    },
+
     #[error("{message}")]
     Conflict {
         #[label("{label}")]
@@ -205,22 +220,42 @@ pub enum Error {
     },
 }
 
-/// Every diagnostic of one compilation, with the source they point into.
-#[derive(Debug, Error, Diagnostic)]
-#[error("could not compile `{name}`: {}", count(.errors.len()))]
+impl Error {
+    /// Whether this is a warning: the file still compiles.
+    pub fn is_warning(&self) -> bool {
+        self.severity() == Some(miette::Severity::Warning)
+    }
+}
+
+/// Every diagnostic of one compilation (errors and warnings), with the
+/// source they point into. A warning at the top when there is no error.
+#[derive(Debug, Error)]
+#[error("{}", self.title())]
 pub struct Diagnostics {
     name: String,
-    #[source_code]
     source_code: NamedSource<String>,
-    #[related]
     errors: Vec<Error>,
 }
 
-fn count(n: usize) -> String {
+impl Diagnostic for Diagnostics {
+    fn severity(&self) -> Option<miette::Severity> {
+        Some(if self.error_count() == 0 { miette::Severity::Warning } else { miette::Severity::Error })
+    }
+
+    fn source_code(&self) -> Option<&dyn miette::SourceCode> {
+        Some(&self.source_code)
+    }
+
+    fn related<'a>(&'a self) -> Option<Box<dyn Iterator<Item = &'a dyn Diagnostic> + 'a>> {
+        Some(Box::new(self.errors.iter().map(|e| e as &dyn Diagnostic)))
+    }
+}
+
+fn count(n: usize, what: &str) -> String {
     if n == 1 {
-        "1 error".into()
+        format!("1 {what}")
     } else {
-        format!("{n} errors")
+        format!("{n} {what}s")
     }
 }
 
@@ -241,7 +276,7 @@ impl Diagnostics {
         }
     }
 
-    /// Number of errors.
+    /// Number of diagnostics, warnings included.
     pub fn len(&self) -> usize {
         self.errors.len()
     }
@@ -250,9 +285,27 @@ impl Diagnostics {
         self.errors.is_empty()
     }
 
-    /// The errors, in source order.
+    /// Number of errors, warnings not included.
+    pub fn error_count(&self) -> usize {
+        self.errors.iter().filter(|e| !e.is_warning()).count()
+    }
+
+    /// The errors and warnings, in source order.
     pub fn errors(&self) -> &[Error] {
         &self.errors
+    }
+
+    /// `could not compile `a.bat`: 2 errors, 1 warning`, or `a.bat`: 1 warning`.
+    fn title(&self) -> String {
+        let errors = self.error_count();
+        let warnings = self.errors.len() - errors;
+        match (errors, warnings) {
+            (0, w) => format!("`{}`: {}", self.name, count(w, "warning")),
+            (e, 0) => format!("could not compile `{}`: {}", self.name, count(e, "error")),
+            (e, w) => {
+                format!("could not compile `{}`: {}, {}", self.name, count(e, "error"), count(w, "warning"))
+            }
+        }
     }
 }
 

@@ -23,10 +23,21 @@ pub use shaping_runtime::program::Program;
 
 /// Compiles the source of one architecture file. `file_name` names the
 /// source in diagnostics and gives the program its default name (its stem).
+/// Warnings are dropped: [`check`] returns them.
 pub fn compile(source: &str, file_name: &str) -> Result<Program, Diagnostics> {
+    match check(source, file_name) {
+        (Some(program), _) => Ok(program),
+        (None, diagnostics) => Err(diagnostics),
+    }
+}
+
+/// Compiles like [`compile`], and returns every diagnostic, warnings
+/// included: the program when no diagnostic is an error.
+pub fn check(source: &str, file_name: &str) -> (Option<Program>, Diagnostics) {
     let file = match syntax::parse(source) {
         Ok(f) => f,
-        Err(errors) => return Err(Diagnostics::new(file_name, source, errors)),
+        Err(errors) => return (None, Diagnostics::new(file_name, source, errors)),
     };
-    lower::lower(&file, file_name).map_err(|errors| Diagnostics::new(file_name, source, errors))
+    let (program, diagnostics) = lower::lower(&file, file_name);
+    (program, Diagnostics::new(file_name, source, diagnostics))
 }

@@ -24,6 +24,11 @@ $B experiment $R/forward-only.bat --seeds $SEEDS --out $R/forward-only --fresh -
 # Shaping against evolution from scratch on the whole task.
 $B experiment examples/scratch-full.bat --seeds $SEEDS --out $R/scratch-full --fresh --criterion full=3 > /dev/null
 
+# The mutation rate (EXPERIMENTS.md, "Settings that differ from the paper"):
+# khepera.bat's navigation over seeds 1..10 at each rate tried in development.
+$B experiment examples/khepera.bat --stage navigation --seeds $SEEDS --out $R/mutation --fresh --no-report \
+  --set navigation.evolve.mutation=0.01,0.02,0.03,0.05 --criterion navigation=0.7 > /dev/null
+
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
 # to learning within the life).
@@ -58,7 +63,7 @@ done
 cargo build --release --quiet --example oracle
 target/release/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
 
-for f in khepera pretrained forward-only scratch-full; do
+for f in khepera pretrained forward-only scratch-full mutation; do
   echo "== $f"
   cat $R/$f/summary.md
 done

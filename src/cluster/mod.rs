@@ -8,8 +8,13 @@
 //! simply takes fewer batches. Rank 0 evaluates too, on a second thread,
 //! while its main thread answers the others. Results are put back in episode
 //! order, and an episode's result depends only on its genome and seed, so
-//! the files are bit-identical for any number of ranks. The messages are in
-//! [`wire`]; the MPI side is in `mpi.rs` (only with the feature).
+//! the files are bit-identical for any number of ranks.
+//!
+//! An experiment with at least as many tasks (a seed of a sweep point) as
+//! ranks runs whole tasks instead: rank 0 hands one out per request, each
+//! rank runs the seed as a single process would and writes its files, and
+//! reports it done. The messages are in [`wire`]; the MPI side is in
+//! `mpi.rs` (only with the feature).
 
 #[cfg(feature = "mpi")]
 mod mpi;
@@ -68,6 +73,17 @@ impl Coordinator {
         match *self {}
     }
     pub fn set_context(&self, _: String, _: &std::path::Path) {
+        match *self {}
+    }
+    pub fn distributes(&self, _: usize) -> bool {
+        match *self {}
+    }
+    pub fn run_tasks(
+        &self,
+        _: &[(u32, u64)],
+        _: &(dyn Fn((u32, u64), usize) -> Result<(), crate::load::CliError> + Sync + '_),
+        _: &(dyn Fn((u32, u64)) -> String + Sync),
+    ) -> Result<(), crate::load::CliError> {
         match *self {}
     }
 }

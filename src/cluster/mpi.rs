@@ -29,10 +29,14 @@ const POLL: Duration = Duration::from_micros(100);
 /// Initialises MPI and runs `body` on rank 0 with the coordinator; the other
 /// ranks serve batches until rank 0 is done. `jobs` is the rayon thread count
 /// of each rank (default: the node's cores shared among its ranks).
+///
+/// `tasks` runs a whole task (a seed of a sweep point) on a worker rank with
+/// the given threads, when rank 0 hands tasks out ([`Coordinator::run_tasks`]).
 pub fn with_mpi(
     jobs: Option<usize>,
     rank_timeout: u64,
     quiet: bool,
+    tasks: Option<&TaskRunner<'_>>,
     body: impl FnOnce(&Coordinator) -> Result<(), CliError>,
 ) -> Result<(), CliError> {
     let Some((universe, _)) = mpi::initialize_with_threading(Threading::Funneled) else {
@@ -48,7 +52,7 @@ pub fn with_mpi(
         .build()
         .map_err(|e| CliError::io(format!("error: rank {rank}: cannot start worker threads: {e}")))?;
     if rank != 0 {
-        return serve(&world, &pool);
+        return serve(&world, &pool, threads, tasks);
     }
     let term = Arc::new(AtomicBool::new(false));
     signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&term))
@@ -58,6 +62,7 @@ pub fn with_mpi(
         world,
         size,
         pool,
+        threads,
         timeout: Duration::from_secs(rank_timeout.max(1)),
         term,
         host,
@@ -71,11 +76,17 @@ pub fn with_mpi(
     result
 }
 
-/// Rank 0's side: spreads the episodes of a generation over the ranks.
+/// Runs one task (a point of a sweep and a seed) with this many threads.
+pub type TaskRunner<'a> = dyn Fn((u32, u64), usize) -> Result<(), CliError> + Sync + 'a;
+
+/// Rank 0's side: spreads the episodes of a generation, or whole tasks, over
+/// the ranks.
 pub struct Coordinator {
     world: SimpleCommunicator,
     size: usize,
     pool: rayon::ThreadPool,
+    /// Threads of each rank's pool (and of a task run on rank 0).
+    threads: usize,
     timeout: Duration,
     term: Arc<AtomicBool>,
     host: String,
@@ -105,6 +116,9 @@ struct Worker {
 
 #[derive(Default)]
 struct Stats {
+    /// Whole tasks run, and those run on other ranks.
+    tasks: u64,
+    remote_tasks: u64,
     rounds: u64,
     episodes: u64,
     remote_episodes: u64,
@@ -146,47 +160,164 @@ impl Coordinator {
         }
         self.load(&mut st, program);
         let bounds = wire::batches(jobs.len(), self.size);
-        let count = bounds.len();
         let base = st.next_batch;
-        st.next_batch += count as u64;
+        st.next_batch += bounds.len() as u64;
+        let version = st.version;
+        let pool = &self.pool;
+        let local = |k: usize| {
+            let (a, b) = bounds[k];
+            Ok(pool.install(|| super::evaluate_local(stage, actions, &jobs[a..b])))
+        };
+        // A worker that has not loaded this program gets it first.
+        let prepare = |st: &mut State, rank: Rank| {
+            let known = st.workers.get(&rank).map_or(0, |w| w.version);
+            if known == version {
+                return false;
+            }
+            let msg = Reply::Load { version, program: st.program.clone() }.encode();
+            self.send(st, rank, &msg);
+            if let Some(w) = st.workers.get_mut(&rank) {
+                w.version = version;
+            }
+            true
+        };
+        let give = |k: usize| {
+            let (a, b) = bounds[k];
+            Reply::encode_work(version, base + k as u64, index as u32, actions, &jobs[a..b])
+        };
+        let take = |st: &State, rank: Rank, k: usize, request: Request| {
+            let (a, b) = bounds[k];
+            match request {
+                Request::Results { batch, evaluations }
+                    if batch == base + k as u64 && evaluations.len() == b - a =>
+                {
+                    evaluations
+                }
+                Request::Results { batch, evaluations } => self.fatal(
+                    st,
+                    format!(
+                        "rank {rank} answered batch {} with {} results for batch {batch}, {} expected",
+                        base + k as u64,
+                        evaluations.len(),
+                        b - a
+                    ),
+                ),
+                _ => self
+                    .fatal(st, format!("rank {rank} did not answer batch {} with results", base + k as u64)),
+            }
+        };
+        let late = |st: &State, _: usize| {
+            format!("answer within {} s during {}", self.timeout.as_secs(), st.context)
+        };
+        let (results, remote) =
+            self.hand_out(&mut st, bounds.len(), &local, &prepare, &give, &take, &late, &mut |_, _| {});
+        st.stats.rounds += 1;
+        st.stats.episodes += jobs.len() as u64;
+        st.stats.remote_episodes +=
+            results.iter().zip(&remote).filter(|(_, r)| **r).map(|(e, _)| e.len() as u64).sum::<u64>();
+        st.stats.wall += started.elapsed();
+        results.into_iter().flatten().collect()
+    }
+
+    /// Whether an experiment of `tasks` tasks hands whole tasks to ranks
+    /// ([`wire::distribute_tasks`]).
+    pub fn distributes(&self, tasks: usize) -> bool {
+        wire::distribute_tasks(tasks, self.size)
+    }
+
+    /// Runs whole tasks over the ranks: each rank (rank 0 on a thread of its
+    /// own) runs a task at a time and writes its files, asking for the next
+    /// when it reports the last done; rank 0 only hands them out.
+    pub fn run_tasks(
+        &self,
+        tasks: &[(u32, u64)],
+        run: &TaskRunner<'_>,
+        describe: &(dyn Fn((u32, u64)) -> String + Sync),
+    ) -> Result<(), CliError> {
+        let started = Instant::now();
+        let mut st = self.state.borrow_mut();
+        let threads = self.threads;
+        let local = |k: usize| {
+            run(tasks[k], threads).map_err(|e| {
+                format!("rank 0, {}: {}", describe(tasks[k]), e.to_string().trim_start_matches("error: "))
+            })
+        };
+        let give = |k: usize| {
+            let (point, seed) = tasks[k];
+            Reply::Task { point, seed }.encode()
+        };
+        let take = |st: &State, rank: Rank, k: usize, request: Request| match request {
+            Request::Done { point, seed } if tasks[k] == (point, seed) => {}
+            _ => self.fatal(st, format!("rank {rank} did not report {} done", describe(tasks[k]))),
+        };
+        let late = |_: &State, k: usize| {
+            format!(
+                "report {} within {} s (`--rank-timeout` bounds a whole seed)",
+                describe(tasks[k]),
+                self.timeout.as_secs()
+            )
+        };
+        let count = tasks.len();
+        let mut done = 0;
+        let mut progress = |k: usize, rank: Rank| {
+            done += 1;
+            eprintln!("{} done on rank {rank} ({done}/{count})", describe(tasks[k]));
+        };
+        let (_, remote) =
+            self.hand_out(&mut st, count, &local, &|_, _| false, &give, &take, &late, &mut progress);
+        st.stats.tasks += count as u64;
+        st.stats.remote_tasks += remote.iter().filter(|&&r| r).count() as u64;
+        st.stats.wall += started.elapsed();
+        Ok(())
+    }
+
+    /// Hands `count` items out, one per request, to the other ranks and to a
+    /// thread of rank 0 that runs `local`, until every item is done; returns
+    /// the results in item order and, per item, whether another rank did it.
+    /// `prepare` may first send a worker something else (then it takes no
+    /// item yet), `give` is the message giving item `k`, `take` reads the
+    /// answer to item `k` (ending the run on a wrong one), `late` says what a
+    /// rank did not do in time, `done` hears of every item done and where.
+    #[allow(clippy::too_many_arguments)]
+    fn hand_out<T: Send>(
+        &self,
+        st: &mut State,
+        count: usize,
+        local: &(dyn Fn(usize) -> Result<T, String> + Sync),
+        prepare: &dyn Fn(&mut State, Rank) -> bool,
+        give: &dyn Fn(usize) -> Vec<u8>,
+        take: &dyn Fn(&State, Rank, usize, Request) -> T,
+        late: &dyn Fn(&State, usize) -> String,
+        done_at: &mut dyn FnMut(usize, Rank),
+    ) -> (Vec<T>, Vec<bool>) {
         let next = AtomicUsize::new(0);
-        let mut results: Vec<Option<Vec<Evaluation>>> = vec![None; count];
+        let mut results: Vec<Option<T>> = (0..count).map(|_| None).collect();
+        let mut remote = vec![false; count];
         let mut done = 0;
         let mut outstanding: HashMap<Rank, (usize, Instant)> = HashMap::new();
-        let mut remote = 0u64;
         std::thread::scope(|s| {
             let (tx, rx) = mpsc::channel();
-            let (next, bounds, pool) = (&next, &bounds, &self.pool);
+            let next = &next;
             s.spawn(move || loop {
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 if k >= count {
                     break;
                 }
-                let (a, b) = bounds[k];
-                let out = pool.install(|| super::evaluate_local(stage, actions, &jobs[a..b]));
-                if tx.send((k, out)).is_err() {
+                let out = local(k);
+                let failed = out.is_err();
+                if tx.send((k, out)).is_err() || failed {
                     break;
                 }
             });
             let mut local_gone = false;
-            // Hands the next batch (or the program first) to a waiting worker.
-            let give = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
-                let version = st.version;
-                let known = st.workers.get(&rank).map_or(0, |w| w.version);
-                if known != version {
-                    let msg = Reply::Load { version, program: st.program.clone() }.encode();
-                    self.send(st, rank, &msg);
-                    if let Some(w) = st.workers.get_mut(&rank) {
-                        w.version = version;
-                    }
+            // Hands the next item (or what must come first) to a waiting worker.
+            let hand = |st: &mut State, rank: Rank, outstanding: &mut HashMap<Rank, (usize, Instant)>| {
+                if prepare(st, rank) {
                     return;
                 }
                 let k = next.fetch_add(1, Ordering::SeqCst);
                 if k < count {
-                    let (a, b) = bounds[k];
-                    let msg =
-                        Reply::encode_work(version, base + k as u64, index as u32, actions, &jobs[a..b]);
-                    self.send(st, rank, &msg);
+                    self.send(st, rank, &give(k));
                     outstanding.insert(rank, (k, Instant::now()));
                 } else if !st.idle.contains(&rank) {
                     st.idle.push(rank);
@@ -194,48 +325,39 @@ impl Coordinator {
             };
             let waiting = std::mem::take(&mut st.idle);
             for rank in waiting {
-                give(&mut st, rank, &mut outstanding);
+                hand(st, rank, &mut outstanding);
             }
             while done < count {
                 let mut busy = false;
-                while let Some((rank, request)) = self.poll(&mut st) {
+                while let Some((rank, request)) = self.poll(st) {
                     busy = true;
                     match request {
                         Request::Hello { pid, host } => {
                             st.workers.insert(rank, Worker { pid, host, version: 0 });
                         }
                         Request::Ready => {}
-                        Request::Results { batch, evaluations } => {
+                        Request::Failed { message } => self.fatal(st, format!("rank {rank}: {message}")),
+                        answer => {
                             let Some((k, _)) = outstanding.remove(&rank) else {
-                                self.fatal(&st, format!("rank {rank} sent results it was not asked for"));
+                                self.fatal(st, format!("rank {rank} sent an answer it was not asked for"));
                             };
-                            let (a, b) = bounds[k];
-                            if batch != base + k as u64 || evaluations.len() != b - a {
-                                self.fatal(
-                                    &st,
-                                    format!(
-                                        "rank {rank} answered batch {} with {} results for batch {batch}, {} expected",
-                                        base + k as u64,
-                                        evaluations.len(),
-                                        b - a
-                                    ),
-                                );
-                            }
-                            remote += evaluations.len() as u64;
-                            results[k] = Some(evaluations);
+                            results[k] = Some(take(st, rank, k, answer));
+                            remote[k] = true;
                             done += 1;
+                            done_at(k, rank);
                         }
-                        Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
                     }
-                    give(&mut st, rank, &mut outstanding);
+                    hand(st, rank, &mut outstanding);
                 }
                 loop {
                     match rx.try_recv() {
-                        Ok((k, out)) => {
+                        Ok((k, Ok(out))) => {
                             results[k] = Some(out);
                             done += 1;
                             busy = true;
+                            done_at(k, 0);
                         }
+                        Ok((_, Err(message))) => self.fatal(st, message),
                         Err(mpsc::TryRecvError::Empty) => break,
                         Err(mpsc::TryRecvError::Disconnected) => {
                             local_gone = true;
@@ -248,28 +370,25 @@ impl Coordinator {
                     && outstanding.is_empty()
                     && next.load(Ordering::SeqCst) >= count
                 {
-                    self.fatal(&st, "an evaluation on rank 0 failed".into());
+                    self.fatal(st, "an evaluation on rank 0 failed".into());
                 }
-                if let Some((&rank, _)) = outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout) {
-                    let who = self.who(&st, rank);
+                if let Some((&rank, &(k, _))) =
+                    outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout)
+                {
                     let msg = format!(
-                        "{who} did not answer within {} s during {}: it died or hangs (`--rank-timeout` sets the limit)",
-                        self.timeout.as_secs(),
-                        st.context
+                        "{} did not {}: it died or hangs (`--rank-timeout` sets the limit)",
+                        self.who(st, rank),
+                        late(st, k)
                     );
-                    self.fatal(&st, msg);
+                    self.fatal(st, msg);
                 }
-                self.check_term(&st, &outstanding);
+                self.check_term(st, &outstanding);
                 if !busy {
                     std::thread::sleep(POLL);
                 }
             }
         });
-        st.stats.rounds += 1;
-        st.stats.episodes += jobs.len() as u64;
-        st.stats.remote_episodes += remote;
-        st.stats.wall += started.elapsed();
-        results.into_iter().flatten().flatten().collect()
+        (results.into_iter().flatten().collect(), remote)
     }
 
     /// Makes `program` the one batches refer to (a new version when it changed).
@@ -337,7 +456,7 @@ impl Coordinator {
                         st.workers.insert(rank, Worker { pid, host, version: 0 });
                     }
                     Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
-                    Request::Ready | Request::Results { .. } => {}
+                    Request::Ready | Request::Results { .. } | Request::Done { .. } => {}
                 }
                 if !st.idle.contains(&rank) {
                     st.idle.push(rank);
@@ -369,6 +488,18 @@ impl Coordinator {
         let st = self.state.borrow();
         let s = &st.stats;
         let rounds = s.rounds.max(1) as f64;
+        if s.tasks > 0 {
+            eprintln!(
+                "mpi: {} ranks x {threads} threads; {} tasks (whole seeds), {} on other ranks, in {:.2} s; {} messages, {:.1} us each",
+                self.size,
+                s.tasks,
+                s.remote_tasks,
+                s.wall.as_secs_f64(),
+                s.messages,
+                s.in_mpi.as_secs_f64() * 1e6 / s.messages.max(1) as f64,
+            );
+            return;
+        }
         eprintln!(
             "mpi: {} ranks x {threads} threads; {} rounds, {} episodes ({} on other ranks), {:.0} episodes/s; {} messages, {:.2} MB, {:.1} us each; rank 0 spent {:.3} ms per round in sends and receives, {:.1} ms per round in all",
             self.size,
@@ -441,7 +572,12 @@ fn alive(pid: u32) -> bool {
 }
 
 /// A worker rank: evaluates the batches rank 0 sends until told to stop.
-fn serve(world: &SimpleCommunicator, pool: &rayon::ThreadPool) -> Result<(), CliError> {
+fn serve(
+    world: &SimpleCommunicator,
+    pool: &rayon::ThreadPool,
+    threads: usize,
+    tasks: Option<&TaskRunner<'_>>,
+) -> Result<(), CliError> {
     let root = world.process_at_rank(0);
     let send = |r: Request| root.send_with_tag(&r.encode()[..], TAG_REQUEST);
     let receive = || loop {
@@ -464,6 +600,13 @@ fn serve(world: &SimpleCommunicator, pool: &rayon::ThreadPool) -> Result<(), Cli
         match Reply::decode(&receive()) {
             Err(e) => fail(format!("cannot read a message from rank 0: {e}")),
             Ok(Reply::Stop) => return Ok(()),
+            Ok(Reply::Task { point, seed }) => {
+                let Some(run) = tasks else { fail("a task came to a rank that runs no experiment".into()) };
+                match run((point, seed), threads) {
+                    Ok(()) => send(Request::Done { point, seed }),
+                    Err(e) => fail(e.to_string().trim_start_matches("error: ").to_string()),
+                }
+            }
             Ok(Reply::Load { version, program: json }) => match serde_json::from_slice::<Program>(&json) {
                 Ok(p) => {
                     program = Some((version, p));

@@ -16,6 +16,8 @@ pub enum Request {
     Results { batch: u64, evaluations: Vec<Evaluation> },
     /// The worker cannot go on.
     Failed { message: String },
+    /// A task (a whole seed of a sweep point) is done: its files are written.
+    Done { point: u32, seed: u64 },
 }
 
 /// From rank 0 to a worker, always in answer to a [`Request`].
@@ -28,6 +30,8 @@ pub enum Reply {
     Work { version: u32, batch: u64, stage: u32, actions: u32, jobs: Vec<(u64, Genome)> },
     /// The run is over: leave.
     Stop,
+    /// Run a whole seed of a sweep point and write its files.
+    Task { point: u32, seed: u64 },
 }
 
 #[derive(Default)]
@@ -124,6 +128,11 @@ impl Request {
                 w.u8(3);
                 w.bytes(message.as_bytes());
             }
+            Request::Done { point, seed } => {
+                w.u8(4);
+                w.u32(*point);
+                w.u64(*seed);
+            }
         }
         w.0
     }
@@ -150,6 +159,7 @@ impl Request {
                 Request::Results { batch, evaluations }
             }
             3 => Request::Failed { message: r.string()? },
+            4 => Request::Done { point: r.u32()?, seed: r.u64()? },
             k => return Err(format!("unknown request kind {k}")),
         };
         r.end()?;
@@ -179,6 +189,11 @@ impl Reply {
                 }
             }
             Reply::Stop => w.u8(2),
+            Reply::Task { point, seed } => {
+                w.u8(3);
+                w.u32(*point);
+                w.u64(*seed);
+            }
         }
         w.0
     }
@@ -220,11 +235,21 @@ impl Reply {
                 Reply::Work { version, batch, stage, actions, jobs }
             }
             2 => Reply::Stop,
+            3 => Reply::Task { point: r.u32()?, seed: r.u64()? },
             k => return Err(format!("unknown reply kind {k}")),
         };
         r.end()?;
         Ok(reply)
     }
+}
+
+/// How an experiment uses the ranks, by the work there is: whole tasks
+/// (seeds of sweep points) to ranks when there are at least as many tasks as
+/// ranks, so the ranks work independently and only report back; else the
+/// tasks one after the other, each generation's episodes in batches over
+/// every rank (a single large run).
+pub fn distribute_tasks(tasks: usize, ranks: usize) -> bool {
+    ranks > 1 && tasks >= ranks
 }
 
 /// Splits `jobs` episodes into batches for `ranks` processes: about four per
@@ -260,6 +285,7 @@ mod tests {
                 ],
             },
             Request::Failed { message: "stage 9 does not exist".into() },
+            Request::Done { point: 7, seed: u64::MAX },
         ];
         for case in cases {
             let back = Request::decode(&case.encode()).unwrap();
@@ -282,7 +308,8 @@ mod tests {
         };
         let borrowed: Vec<(&Genome, u64)> = vec![(&g[0], 9), (&g[1], u64::MAX)];
         assert_eq!(work.encode(), Reply::encode_work(3, 17, 2, 300, &borrowed));
-        for case in [work, Reply::Load { version: 1, program: b"{}".to_vec() }, Reply::Stop] {
+        let task = Reply::Task { point: u32::MAX, seed: 12 };
+        for case in [work, Reply::Load { version: 1, program: b"{}".to_vec() }, Reply::Stop, task] {
             assert_eq!(Reply::decode(&case.encode()).unwrap(), case);
         }
     }
@@ -297,6 +324,15 @@ mod tests {
         assert!(Reply::decode(&work).unwrap_err().contains("truncated"));
         // A length prefix larger than the message.
         assert!(Request::decode(&[3, 255, 255, 255, 255]).unwrap_err().contains("truncated"));
+    }
+
+    #[test]
+    fn whole_tasks_go_to_ranks_only_when_there_are_enough() {
+        assert!(distribute_tasks(6, 2));
+        assert!(distribute_tasks(400, 64));
+        assert!(!distribute_tasks(1, 8), "one large run keeps the batches");
+        assert!(!distribute_tasks(3, 4));
+        assert!(!distribute_tasks(5, 1), "one rank has nothing to distribute");
     }
 
     #[test]

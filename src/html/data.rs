@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
+use shaping_runtime::evolve::{ranking, Checkpoint};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{
     Action, Behavior, Decode, Event, LearnTarget, LearnWhen, Param, Program, Stage, StageRun, StepEnd, World,
@@ -23,7 +24,7 @@ pub struct ReportData {
     pub format: u32,
     /// The program's name.
     pub title: String,
-    /// `run`, `experiment`, `stage` or `replay`.
+    /// `run`, `experiment`, `sweep`, `stage` or `replay`.
     pub kind: &'static str,
     /// The directory the report was made from, as given.
     pub source: String,
@@ -38,6 +39,14 @@ pub struct ReportData {
     /// One series per evolved stage, in program order.
     pub fitness: Vec<FitnessSeries>,
     pub episodes: Vec<Episode>,
+    /// The `summary.json` of the sweep this experiment is a point of (or,
+    /// for a sweep's own directory, of the sweep): every point's settings
+    /// and figures, listed by the page.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<serde_json::Value>,
+    /// The name of the point shown (its settings).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_point: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -58,6 +67,9 @@ pub struct StageView {
     pub genome: Option<String>,
     /// `summary.json` of a test stage.
     pub results: Option<serde_json::Value>,
+    /// Where the frozen genes of the best individual come from: which
+    /// individual of the parent stage's final population (see [`provenance`]).
+    pub frozen_from: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -101,6 +113,9 @@ pub struct GeneView {
     pub value: Option<f32>,
     /// The gene's bits in the best genome.
     pub code: Option<String>,
+    /// For a frozen gene whose value differs from the parent stage's
+    /// `best.genome`: the value there.
+    pub parent_value: Option<f32>,
 }
 
 /// Best and mean fitness per generation of one stage; for an experiment the
@@ -457,6 +472,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
                     bits.iter().map(|&b| if b != 0 { '1' } else { '0' }).collect()
                 })
             }),
+            parent_value: None,
         })
         .collect();
     let links = st
@@ -522,6 +538,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
         genes,
         genome: genome.map(|(_, src)| src),
         results: None,
+        frozen_from: None,
     }
 }
 
@@ -590,6 +607,18 @@ fn run_stages(
         let src = format!("{}/best.genome", st.name);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
         view.results = read_summary(&dir.join("summary.json"));
+        if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
+            let pst = &program.stages[a];
+            let pdir = run.join(&pst.name);
+            // A checkpoint that does not read is reported by `run`; here it only means no provenance.
+            let cp = std::fs::read(pdir.join("checkpoint.json"))
+                .ok()
+                .and_then(|b| serde_json::from_slice::<Checkpoint>(&b).ok());
+            if let Some(cp) = cp {
+                let parent_best = read_genome(&pdir.join("best.genome"), pst.layout.bits);
+                provenance(program, i, a, g, &cp, parent_best.as_ref(), &mut view);
+            }
+        }
         views.push(view);
         let ep = dir.join("episode.json");
         if ep.exists() {
@@ -597,6 +626,106 @@ fn run_stages(
         }
     }
     Ok((views, episodes))
+}
+
+/// The nearest ancestor of evolved stage `index` that evolved (test stages
+/// skipped): the stage whose final population this one started from.
+fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
+    if !matches!(program.stages[index].run, StageRun::Evolve(_)) {
+        return None;
+    }
+    let mut cur = program.stages[index].parent;
+    let mut steps = 0;
+    while let Some(p) = cur {
+        let st = program.stages.get(p)?;
+        if matches!(st.run, StageRun::Evolve(_)) {
+            return Some(p);
+        }
+        steps += 1;
+        cur = st.parent.filter(|_| steps < program.stages.len());
+    }
+    None
+}
+
+/// Says where the frozen genes of `best` (the best individual of stage
+/// `index`) come from. A stage starts from the whole final population of
+/// its evolved ancestor `parent` (individual `i` takes the genes of the
+/// parent's individual of rank `i`) and never changes those genes, so they
+/// are the genes of some individuals of `cp`, the parent's final
+/// checkpoint: not necessarily of the parent's `best.genome`, chosen
+/// afterwards by its mean over fresh episodes. Sets `view.frozen_from`,
+/// and each frozen gene's `parent_value` where it differs from `parent_best`.
+pub fn provenance(
+    program: &Program,
+    index: usize,
+    parent: usize,
+    best: &Genome,
+    cp: &Checkpoint,
+    parent_best: Option<&Genome>,
+    view: &mut StageView,
+) {
+    let st = &program.stages[index];
+    let pname = &program.stages[parent].name;
+    let kept = program.stages[parent].layout.bits as usize;
+    let frozen: Vec<usize> = st
+        .layout
+        .genes
+        .iter()
+        .enumerate()
+        .filter(|(_, g)| g.frozen && (g.offset + g.bits as u32) as usize <= kept)
+        .map(|(i, _)| i)
+        .collect();
+    let (Some(prefix), false) = (best.bits.get(..kept), frozen.is_empty()) else { return };
+    let rank_of = ranking(&cp.fitness);
+    let matches: Vec<usize> =
+        (0..cp.population.len()).filter(|&i| cp.population[i].bits.get(..kept) == Some(prefix)).collect();
+    let mut text = format!("The {} frozen genes of this stage's best individual ", frozen.len());
+    match matches.first() {
+        None => {
+            let _ = write!(
+                text,
+                "match no individual of stage `{pname}`'s final population (its checkpoint is from another run?)"
+            );
+        }
+        Some(&first) => {
+            let who = |i: usize| {
+                let rank = rank_of.iter().position(|&r| r == i).map(|r| r + 1);
+                let fit = cp.fitness.get(i).map(|f| format!(", fitness {}", fmt_num(*f))).unwrap_or_default();
+                match rank {
+                    Some(r) => format!("#{i} (rank {r} of {}{fit})", cp.population.len()),
+                    None => format!("#{i}"),
+                }
+            };
+            let _ = write!(text, "come from individual {} of stage `{pname}`'s final population", who(first));
+            if matches.len() > 1 {
+                let _ =
+                    write!(text, ", and {} other individuals with the same genes there", matches.len() - 1);
+            }
+        }
+    }
+    match parent_best {
+        Some(pb) => {
+            let mut differ = 0;
+            for &i in &frozen {
+                let gene = &st.layout.genes[i];
+                let (a, b) = (gene.offset as usize, gene.offset as usize + gene.bits as usize);
+                if best.bits.get(a..b) != pb.bits.get(a..b) {
+                    differ += 1;
+                    view.genes[i].parent_value = Some(pb.decode(gene));
+                }
+            }
+            if differ == 0 {
+                let _ = write!(text, "; they equal `{pname}/best.genome`.");
+            } else {
+                let _ = write!(
+                    text,
+                    "; {differ} of them differ from `{pname}/best.genome` (selected by its mean over fresh episodes), whose values are shown beside them."
+                );
+            }
+        }
+        None => text.push('.'),
+    }
+    view.frozen_from = Some(text);
 }
 
 fn series_of(program: &Program, fitness: &[Vec<GenRow>], only: Option<usize>) -> Vec<FitnessSeries> {
@@ -637,7 +766,55 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         stages: Vec::new(),
         fitness: Vec::new(),
         episodes: Vec::new(),
+        sweep: None,
+        sweep_point: None,
     }
+}
+
+/// The `summary.json` of a sweep in `dir`, if there is one (with points in
+/// directories of their own).
+fn sweep_summary(dir: &Path) -> Option<serde_json::Value> {
+    let bytes = std::fs::read(dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
+    let points = v["points"].as_array()?;
+    (!points.is_empty() && points.iter().all(|p| p["dir"].as_str().is_some_and(|d| d != "."))).then_some(v)
+}
+
+/// A sweep's directory: the experiment report of its best point (by the
+/// median chosen best of the last evolved stage), listing every point.
+fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, CliError> {
+    let points = summary["points"].as_array().cloned().unwrap_or_default();
+    let score = |p: &serde_json::Value| {
+        p["stages"]
+            .as_array()
+            .and_then(|s| s.iter().rev().find(|x| x["kind"] == "evolve"))
+            .and_then(|x| x["chosen_best"]["median"].as_f64())
+            .unwrap_or(f64::NEG_INFINITY)
+    };
+    // The first of the best, so ties go to the earlier point.
+    let best = points.iter().fold(None::<&serde_json::Value>, |b, p| match b {
+        Some(b) if score(b) >= score(p) => Some(b),
+        _ => Some(p),
+    });
+    let Some(best) = best else {
+        return Err(CliError::io(format!("error: the sweep in `{}` has no points", dir.display())));
+    };
+    let point_dir = dir.join(best["dir"].as_str().unwrap_or_default());
+    let seeds = seed_dirs(&point_dir);
+    if seeds.is_empty() {
+        return Err(CliError::io(format!(
+            "error: the point `{}` has no seed directories",
+            point_dir.display()
+        )));
+    }
+    let mut data = experiment(&point_dir, &seeds)?;
+    data.kind = "sweep";
+    data.source = dir.display().to_string();
+    let name = best["name"].as_str().unwrap_or_default().to_string();
+    data.episodes_note = format!("the best point, {name}: {}", data.episodes_note);
+    data.sweep_point = Some(name);
+    data.sweep = Some(summary);
+    Ok(data)
 }
 
 /// Gathers a report's data from a run, stage, experiment or replay directory.
@@ -676,7 +853,21 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
     }
     let seeds = seed_dirs(dir);
     if !seeds.is_empty() {
-        return experiment(dir, &seeds);
+        let mut data = experiment(dir, &seeds)?;
+        // A point of a sweep lists the sweep's points.
+        let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
+        if let (Some(summary), Some(name)) = (dir.parent().and_then(sweep_summary), name) {
+            let listed =
+                summary["points"].as_array().is_some_and(|p| p.iter().any(|x| x["dir"] == name.as_str()));
+            if listed {
+                data.sweep_point = Some(name);
+                data.sweep = Some(summary);
+            }
+        }
+        return Ok(data);
+    }
+    if let Some(summary) = sweep_summary(dir) {
+        return sweep(dir, summary);
     }
     // A stage directory inside a run.
     let parent = dir.parent().filter(|p| p.join("program.json").exists());
@@ -693,7 +884,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
         }
     }
     Err(CliError::io(format!(
-        "error: `{}` is not a run, stage, experiment or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
+        "error: `{}` is not a run, stage, experiment, sweep or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
         dir.display()
     )))
 }

@@ -58,7 +58,7 @@
   }
 
   // ------------------------------------------------------------------ header
-  const kinds = { run: 'run', experiment: 'experiment over ' + D.seeds.length + ' seeds', stage: 'stage', replay: 'replay' };
+  const kinds = { run: 'run', experiment: 'experiment over ' + D.seeds.length + ' seeds', sweep: 'sweep over ' + D.seeds.length + ' seeds', stage: 'stage', replay: 'replay' };
   $('title').textContent = D.title;
   $('subtitle').textContent = kinds[D.kind] + ' · ' + D.source + ' · stages: ' + D.stages.map((s) => s.name).join(' → ');
   $('footer').textContent = 'Made by ' + D.generator + ' from ' + D.source + '. Self-contained: this file needs no network.';
@@ -510,7 +510,7 @@
     if (!F.length) {
       $('fit-note').textContent = 'No evolved stage in this directory.';
     } else {
-      $('fit-note').textContent = D.kind === 'experiment'
+      $('fit-note').textContent = D.kind === 'experiment' || D.kind === 'sweep'
         ? 'Median over ' + D.seeds.length + ' seeds (' + D.seeds.join(', ') + ') of the best and of the mean fitness per generation; the band is the range of the best over seeds.'
         : 'Best and mean fitness per generation; generations continue across stages (the paper\'s figure 9).';
       $('fit-chart').append(fitnessChart(F));
@@ -552,7 +552,7 @@
       svg.append(sv('path', { d: path(s.generation, s.mean), fill: 'none', stroke: '#e8741c', 'stroke-width': 2 }));
       svg.append(sv('path', { d: path(s.generation, s.best), fill: 'none', stroke: '#2a62c9', 'stroke-width': 2.5 }));
     }
-    const ex = D.kind === 'experiment';
+    const ex = D.kind === 'experiment' || D.kind === 'sweep';
     const legend = [[ex ? 'median best' : 'best', '#2a62c9'], [ex ? 'median mean' : 'mean', '#e8741c']];
     if (ex) legend.push(['range of the best', 'rgba(42, 98, 201, 0.3)']);
     legend.forEach(([name, col], i) => {
@@ -597,7 +597,7 @@
       let text = '';
       if (s && s.best.length) {
         const k = s.best.length - 1;
-        text = D.kind === 'experiment'
+        text = D.kind === 'experiment' || D.kind === 'sweep'
           ? 'median over seeds: final best ' + fmt(s.best[k], 3) + ', final mean ' + fmt(s.mean[k], 3) + ', final best ranges ' + fmt(s.best_min[k], 3) + '..' + fmt(s.best_max[k], 3)
           : 'final best ' + fmt(s.best[k], 3) + ', mean ' + fmt(s.mean[k], 3) + ', highest best ' + fmt(Math.max(...s.best), 3);
       } else if (st.results) {
@@ -735,7 +735,8 @@
     const frozen = genes.filter((g) => g.frozen);
     const fbits = frozen.reduce((s, g) => s + g.bits, 0);
     $('gen-summary').textContent = st.name + ': ' + genes.length + ' genes, ' + bits + ' bits; frozen ' + frozen.length + ' genes (' + fbits + ' bits), evolvable ' + (genes.length - frozen.length) + ' (' + (bits - fbits) + ' bits)' +
-      (st.genome ? '; values decoded from ' + st.genome : '; no genome found, so no values') + '. The strip shows the bit string, one block per gene, coloured by the stage that added it (faded: frozen); click a block to find its gene.';
+      (st.genome ? '; values decoded from ' + st.genome : '; no genome found, so no values') + '. The strip shows the bit string, one block per gene, coloured by the stage that added it (faded: frozen); click a block to find its gene.' +
+      (st.frozen_from ? ' ' + st.frozen_from : '');
     const strip = $('gen-strip');
     strip.textContent = '';
     const stageIndex = (name) => D.stages.findIndex((s) => s.name === name);
@@ -753,7 +754,8 @@
         el('td', { cls: 'num', text: String(g.index) }), el('td', { cls: 'num', text: String(g.offset) }), el('td', { cls: 'num', text: String(g.bits) }),
         el('td', { text: g.stage }), el('td', { text: g.module }), el('td', { text: g.role }),
         el('td', { text: fmt(g.lo, 2) + '..' + fmt(g.hi, 2) }), el('td', { text: g.frozen ? 'frozen' : 'evolvable' }),
-        el('td', { cls: 'code', text: g.code || '' }), el('td', { cls: 'num', text: fmt(g.value, 3) }));
+        el('td', { cls: 'code', text: g.code || '' }),
+        el('td', { cls: 'num', text: fmt(g.value, 3) + (g.parent_value === null || g.parent_value === undefined ? '' : ' (parent best: ' + fmt(g.parent_value, 3) + ')'), title: g.parent_value === null || g.parent_value === undefined ? null : "differs from the parent stage's best.genome" }));
       tr.dataset.search = ('#' + g.index + ' ' + g.stage + ' ' + g.module + ' ' + g.role + ' ' + (g.frozen ? 'frozen' : 'evolvable')).toLowerCase();
       body.append(tr);
     }
@@ -775,8 +777,36 @@
     $('gen-count').textContent = shown + ' of ' + rows.length + ' genes shown';
   }
 
+  // ------------------------------------------------------------------ sweep
+  // Every point of the sweep this experiment belongs to: its settings and,
+  // per evolved stage, the chosen best over the seeds (summary.json).
+  function initSweep() {
+    const S = D.sweep;
+    if (!S || !S.points || !S.points.length) return;
+    $('sec-sweep').hidden = false;
+    $('nav-sweep').hidden = false;
+    const targets = (S.sets || []).map((x) => x.target);
+    const evolved = (S.points[0].stages || []).filter((x) => x.kind === 'evolve').map((x) => x.stage);
+    const spreadText = (v) => v ? fmt(v.median, 3) + ' (' + fmt(v.min, 3) + '..' + fmt(v.max, 3) + ')' : '–';
+    $('sweep-note').textContent = S.points.length + ' points over ' + S.seeds.length + ' seeds; chosen best of each evolved stage, median (min..max) over seeds.' +
+      (D.sweep_point ? ' This page shows the point ' + D.sweep_point + ' (highlighted).' : '');
+    const t = $('sweep-table');
+    t.append(el('tr', {}, ...['point', ...targets, ...evolved.map((e) => e + ' chosen best')].map((h) => el('th', { text: h }))));
+    S.points.forEach((p, i) => {
+      const cells = [el('td', { cls: 'num', text: String(i + 1) })];
+      for (const k of targets) cells.push(el('td', { text: (p.settings || {})[k] || '–' }));
+      for (const e of evolved) {
+        const st = (p.stages || []).find((x) => x.stage === e);
+        cells.push(el('td', { cls: 'num', text: spreadText(st && st.chosen_best) }));
+      }
+      const tr = el('tr', {}, ...cells);
+      if (p.name === D.sweep_point) tr.className = 'shown';
+      t.append(tr);
+    });
+  }
+
   // ------------------------------------------------------------------ start
-  for (const [name, f] of [['replay', initReplay], ['fitness', initFitness], ['architecture', initArchitecture], ['genome', initGenome]]) {
+  for (const [name, f] of [['sweep', initSweep], ['replay', initReplay], ['fitness', initFitness], ['architecture', initArchitecture], ['genome', initGenome]]) {
     try { f(); } catch (e) { showError(name + ': ' + (e && e.stack ? e.stack : e)); }
   }
   document.body.dataset.ready = '1';

@@ -233,6 +233,8 @@ fn sample_data(title: &str) -> ReportData {
         stages: (0..p.stages.len()).map(|i| stage_view(&p, i, None)).collect(),
         fitness: Vec::new(),
         episodes: vec![ep],
+        sweep: None,
+        sweep_point: None,
     }
 }
 
@@ -324,4 +326,67 @@ fn a_training_stage_episode_is_the_training_life() {
     assert_eq!(recorded, trace);
     assert_eq!(ep.actions.x.len(), trace.rows.len());
     assert!(trace.rows.len() > 100);
+}
+
+/// The report names the individual of the parent's final population that
+/// the best's frozen genes came from, and shows the parent's best values of
+/// the frozen genes that differ from them.
+#[test]
+fn frozen_genes_are_traced_to_the_parents_final_population() {
+    let p = program();
+    let (nav, parent) = p.stage("navigation").unwrap();
+    let (col, stage) = p.stage("collect").unwrap();
+    let kept = parent.layout.bits as usize;
+    // The parent's final population: random, with fitness 0, 1, 2, ...
+    let mut cp = shaping_runtime::evolve::start_stage(&p, nav, 5, None).unwrap();
+    let n = cp.population.len();
+    cp.fitness = (0..n).map(|i| i as f32).collect();
+    // The best of `collect` descends from individual 7 (rank n - 7).
+    let mut best = random_genome(stage.layout.bits, 1);
+    best.bits[..kept].copy_from_slice(&cp.population[7].bits[..kept]);
+    // The parent's best.genome is individual 3, which differs in some frozen genes.
+    let parent_best = cp.population[3].clone();
+    let frozen: Vec<usize> =
+        (0..stage.layout.genes.len()).filter(|&i| stage.layout.genes[i].frozen).collect();
+    let differ = frozen
+        .iter()
+        .filter(|&&i| {
+            let g = &stage.layout.genes[i];
+            let r = g.offset as usize..(g.offset + g.bits as u32) as usize;
+            best.bits[r.clone()] != parent_best.bits[r]
+        })
+        .count();
+    assert!(differ > 0 && differ < frozen.len(), "{differ} of {}", frozen.len());
+    let mut v = stage_view(&p, col, Some((&best, "collect/best.genome".into())));
+    data::provenance(&p, col, nav, &best, &cp, Some(&parent_best), &mut v);
+    let text = v.frozen_from.clone().unwrap();
+    assert!(
+        text.contains(&format!("The {} frozen genes", frozen.len()))
+            && text.contains(&format!("individual #7 (rank {} of {n}, fitness 7)", n - 7))
+            && text.contains("stage `navigation`'s final population")
+            && text.contains(&format!("{differ} of them differ from `navigation/best.genome`")),
+        "{text}"
+    );
+    assert_eq!(v.genes.iter().filter(|g| g.parent_value.is_some()).count(), differ);
+    for &i in &frozen {
+        if let Some(pv) = v.genes[i].parent_value {
+            assert_eq!(pv, parent_best.decode(&stage.layout.genes[i]));
+            assert_ne!(Some(pv), v.genes[i].value);
+        }
+    }
+    assert!(v.genes.iter().filter(|g| !g.frozen).all(|g| g.parent_value.is_none()));
+    // Descending from the parent's best itself: equal.
+    best.bits[..kept].copy_from_slice(&parent_best.bits[..kept]);
+    let mut v = stage_view(&p, col, Some((&best, "collect/best.genome".into())));
+    data::provenance(&p, col, nav, &best, &cp, Some(&parent_best), &mut v);
+    let text = v.frozen_from.unwrap();
+    assert!(text.contains("individual #3") && text.contains("they equal `navigation/best.genome`"), "{text}");
+    // Genes from no individual of the checkpoint: said so.
+    let mut stranger = best.clone();
+    for b in &mut stranger.bits[..kept] {
+        *b ^= 1;
+    }
+    let mut v = stage_view(&p, col, Some((&stranger, "collect/best.genome".into())));
+    data::provenance(&p, col, nav, &stranger, &cp, None, &mut v);
+    assert!(v.frozen_from.unwrap().contains("match no individual"));
 }

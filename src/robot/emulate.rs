@@ -1,19 +1,10 @@
-//! `shaping emulate`: an emulated Khepera on a pseudo-terminal.
+//! `shaping emulate`: an emulated Khepera on a pseudo-terminal (Unix only;
+//! elsewhere the command says so).
 
-use std::io::Write as _;
-use std::os::fd::OwnedFd;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
-use std::time::{Duration, Instant};
+use std::path::PathBuf;
 
-use rustix::fs::{Mode, OFlags};
-use rustix::io::Errno;
-use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
-use shaping_runtime::robot::protocol::LineBuffer;
-use shaping_runtime::robot::Emulator;
-
-use super::port::{interrupt_flag, make_raw, wait_readable};
-use crate::load::{self, CliError};
+#[cfg(unix)]
+pub use pty::emulate;
 
 /// Bits on the wire per byte: start, 8 data, 2 stop bits.
 pub const BITS_PER_BYTE: u64 = 11;
@@ -56,79 +47,147 @@ pub struct EmulateArgs {
     pub error_format: crate::diag::ErrorFormat,
 }
 
-/// The paper's architecture, used when no file is given.
-const DEFAULT_FILE: &str = include_str!("../../examples/khepera.bat");
-
-/// Removes the symlink at `path` when dropped.
-struct Symlink(PathBuf);
-
-impl Drop for Symlink {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.0);
-    }
+/// The emulator needs a pseudo-terminal, which Windows does not have.
+#[cfg(not(unix))]
+pub fn emulate(args: EmulateArgs) -> Result<(), crate::load::CliError> {
+    Err(crate::load::CliError::io(format!(
+        "error: `shaping emulate` needs a Unix pseudo-terminal and cannot make `{}` here; \
+         drive a real robot's port, or run the emulator on Linux or macOS",
+        args.port.display()
+    )))
 }
 
-fn create_pty(port: &Path) -> Result<(OwnedFd, OwnedFd, Symlink), CliError> {
-    let err = |e: Errno| CliError::io(format!("error: cannot create a pseudo-terminal: {e}"));
-    let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).map_err(err)?;
-    grantpt(&master).map_err(err)?;
-    unlockpt(&master).map_err(err)?;
-    let name = ptsname(&master, Vec::new()).map_err(err)?;
-    let slave_path = PathBuf::from(name.to_string_lossy().into_owned());
-    // The emulator keeps the slave open itself: the master then never sees a
-    // hang-up between two clients, and the line is raw before anyone connects.
-    let slave = rustix::fs::open(&slave_path, OFlags::RDWR | OFlags::NOCTTY | OFlags::CLOEXEC, Mode::empty())
-        .map_err(err)?;
-    make_raw(&slave, 9600).map_err(err)?;
-    match std::fs::symlink_metadata(port) {
-        Ok(m) if m.file_type().is_symlink() => {
-            let _ = std::fs::remove_file(port);
-        }
-        Ok(_) => {
-            return Err(CliError::io(format!(
-                "error: `{}` exists and is not a symbolic link; choose another `--port`",
-                port.display()
-            )))
-        }
-        Err(_) => {}
-    }
-    std::os::unix::fs::symlink(&slave_path, port)
-        .map_err(|e| CliError::io(format!("error: cannot create `{}`: {e}", port.display())))?;
-    Ok((master, slave, Symlink(port.to_path_buf())))
-}
+/// The emulator on a pseudo-terminal, over `rustix`.
+#[cfg(unix)]
+mod pty {
+    use std::io::Write as _;
+    use std::os::fd::OwnedFd;
+    use std::path::{Path, PathBuf};
+    use std::sync::atomic::Ordering;
+    use std::time::{Duration, Instant};
 
-fn write_all(fd: &OwnedFd, mut bytes: &[u8]) -> Result<(), Errno> {
-    while !bytes.is_empty() {
-        match rustix::io::write(fd, bytes) {
-            Ok(n) => bytes = &bytes[n..],
-            Err(Errno::INTR | Errno::AGAIN) => {}
-            Err(e) => return Err(e),
+    use rustix::event::{poll, PollFd, PollFlags, Timespec};
+    use rustix::fs::{Mode, OFlags};
+    use rustix::io::Errno;
+    use rustix::pty::{grantpt, openpt, ptsname, unlockpt, OpenptFlags};
+    use rustix::termios::{self, ControlModes, OptionalActions};
+    use shaping_runtime::robot::protocol::LineBuffer;
+    use shaping_runtime::robot::Emulator;
+
+    use super::{EmulateArgs, Fault, BITS_PER_BYTE};
+    use crate::load::{self, CliError};
+    use crate::robot::port::interrupt_flag;
+
+    /// The paper's architecture, used when no file is given.
+    const DEFAULT_FILE: &str = include_str!("../../examples/khepera.bat");
+
+    /// Puts a terminal into raw mode at `baud` with 8 data bits and 2 stop bits
+    /// (the Khepera's setting), no flow control.
+    fn make_raw(fd: &OwnedFd, baud: u32) -> rustix::io::Result<()> {
+        let mut t = termios::tcgetattr(fd)?;
+        t.make_raw();
+        t.control_modes |= ControlModes::CSTOPB | ControlModes::CLOCAL | ControlModes::CREAD;
+        t.set_speed(baud)?;
+        termios::tcsetattr(fd, OptionalActions::Now, &t)
+    }
+
+    /// Waits until `fd` is readable or `deadline` passes; `Ok(false)` on timeout.
+    fn wait_readable(fd: &OwnedFd, deadline: Instant) -> Result<bool, Errno> {
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            let ts = Timespec { tv_sec: left.as_secs() as _, tv_nsec: left.subsec_nanos() as _ };
+            let mut fds = [PollFd::new(fd, PollFlags::IN)];
+            match poll(&mut fds, Some(&ts)) {
+                Ok(0) => return Ok(false),
+                Ok(_) => {
+                    let ev = fds[0].revents();
+                    if ev.intersects(PollFlags::IN) {
+                        return Ok(true);
+                    }
+                    // Hang-up or error without data.
+                    return Err(Errno::IO);
+                }
+                Err(Errno::INTR) => {
+                    if Instant::now() >= deadline {
+                        return Ok(false);
+                    }
+                }
+                Err(e) => return Err(e),
+            }
         }
     }
-    Ok(())
-}
 
-pub fn emulate(args: EmulateArgs) -> Result<(), CliError> {
-    let program = match &args.file {
-        Some(f) => load::load_program(f, args.error_format)?,
-        None => shaping_compiler::compile(DEFAULT_FILE, "khepera.bat")
-            .map_err(|_| CliError::io("error: the built-in example does not compile"))?,
-    };
-    let index = match args.stage.as_deref() {
-        Some(_) => load::stage_index(&program, args.stage.as_deref())?,
-        None => program
-            .stages
-            .len()
-            .checked_sub(1)
-            .ok_or_else(|| CliError::io("error: the program has no stages"))?,
-    };
-    let stage = &program.stages[index];
-    let seed = args.seed.unwrap_or_else(|| crate::run::run_seed(&program, None));
-    let mut emu = Emulator::new(&stage.world, seed);
-    let flag = interrupt_flag()?;
-    let (master, _slave, link) = create_pty(&args.port)?;
-    let p = emu.sim().pose();
-    eprintln!(
+    /// Removes the symlink at `path` when dropped.
+    struct Symlink(PathBuf);
+
+    impl Drop for Symlink {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+
+    fn create_pty(port: &Path) -> Result<(OwnedFd, OwnedFd, Symlink), CliError> {
+        let err = |e: Errno| CliError::io(format!("error: cannot create a pseudo-terminal: {e}"));
+        let master = openpt(OpenptFlags::RDWR | OpenptFlags::NOCTTY | OpenptFlags::CLOEXEC).map_err(err)?;
+        grantpt(&master).map_err(err)?;
+        unlockpt(&master).map_err(err)?;
+        let name = ptsname(&master, Vec::new()).map_err(err)?;
+        let slave_path = PathBuf::from(name.to_string_lossy().into_owned());
+        // The emulator keeps the slave open itself: the master then never sees a
+        // hang-up between two clients, and the line is raw before anyone connects.
+        let slave =
+            rustix::fs::open(&slave_path, OFlags::RDWR | OFlags::NOCTTY | OFlags::CLOEXEC, Mode::empty())
+                .map_err(err)?;
+        make_raw(&slave, 9600).map_err(err)?;
+        match std::fs::symlink_metadata(port) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let _ = std::fs::remove_file(port);
+            }
+            Ok(_) => {
+                return Err(CliError::io(format!(
+                    "error: `{}` exists and is not a symbolic link; choose another `--port`",
+                    port.display()
+                )))
+            }
+            Err(_) => {}
+        }
+        std::os::unix::fs::symlink(&slave_path, port)
+            .map_err(|e| CliError::io(format!("error: cannot create `{}`: {e}", port.display())))?;
+        Ok((master, slave, Symlink(port.to_path_buf())))
+    }
+
+    fn write_all(fd: &OwnedFd, mut bytes: &[u8]) -> Result<(), Errno> {
+        while !bytes.is_empty() {
+            match rustix::io::write(fd, bytes) {
+                Ok(n) => bytes = &bytes[n..],
+                Err(Errno::INTR | Errno::AGAIN) => {}
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(())
+    }
+
+    pub fn emulate(args: EmulateArgs) -> Result<(), CliError> {
+        let program = match &args.file {
+            Some(f) => load::load_program(f, args.error_format)?,
+            None => shaping_compiler::compile(DEFAULT_FILE, "khepera.bat")
+                .map_err(|_| CliError::io("error: the built-in example does not compile"))?,
+        };
+        let index = match args.stage.as_deref() {
+            Some(_) => load::stage_index(&program, args.stage.as_deref())?,
+            None => program
+                .stages
+                .len()
+                .checked_sub(1)
+                .ok_or_else(|| CliError::io("error: the program has no stages"))?,
+        };
+        let stage = &program.stages[index];
+        let seed = args.seed.unwrap_or_else(|| crate::run::run_seed(&program, None));
+        let mut emu = Emulator::new(&stage.world, seed);
+        let flag = interrupt_flag()?;
+        let (master, _slave, link) = create_pty(&args.port)?;
+        let p = emu.sim().pose();
+        eprintln!(
         "emulated Khepera on {} (world of stage `{}`, seed {seed}, start x {:.0} mm y {:.0} mm heading {:.0} deg, {} baud{}); Ctrl-C to stop",
         args.port.display(),
         stage.name,
@@ -138,68 +197,69 @@ pub fn emulate(args: EmulateArgs) -> Result<(), CliError> {
         args.baud,
         if args.delay_ms > 0 { format!(", {} ms per answer", args.delay_ms) } else { String::new() },
     );
-    let mut stdout = std::io::stdout().lock();
-    let mut lines = LineBuffer::new();
-    let mut buf = [0u8; 256];
-    let mut last_speed = None;
-    loop {
-        if flag.load(Ordering::Relaxed) {
-            eprintln!("emulator stopped after {} requests, {} actions", emu.requests, emu.actions);
-            return Ok(());
-        }
-        match wait_readable(&master, Instant::now() + Duration::from_millis(100)) {
-            Ok(false) => continue,
-            Ok(true) => {}
-            Err(e) => return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}"))),
-        }
-        let n = match rustix::io::read(&master, &mut buf) {
-            Ok(n) => n,
-            Err(Errno::INTR | Errno::AGAIN) => continue,
-            Err(e) => return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}"))),
-        };
-        lines.push(&buf[..n]);
-        while let Some(line) = lines.next_line() {
-            let started = Instant::now();
-            let number = emu.requests + 1;
-            let line = line.unwrap_or_default();
-            let mut answer = emu.answer(&line);
-            if emu.speed() != last_speed.unwrap_or([i32::MAX; 2]) {
-                last_speed = Some(emu.speed());
-                let [l, r] = emu.speed();
-                let _ = writeln!(stdout, "speed {l} {r} at request {number}");
-                let _ = stdout.flush();
+        let mut stdout = std::io::stdout().lock();
+        let mut lines = LineBuffer::new();
+        let mut buf = [0u8; 256];
+        let mut last_speed = None;
+        loop {
+            if flag.load(Ordering::Relaxed) {
+                eprintln!("emulator stopped after {} requests, {} actions", emu.requests, emu.actions);
+                return Ok(());
             }
-            match args.fault {
-                Some(Fault::Drop(n)) if n == number => {
-                    eprintln!("fault: no answer to request {number}");
-                    continue;
-                }
-                Some(Fault::Garbage(n)) if n == number => {
-                    eprintln!("fault: garbage in answer to request {number}");
-                    answer = "\u{15}#?%\u{7f}~\r\n".to_string();
-                }
-                Some(Fault::Close(n)) if n == number => {
-                    eprintln!("fault: link closed at request {number}");
-                    drop(master);
-                    drop(_slave);
-                    drop(link);
-                    return Ok(());
-                }
-                _ => {}
+            match wait_readable(&master, Instant::now() + Duration::from_millis(100)) {
+                Ok(false) => continue,
+                Ok(true) => {}
+                Err(e) => return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}"))),
             }
-            // The wire's time for the command and its answer, and the robot's delay.
-            let bytes = (line.len() + 1 + answer.len()) as u64;
-            let wire = if args.baud > 0 {
-                Duration::from_micros(bytes * BITS_PER_BYTE * 1_000_000 / u64::from(args.baud))
-            } else {
-                Duration::ZERO
+            let n = match rustix::io::read(&master, &mut buf) {
+                Ok(n) => n,
+                Err(Errno::INTR | Errno::AGAIN) => continue,
+                Err(e) => return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}"))),
             };
-            let due = started + wire + Duration::from_millis(args.delay_ms);
-            if let Some(wait) = due.checked_duration_since(Instant::now()) {
-                std::thread::sleep(wait);
-            }
-            if let Err(e) = write_all(&master, answer.as_bytes()) {
-                return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}")));
+            lines.push(&buf[..n]);
+            while let Some(line) = lines.next_line() {
+                let started = Instant::now();
+                let number = emu.requests + 1;
+                let line = line.unwrap_or_default();
+                let mut answer = emu.answer(&line);
+                if emu.speed() != last_speed.unwrap_or([i32::MAX; 2]) {
+                    last_speed = Some(emu.speed());
+                    let [l, r] = emu.speed();
+                    let _ = writeln!(stdout, "speed {l} {r} at request {number}");
+                    let _ = stdout.flush();
+                }
+                match args.fault {
+                    Some(Fault::Drop(n)) if n == number => {
+                        eprintln!("fault: no answer to request {number}");
+                        continue;
+                    }
+                    Some(Fault::Garbage(n)) if n == number => {
+                        eprintln!("fault: garbage in answer to request {number}");
+                        answer = "\u{15}#?%\u{7f}~\r\n".to_string();
+                    }
+                    Some(Fault::Close(n)) if n == number => {
+                        eprintln!("fault: link closed at request {number}");
+                        drop(master);
+                        drop(_slave);
+                        drop(link);
+                        return Ok(());
+                    }
+                    _ => {}
+                }
+                // The wire's time for the command and its answer, and the robot's delay.
+                let bytes = (line.len() + 1 + answer.len()) as u64;
+                let wire = if args.baud > 0 {
+                    Duration::from_micros(bytes * BITS_PER_BYTE * 1_000_000 / u64::from(args.baud))
+                } else {
+                    Duration::ZERO
+                };
+                let due = started + wire + Duration::from_millis(args.delay_ms);
+                if let Some(wait) = due.checked_duration_since(Instant::now()) {
+                    std::thread::sleep(wait);
+                }
+                if let Err(e) = write_all(&master, answer.as_bytes()) {
+                    return Err(CliError::io(format!("error: the pseudo-terminal failed: {e}")));
+                }
             }
         }
     }

@@ -1,31 +1,20 @@
-//! The serial port: raw 8N2 at a given baud rate, one command and its answer
-//! at a time with a timeout, and the pacing of actions. Implements the
-//! runtime's `Link`.
+//! The serial port: 8N2 at a given baud rate, one command and its answer at
+//! a time with a timeout, and the pacing of actions. Implements the
+//! runtime's `Link` over the `serialport` crate, so that a real Khepera can
+//! be driven from Unix and Windows alike (the emulator's pseudo-terminal is
+//! Unix only: `emulate.rs`).
 
-use std::os::fd::OwnedFd;
+use std::io::{ErrorKind, Read as _, Write as _};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use rustix::event::{poll, PollFd, PollFlags, Timespec};
-use rustix::fs::{Mode, OFlags};
-use rustix::io::Errno;
-use rustix::termios::{self, ControlModes, OptionalActions};
+use serialport::{ClearBuffer, DataBits, FlowControl, Parity, StopBits};
 use shaping_runtime::robot::protocol::LineBuffer;
 use shaping_runtime::robot::{Link, LinkError};
 
 use crate::load::CliError;
-
-/// Puts a terminal into raw mode at `baud` with 8 data bits and 2 stop bits
-/// (the Khepera's setting), no flow control.
-pub fn make_raw(fd: &OwnedFd, baud: u32) -> rustix::io::Result<()> {
-    let mut t = termios::tcgetattr(fd)?;
-    t.make_raw();
-    t.control_modes |= ControlModes::CSTOPB | ControlModes::CLOCAL | ControlModes::CREAD;
-    t.set_speed(baud)?;
-    termios::tcsetattr(fd, OptionalActions::Now, &t)
-}
 
 /// Sets up the Ctrl-C (and SIGTERM) flag.
 pub fn interrupt_flag() -> Result<Arc<AtomicBool>, CliError> {
@@ -37,35 +26,9 @@ pub fn interrupt_flag() -> Result<Arc<AtomicBool>, CliError> {
     Ok(flag)
 }
 
-/// Waits until `fd` is readable or `deadline` passes; `Ok(false)` on timeout.
-pub fn wait_readable(fd: &OwnedFd, deadline: Instant) -> Result<bool, Errno> {
-    loop {
-        let left = deadline.saturating_duration_since(Instant::now());
-        let ts = Timespec { tv_sec: left.as_secs() as _, tv_nsec: left.subsec_nanos() as _ };
-        let mut fds = [PollFd::new(fd, PollFlags::IN)];
-        match poll(&mut fds, Some(&ts)) {
-            Ok(0) => return Ok(false),
-            Ok(_) => {
-                let ev = fds[0].revents();
-                if ev.intersects(PollFlags::IN) {
-                    return Ok(true);
-                }
-                // Hang-up or error without data.
-                return Err(Errno::IO);
-            }
-            Err(Errno::INTR) => {
-                if Instant::now() >= deadline {
-                    return Ok(false);
-                }
-            }
-            Err(e) => return Err(e),
-        }
-    }
-}
-
 /// A robot's serial port.
 pub struct SerialPort {
-    fd: OwnedFd,
+    port: Box<dyn serialport::SerialPort>,
     name: String,
     lines: LineBuffer,
     timeout: Duration,
@@ -77,8 +40,9 @@ pub struct SerialPort {
 }
 
 impl SerialPort {
-    /// Opens `path` at `baud`; an answer must come within `timeout`; one
-    /// action lasts `period`; `interrupted` is the Ctrl-C flag.
+    /// Opens `path` at `baud` with 8 data bits, 2 stop bits (the Khepera's
+    /// setting), no parity and no flow control; an answer must come within
+    /// `timeout`; one action lasts `period`; `interrupted` is the Ctrl-C flag.
     pub fn open(
         path: &Path,
         baud: u32,
@@ -87,14 +51,30 @@ impl SerialPort {
         interrupted: Arc<AtomicBool>,
     ) -> Result<SerialPort, CliError> {
         let name = path.display().to_string();
-        let fd = rustix::fs::open(path, OFlags::RDWR | OFlags::NOCTTY | OFlags::CLOEXEC, Mode::empty())
-            .map_err(|e| CliError::io(format!("error: cannot open the robot's port `{name}`: {e}")))?;
-        make_raw(&fd, baud).map_err(|e| {
-            CliError::io(format!("error: `{name}` is not a serial port (or refuses {baud} baud): {e}"))
-        })?;
-        let _ = termios::tcflush(&fd, termios::QueueSelector::IOFlush);
+        let port = serialport::new(path.to_string_lossy(), baud)
+            .data_bits(DataBits::Eight)
+            .stop_bits(StopBits::Two)
+            .parity(Parity::None)
+            .flow_control(FlowControl::None)
+            .timeout(timeout)
+            .open()
+            .map_err(|e| match e.kind() {
+                // Another program holds the port (its lock, or `TIOCEXCL`).
+                serialport::ErrorKind::NoDevice => CliError::io(format!(
+                    "error: the robot's port `{name}` is in use by another program: {}",
+                    e.description
+                )),
+                serialport::ErrorKind::InvalidInput | serialport::ErrorKind::Unknown => {
+                    CliError::io(format!(
+                        "error: `{name}` is not a serial port (or refuses {baud} baud): {}",
+                        e.description
+                    ))
+                }
+                _ => CliError::io(format!("error: cannot open the robot's port `{name}`: {}", e.description)),
+            })?;
+        let _ = port.clear(ClearBuffer::All);
         Ok(SerialPort {
-            fd,
+            port,
             name,
             lines: LineBuffer::new(),
             timeout,
@@ -113,26 +93,27 @@ impl SerialPort {
     fn drain(&mut self) -> Result<(), LinkError> {
         self.lines.clear();
         let mut buf = [0u8; 256];
-        while wait_readable(&self.fd, Instant::now()).map_err(|_| self.closed())? {
-            match rustix::io::read(&self.fd, &mut buf) {
-                Ok(0) | Err(_) => return Err(self.closed()),
+        loop {
+            let waiting = self.port.bytes_to_read().map_err(|_| self.closed())? as usize;
+            if waiting == 0 {
+                return Ok(());
+            }
+            match self.port.read(&mut buf[..waiting.min(256)]) {
+                Ok(0) => return Err(self.closed()),
                 Ok(_) => {}
+                Err(e) if e.kind() == ErrorKind::Interrupted => {}
+                Err(_) => return Err(self.closed()),
             }
         }
-        Ok(())
     }
 }
 
 impl Link for SerialPort {
     fn exchange(&mut self, command: &str) -> Result<Vec<u8>, LinkError> {
         self.drain()?;
-        let mut out = command.as_bytes();
-        while !out.is_empty() {
-            match rustix::io::write(&self.fd, out) {
-                Ok(n) => out = &out[n..],
-                Err(Errno::INTR | Errno::AGAIN) => {}
-                Err(_) => return Err(self.closed()),
-            }
+        self.port.set_timeout(self.timeout).map_err(|_| self.closed())?;
+        if self.port.write_all(command.as_bytes()).and_then(|()| self.port.flush()).is_err() {
+            return Err(self.closed());
         }
         self.bytes += command.len() as u64;
         let deadline = Instant::now() + self.timeout;
@@ -143,24 +124,26 @@ impl Link for SerialPort {
                     LinkError(format!("garbage on the link after `{}`: {e}", command.trim_end()))
                 });
             }
-            match wait_readable(&self.fd, deadline) {
-                Ok(true) => {}
-                Ok(false) => {
-                    return Err(LinkError(format!(
-                        "no answer to `{}` within {} ms",
-                        command.trim_end(),
-                        self.timeout.as_millis()
-                    )))
-                }
-                Err(_) => return Err(self.closed()),
+            let left = deadline.saturating_duration_since(Instant::now());
+            let timed_out = || {
+                LinkError(format!(
+                    "no answer to `{}` within {} ms",
+                    command.trim_end(),
+                    self.timeout.as_millis()
+                ))
+            };
+            if left.is_zero() {
+                return Err(timed_out());
             }
-            match rustix::io::read(&self.fd, &mut buf) {
+            self.port.set_timeout(left).map_err(|_| self.closed())?;
+            match self.port.read(&mut buf) {
                 Ok(0) => return Err(self.closed()),
                 Ok(n) => {
                     self.bytes += n as u64;
                     self.lines.push(&buf[..n]);
                 }
-                Err(Errno::INTR | Errno::AGAIN) => {}
+                Err(e) if e.kind() == ErrorKind::TimedOut => return Err(timed_out()),
+                Err(e) if matches!(e.kind(), ErrorKind::Interrupted | ErrorKind::WouldBlock) => {}
                 Err(_) => return Err(self.closed()),
             }
         }

@@ -703,6 +703,7 @@ impl F<'_> {
             SettingValue::Truncation(q) => format!("selection truncation keep {}", self.qty(q)),
             SettingValue::Quantity(q) => format!("{} {}", s.name.text, self.qty(q)),
             SettingValue::Word(w) => format!("{} {}", s.name.text, w.text),
+            SettingValue::WordAndNumber(w, q) => format!("{} {} {}", s.name.text, w.text, self.qty(q)),
         }
     }
 
@@ -854,7 +855,10 @@ impl F<'_> {
             Motion::TurnLeft(v) => format!("turn left{}", self.speed(*v, span)),
             Motion::TurnRight(v) => format!("turn right{}", self.speed(*v, span)),
             Motion::Stop => "stop".into(),
-            Motion::Wheels(n, l, r) => format!("{}({}, {})", n.text, self.num(*l, span), self.num(*r, span)),
+            Motion::Wheels(n, speeds) => {
+                let speeds: Vec<String> = speeds.iter().map(|v| self.num(*v, span)).collect();
+                format!("{}({})", n.text, speeds.join(", "))
+            }
         }
     }
 
@@ -873,7 +877,10 @@ impl F<'_> {
             ActionDecl::Wait(_) => "wait".into(),
             ActionDecl::Recharge(_) => "recharge".into(),
             ActionDecl::Reinforce(e, _) => format!("reinforce {}", self.expr(e)),
-            ActionDecl::Set { actuator, state, .. } => format!("{} {}", actuator.text, state.text),
+            ActionDecl::Set { actuator, state: Some(state), .. } => {
+                format!("{} {}", actuator.text, state.text)
+            }
+            ActionDecl::Set { actuator, state: None, .. } => actuator.text.clone(),
         };
         match &s.end {
             None => {}

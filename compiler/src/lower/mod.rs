@@ -161,9 +161,18 @@ pub(crate) struct Lower<'a> {
     trained: HashMap<String, (u16, Vec<TrainedModule>)>,
 }
 
-/// A module of a training stage: its name and its behavior network's shape
-/// (inputs, hidden, outputs), `None` for a script.
-pub(crate) type TrainedModule = (String, Option<(u16, u16, u16)>);
+/// A module of a training stage: its name and its behavior's shape.
+pub(crate) type TrainedModule = (String, TrainedShape);
+
+/// The behavior of a module of a training stage.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum TrainedShape {
+    Script,
+    /// A network: inputs, hidden, outputs.
+    Network(u16, u16, u16),
+    /// The behavior did not compile (reported there): nothing to say about its shape.
+    Failed,
+}
 
 const DEFAULT_BITS: u8 = 4;
 const DEFAULT_WINDOW: u32 = 30;
@@ -185,7 +194,6 @@ fn default_evolution() -> Evolution {
     }
 }
 
-/// Lowers a parsed file to a [`Program`], or every error found.
 /// Whether an error of a stage whose parent is unknown stands without the
 /// parent: a sensor or actuator that no stage declares, an index out of
 /// range, a bad range, unit or gene size, an unknown function or event.
@@ -200,7 +208,18 @@ fn checkable_without_parent(e: &Error) -> bool {
     )
 }
 
-pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
+/// Lowers a parsed file: the program when no diagnostic is an error, and
+/// every diagnostic (errors and warnings), in source order.
+pub fn lower(file: &ast::File, file_name: &str) -> (Option<Program>, Vec<Error>) {
+    let (program, errors) = lower_partial(file, file_name);
+    let failed = errors.iter().any(|e| !e.is_warning());
+    ((!failed).then_some(program), errors)
+}
+
+/// Lowers what a file declares even where it has errors: the program, with
+/// placeholders where an error stands (never to be run), beside every
+/// diagnostic. For the language server, which describes the parts that stand.
+pub fn lower_partial(file: &ast::File, file_name: &str) -> (Program, Vec<Error>) {
     let mut lw = Lower {
         errors: Vec::new(),
         file,
@@ -211,16 +230,12 @@ pub fn lower(file: &ast::File, file_name: &str) -> Result<Program, Vec<Error>> {
         trained: HashMap::new(),
     };
     let program = lw.program(file_name);
-    if lw.errors.is_empty() {
-        Ok(program)
-    } else {
-        let mut errors = lw.errors;
-        errors.sort_by_key(|e| {
-            use miette::Diagnostic;
-            e.labels().and_then(|mut l| l.next()).map(|l| l.offset()).unwrap_or(0)
-        });
-        Err(errors)
-    }
+    let mut errors = lw.errors;
+    errors.sort_by_key(|e| {
+        use miette::Diagnostic;
+        e.labels().and_then(|mut l| l.next()).map(|l| l.offset()).unwrap_or(0)
+    });
+    (program, errors)
 }
 
 impl<'a> Lower<'a> {
@@ -254,6 +269,41 @@ impl<'a> Lower<'a> {
             name: name.text.clone(),
             help: did_you_mean(&name.text, names),
         });
+    }
+
+    /// Reports every setting named again in one scope (a block, or the
+    /// blocks of one stage): the later one would silently replace the first.
+    pub(crate) fn repeated(
+        &mut self,
+        what: &'static str,
+        settings: impl IntoIterator<Item = (String, Span)>,
+    ) {
+        let mut first: HashMap<String, Span> = HashMap::new();
+        for (name, span) in settings {
+            match first.get(&name) {
+                Some(f) => {
+                    self.errors.push(Error::Duplicate { span: span.into(), first: (*f).into(), what, name })
+                }
+                None => {
+                    first.insert(name, span);
+                }
+            }
+        }
+    }
+
+    /// Gene settings named twice in the `genome` blocks of one scope.
+    fn repeated_genes<'g>(&mut self, blocks: impl IntoIterator<Item = &'g ast::GenomeBlock>) {
+        let mut settings = Vec::new();
+        for set in blocks.into_iter().flat_map(|b| &b.settings) {
+            let group = set.group.as_ref().map(|g| format!("{} ", g.text)).unwrap_or_default();
+            if let Some(q) = &set.bits {
+                settings.push((format!("{group}bits"), q.span));
+            }
+            if let Some(r) = &set.range {
+                settings.push((format!("{group}range"), r.span));
+            }
+        }
+        self.repeated("gene setting", settings);
     }
 
     // ------------------------------------------------------------ quantities
@@ -373,14 +423,14 @@ impl<'a> Lower<'a> {
 
     fn program(&mut self, file_name: &str) -> Program {
         let file = self.file;
-        for (i, r) in file.robots.iter().enumerate().skip(1) {
-            self.errors.push(Error::Duplicate {
+        for r in file.robots.iter().skip(1) {
+            self.errors.push(Error::Conflict {
                 span: r.name.span.into(),
-                first: file.robots[0].name.span.into(),
-                what: "robot",
-                name: r.name.text.clone(),
+                other: file.robots[0].name.span.into(),
+                message: "a file has one robot; a stage adds hardware with `robot adds { ... }`".into(),
+                label: "a second robot".into(),
+                other_label: "the robot of this file".into(),
             });
-            let _ = i;
         }
         let name = file.robots.first().map(|r| r.name.text.clone()).unwrap_or_else(|| stem(file_name));
         if file.stages.is_empty() {
@@ -502,30 +552,36 @@ impl<'a> Lower<'a> {
                 cur = p;
             }
         }
-        // Dependency order, stable by declaration.
+        // Dependency order, stable by declaration: parents first, and the
+        // stages whose weights a stage uses (`weights trained STAGE`). Uses
+        // that depend on each other cannot all be met: then the first stage
+        // whose parent is ready goes next, and reports the use it misses.
+        let uses: Vec<Vec<usize>> = file
+            .stages
+            .iter()
+            .map(|s| trained_uses(s).filter_map(|n| by_name.get(n.text.as_str()).copied()).collect())
+            .collect();
         let mut index: Vec<Option<usize>> = vec![None; file.stages.len()];
         let mut order = Vec::new();
+        let eligible = |i: usize, index: &[Option<usize>]| {
+            index[i].is_none()
+                && !in_cycle[i]
+                && by_name.get(file.stages[i].name.text.as_str()) == Some(&i)
+                && parent[i].is_none_or(|p| index[p].is_some())
+        };
         loop {
             let mut progress = false;
             for i in 0..file.stages.len() {
-                if index[i].is_some()
-                    || in_cycle[i]
-                    || by_name.get(file.stages[i].name.text.as_str()) != Some(&i)
-                {
-                    continue;
-                }
-                let ready = match parent[i] {
-                    None => true,
-                    Some(p) => index[p].is_some(),
-                };
-                if ready {
+                if eligible(i, &index) && uses[i].iter().all(|&u| u == i || index[u].is_some()) {
                     index[i] = Some(order.len());
                     order.push(i);
                     progress = true;
                 }
             }
             if !progress {
-                break;
+                let Some(i) = (0..file.stages.len()).find(|&i| eligible(i, &index)) else { break };
+                index[i] = Some(order.len());
+                order.push(i);
             }
         }
         let mut states: Vec<StageSt> = Vec::new();
@@ -584,8 +640,12 @@ impl<'a> Lower<'a> {
                     .iter()
                     .map(|m| {
                         let shape = match &m.behavior {
-                            Behavior::Neural(nb) => Some((nb.net.inputs, nb.net.hidden, nb.net.outputs)),
-                            Behavior::Script(_) => None,
+                            Behavior::Neural(nb) => {
+                                TrainedShape::Network(nb.net.inputs, nb.net.hidden, nb.net.outputs)
+                            }
+                            // A script has a step: none is the placeholder of a failed behavior.
+                            Behavior::Script(sc) if sc.steps.is_empty() => TrainedShape::Failed,
+                            Behavior::Script(_) => TrainedShape::Script,
                         };
                         (m.name.clone(), shape)
                     })
@@ -636,6 +696,9 @@ impl<'a> Lower<'a> {
             if !report {
                 self.errors.truncate(saved);
             }
+        }
+        if s == 0 {
+            self.repeated_genes(&file.genomes);
         }
         for g in &file.genomes {
             let saved = self.errors.len();
@@ -816,6 +879,10 @@ impl<'a> Lower<'a> {
                 self.hardware(&mut st, hw, s);
             }
         }
+        self.repeated_genes(decl.items.iter().filter_map(|i| match i {
+            I::Genome(g) => Some(g),
+            _ => None,
+        }));
         for item in &decl.items {
             if let I::Genome(g) = item {
                 self.genome(&mut st.genome, g);
@@ -858,6 +925,7 @@ impl<'a> Lower<'a> {
                     break;
                 }
                 declared_here.insert(m.name.text.clone(), m.name.span);
+                self.similar_module(&st.modules, m, s);
                 self.module(&hw, &mut st.modules, m, s);
             }
         }
@@ -876,8 +944,24 @@ impl<'a> Lower<'a> {
         }
         self.links(&mut st, decl, s);
         // Fitness.
+        // A `fitness` without `adds` replaces the fitness: after another
+        // `fitness` of the same stage, it would silently drop that one.
+        let mut first_fitness: Option<Span> = None;
         for item in &decl.items {
             if let I::Fitness(f) = item {
+                if let (Some(first), false) = (first_fitness, f.adds) {
+                    self.errors.push(Error::Conflict {
+                        span: f.span.into(),
+                        other: first.into(),
+                        message: format!(
+                            "stage `{sname}` declares its fitness twice; add terms with `fitness adds ...` or after a `,`"
+                        ),
+                        label: "replaces the first".into(),
+                        other_label: "first `fitness`".into(),
+                    });
+                    continue;
+                }
+                first_fitness = first_fitness.or(Some(f.span));
                 self.fitness(&hw, &mut st, f);
             }
         }
@@ -898,6 +982,38 @@ impl<'a> Lower<'a> {
 }
 
 impl Lower<'_> {
+    /// Warns about a new module whose name is one edit (or one swap of
+    /// neighbours) from an inherited module's: most likely a typo that
+    /// declares a module instead of changing the inherited one. Names under
+    /// four letters and names that differ in digits only are left alone
+    /// (`a` and `b`, `avoid` and `avoid2` are names, not typos).
+    fn similar_module(&mut self, modules: &[ModuleSt], m: &ast::ModuleDecl, s: u16) {
+        let name = &m.name.text;
+        if name.chars().count() < 4 || modules.iter().any(|x| x.name == *name) {
+            return;
+        }
+        let letters = |n: &str| n.chars().filter(|c| !c.is_ascii_digit()).collect::<String>();
+        let close = modules.iter().find(|x| {
+            x.stage < s
+                && x.name.chars().count() >= 4
+                && strsim::osa_distance(&x.name, name) == 1
+                && letters(&x.name) != letters(name)
+        });
+        if let Some(x) = close {
+            self.errors.push(Error::SimilarName {
+                span: m.name.span.into(),
+                similar_span: x.span.into(),
+                name: name.clone(),
+                similar: x.name.clone(),
+                stage: self.stage_names.get(x.stage as usize).cloned().unwrap_or_default(),
+                help: Some(format!(
+                    "to change the inherited module, write `module {}`; to add a module, choose a name further from it",
+                    x.name
+                )),
+            });
+        }
+    }
+
     /// The genome and the population's genomes within the resource limits
     /// (`shaping_runtime::limits`), checked before anything is allocated.
     fn check_genome_size(&mut self, st: &StageSt, decl: &ast::StageDecl) {
@@ -984,6 +1100,23 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
         run: st.run.clone(),
         inheritance: st.inheritance,
     }
+}
+
+/// The stages named by the `weights trained STAGE` of a stage's modules.
+fn trained_uses(s: &ast::StageDecl) -> impl Iterator<Item = &ast::Name> {
+    s.items
+        .iter()
+        .filter_map(|item| match item {
+            ast::StageItem::Module(m) => Some(m.items.iter().filter_map(|mi| match mi {
+                ast::ModuleItem::Behavior(ast::BehaviorDecl::Neural(n)) => match &n.weights {
+                    Some(ast::WeightSource::Trained(by, _)) => Some(by),
+                    _ => None,
+                },
+                _ => None,
+            })),
+            _ => None,
+        })
+        .flatten()
 }
 
 fn unit_desc(u: Unit) -> String {

@@ -4,10 +4,13 @@ use shaping_runtime::catalog::{self, ActuatorKind};
 use shaping_runtime::limits::MAX_HIDDEN;
 use shaping_runtime::program::*;
 
-use super::{expr::Scope, Hw, Lower, ModuleSt, Source, DEFAULT_RATES, DEFAULT_WINDOW};
+use super::{expr::Scope, Hw, Lower, ModuleSt, Source, TrainedShape, DEFAULT_RATES, DEFAULT_WINDOW};
 use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
 use crate::syntax::Span;
+
+/// The words that start an action (`turn toward(...)` starts with `turn`).
+const ACTIONS: [&str; 8] = ["forward", "back", "turn", "stop", "toward", "wait", "recharge", "reinforce"];
 
 impl Lower<'_> {
     /// Declares a new module, or changes an inherited one.
@@ -288,7 +291,38 @@ impl Lower<'_> {
         false
     }
 
+    /// Reports a name in the place of an action that is neither an action
+    /// nor an actuator of the stage (`forwrd(1.0)`, `forwrd`, `turm left`).
+    fn unknown_action(&mut self, hw: &Hw, name: &ast::Name) {
+        if self.poisoned.contains(&name.text) || self.hw_origin.contains_key(&name.text) {
+            return self.unknown_hardware(hw, "actuator", name);
+        }
+        let actuators = hw.actuators.iter().map(|a| a.name.as_str());
+        let turn = match name.text.as_str() {
+            "left" | "right" => Some(format!("write `turn {}`", name.text)),
+            "turn" => Some("`turn` needs a direction: `turn left` or `turn right`".to_string()),
+            _ => None,
+        };
+        self.errors.push(Error::Unknown {
+            span: name.span.into(),
+            what: "action",
+            name: name.text.clone(),
+            help: turn.or_else(|| did_you_mean(&name.text, ACTIONS.into_iter().chain(actuators))).or_else(|| {
+                Some(format!(
+                    "the actions are {}, and an actuator's name with a state or speeds (`arm down`, `wheels(0.5, 0.5)`)",
+                    super::expr::backticked(&ACTIONS)
+                ))
+            }),
+        });
+    }
+
     fn motion(&mut self, hw: &Hw, m: &Motion, span: Span) -> Option<[f32; 2]> {
+        if let Motion::Wheels(name, _) = m {
+            if !hw.actuators.iter().any(|a| a.name == name.text) {
+                self.unknown_action(hw, name);
+                return None;
+            }
+        }
         if !self.has_wheels(hw, span) {
             return None;
         }
@@ -310,7 +344,7 @@ impl Lower<'_> {
                 [v, -v]
             }
             Motion::Stop => [0.0, 0.0],
-            Motion::Wheels(name, l, r) => {
+            Motion::Wheels(name, speeds) => {
                 match hw.actuators.iter().find(|a| a.name == name.text) {
                     Some(a) if a.kind == ActuatorKind::Speed => {}
                     Some(a) => {
@@ -326,12 +360,18 @@ impl Lower<'_> {
                         );
                         return None;
                     }
-                    None => {
-                        self.unknown_hardware(hw, "actuator", name);
-                        return None;
-                    }
+                    None => return None,
                 }
-                [self.speed(Some(*l), span), self.speed(Some(*r), span)]
+                let &[l, r] = &speeds[..] else {
+                    self.value_error(
+                        span,
+                        format!("`{}(LEFT, RIGHT)` takes two speeds, not {}", name.text, speeds.len()),
+                        "two speeds",
+                        Some(format!("write `{}(0.5, -0.5)`, or `forward(0.5)`", name.text)),
+                    );
+                    return None;
+                };
+                [self.speed(Some(l), span), self.speed(Some(r), span)]
             }
         })
     }
@@ -387,7 +427,7 @@ impl Lower<'_> {
                             None,
                         );
                     } else {
-                        self.unknown_hardware(hw, "actuator", actuator);
+                        self.unknown_action(hw, actuator);
                     }
                     return None;
                 };
@@ -401,6 +441,15 @@ impl Lower<'_> {
                     );
                     return None;
                 }
+                let Some(state) = state else {
+                    self.value_error(
+                        *span,
+                        format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
+                        "no state",
+                        Some(format!("write `{} {}`", a.name, info.states[0])),
+                    );
+                    return None;
+                };
                 let Some(i) = info.states.iter().position(|s| *s == state.text) else {
                     self.errors.push(Error::Unknown {
                         span: state.span.into(),
@@ -570,15 +619,7 @@ impl Lower<'_> {
         shape: (u16, u16, u16),
     ) -> Option<Vec<Param>> {
         let Some((stage, modules)) = self.trained.get(&by.text) else {
-            let help = did_you_mean(&by.text, self.trained.keys().map(String::as_str)).or_else(|| {
-                Some("name a training stage (`train for N actions`) declared before this one".into())
-            });
-            self.errors.push(Error::Unknown {
-                span: by.span.into(),
-                what: "training stage",
-                name: by.text.clone(),
-                help,
-            });
+            self.untrained(by);
             return None;
         };
         let stage = *stage;
@@ -591,11 +632,13 @@ impl Lower<'_> {
             );
             return None;
         };
-        if *found != Some(shape) {
-            let what = match found {
-                Some((i, h, o)) => format!("{i} inputs, {h} hidden and {o} outputs"),
-                None => "a scripted behavior".into(),
-            };
+        let what = match *found {
+            TrainedShape::Network(i, h, o) if (i, h, o) == shape => None,
+            TrainedShape::Failed => return None,
+            TrainedShape::Network(i, h, o) => Some(format!("{i} inputs, {h} hidden and {o} outputs")),
+            TrainedShape::Script => Some("a scripted behavior".to_string()),
+        };
+        if let Some(what) = what {
             self.value_error(
                 span,
                 format!(
@@ -609,6 +652,55 @@ impl Lower<'_> {
         }
         let count = Network::param_count(shape.0 as usize, shape.1 as usize, shape.2 as usize) as u32;
         Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
+    }
+
+    /// Reports `weights trained STAGE` where `STAGE` has trained nothing
+    /// before this stage: it is no stage, no training stage, this stage, or
+    /// a training stage that uses this one's weights in turn. A training
+    /// stage whose own declaration failed was reported already.
+    fn untrained(&mut self, by: &ast::Name) {
+        let file = self.file;
+        let is_training =
+            |s: &ast::StageDecl| s.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }));
+        let Some(decl) = file.stages.iter().find(|s| s.name.text == by.text) else {
+            let training = file.stages.iter().filter(|s| is_training(s)).map(|s| s.name.text.as_str());
+            self.errors.push(Error::Unknown {
+                span: by.span.into(),
+                what: "training stage",
+                name: by.text.clone(),
+                help: did_you_mean(&by.text, training)
+                    .or_else(|| Some("name a training stage (`train for N actions`)".into())),
+            });
+            return;
+        };
+        let current = self.stage_names.last().map(String::as_str);
+        let (message, label, other_label) = if !is_training(decl) {
+            (
+                format!("stage `{}` is not a training stage: it trains no weights", by.text),
+                "not a training stage",
+                "declared here without `train for N actions`",
+            )
+        } else if current == Some(by.text.as_str()) {
+            (format!("stage `{}` uses the weights it trains itself", by.text), "this stage", "declared here")
+        } else if self.stage_names.contains(&by.text) {
+            return;
+        } else {
+            (
+                format!(
+                    "training stage `{}` and this stage use each other's trained weights: neither can train first",
+                    by.text
+                ),
+                "used before it is trained",
+                "declared here",
+            )
+        };
+        self.errors.push(Error::Conflict {
+            span: by.span.into(),
+            other: decl.name.span.into(),
+            message,
+            label: label.into(),
+            other_label: other_label.into(),
+        });
     }
 
     fn learn(&mut self, l: &ast::LearnDecl) -> Option<Learning> {

@@ -15,6 +15,11 @@ impl Lower<'_> {
         use ast::StageItem as I;
         let mut evolve_span = None;
         let mut test_span: Option<Span> = None;
+        let evolve_settings = decl.items.iter().flat_map(|i| match i {
+            I::Evolve(settings, _) => settings.as_slice(),
+            _ => &[],
+        });
+        self.repeated("evolution setting", evolve_settings.map(|s| (s.name.text.clone(), s.span)));
         for item in &decl.items {
             match item {
                 I::Train { actions, span } => {
@@ -108,6 +113,24 @@ impl Lower<'_> {
                         ev.selection = Selection::Truncation { keep: k as u32 };
                         keep_span = Some(q.span);
                     }
+                }
+                (ast::SettingValue::WordAndNumber(w, q), _) => {
+                    let message = match w.text.as_str() {
+                        "truncation" => "`selection truncation` takes its number after `keep`".to_string(),
+                        "roulette" => "`selection roulette` takes no number".to_string(),
+                        other => {
+                            self.errors.push(Error::Unknown {
+                                span: w.span.into(),
+                                what: "selection",
+                                name: other.to_string(),
+                                help: did_you_mean(other, ["truncation", "roulette"])
+                                    .map(|d| format!("{d} {}", evolve_help("selection")))
+                                    .or_else(|| Some(evolve_help("selection"))),
+                            });
+                            continue;
+                        }
+                    };
+                    self.value_error(q.span, message, "unexpected number", Some(evolve_help("selection")));
                 }
                 (ast::SettingValue::Word(w), "selection") => {
                     if w.text == "roulette" {
@@ -242,6 +265,7 @@ impl Lower<'_> {
             }
         }
         const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
+        self.repeated("bonus for the event", f.bonuses.iter().map(|b| (b.event.text.clone(), b.span)));
         for b in &f.bonuses {
             let event = match b.event.text.as_str() {
                 "grip" => Event::Grip,

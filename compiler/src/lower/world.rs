@@ -182,6 +182,7 @@ impl Lower<'_> {
 
     pub(super) fn body(&mut self, body: &mut Body, settings: &[ast::Setting]) {
         const NAMES: [&str; 6] = ["radius", "wheel_base", "v_max", "action", "wheel_noise", "sensor_noise"];
+        self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
             let n = set.name.text.as_str();
             let ast::SettingValue::Quantity(q) = &set.value else {

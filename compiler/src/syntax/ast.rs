@@ -163,6 +163,9 @@ pub enum SettingValue {
     Word(Name),
     /// `selection truncation keep N`
     Truncation(Quantity),
+    /// `selection WORD N`: a word and a number, which only `truncation keep`
+    /// takes (an error the compiler names).
+    WordAndNumber(Name, Quantity),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -304,7 +307,8 @@ pub enum Motion {
     TurnRight(Option<f64>),
     Stop,
     /// `wheels(l, r)`: by the name of a `speed` actuator.
-    Wheels(Name, f64, f64),
+    /// Any other count of numbers is an error the compiler names.
+    Wheels(Name, Vec<f64>),
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -318,10 +322,11 @@ pub enum ActionDecl {
     Wait(Span),
     Recharge(Span),
     Reinforce(Expr, Span),
-    /// `arm down`: an actuator and a state.
+    /// `arm down`: an actuator and a state. A lone name (`forwrd`) has no
+    /// state: the compiler reports it as an unknown action or a missing state.
     Set {
         actuator: Name,
-        state: Name,
+        state: Option<Name>,
         span: Span,
     },
 }

@@ -2,7 +2,8 @@
 
 pub mod ast;
 mod parser;
+mod recover;
 pub mod span;
 
-pub use parser::{parse, RESERVED};
+pub use parser::{parse, parse_recovering, RESERVED};
 pub use span::Span;

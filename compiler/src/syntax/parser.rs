@@ -10,7 +10,7 @@ use crate::diag::Error;
 
 #[derive(pest_derive::Parser)]
 #[grammar = "../../grammar/shaping.pest"]
-struct BatParser;
+pub(super) struct BatParser;
 
 /// The reserved words of the grammar's `keyword` rule.
 pub const RESERVED: [&str; 29] = [
@@ -55,32 +55,64 @@ const MAX_LINE: usize = 4096;
 /// Budget of pest rule calls for one file.
 const CALL_LIMIT: usize = 20_000_000;
 
-/// Parses a file. On a syntax error, returns that one error (the checker
-/// reports every error of a file that parses).
+/// Parses a file. On syntax errors, returns every one of them (each part
+/// that does not parse gives its own, see [`parse_recovering`]).
 pub fn parse(src: &str) -> Result<File, Vec<Error>> {
+    match parse_with_limit(src, CALL_LIMIT) {
+        (Some(file), errors) if errors.is_empty() => Ok(file),
+        (_, errors) => Err(errors),
+    }
+}
+
+/// Parses a file as far as it can: on syntax errors, the AST of the parts
+/// that parse (top-level items, and the items of a stage) beside every
+/// syntax error, each at its place. `None` for a file refused before
+/// parsing (the limits on line length, nesting and pest's call budget).
+pub fn parse_recovering(src: &str) -> (Option<File>, Vec<Error>) {
     parse_with_limit(src, CALL_LIMIT)
 }
 
-fn parse_with_limit(src: &str, call_limit: usize) -> Result<File, Vec<Error>> {
+fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) {
     if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
-        return Err(vec![err]);
+        return (None, vec![err]);
     }
     pest::set_call_limit(std::num::NonZeroUsize::new(call_limit));
-    let mut pairs = match BatParser::parse(Rule::file, src) {
-        Ok(p) => p,
-        Err(e) => return Err(vec![syntax_error(src, e)]),
+    // Literals the parse expected, for messages at the right place (set on
+    // every parse, never unset, so that every thread gets the same messages).
+    pest::set_error_detail(true);
+    let (masked, mut errors) = match BatParser::parse(Rule::file, src) {
+        Ok(pairs) => return build(pairs, Vec::new()),
+        Err(e) if matches!(e.variant, pest::error::ErrorVariant::CustomError { .. }) => {
+            return (None, vec![syntax_error(src, e)])
+        }
+        Err(e) => {
+            let (masked, mut errors) = super::recover::recover(src);
+            if errors.is_empty() {
+                errors.push(syntax_error(src, e));
+            }
+            (masked, errors)
+        }
     };
+    match masked.as_deref().map(|m| BatParser::parse(Rule::file, m)) {
+        Some(Ok(pairs)) => build(pairs, errors),
+        _ => {
+            errors.dedup_by_key(|e| e.to_string());
+            (None, errors)
+        }
+    }
+}
+
+/// The AST of a parsed file, with the errors found building it after the
+/// syntax errors already found.
+fn build(mut pairs: pest::iterators::Pairs<Rule>, mut errors: Vec<Error>) -> (Option<File>, Vec<Error>) {
     if let Some(err) = check_numbers(&pairs) {
-        return Err(vec![err]);
+        errors.push(err);
     }
     let mut b = Builder { pratt: pratt(), errors: Vec::new() };
     let file =
         pairs.next().map(|p| b.file(p)).unwrap_or(File { robots: vec![], genomes: vec![], stages: vec![] });
-    if b.errors.is_empty() {
-        Ok(file)
-    } else {
-        Err(b.errors)
-    }
+    errors.extend(b.errors);
+    (Some(file), errors)
 }
 
 fn pratt() -> PrattParser<Rule> {
@@ -101,18 +133,31 @@ fn pratt() -> PrattParser<Rule> {
 }
 
 /// Rejects the first number a 32-bit float cannot hold (the runtime computes
-/// in `f32`, so `1e39` would become infinite).
+/// in `f32`, so `1e39` would become infinite), and the first unknown unit
+/// glued to a number (`0.25s`).
 fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
-    pairs.clone().flatten().filter(|p| matches!(p.as_rule(), Rule::number | Rule::unsigned)).find_map(|p| {
-        let v = num(&p);
-        (v.is_nan() || v.abs() > f32::MAX as f64).then(|| Error::Value {
+    pairs.clone().flatten().find_map(|p| match p.as_rule() {
+        Rule::number | Rule::unsigned => {
+            let v = num(&p);
+            (v.is_nan() || v.abs() > f32::MAX as f64).then(|| Error::Value {
+                span: span(&p).into(),
+                message: format!("the number `{}` is too large", p.as_str()),
+                label: "too large".into(),
+                help: Some(format!("numbers are at most {:e} in magnitude", f32::MAX)),
+            })
+        }
+        Rule::unknown_unit => Some(Error::Value {
             span: span(&p).into(),
-            message: format!("the number `{}` is too large", p.as_str()),
-            label: "too large".into(),
-            help: Some(format!("numbers are at most {:e} in magnitude", f32::MAX)),
-        })
+            message: format!("unknown unit `{}`", p.as_str()),
+            label: "not a unit".into(),
+            help: Some(UNITS.into()),
+        }),
+        _ => None,
     })
 }
+
+/// The units of the grammar's `unit` rule, for messages.
+const UNITS: &str = "the units are `mm` and `cm` (lengths), `ms` (durations) and `actions` (counts)";
 
 /// Rejects the first line longer than [`MAX_LINE`], labelled at its start.
 fn check_lines(src: &str) -> Option<Error> {
@@ -177,7 +222,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::integer => "a whole number",
         Rule::number | Rule::quantity => "a number",
         Rule::unsigned | Rule::literal => "a number",
-        Rule::unit => "a unit",
+        Rule::unit | Rule::unknown_unit => "a unit",
         Rule::range => "a range `lo..hi`",
         Rule::robot | Rule::robot_adds => "`robot`",
         Rule::genome => "`genome`",
@@ -286,12 +331,56 @@ fn token_at(src: &str, pos: usize) -> (Span, String) {
     (Span::new(pos, pos + len), found)
 }
 
-fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
+/// The words and punctuation a parse expected where a literal of the
+/// grammar (`wall`, `->`, `}`) got further than any rule: pest reports
+/// failed rules only, at the start of the rule around the literal, which
+/// points at the wrong place (`charger` instead of the `wal` after it).
+fn expected_literals(e: &pest::error::Error<Rule>, rule_pos: usize) -> Option<(usize, Vec<String>)> {
+    let attempts = e.parse_attempts()?;
+    if attempts.max_position <= rule_pos {
+        return None;
+    }
+    // pest does not export its token type: its text is the literal, a
+    // character range `a..z` or `BUILTIN_RULE`.
+    let is_range = |t: &str| t.chars().count() == 4 && t.get(1..3) == Some("..");
+    let mut tokens: Vec<String> = attempts
+        .expected_tokens()
+        .into_iter()
+        .map(|t| t.to_string())
+        // Whitespace, comments, and the characters that continue a name or
+        // a number are not what the user missed.
+        .filter(|t| {
+            !(t.trim().is_empty()
+                || is_range(t)
+                || t == "BUILTIN_RULE"
+                || t == "//"
+                || t == "/*"
+                || t == "-"
+                || t == "."
+                || (t.len() == 1 && t.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')))
+        })
+        .map(|t| format!("`{t}`"))
+        .collect();
+    tokens.sort_unstable();
+    tokens.dedup();
+    (!tokens.is_empty()).then_some((attempts.max_position, tokens))
+}
+
+pub(super) fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
+    syntax_error_shifted(src, e, 0)
+}
+
+/// [`syntax_error`] for an error of a part of `src` parsed alone, whose
+/// positions are `shift` bytes before their place in `src` (the recovery
+/// parses a stage item wrapped in a stage of its own).
+pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift: isize) -> Error {
     let pos = match e.location {
         pest::error::InputLocation::Pos(p) => p,
         pest::error::InputLocation::Span((a, _)) => a,
     };
-    let pos = pos.min(src.len());
+    let literals = expected_literals(&e, pos);
+    let place = |p: usize| p.saturating_add_signed(shift);
+    let pos = place(literals.as_ref().map_or(pos, |(p, _)| *p)).min(src.len());
     let (mut span, found) = token_at(src, pos);
     if pos == src.len() {
         // Point at the last token, so that the label shows.
@@ -299,19 +388,16 @@ fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
         let start = src[..end].char_indices().next_back().map(|(i, _)| i).unwrap_or(0);
         span = Span::new(start, end.max(start));
     }
-    let expected = match &e.variant {
-        pest::error::ErrorVariant::ParsingError { positives, .. } => {
+    let expected = match (&e.variant, literals) {
+        (pest::error::ErrorVariant::CustomError { message }, _) => {
+            return Error::TooComplex { span: span.into(), reason: message.to_lowercase() };
+        }
+        (_, Some((_, tokens))) => one_of(tokens.iter().map(String::as_str).collect()),
+        (pest::error::ErrorVariant::ParsingError { positives, .. }, None) => {
             let mut names: Vec<&str> = positives.iter().filter_map(|r| describe(*r)).collect();
             names.sort_unstable();
             names.dedup();
-            match names.len() {
-                0 => "something else".to_string(),
-                1 => names[0].to_string(),
-                n => format!("{} or {}", names[..n - 1].join(", "), names[n - 1]),
-            }
-        }
-        pest::error::ErrorVariant::CustomError { message } => {
-            return Error::TooComplex { span: span.into(), reason: message.to_lowercase() };
+            one_of(names)
         }
     };
     let word = found.trim_matches('`');
@@ -323,6 +409,15 @@ fn syntax_error(src: &str, e: pest::error::Error<Rule>) -> Error {
         None
     };
     Error::Syntax { span: span.into(), expected, found, help }
+}
+
+/// `a`, `a or b`, `a, b or c`.
+fn one_of(names: Vec<&str>) -> String {
+    match names.len() {
+        0 => "something else".to_string(),
+        1 => names[0].to_string(),
+        n => format!("{} or {}", names[..n - 1].join(", "), names[n - 1]),
+    }
 }
 
 /// The span of a pair, without the whitespace a trailing optional part
@@ -435,9 +530,7 @@ fn motion(p: Pair<Rule>) -> Motion {
         }
         Rule::set_wheels => {
             let n = it.next().map(name).unwrap_or(Name { text: String::new(), span: Span::default() });
-            let l = it.next().map(|x| num(&x)).unwrap_or(0.0);
-            let r = it.next().map(|x| num(&x)).unwrap_or(0.0);
-            Motion::Wheels(n, l, r)
+            Motion::Wheels(n, it.map(|x| num(&x)).collect())
         }
         _ => Motion::Stop,
     }
@@ -474,6 +567,29 @@ struct Builder {
 }
 
 impl Builder {
+    /// Reports an option given again in one block (`hidden 1 hidden 2`):
+    /// the AST keeps one of each, so the later one would silently win.
+    fn once(&mut self, seen: &mut Vec<(Rule, Span)>, what: &'static str, p: &Pair<Rule>) {
+        let name = match p.as_rule() {
+            Rule::weights_source | Rule::neural_weights => "weights",
+            Rule::hidden => "hidden",
+            Rule::range_setting => "range",
+            Rule::sense => "sense",
+            Rule::outputs => "outputs",
+            _ => return,
+        };
+        let key = if p.as_rule() == Rule::neural_weights { Rule::weights_source } else { p.as_rule() };
+        match seen.iter().find(|(r, _)| *r == key) {
+            Some((_, first)) => self.errors.push(Error::Duplicate {
+                span: span(p).into(),
+                first: (*first).into(),
+                what,
+                name: name.into(),
+            }),
+            None => seen.push((key, span(p))),
+        }
+    }
+
     fn file(&mut self, p: Pair<Rule>) -> File {
         let mut f = File { robots: vec![], genomes: vec![], stages: vec![] };
         for item in p.into_inner() {
@@ -592,7 +708,9 @@ impl Builder {
                 Rule::sense => items.push(ModuleItem::Sense(c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::activation => {
                     let mut a = ActivationDecl { source: None, hidden: None, range: None, span: csp };
+                    let mut seen = Vec::new();
                     for o in c.into_inner() {
+                        self.once(&mut seen, "activation option", &o);
                         match o.as_rule() {
                             Rule::weights_source => a.source = Some(weight_source(o)),
                             Rule::hidden => a.hidden = o.into_inner().nth(1).map(quantity),
@@ -674,8 +792,10 @@ impl Builder {
     fn neural(&mut self, p: Pair<Rule>) -> NeuralDecl {
         let sp = span(&p);
         let mut n = NeuralDecl { sense: None, hidden: None, outputs: None, weights: None, span: sp };
+        let mut seen = Vec::new();
         for c in p.into_inner() {
             let csp = span(&c);
+            self.once(&mut seen, "neural option", &c);
             match c.as_rule() {
                 Rule::sense => n.sense = Some((c.into_inner().map(sensor_ref).collect(), csp)),
                 Rule::hidden => n.hidden = c.into_inner().nth(1).map(quantity),
@@ -777,8 +897,8 @@ impl Builder {
             _ => {
                 let mut it = p.into_inner();
                 let blank = Name { text: String::new(), span: sp };
-                let actuator = it.next().map(name).unwrap_or(blank.clone());
-                let state = it.next().map(name).unwrap_or(blank);
+                let actuator = it.next().map(name).unwrap_or(blank);
+                let state = it.next().map(name);
                 ActionDecl::Set { actuator, state, span: sp }
             }
         }
@@ -945,10 +1065,11 @@ fn setting(p: Pair<Rule>) -> Setting {
     let rule = p.as_rule();
     let mut it = p.into_inner();
     if rule == Rule::selection {
-        let v = match it.next() {
-            Some(q) if q.as_rule() == Rule::quantity => SettingValue::Truncation(quantity(q)),
-            Some(w) => SettingValue::Word(name(w)),
-            None => SettingValue::Word(Name { text: String::new(), span: sp }),
+        let v = match (it.next(), it.next()) {
+            (Some(q), _) if q.as_rule() == Rule::quantity => SettingValue::Truncation(quantity(q)),
+            (Some(w), Some(q)) => SettingValue::WordAndNumber(name(w), quantity(q)),
+            (Some(w), None) => SettingValue::Word(name(w)),
+            (None, _) => SettingValue::Word(Name { text: String::new(), span: sp }),
         };
         return Setting {
             name: Name { text: "selection".into(), span: Span::new(sp.start, sp.start + 9) },
@@ -980,10 +1101,10 @@ mod tests {
     #[test]
     fn exceeding_the_call_limit_is_a_diagnostic() {
         let src = "robot r { sensor ir[8] proximity }\nstage s { module m { sense ir behavior stop } }";
-        let errors = parse_with_limit(src, 50).unwrap_err();
+        let errors = parse_with_limit(src, 50).1;
         assert!(matches!(&errors[..], [Error::TooComplex { .. }]), "{errors:?}");
         assert!(errors[0].to_string().starts_with("the file is too complex to parse"));
-        assert!(parse_with_limit(src, CALL_LIMIT).is_ok());
+        assert!(parse_with_limit(src, CALL_LIMIT).1.is_empty());
     }
 
     #[test]

@@ -9,6 +9,7 @@ mod layout;
 mod limits;
 mod parse;
 mod props;
+mod recover;
 mod ui;
 
 use std::path::Path;
@@ -28,16 +29,20 @@ pub fn render(d: &dyn miette::Diagnostic) -> String {
     s
 }
 
-/// Compiles a file of the repository, panicking with the rendered diagnostics.
+/// Compiles a file of the repository, panicking with the rendered diagnostics
+/// (warnings included: the files of the repository have none).
 pub fn compile_ok(src: &str, name: &str) -> shaping_compiler::Program {
-    match shaping_compiler::compile(src, name) {
-        Ok(p) => {
+    match shaping_compiler::check(src, name) {
+        (Some(p), d) => {
+            if !d.is_empty() {
+                panic!("{name} compiles with warnings:\n{}", render(&d));
+            }
             // What the compiler emits is always a program the runtime accepts.
             if let Err(e) = p.validate() {
                 panic!("{name} compiles to an invalid program: {e}");
             }
             p
         }
-        Err(e) => panic!("{name} does not compile:\n{}", render(&e)),
+        (None, e) => panic!("{name} does not compile:\n{}", render(&e)),
     }
 }

@@ -1,5 +1,6 @@
-//! Bad inputs: every file of `tests/ui/` must fail; the snapshot is the
-//! source followed by the rendered diagnostics (no colour, 80 columns).
+//! Bad inputs: every file of `tests/ui/` must fail, or compile with
+//! warnings; the snapshot is the source followed by the rendered
+//! diagnostics (no colour, 80 columns).
 //! Inputs too big for a file are generated, and only their diagnostics kept.
 
 use shaping_compiler::Error;
@@ -11,13 +12,14 @@ fn ui() {
     insta::glob!("../../..", "tests/ui/*.bat", |path| {
         let src = std::fs::read_to_string(path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy();
-        match shaping_compiler::compile(&src, &name) {
-            Ok(_) => panic!("{name} compiles, but every file in tests/ui must fail"),
-            Err(d) => {
-                assert!(!d.is_empty());
-                insta::assert_snapshot!(format!("{src}\n{}", render(&d)));
-            }
-        }
+        let (program, d) = shaping_compiler::check(&src, &name);
+        assert!(
+            !d.is_empty(),
+            "{name} compiles without a diagnostic, but every file in tests/ui must have one"
+        );
+        // A file compiles exactly when its diagnostics are warnings only.
+        assert_eq!(program.is_some(), d.error_count() == 0, "{name}");
+        insta::assert_snapshot!(format!("{src}\n{}", render(&d)));
     });
 }
 
@@ -61,10 +63,11 @@ fn kind(e: &Error) -> &'static str {
         Error::Value { .. } => "Value",
         Error::StackTooDeep { .. } => "StackTooDeep",
         Error::Conflict { .. } => "Conflict",
+        Error::SimilarName { .. } => "SimilarName",
     }
 }
 
-const KINDS: [&str; 20] = [
+const KINDS: [&str; 21] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -85,6 +88,7 @@ const KINDS: [&str; 20] = [
     "Value",
     "StackTooDeep",
     "Conflict",
+    "SimilarName",
 ];
 
 #[test]
@@ -94,7 +98,7 @@ fn every_error_kind_has_a_ui_test() {
     for entry in std::fs::read_dir(crate::root().join("tests/ui")).unwrap() {
         let path = entry.unwrap().path();
         let src = std::fs::read_to_string(&path).unwrap();
-        let d = shaping_compiler::compile(&src, "ui.bat").unwrap_err();
+        let (_, d) = shaping_compiler::check(&src, "ui.bat");
         seen.extend(d.errors().iter().map(kind));
         files += 1;
     }
