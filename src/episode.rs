@@ -9,8 +9,11 @@
 //! the same episode as an unrecorded one with the same seed.
 
 use serde::{Deserialize, Serialize};
-use shaping_runtime::catalog::{ActuatorKind, CHANNELS, CH_BARRIER, CH_IR, SENSOR_BEARING_DEG};
+use shaping_runtime::catalog::{
+    ActuatorKind, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, SENSOR_BEARING_DEG,
+};
 use shaping_runtime::controller::{Robot, Trace};
+use shaping_runtime::robot::{Link, SerialRobot};
 use shaping_runtime::sim::{ir, Command, ObjectState, Outcome, Pose, Scene, Sim};
 
 /// Version of the `episode.json` format.
@@ -20,7 +23,13 @@ pub const EPISODE_FORMAT: u32 = 1;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
     pub ir: [f32; ir::SENSORS],
+    /// Ambient light on the same photodiodes.
+    pub light: [f32; ir::SENSORS],
     pub barrier: bool,
+    /// The ground sensor (the floor's grey level under the body).
+    pub floor: f32,
+    /// The distance to the nearest lamp, as sensed (0..1 of a metre).
+    pub lamp_distance: f32,
     pub arm_down: bool,
     pub claw_closed: bool,
     /// The wheel command of the action that led here (zero at the start).
@@ -29,17 +38,35 @@ pub struct Frame {
     pub objects: Vec<[f32; 4]>,
 }
 
+/// A robot whose world can be drawn: the simulator, or a real robot with
+/// the part of the world simulated on the host (virtual objects, battery).
+pub trait Shown: Robot {
+    fn scene(&self) -> Scene;
+}
+
+impl Shown for Sim {
+    fn scene(&self) -> Scene {
+        Sim::scene(self)
+    }
+}
+
+impl<L: Link> Shown for SerialRobot<L> {
+    fn scene(&self) -> Scene {
+        self.host().scene()
+    }
+}
+
 /// A [`Robot`] that records a [`Frame`] every time the controller senses:
 /// once at the start, then once after every action.
-pub struct Recorder<'a> {
-    pub sim: &'a mut Sim,
+pub struct Recorder<'a, R: Shown = Sim> {
+    pub robot: &'a mut R,
     pub frames: Vec<Frame>,
     wheels: [f32; 2],
 }
 
-impl<'a> Recorder<'a> {
-    pub fn new(sim: &'a mut Sim) -> Recorder<'a> {
-        Recorder { sim, frames: Vec::new(), wheels: [0.0; 2] }
+impl<'a, R: Shown> Recorder<'a, R> {
+    pub fn new(robot: &'a mut R) -> Recorder<'a, R> {
+        Recorder { robot, frames: Vec::new(), wheels: [0.0; 2] }
     }
 }
 
@@ -58,15 +85,20 @@ fn object_rows(scene: &Scene) -> Vec<[f32; 4]> {
         .collect()
 }
 
-impl Robot for Recorder<'_> {
+impl<R: Shown> Robot for Recorder<'_, R> {
     fn sense(&mut self, out: &mut [f32; CHANNELS]) {
-        self.sim.sense(out);
-        let scene = self.sim.scene();
+        self.robot.sense(out);
+        let scene = self.robot.scene();
         let mut irv = [0.0; ir::SENSORS];
         irv.copy_from_slice(&out[CH_IR..CH_IR + ir::SENSORS]);
+        let mut light = [0.0; ir::SENSORS];
+        light.copy_from_slice(&out[CH_LIGHT..CH_LIGHT + ir::SENSORS]);
         self.frames.push(Frame {
             ir: irv,
+            light,
             barrier: out[CH_BARRIER] > 0.5,
+            floor: out[CH_FLOOR],
+            lamp_distance: out[CH_LAMP_DISTANCE],
             arm_down: scene.arm_down,
             claw_closed: scene.claw_closed,
             wheels: self.wheels,
@@ -75,19 +107,19 @@ impl Robot for Recorder<'_> {
     }
     fn step(&mut self, cmd: &Command) -> Outcome {
         self.wheels = cmd.wheels;
-        self.sim.step(cmd)
+        self.robot.step(cmd)
     }
     fn alive(&self) -> bool {
-        self.sim.alive()
+        self.robot.alive()
     }
     fn battery(&self) -> f32 {
-        self.sim.battery()
+        self.robot.battery()
     }
     fn pose(&self) -> Pose {
-        self.sim.pose()
+        self.robot.pose()
     }
     fn holding(&self) -> Option<bool> {
-        Some(self.sim.holding())
+        self.robot.holding()
     }
 }
 
@@ -141,7 +173,15 @@ pub struct EpisodeColumns {
     pub performance: Vec<Vec<f32>>,
     /// Proximity readings the robot sensed after the action.
     pub ir: Vec<[f32; ir::SENSORS]>,
+    /// Ambient light readings the robot sensed after the action.
+    #[serde(default)]
+    pub light: Vec<[f32; ir::SENSORS]>,
     pub barrier: Vec<u8>,
+    /// The ground sensor and the sensed lamp distance after the action.
+    #[serde(default)]
+    pub floor: Vec<f32>,
+    #[serde(default)]
+    pub lamp_distance: Vec<f32>,
     pub arm_down: Vec<u8>,
     pub claw_closed: Vec<u8>,
     pub wheels: Vec<[f32; 2]>,
@@ -253,7 +293,10 @@ pub fn episode(
         for (k, f) in part.frames.iter().skip(1).enumerate() {
             let action = from + k as u32;
             c.ir.push(f.ir.map(|v| round(v, 3)));
+            c.light.push(f.light.map(|v| round(v, 3)));
             c.barrier.push(f.barrier as u8);
+            c.floor.push(round(f.floor, 3));
+            c.lamp_distance.push(round(f.lamp_distance, 3));
             c.arm_down.push(f.arm_down as u8);
             c.claw_closed.push(f.claw_closed as u8);
             c.wheels.push(f.wheels.map(|v| round(v, 3)));

@@ -568,31 +568,28 @@ fn print_text(text: &str) {
 }
 
 /// Checks every file, printing every diagnostic; the worst outcome decides the exit code.
+/// With `--error-format json`, one JSON object per file on stdout, good files included.
 fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     let mut worst: Option<CliError> = None;
     for file in files {
-        match load::load_program_warnings(file, format) {
+        let result = load::load_program_warnings(file, format);
+        if format == ErrorFormat::Json {
+            println!("{}", check_json(file, &result));
+        }
+        match result {
             Ok((program, warnings)) => {
-                // Warnings do not change the exit code.
-                match warnings {
-                    Some(w) if format == ErrorFormat::Json => println!("{}", w.trim_end()),
-                    Some(w) => eprintln!("{}", w.trim_end()),
-                    None => {}
-                }
                 if format != ErrorFormat::Json {
+                    // Warnings do not change the exit code.
+                    if let Some(w) = warnings {
+                        eprintln!("{}", w.trim_end());
+                    }
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();
                     println!("{}: ok ({})", file.display(), genes.join(", "));
                 }
             }
             Err(e) => {
-                if format == ErrorFormat::Json {
-                    if let CliError::Diagnostics(s) = &e {
-                        println!("{}", s.trim_end());
-                    } else {
-                        eprintln!("{e}");
-                    }
-                } else {
+                if format != ErrorFormat::Json {
                     eprintln!("{e}");
                 }
                 // I/O problems (exit 2) outrank diagnostics (exit 1).
@@ -608,4 +605,43 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
         Some(CliError::Diagnostics(_)) => Err(CliError::Diagnostics(String::new())),
         Some(CliError::Io(_)) => Err(CliError::Io(String::new())),
     }
+}
+
+/// The JSON object `check --error-format json` prints for one file: `file`
+/// and `ok` always; for a good file its stages and their genome bits; for a
+/// bad one the diagnostic (`message`, `severity`, `labels`, `related`, ...).
+fn check_json(
+    file: &std::path::Path,
+    result: &Result<(shaping_runtime::program::Program, Option<String>), CliError>,
+) -> String {
+    let name = file.display().to_string();
+    let value = match result {
+        Ok((program, warnings)) => {
+            let stages: Vec<serde_json::Value> = program
+                .stages
+                .iter()
+                .map(|s| serde_json::json!({"name": s.name, "bits": s.layout.bits}))
+                .collect();
+            let mut v = serde_json::json!({"file": name, "ok": true, "stages": stages});
+            // A good file's warnings: the diagnostic object of the warnings.
+            if let Some(w) = warnings {
+                v["warnings"] =
+                    serde_json::from_str(w).unwrap_or_else(|_| serde_json::Value::String(w.trim().into()));
+            }
+            v
+        }
+        Err(CliError::Diagnostics(text)) => match serde_json::from_str::<serde_json::Value>(text) {
+            Ok(serde_json::Value::Object(mut diagnostic)) => {
+                diagnostic.insert("file".into(), name.into());
+                diagnostic.insert("ok".into(), false.into());
+                serde_json::Value::Object(diagnostic)
+            }
+            _ => serde_json::json!({"file": name, "ok": false, "severity": "error", "message": text.trim()}),
+        },
+        Err(CliError::Io(msg)) => {
+            let msg = msg.trim().strip_prefix("error: ").unwrap_or(msg.trim());
+            serde_json::json!({"file": name, "ok": false, "severity": "error", "message": msg})
+        }
+    };
+    value.to_string()
 }

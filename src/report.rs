@@ -3,11 +3,13 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT};
 use shaping_runtime::controller::Trace;
 use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
+use crate::episode::{Episode, EpisodeColumns};
 use crate::load::{write_atomic, CliError};
 use crate::plot;
 
@@ -60,8 +62,78 @@ pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(),
         .map_err(|e| CliError::io(format!("error: {e}")))
 }
 
-/// `trace.csv`: one row per action.
-pub fn trace_csv(trace: &Trace) -> String {
+/// Where the value of one declared sensor or actuator element comes from in
+/// a recorded episode.
+#[derive(Clone, Copy)]
+enum Source {
+    Ir(usize),
+    Light(usize),
+    Battery,
+    Barrier,
+    Floor,
+    LampDistance,
+    Wheel(usize),
+    Arm,
+    Claw,
+}
+
+impl Source {
+    /// The value at action `k` (`NaN` where the episode has none).
+    fn at(self, c: &EpisodeColumns, k: usize) -> f32 {
+        let channel = |v: &[[f32; 8]], i: usize| v.get(k).and_then(|r| r.get(i)).copied();
+        let flag = |v: &[u8]| v.get(k).map(|&b| f32::from(b));
+        match self {
+            Source::Ir(i) => channel(&c.ir, i),
+            Source::Light(i) => channel(&c.light, i),
+            Source::Battery => c.battery.get(k).copied(),
+            Source::Barrier => flag(&c.barrier),
+            Source::Floor => c.floor.get(k).copied(),
+            Source::LampDistance => c.lamp_distance.get(k).copied(),
+            Source::Wheel(i) => c.wheels.get(k).map(|w| w[i.min(1)]),
+            Source::Arm => flag(&c.arm_down),
+            Source::Claw => flag(&c.claw_closed),
+        }
+        .unwrap_or(f32::NAN)
+    }
+}
+
+/// The columns of the robot's declared sensors and actuators, one per
+/// element, named `NAME[i]` after the declaration (also a single-valued one:
+/// `battery[0]`, so no name can be one of the fixed columns).
+fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
+    let mut out = Vec::new();
+    for s in &stage.sensors {
+        for i in 0..s.count as usize {
+            let ch = s.channel as usize + i;
+            let source = match s.kind {
+                SensorKind::Proximity => Source::Ir(ch.saturating_sub(CH_IR)),
+                SensorKind::Ambient => Source::Light(ch.saturating_sub(CH_LIGHT)),
+                SensorKind::Level => Source::Battery,
+                SensorKind::Optical => Source::Barrier,
+                SensorKind::Ground => Source::Floor,
+                SensorKind::LampDistance => Source::LampDistance,
+            };
+            out.push((format!("{}[{i}]", s.name), source));
+        }
+    }
+    for a in &stage.actuators {
+        let sources: &[Source] = match a.kind {
+            ActuatorKind::Speed => &[Source::Wheel(0), Source::Wheel(1)],
+            ActuatorKind::Lift => &[Source::Arm],
+            ActuatorKind::Grip => &[Source::Claw],
+        };
+        out.extend(sources.iter().enumerate().map(|(i, &src)| (format!("{}[{i}]", a.name), src)));
+    }
+    out
+}
+
+/// `trace.csv`: one row per action: what the controller did (the winner,
+/// activations, reinforcements, performance indicators), where the robot
+/// went, and, named after the robot's declarations, what each sensor read
+/// after the action and what each actuator was set to (from the recorded
+/// `episode`, `NaN` where it has no value).
+pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
+    let declared = declared_columns(stage);
     let mut s =
         String::from("action,winner,battery,holding,grips,releases_outside,recharged,collided,x,y,theta");
     for m in &trace.modules {
@@ -73,8 +145,11 @@ pub fn trace_csv(trace: &Trace) -> String {
     for m in &trace.modules {
         let _ = write!(s, ",perf_{m}");
     }
+    for (name, _) in &declared {
+        let _ = write!(s, ",{name}");
+    }
     s.push('\n');
-    for r in &trace.rows {
+    for (k, r) in trace.rows.iter().enumerate() {
         let winner = trace.modules.get(r.winner as usize).map_or("", |m| m.as_str());
         let _ = write!(
             s,
@@ -94,6 +169,9 @@ pub fn trace_csv(trace: &Trace) -> String {
         for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
             let _ = write!(s, ",{v:.4}");
         }
+        for (_, source) in &declared {
+            let _ = write!(s, ",{:.4}", source.at(&episode.actions, k));
+        }
         s.push('\n');
     }
     s
@@ -102,16 +180,18 @@ pub fn trace_csv(trace: &Trace) -> String {
 /// Writes `trace.csv` and the pictures of one episode into `dir`:
 /// `activations` (figure 11), `reinforcement` (figures 5, 10, 13) for every
 /// learning module, and `trajectory`.
+#[allow(clippy::too_many_arguments)]
 pub fn episode_files(
     dir: &Path,
     title: &str,
     stage: &Stage,
     trace: &Trace,
+    episode: &Episode,
     scene: &Scene,
     marks: &[(u32, String)],
 ) -> Result<(), CliError> {
     let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
-    write_atomic(&dir.join("trace.csv"), trace_csv(trace).as_bytes())?;
+    write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());
     }

@@ -3,6 +3,8 @@
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -92,6 +94,37 @@ pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evalua
     }
 }
 
+/// The error for a saved result (checkpoint or trained weights) that does
+/// not belong to the program as it is now.
+fn stale(path: &Path, e: &evolve::EvolveError) -> CliError {
+    let hint = match e {
+        evolve::EvolveError::TooManyGenerations { done, .. } => {
+            format!("declare at least {done} generations, pass `--fresh` to start again, or choose another `--out`")
+        }
+        _ => "pass `--fresh` to start again, or choose another `--out`".to_string(),
+    };
+    CliError::io(format!("error: cannot resume from `{}`: {e}; {hint}", path.display()))
+}
+
+/// Ctrl-C (or SIGTERM) during a run in one process: the generation under
+/// way finishes and is saved, then the run stops saying where; a second
+/// Ctrl-C ends it at once. (On a robot the robot's own handler stops the
+/// motors first, so there the second one does not end the process.)
+fn interrupt_flag(exit_on_second: bool) -> Option<Arc<AtomicBool>> {
+    static FLAG: OnceLock<Option<Arc<AtomicBool>>> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+            if exit_on_second {
+                signal_hook::flag::register_conditional_shutdown(sig, 2, Arc::clone(&flag)).ok()?;
+            }
+            signal_hook::flag::register(sig, Arc::clone(&flag)).ok()?;
+        }
+        Some(flag)
+    })
+    .clone()
+}
+
 fn ckpt_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.json")
 }
@@ -135,18 +168,33 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
         .build()
         .map_err(|e| CliError::io(format!("error: cannot start worker threads: {e}")))?;
     create_dir(&out)?;
+    let interrupted = if cluster.is_none() { interrupt_flag(args.robot.is_none()) } else { None };
     // The compiled program, for `shaping report` (and `shaping run program.json`).
     write_atomic(&out.join("program.json"), compact_json(&program)?.as_bytes())?;
     let started = Instant::now();
     let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
+    // What each stage ended with, for the last line of `--json`.
+    let mut results = Vec::new();
     for &index in &stages {
+        // Ctrl-C during a training life, a test or the choice of a best: the
+        // step under way finished and is saved; stop before the next.
+        if interrupted.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            return Err(CliError::io(format!(
+                "interrupted: stopped before stage `{}`; what ran is saved in `{}`, and the same command resumes",
+                program.stages[index].name,
+                out.display()
+            )));
+        }
         if let StageRun::Train { .. } = program.stages[index].run {
             let dir = out.join(&program.stages[index].name);
             create_dir(&dir)?;
             let trained = train_step(&program, index, seed, &dir, &args)?;
-            train_episode(&program.stages[index], index, seed, &dir)?;
             evolve::train::bind(&mut program, index, &trained)
                 .map_err(|e| CliError::io(format!("error: {e}")))?;
+            results.push(serde_json::json!({
+                "stage": program.stages[index].name, "kind": "train",
+                "actions": trained.result.actions, "performance": trained.performance,
+            }));
             continue;
         }
         let stage = &program.stages[index];
@@ -156,25 +204,40 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
             StageRun::Evolve(_) => {
                 let parent = evolved_parent(&program, index, &finals)?;
                 let cp = match cluster {
-                    None => {
-                        pool.install(|| evolve_stage(&program, index, seed, parent, &dir, &args, None))?
-                    }
+                    None => pool.install(|| {
+                        evolve_stage(&program, index, seed, parent, &dir, &args, None, interrupted.as_deref())
+                    })?,
                     // The coordinator's loop calls MPI, so it stays on this thread.
-                    Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c))?,
+                    Some(c) => evolve_stage(&program, index, seed, parent, &dir, &args, Some(c), None)?,
                 };
                 best_episode(stage, &cp, seed, &dir)?;
+                if let Some((genome, fitness)) = evolve::best_of(&cp) {
+                    results.push(serde_json::json!({
+                        "stage": stage.name, "kind": "evolve", "generations": cp.generation,
+                        "best": fitness, "genome": genome.to_bitstring(),
+                    }));
+                }
                 finals[index] = Some(cp);
             }
             StageRun::Test { actions, learning } => {
                 let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
                     CliError::io(format!("error: test stage `{}` extends no evolved stage", stage.name))
                 })?;
-                test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+                let summary = test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+                results.push(serde_json::json!({"kind": "test", "summary": summary, "stage": stage.name}));
             }
             StageRun::Train { .. } => unreachable!("training stages run above"),
         }
     }
     let report = if args.no_report { None } else { Some(html::write(&out, None)?) };
+    if args.json {
+        let line = serde_json::json!({
+            "done": true, "out": out.display().to_string(), "seed": seed,
+            "seconds": started.elapsed().as_secs_f64(), "stages": results,
+            "report": report.as_ref().map(|p| p.display().to_string()),
+        });
+        println!("{line}");
+    }
     if !args.quiet && !args.json {
         eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), out.display());
         if let Some(path) = report {
@@ -186,17 +249,6 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
 
 fn compact_json<T: serde::Serialize>(value: &T) -> Result<String, CliError> {
     serde_json::to_string(value).map_err(|e| CliError::io(format!("error: cannot serialise: {e}")))
-}
-
-/// `episode.json` of a training stage: its life recorded again, the same
-/// life as `evolve::train_stage`'s (the same episode seed and genome).
-fn train_episode(stage: &Stage, index: usize, seed: u64, dir: &Path) -> Result<(), CliError> {
-    let StageRun::Train { actions } = stage.run else { return Ok(()) };
-    let opts = EpisodeOptions { actions, learning: true, seed: evolve::train::training_seed(seed, index) };
-    let genome = Genome::zeros(stage.layout.bits as usize);
-    let (_, _, ep) =
-        episode::run_recorded(stage, &genome, &opts).map_err(|e| CliError::io(format!("error: {e}")))?;
-    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
 }
 
 /// `episode.json` of an evolved stage: one recorded episode of its best
@@ -229,6 +281,7 @@ fn evolved_parent<'a>(
     Ok(None)
 }
 
+#[allow(clippy::too_many_arguments)]
 fn evolve_stage(
     program: &Program,
     index: usize,
@@ -237,26 +290,37 @@ fn evolve_stage(
     dir: &Path,
     args: &RunArgs,
     cluster: Option<&Coordinator>,
+    interrupted: Option<&AtomicBool>,
 ) -> Result<Checkpoint, CliError> {
     let stage = &program.stages[index];
     let StageRun::Evolve(evo) = &stage.run else { unreachable!("evolve_stage is called for evolved stages") };
     let path = ckpt_path(dir);
     let existing = if args.fresh { None } else { read_checkpoint(&path)? };
     let mut cp = match existing {
-        Some(cp) => {
-            evolve::check_resume(program, &cp).map_err(|e| {
-                CliError::io(format!(
-                    "error: cannot resume from `{}`: {e}; pass `--fresh` (or another `--out`) to start again",
-                    path.display()
-                ))
-            })?;
-            if cp.stage != index || cp.seed != seed {
+        Some(mut cp) => {
+            if cp.seed != seed {
                 return Err(CliError::io(format!(
-                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it or `--fresh` to start again",
+                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it, `--fresh` to start again, or another `--out`",
                     path.display(),
                     cp.seed,
                     cp.seed
                 )));
+            }
+            evolve::resume(program, index, &mut cp).map_err(|e| stale(&path, &e))?;
+            if !args.quiet && !args.json {
+                if evolve::is_finished(program, &cp) && cp.validated {
+                    eprintln!(
+                        "stage {:<12} all {} generations done before, from {}",
+                        stage.name,
+                        cp.generation,
+                        path.display()
+                    );
+                } else {
+                    eprintln!(
+                        "resuming `{}` at generation {} of {}",
+                        stage.name, cp.generation, evo.generations
+                    );
+                }
             }
             cp
         }
@@ -270,7 +334,10 @@ fn evolve_stage(
         .map_err(|e| CliError::io(format!("error: stage `{}` cannot run: {e}", stage.name)))?;
     let bar = progress_bar(args, stage, evo.generations, cp.generation);
     let sim_eval = evaluator(stage, evo.actions);
-    let robot_eval = args.robot.as_ref().map(|r| r.evaluator(stage, evo.actions, dir)).transpose()?;
+    // The robot's episode log is tied to the stage as the checkpoint is.
+    let digest = evolve::fingerprint::digest(&cp.fingerprint);
+    let robot_eval =
+        args.robot.as_ref().map(|r| r.evaluator(stage, evo.actions, dir, digest, args.fresh)).transpose()?;
     let eval: &(dyn Fn(&Genome, u64) -> Evaluation + Sync) = match &robot_eval {
         Some(e) => e,
         None => &sim_eval,
@@ -293,6 +360,16 @@ fn evolve_stage(
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats);
+        if interrupted.is_some_and(|f| f.load(Ordering::Relaxed)) && !evolve::is_finished(program, &cp) {
+            bar.abandon();
+            return Err(CliError::io(format!(
+                "interrupted: stage `{}` stopped after generation {} of {}, saved in `{}`; the same command resumes it",
+                stage.name,
+                cp.generation,
+                evo.generations,
+                path.display()
+            )));
+        }
     }
     bar.finish_and_clear();
     if !cp.validated {
@@ -395,7 +472,7 @@ fn test_stage(
     learning: bool,
     dir: &Path,
     args: &RunArgs,
-) -> Result<(), CliError> {
+) -> Result<serde_json::Value, CliError> {
     let stage = &program.stages[index];
     let eval = |genome: &Genome, episode: u64| {
         Evaluation::of_episode(run_episode(
@@ -411,7 +488,7 @@ fn test_stage(
     let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
     let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
     let mark = [(ba.switch, format!("world of `{}`", stage.name))];
-    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.scene, &mark)?;
+    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.episode, &ba.scene, &mark)?;
     write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
     let perf = |r: &EpisodeResult| {
@@ -444,7 +521,7 @@ fn test_stage(
             dir.display()
         );
     }
-    Ok(())
+    Ok(summary)
 }
 
 /// Mean reinforcement of each learning module over the life before the world
@@ -514,20 +591,33 @@ fn train_step(
     let path = dir.join("trained.json");
     if !args.fresh {
         if let Some(t) = read_trained(&path)? {
-            if t.fingerprint == evolve::train::training_fingerprint(stage) && t.run_seed == seed {
-                if !args.quiet && !args.json {
-                    eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
-                }
-                return Ok(t);
+            if t.run_seed != seed {
+                return Err(CliError::io(format!(
+                    "error: `{}` belongs to a run with seed {} (this run has seed {seed}); pass `--seed {}` to resume it, `--fresh` to start again, or another `--out`",
+                    path.display(),
+                    t.run_seed,
+                    t.run_seed
+                )));
             }
+            evolve::train::check(program, index, &t).map_err(|e| stale(&path, &e))?;
+            if !args.quiet && !args.json {
+                eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
+            }
+            return Ok(t);
         }
     }
-    let mut trace = Trace::default();
-    let trained = evolve::train_stage(program, index, seed, Some(&mut trace))
+    let trained =
+        evolve::train_stage(program, index, seed, None).map_err(|e| CliError::io(format!("error: {e}")))?;
+    // The same life recorded again (the same episode seed and genome), for
+    // `trace.csv`, the pictures and `episode.json`.
+    let StageRun::Train { actions } = stage.run else { unreachable!("train_step runs training stages") };
+    let episode_seed = evolve::train::training_seed(seed, index);
+    let opts = EpisodeOptions { actions, learning: true, seed: episode_seed };
+    let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
-    let (sim_seed, _) = episode_rngs(evolve::train::training_seed(seed, index));
-    let scene = Sim::new(&stage.world, sim_seed).scene();
-    report::episode_files(dir, &stage.name, stage, &trace, &scene, &[])?;
+    let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
+    report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
     write_atomic(&path, to_json(&trained)?.as_bytes())?;
     if args.json {
         println!(
@@ -569,17 +659,35 @@ fn read_trained(path: &Path) -> Result<Option<evolve::Trained>, CliError> {
 }
 
 /// Binds the weights of every training stage into `program`: from the
-/// `trained.json` files of run directory `run_dir` where they exist and fit,
-/// else by training again from `seed` (training is deterministic by seed).
-pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -> Result<(), CliError> {
+/// `trained.json` files of run directory `run_dir` where they exist and fit
+/// (a stale one is said and not used), else by training again from `seed`
+/// (training is deterministic by seed). Returns what each training stage
+/// learned. Every command that runs a stage of a file binds through here
+/// (`run` binds each training stage as it runs it).
+pub fn bind_training(
+    program: &mut Program,
+    run_dir: Option<&Path>,
+    seed: u64,
+) -> Result<Vec<(usize, evolve::Trained)>, CliError> {
+    let mut all = Vec::new();
     for i in 0..program.stages.len() {
         if !matches!(program.stages[i].run, StageRun::Train { .. }) {
             continue;
         }
-        let stage = &program.stages[i];
         let saved = match run_dir {
-            Some(d) => read_trained(&d.join(&stage.name).join("trained.json"))?
-                .filter(|t| t.fingerprint == evolve::train::training_fingerprint(stage)),
+            Some(d) => {
+                let path = d.join(&program.stages[i].name).join("trained.json");
+                match read_trained(&path)? {
+                    Some(t) => match evolve::train::check(program, i, &t) {
+                        Ok(()) => Some(t),
+                        Err(e) => {
+                            eprintln!("note: not using `{}`: {e}; training the stage again", path.display());
+                            None
+                        }
+                    },
+                    None => None,
+                }
+            }
             None => None,
         };
         let trained = match saved {
@@ -588,8 +696,9 @@ pub fn bind_training(program: &mut Program, run_dir: Option<&Path>, seed: u64) -
                 .map_err(|e| CliError::io(format!("error: {e}")))?,
         };
         evolve::train::bind(program, i, &trained).map_err(|e| CliError::io(format!("error: {e}")))?;
+        all.push((i, trained));
     }
-    Ok(())
+    Ok(all)
 }
 
 #[cfg(test)]

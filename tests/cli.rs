@@ -111,8 +111,11 @@ fn check_prints_warnings_and_exits_0() {
     let json = run(shaping().arg("check").arg(&file).arg("--error-format").arg("json"));
     assert_eq!(json.status.code(), Some(0));
     let first = text(&json.stdout).lines().next().unwrap_or_default().to_string();
+    // One object per file: the good file's, its warnings inside.
     let v: serde_json::Value = serde_json::from_str(&first).unwrap();
-    assert_eq!(v["related"][0]["severity"], "warning", "{v}");
+    assert_eq!(text(&json.stdout).lines().count(), 1, "{}", text(&json.stdout));
+    assert_eq!(v["ok"], true, "{v}");
+    assert_eq!(v["warnings"]["related"][0]["severity"], "warning", "{v}");
 }
 
 #[test]
@@ -257,10 +260,11 @@ fn run_writes_statistics_genomes_and_plots_and_is_deterministic() {
     assert!(run_tiny(&a, &["--jobs", "1"]).status.success());
     let out = run(shaping().arg("run").arg(tiny()).arg("--out").arg(&b).args(["--jobs", "2", "--json"]));
     assert!(out.status.success(), "{}", text(&out.stderr));
-    // One JSON line per generation: 6 + 4.
+    // One JSON line per generation: 6 + 4, then the end of the run.
     let lines: Vec<serde_json::Value> =
         text(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
-    assert_eq!(lines.len(), 10);
+    assert_eq!(lines.len(), 11);
+    assert_eq!(lines[10]["done"], true);
     assert_eq!(lines[9]["generation"], 9);
     for stage in ["first", "second"] {
         for f in ["generations.csv", "best.genome", "checkpoint.json", "fitness.svg", "fitness.png"] {
@@ -589,6 +593,337 @@ fn run_under_an_mpi_launcher_without_mpi_support_refuses() {
         .arg("--quiet")
         .env("OMPI_COMM_WORLD_SIZE", "1"));
     assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+// ------------------------------------------------------------ trust (issue 19)
+
+/// The issue's file: two scripted modules, links evolved.
+const EDITED: &str = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s {
+  evolve { population 20  generations 5  actions 100  seed 1 }
+  fitness per action wheels[0]
+  module m { sense ir  behavior forward }
+  module n { sense ir  behavior turn left }
+  links all evolvable
+}
+";
+
+fn run_file(file: &Path, out: &Path, extra: &[&str]) -> Output {
+    run(shaping().arg("run").arg(file).arg("--out").arg(out).arg("--no-report").args(extra))
+}
+
+/// Editing anything a checkpoint depends on makes the run refuse it, saying
+/// what changed; `--fresh` starts again and shows the new result. Fewer
+/// generations than the checkpoint holds are refused naming both numbers;
+/// more continue it to the result of a straight run, saying so.
+#[test]
+fn an_edited_file_is_not_resumed_from_its_old_checkpoint() {
+    let dir = scratch("edited");
+    let file = dir.join("s.bat");
+    let out = dir.join("out");
+    std::fs::write(&file, EDITED).unwrap();
+    let first = run_file(&file, &out, &[]);
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    let again = run_file(&file, &out, &[]);
+    assert!(text(&again.stderr).contains("all 5 generations done before"), "{}", text(&again.stderr));
+
+    for (edit, what) in [
+        (
+            EDITED.replace("per action wheels[0]", "per action wheels[0] * 0.5 + 7"),
+            "the fitness of `s` changed",
+        ),
+        (EDITED.replace("behavior turn left", "behavior turn right"), "the modules of `s` changed"),
+        (
+            EDITED.replace("stage s {", "stage s {\n  world { arena 800mm x 800mm }"),
+            "the world of `s` changed",
+        ),
+    ] {
+        std::fs::write(&file, &edit).unwrap();
+        let stale = run_file(&file, &out, &[]);
+        assert_eq!(stale.status.code(), Some(2));
+        let err = text(&stale.stderr);
+        assert!(err.contains("cannot resume from") && err.contains("checkpoint.json"), "{err}");
+        assert!(err.contains(what) && err.contains("`--fresh`") && err.contains("`--out`"), "{err}");
+    }
+    // Nor does `replay` take the run's best for the edited stage.
+    let replay =
+        run(shaping().arg("replay").arg(&file).arg("--run").arg(&out).arg("--out").arg(dir.join("r")));
+    assert_eq!(replay.status.code(), Some(2));
+    let err = text(&replay.stderr);
+    assert!(err.contains("is not of this program") && err.contains("the world of `s` changed"), "{err}");
+    // The last edit, started again: the fitness is that of the edited file.
+    std::fs::write(&file, EDITED.replace("per action wheels[0]", "per action wheels[0] * 0.5 + 7")).unwrap();
+    let fresh = run_file(&file, &out, &["--fresh", "--json"]);
+    assert!(fresh.status.success(), "{}", text(&fresh.stderr));
+    let last: serde_json::Value = serde_json::from_str(text(&fresh.stdout).lines().last().unwrap()).unwrap();
+    let best = last["stages"][0]["best"].as_f64().unwrap();
+    assert!(best > 700.0, "100 actions of at least 7: {best}");
+
+    std::fs::write(&file, EDITED.replace("generations 5", "generations 4")).unwrap();
+    let fewer = run_file(&file, &dir.join("fewer"), &[]);
+    assert!(fewer.status.success());
+    std::fs::write(&file, EDITED.replace("generations 5", "generations 3")).unwrap();
+    let cut = run_file(&file, &dir.join("fewer"), &[]);
+    assert_eq!(cut.status.code(), Some(2));
+    let err = text(&cut.stderr);
+    assert!(err.contains("holds 4 generations of stage `s`, which now declares 3"), "{err}");
+
+    std::fs::write(&file, EDITED.replace("generations 5", "generations 7")).unwrap();
+    let more = run_file(&file, &dir.join("fewer"), &[]);
+    assert!(text(&more.stderr).contains("resuming `s` at generation 4 of 7"), "{}", text(&more.stderr));
+    assert!(run_file(&file, &dir.join("straight"), &[]).status.success());
+    let ckpt = |d: &str| std::fs::read(dir.join(d).join("s/checkpoint.json")).unwrap();
+    assert!(ckpt("fewer") == ckpt("straight"), "the extended run differs from the straight run");
+}
+
+/// `trained.json` is tied to its training stage the same way.
+#[test]
+fn stale_trained_weights_are_refused() {
+    let dir = scratch("stale-trained");
+    let source = std::fs::read_to_string(root().join("examples/pretrained.bat")).unwrap();
+    let file = dir.join("p.bat");
+    std::fs::write(&file, &source).unwrap();
+    let first = run_file(&file, &dir.join("out"), &["--stage", "avoidance"]);
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    std::fs::write(&file, source.replace("train for 1000 actions", "train for 900 actions")).unwrap();
+    let stale = run_file(&file, &dir.join("out"), &["--stage", "avoidance"]);
+    assert_eq!(stale.status.code(), Some(2));
+    let err = text(&stale.stderr);
+    assert!(err.contains("trained.json") && err.contains("the settings of `avoidance` changed"), "{err}");
+}
+
+/// Ctrl-C lets the generation under way finish and be saved, and says where
+/// the run stopped; the same command resumes it, saying so.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_says_where_the_run_stopped_and_it_resumes() {
+    let dir = scratch("ctrl-c");
+    let file = dir.join("s.bat");
+    std::fs::write(&file, EDITED.replace("generations 5", "generations 1000")).unwrap();
+    let out = dir.join("out");
+    let child = shaping()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .args(["--no-report", "--jobs", "1"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !out.join("s/checkpoint.json").exists() {
+        assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let kill = run(Command::new("kill").args(["-INT", &child.id().to_string()]));
+    assert!(kill.status.success());
+    let done = child.wait_with_output().unwrap();
+    assert_eq!(done.status.code(), Some(2));
+    let err = text(&done.stderr);
+    let at = err.find("interrupted: stage `s` stopped after generation ").unwrap_or_else(|| panic!("{err}"));
+    let generation: u32 =
+        err[at..].split("generation ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(err.contains("of 1000, saved in") && err.contains("the same command resumes it"), "{err}");
+    std::fs::write(&file, EDITED.replace("generations 5", &format!("generations {}", generation + 1)))
+        .unwrap();
+    let resumed = run_file(&file, &out, &[]);
+    assert!(resumed.status.success(), "{}", text(&resumed.stderr));
+    assert!(
+        text(&resumed.stderr).contains(&format!("resuming `s` at generation {generation}")),
+        "{}",
+        text(&resumed.stderr)
+    );
+}
+
+/// A checkpoint with a bit that is not 0 or 1 is refused naming the file and
+/// the place; so is a genome argument or file that is not a bit string.
+#[test]
+fn bad_bits_and_genomes_are_refused_naming_where() {
+    let dir = scratch("bits");
+    assert!(run_tiny(&dir, &[]).status.success());
+    let path = dir.join("first/checkpoint.json");
+    let mut cp: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    cp["population"][3]["bits"][5] = serde_json::json!(2);
+    std::fs::write(&path, serde_json::to_vec(&cp).unwrap()).unwrap();
+    let out = run_tiny(&dir, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(err.contains("first/checkpoint.json") && err.contains("bit 5 of individual 3 is 2"), "{err}");
+
+    let replay = |genome: &str| {
+        run(shaping().arg("replay").arg(tiny()).args(["--stage", "first", "--genome", genome]))
+    };
+    let out = replay("2101");
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(err.contains("`--genome 2101` is not a genome: character 1 is `2`"), "{err}");
+    assert!(!err.contains("cannot read"), "not read as a file: {err}");
+    let file = dir.join("g.genome");
+    std::fs::write(&file, "0101\n0171\n").unwrap();
+    let out = replay(file.to_str().unwrap());
+    let err = text(&out.stderr);
+    assert!(err.contains("g.genome` does not hold a genome: line 2, column 3 is `7`"), "{err}");
+    let out = replay("no-such-file");
+    let err = text(&out.stderr);
+    assert!(err.contains("`--genome no-such-file` is neither a string of 0 and 1"), "{err}");
+}
+
+/// Replaying a training stage of a run replays its training life.
+#[test]
+fn replay_of_a_training_stage_replays_its_life() {
+    let dir = scratch("replay-training");
+    let file = root().join("examples/pretrained.bat");
+    let out = dir.join("out");
+    let first = run_file(&file, &out, &["--stage", "avoidance", "--seed", "5"]);
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    let life = run(shaping()
+        .arg("replay")
+        .arg(&file)
+        .args(["--stage", "avoidance", "--run"])
+        .arg(&out)
+        .arg("--out")
+        .arg(dir.join("life")));
+    assert!(life.status.success(), "{}", text(&life.stderr));
+    let trained: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("avoidance/trained.json")).unwrap()).unwrap();
+    let r = &trained["result"];
+    let said = text(&life.stdout);
+    let expected = format!(
+        "avoidance: {} actions, fitness {:.3}, {} grips, {} released outside, {} recharges, {} collisions",
+        r["actions"],
+        r["fitness"].as_f64().unwrap(),
+        r["grips"],
+        r["releases_outside"],
+        r["recharges"],
+        r["collisions"]
+    );
+    assert!(said.starts_with(&expected), "{said} is not the training life: {expected}");
+    let trace = std::fs::read_to_string(dir.join("life/trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "perf_avoid").unwrap();
+    let last: f64 = trace.lines().last().unwrap().split(',').nth(col).unwrap().parse().unwrap();
+    let learned = trained["performance"][1].as_f64().unwrap();
+    assert!((last - learned).abs() < 1e-3, "performance {last} at the end of the replay, {learned} trained");
+}
+
+/// Every command that runs a stage binds the trained weights the same way:
+/// `replay` of every stage of every example (the training stages trained
+/// on the fly, no run directory needed).
+#[test]
+fn replay_runs_every_stage_of_every_example() {
+    let dir = scratch("every-stage");
+    for example in std::fs::read_dir(root().join("examples")).unwrap() {
+        let file = example.unwrap().path();
+        if file.extension().is_none_or(|e| e != "bat") {
+            continue;
+        }
+        for (stage, bits) in stages_of(&file, &dir.join("program.json")) {
+            // In an empty directory: no `runs/` of an earlier run is used.
+            let out = run(shaping()
+                .current_dir(&dir)
+                .arg("replay")
+                .arg(&file)
+                .args(["--stage", &stage, "--actions", "5", "--genome", &"0".repeat(bits)])
+                .arg("--out")
+                .arg(dir.join("r")));
+            assert!(out.status.success(), "{} {stage}: {}", file.display(), text(&out.stderr));
+        }
+    }
+}
+
+/// The stages of a file and their genome lengths.
+fn stages_of(file: &Path, built: &Path) -> Vec<(String, usize)> {
+    let out = run(shaping().arg("build").arg(file).arg("-o").arg(built));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let program: serde_json::Value = serde_json::from_slice(&std::fs::read(built).unwrap()).unwrap();
+    program["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| (s["name"].as_str().unwrap().to_string(), s["layout"]["bits"].as_u64().unwrap() as usize))
+        .collect()
+}
+
+/// `check --error-format json` prints one object per file, good files
+/// included; `run --json` ends with the chosen best of every stage, also
+/// for a run that had nothing left to do.
+#[test]
+fn machine_readable_output_covers_every_file_and_the_end_of_a_run() {
+    let dir = scratch("json");
+    let bad = dir.join("bad.bat");
+    std::fs::write(
+        &bad,
+        "robot r { sensor ir[8] proximty }\nstage s { module m { sense ir  behavior forward(1) } }\n",
+    )
+    .unwrap();
+    let out = run(shaping()
+        .args(["check", "--error-format", "json"])
+        .arg(tiny())
+        .arg(&bad)
+        .arg(dir.join("none.bat")));
+    assert_eq!(out.status.code(), Some(2));
+    let lines: Vec<serde_json::Value> =
+        text(&out.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 3, "{}", text(&out.stdout));
+    assert_eq!(lines[0]["ok"], true);
+    assert_eq!(lines[0]["stages"][1]["name"], "second");
+    assert!(lines[0]["file"].as_str().unwrap().ends_with("tiny.bat"));
+    assert_eq!(lines[1]["ok"], false);
+    assert!(lines[1]["related"][0]["message"].as_str().unwrap().contains("proximty"), "{}", lines[1]);
+    assert_eq!(lines[2]["ok"], false);
+    assert!(lines[2]["message"].as_str().unwrap().contains("cannot read"), "{}", lines[2]);
+
+    for pass in 0..2 {
+        let out = run_tiny(&dir.join("run"), &["--json", "--no-report"]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let last: serde_json::Value =
+            serde_json::from_str(text(&out.stdout).lines().last().unwrap()).unwrap();
+        assert_eq!(last["done"], true, "pass {pass}: {last}");
+        let stages = last["stages"].as_array().unwrap();
+        assert_eq!(stages.len(), 2);
+        let best = std::fs::read_to_string(dir.join("run/second/best.genome")).unwrap();
+        assert_eq!(stages[1]["genome"].as_str().unwrap(), best.trim());
+        assert!(stages[1]["best"].as_f64().is_some());
+    }
+}
+
+/// `trace.csv` has a column per declared sensor and actuator element, named
+/// after the declaration, and `episode.json` the ambient light readings.
+#[test]
+fn the_trace_has_what_the_robot_sensed_and_did() {
+    let dir = scratch("trace-columns");
+    let out = run(shaping()
+        .arg("replay")
+        .arg(tiny())
+        .args(["--stage", "first", "--actions", "30", "--genome", &"0".repeat(84), "--out"])
+        .arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let trace = std::fs::read_to_string(dir.join("trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> =
+        trace.lines().skip(1).map(|l| l.split(',').skip(2).map(|v| v.parse().unwrap()).collect()).collect();
+    let col =
+        |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no `{name}`")) - 2;
+    let episode: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("episode.json")).unwrap()).unwrap();
+    let light = episode["actions"]["light"].as_array().unwrap();
+    assert_eq!(light.len(), rows.len());
+    for (k, row) in rows.iter().enumerate() {
+        for i in 0..8 {
+            let ir = episode["actions"]["ir"][k][i].as_f64().unwrap();
+            assert!((row[col(&format!("ir[{i}]"))] - ir).abs() < 1e-3, "ir[{i}] at {k}");
+            assert!((row[col(&format!("light[{i}]"))] - light[k][i].as_f64().unwrap()).abs() < 1e-3);
+        }
+        assert_eq!(row[col("battery[0]")], row[col("battery")]);
+        for i in 0..2 {
+            let w = episode["actions"]["wheels"][k][i].as_f64().unwrap();
+            assert!((row[col(&format!("wheels[{i}]"))] - w).abs() < 1e-3);
+        }
+    }
+    // The lamp lights the arena: the light readings are not all zero.
+    assert!(rows.iter().any(|r| r[col("light[0]")] > 0.0));
+    assert!(rows.iter().any(|r| r[col("wheels[0]")] != 0.0));
 }
 
 /// Every regular file under `dir`, relative to it, sorted, with its bytes

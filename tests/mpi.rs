@@ -152,16 +152,22 @@ fn rank_pid(mpirun: u32, rank: usize) -> Option<u32> {
     None
 }
 
-/// Starts `mpirun -n 3` on the long run, waits for `generations` JSON lines,
-/// sends `signal` to rank `rank` and returns rank 0's stderr and the exit status.
-fn disturb(out: &Path, rank: usize, signal: &str, generations: usize) -> (String, u32, bool) {
+/// Starts `mpirun -n 3` on the long run with `--rank-timeout timeout`,
+/// waits for `generations` JSON lines, sends `signal` to rank `rank` and
+/// returns rank 0's stderr and the exit status.
+///
+/// The timeout must be long enough for a healthy rank's batch on a loaded
+/// machine (25 episodes of 1000 actions, a fraction of a second unloaded):
+/// with 3 s, a CI machine busy with other builds could time out a healthy
+/// rank before the disturbed one, and the message named the wrong rank.
+fn disturb(out: &Path, rank: usize, signal: &str, generations: usize, timeout: u64) -> (String, u32, bool) {
     let long = root().join("tests/mpi/long.bat");
     let mut child: Child = mpirun(3)
         .arg("run")
         .arg(&long)
         .arg("--out")
         .arg(out)
-        .args(["--json", "--rank-timeout", "3"])
+        .args(["--json", "--rank-timeout", &timeout.to_string()])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -177,9 +183,9 @@ fn disturb(out: &Path, rank: usize, signal: &str, generations: usize) -> (String
         if let Some(s) = child.try_wait().unwrap() {
             break s;
         }
-        if started.elapsed() > Duration::from_secs(60) {
+        if started.elapsed() > Duration::from_secs(timeout + 120) {
             let _ = child.kill();
-            panic!("mpirun still runs 60 s after rank {rank} got {signal}");
+            panic!("mpirun still runs {} s after rank {rank} got {signal}", timeout + 120);
         }
         std::thread::sleep(Duration::from_millis(50));
     };
@@ -199,7 +205,8 @@ fn straight(dir: &Path) -> PathBuf {
 fn a_dead_rank_is_named_and_the_checkpoint_resumes_on_other_ranks() {
     let dir = scratch("dead");
     let out = dir.join("mpi");
-    let (err, pid, success) = disturb(&out, 2, "-KILL", 3);
+    // A death is seen at once (mpirun ends the other ranks): no timeout needed.
+    let (err, pid, success) = disturb(&out, 2, "-KILL", 3, 600);
     assert!(!success, "the run succeeded with a dead rank:\n{err}");
     // Under load mpirun may take another rank down before rank 0 notices the
     // dead one: the message then names both ("error: rank 1 (...), rank 2
@@ -212,14 +219,18 @@ fn a_dead_rank_is_named_and_the_checkpoint_resumes_on_other_ranks() {
     assert_same_files(&straight(&dir), &out);
 }
 
+/// The `--rank-timeout` of the hung-rank test: the time the test waits for
+/// the stopped rank to be named, and far longer than a healthy batch takes.
+const HUNG_TIMEOUT: u64 = 20;
+
 #[test]
 fn a_hung_rank_times_out_and_the_checkpoint_resumes_on_one_process() {
     let dir = scratch("hung");
     let out = dir.join("mpi");
-    let (err, pid, success) = disturb(&out, 1, "-STOP", 2);
+    let (err, pid, success) = disturb(&out, 1, "-STOP", 2, HUNG_TIMEOUT);
     assert!(!success, "the run succeeded with a stopped rank:\n{err}");
     assert!(err.contains(&format!("error: rank 1 (pid {pid} on ")), "rank 0 did not name the rank:\n{err}");
-    assert!(err.contains("within 3 s during "), "no timeout in the message:\n{err}");
+    assert!(err.contains(&format!("within {HUNG_TIMEOUT} s during ")), "no timeout in the message:\n{err}");
     assert!(
         err.contains("generation") || err.contains("the best of stage"),
         "no generation in the message:\n{err}"

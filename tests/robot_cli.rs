@@ -46,7 +46,8 @@ impl Emulator {
             .expect("the emulator starts");
         let t = Instant::now();
         while std::fs::symlink_metadata(&port).is_err() {
-            assert!(t.elapsed() < Duration::from_secs(20), "the emulator made no port");
+            // Generous: a loaded machine may take long to start a process.
+            assert!(t.elapsed() < Duration::from_secs(120), "the emulator made no port");
             std::thread::sleep(Duration::from_millis(20));
         }
         Emulator { child, port }
@@ -86,11 +87,15 @@ fn evolved(dir: &Path) -> PathBuf {
     runs
 }
 
+/// The longest wait for an answer of the emulator in the tests that expect
+/// none to be late: generous, so a loaded machine cannot make one late.
+const PATIENT_MS: &str = "10000";
+
 fn drive(emu: &Emulator, runs: &Path, out: &Path, extra: &[&str]) -> Output {
     shaping()
         .arg("drive")
         .arg(file())
-        .args(["--stage", "roam", "--period", "0", "--run"])
+        .args(["--stage", "roam", "--period", "0", "--timeout", PATIENT_MS, "--run"])
         .arg(runs)
         .arg("--port")
         .arg(&emu.port)
@@ -162,8 +167,12 @@ fn fitness_over_the_link_is_close_to_replay() {
 #[test]
 fn run_on_the_robot_evolves_and_resumes_after_being_killed() {
     let dir = scratch("evolve");
-    // 1 ms per answer: slow enough to be killed in the middle.
-    let emu = Emulator::start(&dir, &["--delay", "1"]);
+    // The emulator drops its answer to request 1000 (an episode takes about
+    // 164 requests: in the seventh), and the first run waits a minute for
+    // it: it is killed there, whatever the machine's load, not in a race with
+    // its own end.
+    let mut emu = Emulator::start(&dir, &["--fault", "drop@1000"]);
+    let mut said = std::io::BufReader::new(emu.child.stderr.take().unwrap());
     let out = dir.join("runs");
     let run = || {
         let mut c = shaping();
@@ -175,22 +184,22 @@ fn run_on_the_robot_evolves_and_resumes_after_being_killed() {
         c
     };
     let log = out.join("roam/robot-episodes.jsonl");
-    let mut first = run().stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
-    // Killed once it has evaluated a few individuals, in the second generation.
-    let t = Instant::now();
-    loop {
-        let n = std::fs::read_to_string(&log).map_or(0, |s| s.lines().count());
-        if n >= 6 {
-            break;
-        }
-        assert!(first.try_wait().unwrap().is_none(), "the run ended before it was killed");
-        assert!(t.elapsed() < Duration::from_secs(60), "no episodes logged");
-        std::thread::sleep(Duration::from_millis(5));
+    let mut first =
+        run().args(["--timeout", "60000"]).stdout(Stdio::null()).stderr(Stdio::null()).spawn().unwrap();
+    // Killed once the emulator has dropped that answer (the run waits for it),
+    // having evaluated a few individuals, in the second generation.
+    let mut line = String::new();
+    while !line.contains("fault: no answer to request 1000") {
+        line.clear();
+        let n = std::io::BufRead::read_line(&mut said, &mut line).unwrap();
+        assert!(n > 0, "the emulator ended before the fault");
     }
+    assert!(first.try_wait().unwrap().is_none(), "the run ended before it was killed");
+    assert!(std::fs::read_to_string(&log).unwrap().lines().count() >= 5, "few episodes logged");
     first.kill().unwrap();
     first.wait().unwrap();
     let before = std::fs::read_to_string(&log).unwrap().lines().count();
-    let second = run().output().unwrap();
+    let second = run().args(["--timeout", PATIENT_MS]).output().unwrap();
     assert!(second.status.success(), "{}", text(&second.stderr));
     let err = text(&second.stderr);
     assert!(err.contains("episodes already done on the robot"), "{err}");
@@ -221,7 +230,10 @@ fn faulty_drive(name: &str, fault: &str) -> (Output, Option<(i32, i32)>) {
             "--period",
             "0",
             "--timeout",
-            "300",
+            // The wait for the dropped answer; long enough that no answer of
+            // a healthy emulator on a loaded machine comes later (with 300 ms,
+            // one could, and the test saw a timeout, not its fault).
+            "3000",
             "--actions",
             "300",
             "--genome",
@@ -354,4 +366,83 @@ fn bad_robot_arguments_are_errors() {
     let out = shaping().args(["emulate", "--fault", "melt@3", "--port"]).arg(dir.join("p")).output().unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("unknown fault"), "{}", text(&out.stderr));
+}
+
+/// `drive` binds trained weights as `replay` does (it used to refuse every
+/// stage using a training stage's weights): every stage of every example is
+/// driven for a few actions, its training stages trained on the fly, and
+/// with `--run` a run's training stage is driven through its own life.
+#[test]
+fn drive_runs_every_stage_of_every_example() {
+    let dir = scratch("every-stage");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let emu = Emulator::start(&dir, &[]);
+    let built = dir.join("program.json");
+    for example in std::fs::read_dir(root.join("examples")).unwrap() {
+        let file = example.unwrap().path();
+        if file.extension().is_none_or(|e| e != "bat") {
+            continue;
+        }
+        let out = shaping().arg("build").arg(&file).arg("-o").arg(&built).output().unwrap();
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let program: serde_json::Value = serde_json::from_slice(&std::fs::read(&built).unwrap()).unwrap();
+        for stage in program["stages"].as_array().unwrap() {
+            let name = stage["name"].as_str().unwrap();
+            let bits = stage["layout"]["bits"].as_u64().unwrap() as usize;
+            let physical = stage["world"]["objects"].as_object().is_some_and(|o| o["virtual_"] == false);
+            // In an empty directory: no `runs/` of an earlier run is used.
+            let out = shaping()
+                .current_dir(&dir)
+                .arg("drive")
+                .arg(&file)
+                .args(["--stage", name, "--actions", "3", "--period", "0", "--timeout", PATIENT_MS])
+                .args(["--genome", &"0".repeat(bits)])
+                .arg("--port")
+                .arg(&emu.port)
+                .arg("--out")
+                .arg(dir.join("d"))
+                .output()
+                .unwrap();
+            let err = text(&out.stderr);
+            if physical {
+                assert!(err.contains("the objects must be `virtual`"), "{} {name}: {err}", file.display());
+            } else {
+                assert!(out.status.success(), "{} {name}: {err}", file.display());
+            }
+        }
+    }
+}
+
+/// The robot's episode log is tied to the stage like a checkpoint: episodes
+/// of another version are not reused (the run refuses), and `--fresh` moves
+/// the log aside and starts again.
+#[test]
+fn robot_episodes_of_another_version_of_the_stage_are_not_reused() {
+    let dir = scratch("stale-log");
+    let emu = Emulator::start(&dir, &[]);
+    let out = dir.join("runs");
+    std::fs::create_dir_all(out.join("roam")).unwrap();
+    let log = out.join("roam/robot-episodes.jsonl");
+    std::fs::write(&log, "{\"seed\":1,\"fitness\":0.5,\"learned\":null,\"pose\":[0,0,0]}\n").unwrap();
+    let run = |extra: &[&str]| {
+        shaping()
+            .arg("run")
+            .arg(file())
+            .args(["--stage", "roam", "--quiet", "--period", "0", "--timeout", PATIENT_MS, "--robot"])
+            .arg(&emu.port)
+            .arg("--out")
+            .arg(&out)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let stale = run(&[]);
+    assert_eq!(stale.status.code(), Some(2));
+    let err = text(&stale.stderr);
+    assert!(err.contains("line 1 of") && err.contains("another version of stage `roam`"), "{err}");
+    let fresh = run(&["--fresh"]);
+    assert!(fresh.status.success(), "{}", text(&fresh.stderr));
+    assert!(out.join("roam/robot-episodes.jsonl.old").exists());
+    let lines = std::fs::read_to_string(&log).unwrap();
+    assert!(lines.lines().all(|l| l.contains("\"program\":")), "{lines}");
 }

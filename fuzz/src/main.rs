@@ -11,12 +11,20 @@
 //!   validation). A program that is accepted must run a short episode of
 //!   every stage without a panic. Mutations are byte-level and structural
 //!   (a number or a list of the JSON tree replaced by an extreme value).
+//! - `checkpoint`: bytes and JSON trees through `checkpoint.json` loading
+//!   against `tests/cli/tiny.bat` (serde, then `evolve::resume` for each of
+//!   its stages, as `run` does), seeded with checkpoints of a short run of
+//!   it. A checkpoint that is accepted must continue (a few generations,
+//!   the choice of the best, the next stage's start) without a panic.
+//! - `trained`: the same for `trained.json` against
+//!   `examples/pretrained.bat` (serde, then `evolve::train::check`); accepted
+//!   weights are bound and the stage using them runs a short episode.
 //!
 //! A panic is caught, its input written to `--crashes` (default
 //! `target/fuzz-crashes/`), and the run exits with status 1. Every crash
 //! found becomes a regression test.
 //!
-//! `shaping-fuzz [text|json|all] [--secs N] [--seed S] [--crashes DIR]`
+//! `shaping-fuzz [text|json|checkpoint|trained|all] [--secs N] [--seed S] [--crashes DIR]`
 
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
@@ -29,6 +37,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
 use shaping_runtime::controller::{run_episode, EpisodeOptions};
+use shaping_runtime::evolve::{self, Checkpoint, Evaluation, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
@@ -279,6 +288,99 @@ fn json_target(input: &[u8]) {
     }
 }
 
+/// The programs the `checkpoint` and `trained` targets load their files
+/// against, and the files of a real run of them (the seeds of the corpus).
+struct Saved {
+    tiny: Program,
+    pretrained: Program,
+    checkpoints: Vec<Value>,
+    trained: Vec<Value>,
+}
+
+static SAVED: std::sync::OnceLock<Saved> = std::sync::OnceLock::new();
+
+/// A cheap stand-in for an episode: the share of ones, so a generation
+/// costs nothing and still ranks individuals.
+fn ones(g: &Genome, _seed: u64) -> Evaluation {
+    let ones = g.bits.iter().filter(|&&b| b == 1).count();
+    Evaluation { fitness: ones as f32 / g.bits.len().max(1) as f32, ..Evaluation::default() }
+}
+
+fn compile(root: &Path, file: &str) -> Program {
+    let src = std::fs::read_to_string(root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    shaping_compiler::compile(&src, file).unwrap_or_else(|_| panic!("{file} does not compile"))
+}
+
+fn saved(root: &Path) -> Saved {
+    let tiny = compile(root, "tests/cli/tiny.bat");
+    let mut checkpoints = Vec::new();
+    let mut cp = evolve::start_stage(&tiny, 0, 3, None).expect("tiny.bat starts");
+    checkpoints.push(cp.clone());
+    while !evolve::is_finished(&tiny, &cp) {
+        evolve::step_generation(&tiny, &mut cp, &ones).expect("a generation");
+        checkpoints.push(cp.clone());
+    }
+    evolve::validate_best(&tiny, &mut cp, &ones, 3, 2).expect("the best");
+    checkpoints.push(cp.clone());
+    let mut second = evolve::start_stage(&tiny, 1, 3, Some(&cp)).expect("the second stage starts");
+    evolve::step_generation(&tiny, &mut second, &ones).expect("a generation");
+    checkpoints.push(second);
+    let pretrained = compile(root, "examples/pretrained.bat");
+    let trained = evolve::train_stage(&pretrained, 0, 1, None).expect("the training stage trains");
+    let value = |v: Result<Value, serde_json::Error>| v.expect("a saved result serialises");
+    Saved {
+        tiny,
+        pretrained,
+        checkpoints: checkpoints.iter().map(|c| value(serde_json::to_value(c))).collect(),
+        trained: vec![value(serde_json::to_value(&trained))],
+    }
+}
+
+fn checkpoint_target(input: &[u8]) {
+    let Some(saved) = SAVED.get() else { return };
+    let Ok(cp) = serde_json::from_slice::<Checkpoint>(input) else { return };
+    let program = &saved.tiny;
+    for index in 0..program.stages.len() {
+        let mut cp = cp.clone();
+        match evolve::resume(program, index, &mut cp) {
+            Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
+            Ok(_) => {
+                ACCEPTED.fetch_add(1, Ordering::Relaxed);
+                for _ in 0..3 {
+                    if evolve::is_finished(program, &cp) {
+                        break;
+                    }
+                    evolve::step_generation(program, &mut cp, &ones)
+                        .expect("an accepted checkpoint continues");
+                }
+                if evolve::is_finished(program, &cp) {
+                    let best = evolve::validate_best(program, &mut cp, &ones, 3, 2);
+                    best.expect("an accepted checkpoint's best is chosen");
+                    if index == 0 {
+                        evolve::start_stage(program, 1, cp.seed, Some(&cp)).expect("the next stage starts");
+                    }
+                }
+                std::hint::black_box(evolve::best_of(&cp));
+            }
+        }
+    }
+}
+
+fn trained_target(input: &[u8]) {
+    let Some(saved) = SAVED.get() else { return };
+    let Ok(t) = serde_json::from_slice::<Trained>(input) else { return };
+    let mut program = saved.pretrained.clone();
+    match evolve::train::bind(&mut program, 0, &t) {
+        Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
+        Ok(_) => {
+            if let Err(e) = program.validate() {
+                panic!("accepted trained weights make an invalid program: {e}");
+            }
+            run_all(&program);
+        }
+    }
+}
+
 fn corpus_files(root: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for dir in ["examples", "tests/ui", "tests/parse", "tests/lower", "tests/cli"] {
@@ -294,6 +396,8 @@ fn corpus_files(root: &Path) -> Vec<PathBuf> {
     out
 }
 
+const TARGETS: [&str; 4] = ["text", "json", "checkpoint", "trained"];
+
 struct Args {
     targets: Vec<&'static str>,
     secs: f64,
@@ -302,23 +406,21 @@ struct Args {
 }
 
 fn args(root: &Path) -> Result<Args, String> {
-    let mut a = Args {
-        targets: vec!["text", "json"],
-        secs: 10.0,
-        seed: 1,
-        crashes: root.join("target/fuzz-crashes"),
-    };
+    let mut a =
+        Args { targets: TARGETS.to_vec(), secs: 10.0, seed: 1, crashes: root.join("target/fuzz-crashes") };
     let mut it = std::env::args().skip(1);
     while let Some(x) = it.next() {
         let mut value = |name: &str| it.next().ok_or_else(|| format!("`{name}` needs a value"));
         match x.as_str() {
             "text" => a.targets = vec!["text"],
             "json" => a.targets = vec!["json"],
-            "all" => a.targets = vec!["text", "json"],
+            "checkpoint" => a.targets = vec!["checkpoint"],
+            "trained" => a.targets = vec!["trained"],
+            "all" => a.targets = TARGETS.to_vec(),
             "--secs" => a.secs = value("--secs")?.parse().map_err(|e| format!("--secs: {e}"))?,
             "--seed" => a.seed = value("--seed")?.parse().map_err(|e| format!("--seed: {e}"))?,
             "--crashes" => a.crashes = PathBuf::from(value("--crashes")?),
-            _ => return Err(format!("unknown argument `{x}`; usage: shaping-fuzz [text|json|all] [--secs N] [--seed S] [--crashes DIR]")),
+            _ => return Err(format!("unknown argument `{x}`; usage: shaping-fuzz [text|json|checkpoint|trained|all] [--secs N] [--seed S] [--crashes DIR]")),
         }
     }
     Ok(a)
@@ -343,22 +445,31 @@ fn main() {
         .filter_map(|s| shaping_compiler::compile(&String::from_utf8_lossy(s), "seed.bat").ok())
         .filter_map(|p| serde_json::to_value(&p).ok())
         .collect();
-    let json_corpus: Vec<Vec<u8>> =
-        programs.iter().map(|v| serde_json::to_vec(v).expect("a value serialises")).collect();
+    let saved = SAVED.get_or_init(|| saved(&root));
+    let bytes = |values: &[Value]| -> Vec<Vec<u8>> {
+        values.iter().map(|v| serde_json::to_vec(v).expect("a value serialises")).collect()
+    };
+    let json_corpus = bytes(&programs);
+    let checkpoint_corpus = bytes(&saved.checkpoints);
+    let trained_corpus = bytes(&saved.trained);
     // Quiet panics: they are reported with their input below.
     std::panic::set_hook(Box::new(|_| {}));
     let budget = Duration::from_secs_f64(args.secs / args.targets.len() as f64);
     let mut crashes = 0;
     for target in &args.targets {
         let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
-        let corpus: &[Vec<u8>] = if *target == "text" { &sources } else { &json_corpus };
-        let run: Target = if *target == "text" { text_target } else { json_target };
+        let (corpus, trees, run): (&[Vec<u8>], &[Value], Target) = match *target {
+            "text" => (&sources, &[], text_target),
+            "json" => (&json_corpus, &programs, json_target),
+            "checkpoint" => (&checkpoint_corpus, &saved.checkpoints, checkpoint_target),
+            _ => (&trained_corpus, &saved.trained, trained_target),
+        };
         let start = Instant::now();
         let mut execs = 0u64;
         ACCEPTED.store(0, Ordering::Relaxed);
         while start.elapsed() < budget {
-            let input = if *target == "json" && rng.random_range(0..3) > 0 {
-                let mut v = programs[rng.random_range(0..programs.len())].clone();
+            let input = if !trees.is_empty() && rng.random_range(0..3) > 0 {
+                let mut v = trees[rng.random_range(0..trees.len())].clone();
                 for _ in 0..1 + rng.random_range(0..3) {
                     mutate_tree(&mut rng, &mut v);
                 }

@@ -56,16 +56,23 @@ impl Genome {
 
     /// Parses a string of `0` and `1` (whitespace and `_` ignored).
     pub fn from_bitstring(s: &str) -> Option<Genome> {
+        Genome::parse_bitstring(s).ok()
+    }
+
+    /// Parses a string of `0` and `1` (whitespace and `_` ignored); the
+    /// error is the first other character and its position (1-based, in
+    /// characters).
+    pub fn parse_bitstring(s: &str) -> Result<Genome, (usize, char)> {
         let mut bits = Vec::with_capacity(s.len());
-        for c in s.chars() {
+        for (i, c) in s.chars().enumerate() {
             match c {
                 '0' => bits.push(0),
                 '1' => bits.push(1),
                 '_' | ' ' | '\n' | '\r' | '\t' => {}
-                _ => return None,
+                _ => return Err((i + 1, c)),
             }
         }
-        Some(Genome { bits })
+        Ok(Genome { bits })
     }
 }
 

@@ -274,13 +274,24 @@ fn next_stage_keeps_frozen_bits_and_grows_the_genome() {
 }
 
 #[test]
-fn fingerprint_mismatch_names_the_stage_and_appended_stages_are_accepted() {
+fn a_checkpoint_is_refused_when_anything_it_depends_on_changed_saying_what() {
     let program = two_stages(10, 2);
     let mut cp0 = start_stage(&program, 0, 1, None).unwrap();
     run_stage(&program, &mut cp0, &ones);
     let mut cp1 = start_stage(&program, 1, 1, Some(&cp0)).unwrap();
     step_generation(&program, &mut cp1, &ones).unwrap();
     check_resume(&program, &cp1).unwrap();
+    let changed = |edit: &dyn Fn(&mut Program)| {
+        let mut p = program.clone();
+        edit(&mut p);
+        match check_resume(&p, &cp1) {
+            Err(EvolveError::Changed { stage, what }) => {
+                assert_eq!(stage, "second");
+                what
+            }
+            other => panic!("{other:?}"),
+        }
+    };
 
     // A new stage appended after the checkpoint's: accepted.
     let mut appended = program.clone();
@@ -288,7 +299,7 @@ fn fingerprint_mismatch_names_the_stage_and_appended_stages_are_accepted() {
     third.inheritance = Inheritance::Lamarckian;
     appended.stages.push(third);
     check_resume(&appended, &cp1).unwrap();
-    step_generation(&appended, &mut cp1, &ones).unwrap();
+    step_generation(&appended, &mut cp1.clone(), &ones).unwrap();
 
     // More generations for the current stage: accepted (extends the run).
     let mut longer = program.clone();
@@ -297,28 +308,51 @@ fn fingerprint_mismatch_names_the_stage_and_appended_stages_are_accepted() {
     }
     check_resume(&longer, &cp1).unwrap();
 
-    // An earlier stage's layout changed: an error naming it.
-    let mut changed = program.clone();
-    changed.stages[0].layout.genes[3].hi = 2.0;
-    let err = check_resume(&changed, &cp1).unwrap_err();
-    assert_eq!(err, EvolveError::StageChanged { stage: "first".into(), index: 0 });
-    assert!(err.to_string().contains("`first`"), "{err}");
-
-    // The current stage's population size changed.
-    let mut resized = program.clone();
-    if let StageRun::Evolve(evo) = &mut resized.stages[1].run {
-        evo.population = 12;
-    }
+    // Everything else of the stage, and all of the stage it extends, counts.
+    assert_eq!(changed(&|p| p.stages[1].fitness.bonuses.push(bonus())), "the fitness of `second`");
     assert_eq!(
-        check_resume(&resized, &cp1).unwrap_err(),
-        EvolveError::StageChanged { stage: "second".into(), index: 1 }
+        changed(&|p| {
+            p.stages[1].world.arena = [800.0, 800.0];
+            p.stages[1].fitness.bonuses.push(bonus());
+        }),
+        "the world and fitness of `second`"
     );
+    assert_eq!(
+        changed(&|p| if let StageRun::Evolve(evo) = &mut p.stages[1].run {
+            evo.population = 12;
+        }),
+        "the settings of `second`"
+    );
+    assert_eq!(
+        changed(&|p| p.stages[0].layout.genes[3].hi = 2.0),
+        "the genes of `first`, which `second` extends"
+    );
+    // The parent's generations decide the population the stage started from.
+    assert_eq!(
+        changed(&|p| if let StageRun::Evolve(evo) = &mut p.stages[0].run {
+            evo.generations = 3;
+        }),
+        "the generations of `first`, which `second` extends"
+    );
+    assert_eq!(
+        changed(&|p| {
+            p.stages[0].world.body.wheel_noise = 0.5;
+            p.stages[1].world.body.wheel_noise = 0.5;
+        }),
+        "the world of `second`; the world of `first`, which `second` extends"
+    );
+    // A stage inserted before it moves it (its seeds depend on its place).
+    let mut moved = program.clone();
+    moved.stages.insert(0, stage("zero", None, layout(1, 0), StageRun::Train { actions: 5 }));
+    moved.stages[2].parent = Some(1);
+    let err = evolve::resume(&moved, 2, &mut cp1.clone()).unwrap_err().to_string();
+    assert!(err.contains("the position of `second`; the position of `first`, which"), "{err}");
 
     // A stage removed.
-    assert_eq!(
-        check_resume(&one_stage(10, 2), &cp1).unwrap_err(),
-        EvolveError::StageMissing { expected: 2, count: 1 }
-    );
+    assert!(matches!(
+        check_resume(&one_stage(10, 2), &cp1),
+        Err(EvolveError::StageIndex { index: 1, count: 1 })
+    ));
 
     // A checkpoint of another format.
     let mut old = cp1.clone();
@@ -326,17 +360,88 @@ fn fingerprint_mismatch_names_the_stage_and_appended_stages_are_accepted() {
     assert!(matches!(check_resume(&program, &old), Err(EvolveError::CheckpointFormat { .. })));
 
     // Starting the second stage from a parent made with another program fails too.
-    assert!(matches!(start_stage(&changed, 1, 1, Some(&cp0)), Err(EvolveError::StageChanged { .. })));
+    let mut other = program.clone();
+    other.stages[0].layout.genes[3].hi = 2.0;
+    assert!(matches!(start_stage(&other, 1, 1, Some(&cp0)), Err(EvolveError::Changed { .. })));
+}
+
+fn bonus() -> shaping_runtime::program::Bonus {
+    shaping_runtime::program::Bonus { event: shaping_runtime::program::Event::Grip, points: 1.0 }
+}
+
+#[test]
+fn a_checkpoint_beyond_the_declared_generations_or_with_bad_bits_is_refused() {
+    let program = one_stage(10, 4);
+    let mut cp = start_stage(&program, 0, 1, None).unwrap();
+    run_stage(&program, &mut cp, &ones);
+    let mut shorter = program.clone();
+    if let StageRun::Evolve(evo) = &mut shorter.stages[0].run {
+        evo.generations = 3;
+    }
+    let err = check_resume(&shorter, &cp).unwrap_err();
+    assert_eq!(err, EvolveError::TooManyGenerations { stage: "first".into(), done: 4, declared: 3 });
+    assert!(err.to_string().contains("holds 4 generations of stage `first`, which now declares 3"), "{err}");
+
+    let refused = |edit: &dyn Fn(&mut Checkpoint)| {
+        let mut bad = cp.clone();
+        edit(&mut bad);
+        check_resume(&program, &bad).unwrap_err().to_string()
+    };
+    let err = refused(&|c| c.population[3].bits[5] = 2);
+    assert!(err.contains("bit 5 of individual 3 is 2; bits are 0 or 1"), "{err}");
+    let err = refused(&|c| c.best.as_mut().unwrap().0.bits[0] = 7);
+    assert!(err.contains("bit 0 of the best individual is 7"), "{err}");
+    let err = refused(&|c| c.fitness[2] = f32::NAN);
+    assert!(err.contains("the fitness of individual 2 is NaN"), "{err}");
+    let err = refused(&|c| c.generation = 2);
+    assert!(err.contains("4 generations of statistics for 2 generations done"), "{err}");
+    let err = refused(&|c| {
+        c.validated = true;
+        c.best = None;
+    });
+    assert!(err.contains("holds none"), "{err}");
+}
+
+#[test]
+fn a_finished_stage_given_more_generations_ends_as_a_straight_run() {
+    let (short, long) = (one_stage(20, 3), one_stage(20, 6));
+    let eval = onemax(frozen_mask(&short.stages[0].layout));
+    let mut straight = start_stage(&long, 0, 4, None).unwrap();
+    run_stage(&long, &mut straight, &eval);
+    evolve::validate_best(&long, &mut straight, &eval, 4, 2).unwrap();
+
+    let mut cp = start_stage(&short, 0, 4, None).unwrap();
+    run_stage(&short, &mut cp, &eval);
+    evolve::validate_best(&short, &mut cp, &eval, 4, 2).unwrap();
+    assert!(!evolve::resume(&short, 0, &mut cp).unwrap(), "finished: nothing to reopen");
+    assert!(evolve::resume(&long, 0, &mut cp).unwrap());
+    run_stage(&long, &mut cp, &eval);
+    evolve::validate_best(&long, &mut cp, &eval, 4, 2).unwrap();
+    assert_eq!(cp, straight);
 }
 
 #[test]
 fn fingerprints_are_stable() {
-    // The hash of a fixed stage must not change across runs or platforms.
+    // The hashes of a fixed stage must not change across runs or platforms.
     let program = two_stages(10, 2);
-    let fp = evolve::stage_fingerprint(&program.stages[0]);
-    assert_eq!(fp, evolve::stage_fingerprint(&program.clone().stages[0]));
-    assert_ne!(fp, evolve::stage_fingerprint(&program.stages[1]));
-    insta::assert_snapshot!(format!("{fp:016x}"), @"a26b9d3c550689be");
+    let fp = evolve::fingerprint(&program, 1);
+    assert_eq!(fp, evolve::fingerprint(&program.clone(), 1));
+    assert_eq!(fp.len(), 2, "the stage and the stage it extends");
+    assert_ne!(fp[0].parts, fp[1].parts);
+    let parts: Vec<String> = fp[1].parts.iter().map(|(k, v)| format!("{k} {v:016x}")).collect();
+    insta::assert_snapshot!(parts.join("\n"), @r"
+    extends 5b9bc4ba528108e4
+    fitness 62fa0ab6d910691b
+    generations af63af4c8601a015
+    genes 9e81b87f7dfd2057
+    inheritance 106ac1d7d7998448
+    links 09612b07b5ecb5a5
+    modules 09612b07b5ecb5a5
+    position af63ad4c86019caf
+    robot 9d73114e90492e2d
+    settings a85cce9cbd713a73
+    world 4a10de298bbc1f51
+    ");
 }
 
 #[test]

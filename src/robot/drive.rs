@@ -7,12 +7,12 @@ use std::time::{Duration, Instant};
 use shaping_runtime::catalog::ActuatorKind;
 use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Trace};
 use shaping_runtime::evolve::EvalOptions;
-use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Stage;
 use shaping_runtime::robot::{RobotError, SerialRobot};
 
 use super::port::{interrupt_flag, SerialPort};
-use crate::load::{self, create_dir, write_atomic, CliError};
+use crate::episode::{self, Part, Recorder};
+use crate::load::{create_dir, write_atomic, CliError};
 use crate::{replay, report, run};
 
 pub struct DriveArgs {
@@ -67,32 +67,25 @@ pub fn failure(err: &RobotError, stopped: &Result<(), RobotError>) -> String {
 }
 
 pub fn drive(args: DriveArgs) -> Result<(), CliError> {
-    let program = load::load_program(&args.file, args.error_format)?;
-    let index = load::stage_index(&program, args.stage.as_deref())?;
+    let chosen = replay::choose(
+        &args.file,
+        args.stage.as_deref(),
+        args.genome.as_deref(),
+        args.run.as_deref(),
+        args.error_format,
+    )?;
+    let replay::Chosen { program, index, genome, training_seed } = chosen;
     let stage = &program.stages[index];
     check_robot_world(stage)?;
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
-    let genome = match &args.genome {
-        Some(g) => replay::parse_genome(g)?,
-        None if stage.layout.bits == 0 && args.run.is_none() => Genome::zeros(0),
-        None => {
-            let source = &program.stages[replay::evolved_source(&program, index)];
-            let path = run_dir.join(&source.name).join("best.genome");
-            if !path.exists() {
-                return Err(CliError::io(format!(
-                    "error: no evolved individual at `{}`; run `shaping run {}` first, or pass `--genome` or `--run`",
-                    path.display(),
-                    args.file.display()
-                )));
-            }
-            replay::parse_genome(&path.to_string_lossy())?
-        }
-    };
     // The life length and learning the stage declares, as in `replay`.
     let declared = EvalOptions::of(stage);
     let actions = args.actions.unwrap_or(declared.actions);
     let learning = declared.learning && !args.no_learning;
-    let seed = args.seed.unwrap_or_else(|| run::run_seed(&program, None));
+    let seed = args.seed.unwrap_or_else(|| match training_seed {
+        Some(run_seed) => shaping_runtime::evolve::train::training_seed(run_seed, index),
+        None => run::run_seed(&program, None),
+    });
     let (sim_seed, rng) = episode_rngs(seed);
     let mut ctl = Controller::new(stage, &genome, rng)
         .map_err(|e| CliError::io(format!("error: the genome does not fit stage `{}`: {e}", stage.name)))?;
@@ -115,8 +108,16 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let scene = robot.host().scene();
     let started = Instant::now();
     let mut trace = Trace::default();
+    let mut frames = Vec::new();
     let result = match robot.connect() {
-        Ok(()) => Some(ctl.run(&mut robot, &EpisodeOptions { actions, learning, seed }, Some(&mut trace))),
+        Ok(()) => {
+            // Recorded as `replay` records the simulator: what the robot sensed, for
+            // `trace.csv` and `episode.json`.
+            let mut rec = Recorder::new(&mut robot);
+            let r = ctl.run(&mut rec, &EpisodeOptions { actions, learning, seed }, Some(&mut trace));
+            frames = rec.frames;
+            Some(r)
+        }
         Err(_) => None,
     };
     // Whatever happened, the wheels stop before anything else.
@@ -128,7 +129,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
 
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
     create_dir(&out)?;
-    report::episode_files(&out, &stage.name, stage, &trace, &scene, &[])?;
+    let parts = [Part { stage: &stage.name, scene: scene.clone(), frames }];
+    let ep = episode::episode(stage, seed, learning, &trace, &parts);
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).unwrap_or_default().as_bytes())?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     let done = trace.rows.len();
     let rate = if elapsed > 0.0 { done as f64 / elapsed } else { 0.0 };

@@ -36,6 +36,10 @@ struct Episode {
     /// were recorded read as none).
     #[serde(default)]
     events: Events,
+    /// [`shaping_runtime::evolve::fingerprint::digest`] of the stage the episode was run for (none in
+    /// logs written before it was recorded: those are not reused).
+    #[serde(default)]
+    program: Option<u64>,
 }
 
 struct State {
@@ -45,6 +49,8 @@ struct State {
     done: HashMap<u64, Evaluation>,
     log: Option<PathBuf>,
     error: Option<String>,
+    /// The digest of the stage being evaluated, written with each episode.
+    program: u64,
 }
 
 /// The robot of a `run --robot`, shared by the stages of the run.
@@ -70,7 +76,14 @@ impl RobotRun {
             period_ms,
             timeout_ms,
             flag: interrupt_flag()?,
-            state: Mutex::new(State { port: None, pose: None, done: HashMap::new(), log: None, error: None }),
+            state: Mutex::new(State {
+                port: None,
+                pose: None,
+                done: HashMap::new(),
+                log: None,
+                error: None,
+                program: 0,
+            }),
         })
     }
 
@@ -84,7 +97,10 @@ impl RobotRun {
     }
 
     /// The evaluation of one genome on the robot for `stage`, whose
-    /// directory is `dir`: episodes already in its log are taken from there.
+    /// directory is `dir`: episodes already in its log are taken from there,
+    /// if they were run for the stage as it is (`program`, the digest of its
+    /// fingerprint; else the run is refused). With `fresh`, an existing log
+    /// is moved aside to `robot-episodes.jsonl.old` and not used.
     /// After a failure every evaluation gives NaN, so the generation fails
     /// and its checkpoint is not written; [`RobotRun::failure`] says why.
     pub fn evaluator<'a>(
@@ -92,17 +108,34 @@ impl RobotRun {
         stage: &'a Stage,
         actions: u32,
         dir: &Path,
+        program: u64,
+        fresh: bool,
     ) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + 'a, CliError> {
         check_robot_world(stage)?;
         let log = dir.join("robot-episodes.jsonl");
+        if fresh && log.exists() {
+            let old = dir.join("robot-episodes.jsonl.old");
+            std::fs::rename(&log, &old)
+                .map_err(|e| CliError::io(format!("error: cannot move `{}` aside: {e}", log.display())))?;
+            eprintln!("stage {}: starting again; the earlier episodes are in {}", stage.name, old.display());
+        }
         {
             let mut st = self.lock();
             st.done.clear();
+            st.program = program;
             if log.exists() {
                 let bytes = load::read_bytes(&log)?;
                 // A torn last line (a crash while writing) is skipped.
-                for line in bytes.split(|&b| b == b'\n') {
+                for (n, line) in bytes.split(|&b| b == b'\n').enumerate() {
                     if let Ok(e) = serde_json::from_slice::<Episode>(line) {
+                        if e.program != Some(program) {
+                            return Err(CliError::io(format!(
+                                "error: line {} of `{}` is an episode of another version of stage `{}`; pass `--fresh` to start again (the log is kept as `robot-episodes.jsonl.old`), or choose another `--out`",
+                                n + 1,
+                                log.display(),
+                                stage.name
+                            )));
+                        }
                         let learned = e.learned.as_deref().and_then(Genome::from_bitstring);
                         st.done.insert(e.seed, Evaluation { fitness: e.fitness, learned, events: e.events });
                         st.pose = Some(Pose { x: e.pose[0], y: e.pose[1], theta: e.pose[2] });
@@ -179,6 +212,7 @@ impl RobotRun {
             learned: ev.learned.as_ref().map(Genome::to_bitstring),
             pose: [pose.x, pose.y, pose.theta],
             events: ev.events,
+            program: Some(st.program),
         };
         if let Some(log) = st.log.clone() {
             if let Err(e) = append_line(&log, &line) {

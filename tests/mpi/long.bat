@@ -1,5 +1,7 @@
-// A two-stage run for the MPI tests: long enough (a few seconds) to stop a
-// rank in the middle of it.
+// A two-stage run for the MPI tests: long enough (about 5 s in one process,
+// 240 generations of a few milliseconds) to disturb a rank in the middle of
+// it whatever the load. With 40 generations (about 1 s) a loaded machine let
+// the run end, or reach its last steps, before the test's signal landed.
 robot khepera {
   sensor ir[8]       proximity
   sensor light[8]    ambient
@@ -15,7 +17,7 @@ stage first {
     charger 200mm on north wall with lamp
     battery 200 actions, recharge 20 actions
   }
-  evolve { population 300  generations 30  actions 1000  seed 5  selection truncation keep 6 }
+  evolve { population 300  generations 200  actions 1000  seed 5  selection truncation keep 6 }
   fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) / 1000
 
   module wander { sense ir  behavior forward(1.0) }
@@ -24,7 +26,7 @@ stage first {
 }
 
 stage second extends first {
-  evolve { generations 10 }
+  evolve { generations 40 }
   module spin { sense ir[2..3]  behavior turn left }
   links all evolvable
 }

@@ -52,11 +52,11 @@ pub enum EvolveError {
     #[error("checkpoint format {found} is not supported (expected {expected})")]
     CheckpointFormat { found: u32, expected: u32 },
 
-    #[error("the checkpoint was made with a different stage `{stage}` (stage {index}): its layout or evolution parameters changed since")]
-    StageChanged { stage: String, index: usize },
+    #[error("it was made by another version of the program: {what} changed")]
+    Changed { stage: String, what: String },
 
-    #[error("the checkpoint covers {expected} stages but the program has only {count}")]
-    StageMissing { expected: usize, count: usize },
+    #[error("it holds {done} generations of stage `{stage}`, which now declares {declared}")]
+    TooManyGenerations { stage: String, done: u32, declared: u32 },
 
     #[error("inconsistent checkpoint of stage `{stage}`: {what}")]
     Inconsistent { stage: String, what: String },

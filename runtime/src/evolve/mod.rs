@@ -52,7 +52,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 pub use error::EvolveError;
-pub use fingerprint::stage_fingerprint;
+pub use fingerprint::{fingerprint, Fingerprint};
 pub use ga::{frozen_mask, next_generation, ranking};
 pub use glue::{evaluate_with_controller, EvalOptions};
 pub use train::{train_all, train_stage, Trained};
@@ -61,7 +61,7 @@ use crate::genome::Genome;
 use crate::program::{Evolution, Inheritance, Program, Stage, StageRun};
 
 /// Version of the [`Checkpoint`] format.
-pub const CHECKPOINT_FORMAT: u32 = 1;
+pub const CHECKPOINT_FORMAT: u32 = 2;
 
 /// Runs one episode of a genome with the given episode seed.
 pub type Evaluate<'a> = &'a (dyn Fn(&Genome, u64) -> Evaluation + Sync);
@@ -156,9 +156,8 @@ pub struct GenStats {
 pub struct Checkpoint {
     /// [`CHECKPOINT_FORMAT`].
     pub format: u32,
-    /// [`stage_fingerprint`] of every stage of the program up to and
-    /// including `stage`.
-    pub fingerprint: Vec<u64>,
+    /// [`fingerprint()`] of `stage`: what the checkpoint was computed from.
+    pub fingerprint: Fingerprint,
     /// Index of the stage in `Program::stages`.
     pub stage: usize,
     /// Generations done in this stage.
@@ -178,6 +177,11 @@ pub struct Checkpoint {
     /// [`validate_best`] has chosen `best`.
     #[serde(default)]
     pub validated: bool,
+    /// The best single evaluation `best` held before [`validate_best`]
+    /// replaced it: [`resume`] puts it back when the stage is given more
+    /// generations, so the extended run equals a straight one.
+    #[serde(default)]
+    pub evaluated_best: Option<(Genome, f32)>,
 }
 
 /// The evolution parameters of an evolved stage.
@@ -266,7 +270,7 @@ pub fn start_stage(
     };
     Ok(Checkpoint {
         format: CHECKPOINT_FORMAT,
-        fingerprint: program.stages[..=stage].iter().map(stage_fingerprint).collect(),
+        fingerprint: fingerprint(program, stage),
         stage,
         generation: 0,
         seed,
@@ -275,6 +279,7 @@ pub fn start_stage(
         history,
         best: None,
         validated: false,
+        evaluated_best: None,
     })
 }
 
@@ -418,32 +423,58 @@ pub fn is_finished(program: &Program, cp: &Checkpoint) -> bool {
     }
 }
 
-/// Checks that a checkpoint can continue with this program: same format, and
-/// every stage up to the checkpoint's has the fingerprint it had when the
-/// checkpoint was made (stages appended after it are fine), and the
-/// population fits the stage.
+/// Checks that a checkpoint can continue with this program: same format,
+/// made from the same stage and the same stages it extends (see
+/// [`fingerprint`](mod@fingerprint); stages that do not matter to it may
+/// change), no more generations than the stage declares, and a population,
+/// fitness and best that fit the stage.
 pub fn check_resume(program: &Program, cp: &Checkpoint) -> Result<(), EvolveError> {
+    check_resume_of(program, cp.stage, cp)
+}
+
+/// [`check_resume`] for a checkpoint meant to be of stage `index` (the stage
+/// may have moved since: that is a change).
+pub fn check_resume_of(program: &Program, index: usize, cp: &Checkpoint) -> Result<(), EvolveError> {
     if cp.format != CHECKPOINT_FORMAT {
         return Err(EvolveError::CheckpointFormat { found: cp.format, expected: CHECKPOINT_FORMAT });
     }
-    if cp.fingerprint.len() != cp.stage + 1 {
+    let st = get_stage(program, index)?;
+    let what = fingerprint::changes(&cp.fingerprint, &fingerprint(program, index));
+    if !what.is_empty() {
+        return Err(EvolveError::Changed { stage: st.name.clone(), what: what.join("; ") });
+    }
+    if cp.stage != index {
         return Err(EvolveError::Inconsistent {
-            stage: format!("#{}", cp.stage),
-            what: format!("{} fingerprints for stage index {}", cp.fingerprint.len(), cp.stage),
+            stage: st.name.clone(),
+            what: format!("it says it is of stage {}, this is stage {index}", cp.stage),
         });
     }
-    if program.stages.len() < cp.fingerprint.len() {
-        return Err(EvolveError::StageMissing {
-            expected: cp.fingerprint.len(),
-            count: program.stages.len(),
+    let evo = evolution(st)?;
+    if cp.generation > evo.generations {
+        return Err(EvolveError::TooManyGenerations {
+            stage: st.name.clone(),
+            done: cp.generation,
+            declared: evo.generations,
         });
     }
-    for (index, (stage, &fp)) in program.stages.iter().zip(&cp.fingerprint).enumerate() {
-        if stage_fingerprint(stage) != fp {
-            return Err(EvolveError::StageChanged { stage: stage.name.clone(), index });
-        }
+    check_population(st, cp)
+}
+
+/// Takes up a saved checkpoint of stage `index` to continue it: checks it
+/// ([`check_resume`]), records the stage's generations as the program now
+/// declares them, and if the stage was finished but now declares more
+/// generations, puts its best back to the best single evaluation (see
+/// [`Checkpoint::evaluated_best`]), to be chosen again at the end, as in a
+/// straight run. Returns whether a finished stage was reopened.
+pub fn resume(program: &Program, index: usize, cp: &mut Checkpoint) -> Result<bool, EvolveError> {
+    check_resume_of(program, index, cp)?;
+    cp.fingerprint = fingerprint(program, index);
+    if !cp.validated || is_finished(program, cp) {
+        return Ok(false);
     }
-    check_population(&program.stages[cp.stage], cp)
+    cp.validated = false;
+    cp.best = cp.evaluated_best.take();
+    Ok(true)
 }
 
 /// How many candidates [`validate_best`] re-evaluates, and on how many episodes.
@@ -529,7 +560,7 @@ pub fn validate_best_with(
         }
     }
     let chosen = (pool[best.0].clone(), best.1 as f32);
-    cp.best = Some(chosen.clone());
+    cp.evaluated_best = cp.best.replace(chosen.clone());
     cp.validated = true;
     Ok(chosen)
 }
@@ -659,18 +690,46 @@ fn check_extension(st: &Stage, pst: &Stage) -> Result<(), EvolveError> {
 fn check_population(st: &Stage, cp: &Checkpoint) -> Result<(), EvolveError> {
     let bad = |what: String| Err(EvolveError::Inconsistent { stage: st.name.clone(), what });
     let evo = evolution(st)?;
+    let bits = st.layout.bits as usize;
     if cp.population.len() != evo.population as usize {
         return bad(format!("{} individuals, the stage declares {}", cp.population.len(), evo.population));
     }
-    if let Some(i) = cp.population.iter().position(|g| g.bits.len() != st.layout.bits as usize) {
-        return bad(format!(
-            "individual {i} has {} bits, the layout {}",
-            cp.population[i].bits.len(),
-            st.layout.bits
-        ));
+    if let Some(i) = cp.population.iter().position(|g| g.bits.len() != bits) {
+        return bad(format!("individual {i} has {} bits, the layout {bits}", cp.population[i].bits.len()));
+    }
+    let fits = |g: &Genome| g.bits.iter().position(|&b| b > 1).map(|p| (p, g.bits[p]));
+    for (i, g) in cp.population.iter().enumerate() {
+        if let Some((p, v)) = fits(g) {
+            return bad(format!("bit {p} of individual {i} is {v}; bits are 0 or 1"));
+        }
     }
     if cp.generation > 0 && cp.fitness.len() != cp.population.len() {
         return bad(format!("{} fitness values for {} individuals", cp.fitness.len(), cp.population.len()));
+    }
+    if cp.generation == 0 && !cp.fitness.is_empty() {
+        return bad(format!("{} fitness values before the first generation", cp.fitness.len()));
+    }
+    if let Some(i) = cp.fitness.iter().position(|f| !f.is_finite()) {
+        return bad(format!("the fitness of individual {i} is {}", cp.fitness[i]));
+    }
+    let own = cp.history.iter().filter(|h| h.stage == st.name).count();
+    if own != cp.generation as usize {
+        return bad(format!("{own} generations of statistics for {} generations done", cp.generation));
+    }
+    for (what, best) in [("best", &cp.best), ("evaluated best", &cp.evaluated_best)] {
+        let Some((g, f)) = best else { continue };
+        if g.bits.len() != bits {
+            return bad(format!("the {what} individual has {} bits, the layout {bits}", g.bits.len()));
+        }
+        if let Some((p, v)) = fits(g) {
+            return bad(format!("bit {p} of the {what} individual is {v}; bits are 0 or 1"));
+        }
+        if !f.is_finite() {
+            return bad(format!("the fitness of the {what} individual is {f}"));
+        }
+    }
+    if cp.validated && cp.best.is_none() {
+        return bad("it says its best was chosen, but holds none".into());
     }
     Ok(())
 }

@@ -4,19 +4,19 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{fingerprint::fnv1a, seed, EvolveError};
+use super::{fingerprint, seed, EvolveError, Fingerprint};
 use crate::controller::{episode_rngs, Controller, EpisodeOptions, EpisodeResult, Trace};
 use crate::genome::Genome;
-use crate::program::{bind_trained, Program, StageRun};
+use crate::program::{bind_trained, Behavior, Program, StageRun};
 use crate::sim::Sim;
 
 /// What one training stage learned, as written to `trained.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Trained {
     pub stage: String,
-    /// [`training_fingerprint`] of the training stage: a `trained.json` made
-    /// by another version of the stage is not reused.
-    pub fingerprint: u64,
+    /// [`fingerprint()`](super::fingerprint()) of the training stage: a
+    /// `trained.json` made by another version of the stage is not reused.
+    pub fingerprint: Fingerprint,
     /// The run seed the life was derived from.
     pub run_seed: u64,
     /// Behavior weights per module of the stage, in declaration order
@@ -25,13 +25,6 @@ pub struct Trained {
     /// Performance indicator of each module at the end of the life.
     pub performance: Vec<f32>,
     pub result: EpisodeResult,
-}
-
-/// A stable hash of everything a training stage's result depends on: the
-/// whole stage (world, modules, learning, reinforcement, length), as compact
-/// JSON hashed with 64-bit FNV-1a.
-pub fn training_fingerprint(stage: &crate::program::Stage) -> u64 {
-    fnv1a(&serde_json::to_vec(stage).unwrap_or_default())
 }
 
 /// The episode seed of training stage `index`'s life in a run with `run_seed`.
@@ -62,7 +55,7 @@ pub fn train_stage(
     let n = stage.modules.len();
     Ok(Trained {
         stage: stage.name.clone(),
-        fingerprint: training_fingerprint(stage),
+        fingerprint: fingerprint(program, index),
         run_seed,
         weights: (0..n).map(|m| ctl.behavior_weights(m).to_vec()).collect(),
         performance: (0..n).map(|m| ctl.performance(m)).collect(),
@@ -72,20 +65,45 @@ pub fn train_stage(
 
 /// Binds what training stage `index` learned into the stages that use it
 /// (`weights trained STAGE`). Refuses a `trained` record of another stage or
-/// of another version of it.
+/// of another version of it, and weights that do not fit its modules.
 pub fn bind(program: &mut Program, index: usize, trained: &Trained) -> Result<usize, EvolveError> {
+    check(program, index, trained)?;
+    Ok(bind_trained(program, index, &trained.weights))
+}
+
+/// Checks that `trained` was made by training stage `index` as `program`
+/// has it, and that its weights fit the stage's modules.
+pub fn check(program: &Program, index: usize, trained: &Trained) -> Result<(), EvolveError> {
     let stage =
         program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })?;
-    if trained.stage != stage.name || trained.fingerprint != training_fingerprint(stage) {
-        return Err(EvolveError::Inconsistent {
-            stage: stage.name.clone(),
-            what: format!(
-                "the trained weights were made by another stage or another version of `{}`",
-                stage.name
-            ),
-        });
+    let bad = |what: String| Err(EvolveError::Inconsistent { stage: stage.name.clone(), what });
+    if trained.stage != stage.name {
+        return bad(format!("the trained weights are of stage `{}`", trained.stage));
     }
-    Ok(bind_trained(program, index, &trained.weights))
+    let what = fingerprint::changes(&trained.fingerprint, &fingerprint(program, index));
+    if !what.is_empty() {
+        return Err(EvolveError::Changed { stage: stage.name.clone(), what: what.join("; ") });
+    }
+    if trained.weights.len() != stage.modules.len() {
+        return bad(format!(
+            "weights for {} modules, the stage has {}",
+            trained.weights.len(),
+            stage.modules.len()
+        ));
+    }
+    for (m, w) in stage.modules.iter().zip(&trained.weights) {
+        let need = match &m.behavior {
+            Behavior::Neural(nb) => nb.net.params.len(),
+            Behavior::Script(_) => 0,
+        };
+        if w.len() != need {
+            return bad(format!("{} weights for module `{}`, which has {need}", w.len(), m.name));
+        }
+        if let Some(x) = w.iter().find(|x| !x.is_finite()) {
+            return bad(format!("a weight of module `{}` is {x}", m.name));
+        }
+    }
+    Ok(())
 }
 
 /// Trains every training stage of `program` in order (each life derived from
