@@ -85,7 +85,7 @@ stage navigation {
   }
 
   // The bar charges only within 3 mm of the body, but the proximity
-  // sensors saturate from about 15 mm, and evolved activations make this
+  // sensors saturate from about 12 mm, and evolved activations make this
   // module win 20 to 35 mm from the bar: dock by driving on for 3 actions
   // (up to 60 mm; a move stops at the bar), then freeze the motors until
   // the battery is full (or stops filling: not the charger). Committed, so
