@@ -112,16 +112,25 @@ stage collect extends navigation {
   evolve { generations 40 }
   fitness adds 0.5 per grip, 1.0 per release outside
 
-  // Approach, lower the arm and back until the object is between the arms:
-  // an object there (the barrier on, the claw open) is rewarded; a wall, or
-  // an object already held (the barrier on, the claw closed), is punished;
-  // then grip and lift. A claw a failed grip left closed on nothing opens
-  // again; a held object stays in the claw. Committed: cut short, the
-  // sequence would leave the arm down.
+  // Approach, face what the sensors see, lower the arm and back until the
+  // object is between the arms: an object there (the barrier on, the claw
+  // open) is rewarded; a wall, or an object already held (the barrier on,
+  // the claw closed), is punished; then grip and lift. `toward` drives
+  // straight once its target is within 20 degrees of the heading, where a
+  // 10 mm object is already at the edge of the claw: the four conditional
+  // turns face it (one coarse, one fine, each only when one side sees more);
+  // they raise the share of objects in front caught from 0.64 to 0.94
+  // (`cargo run --release --example grip`). A claw a failed grip left closed
+  // on nothing opens again; a held object stays in the claw. Committed: cut
+  // short, the sequence would leave the arm down.
   module grip {
     sense ir, barrier
     behavior script commit {
       toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
+      turn left(0.5) if ir[0] + ir[1] > ir[4] + ir[5] + 0.2
+      turn right(0.5) if ir[4] + ir[5] > ir[0] + ir[1] + 0.2
+      turn left(0.25) if ir[1] + ir[2] > ir[3] + ir[4] + 0.2
+      turn right(0.25) if ir[3] + ir[4] > ir[1] + ir[2] + 0.2
       arm down
       claw open if not barrier
       back(0.5) until barrier within 6 actions
@@ -132,15 +141,20 @@ stage collect extends navigation {
     learn crbp(1, 0.5) on activation always
   }
 
-  // Drop the object outside: approach the obstacle, lower the arm, open
-  // the claw. Rewarded when an object held before opening (the barrier on)
-  // is gone after (thrown over the wall), punished when it falls in front
-  // (not a wall) or when nothing was held: the reverse of the grip
-  // module's discrimination.
+  // Drop the object outside: approach the obstacle, face it (as the grip
+  // module does: the object goes over a wall only when the robot faces it
+  // within 30 degrees), lower the arm, open the claw. Rewarded when an
+  // object held before opening (the barrier on) is gone after (thrown over
+  // the wall), punished when it falls in front (not a wall) or when nothing
+  // was held: the reverse of the grip module's discrimination.
   module release {
     sense ir, barrier
     behavior script commit {
       toward(ir, 0.5) until max(ir[1..4]) > 0.9 within 4 actions
+      turn left(0.5) if ir[0] + ir[1] > ir[4] + ir[5] + 0.2
+      turn right(0.5) if ir[4] + ir[5] > ir[0] + ir[1] + 0.2
+      turn left(0.25) if ir[1] + ir[2] > ir[3] + ir[4] + 0.2
+      turn right(0.25) if ir[3] + ir[4] > ir[1] + ir[2] + 0.2
       arm down
       claw open
       reinforce prev barrier and not barrier ? 1 : -1

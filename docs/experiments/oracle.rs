@@ -9,10 +9,10 @@
 //!   episodes.
 //!
 //! ```sh
-//! cargo run --release --example oracle -- [FILE] [--stage collect] [--seeds 10] [--actions 300] [--run DIR]
+//! cargo run --release --example oracle -- [FILE] [--stage collect] [--seeds 10] [--first-seed 1] [--actions 300] [--run DIR]
 //! ```
 //!
-//! For run seeds 1..=seeds (the seed of the training stage that teaches the
+//! For run seeds first-seed.. (seeds of them, from 1 unless told) (the seed of the training stage that teaches the
 //! avoid module, and of the evolved run) and episode seeds 101..=103 (those
 //! of `run.sh`'s replays; the search, which has no architecture, runs
 //! episode seed `1000 * run seed + episode` so that its lives differ), it prints one line per episode, objects at random
@@ -30,6 +30,7 @@ struct Args {
     file: String,
     stage: String,
     seeds: u64,
+    first_seed: u64,
     actions: u32,
     run: Option<String>,
 }
@@ -39,6 +40,7 @@ fn parse_args() -> Result<Args, String> {
         file: "examples/khepera.bat".into(),
         stage: "collect".into(),
         seeds: 10,
+        first_seed: 1,
         actions: 300,
         run: None,
     };
@@ -49,6 +51,9 @@ fn parse_args() -> Result<Args, String> {
             "--stage" => a.stage = value("--stage")?,
             "--run" => a.run = Some(value("--run")?),
             "--seeds" => a.seeds = value("--seeds")?.parse().map_err(|e| format!("--seeds: {e}"))?,
+            "--first-seed" => {
+                a.first_seed = value("--first-seed")?.parse().map_err(|e| format!("--first-seed: {e}"))?
+            }
             "--actions" => a.actions = value("--actions")?.parse().map_err(|e| format!("--actions: {e}"))?,
             s if s.starts_with("--") => return Err(format!("unknown option `{s}`")),
             s => a.file = s.into(),
@@ -92,7 +97,7 @@ fn run() -> Result<(), String> {
     // Under `decisions` with random placement: grip and release signals
     // (rewarded, punished) and the actions won by wander, avoid, follow.
     let (mut grip_signals, mut release_signals, mut drove) = ((0, 0), (0, 0), [0usize; 3]);
-    for seed in 1..=args.seeds {
+    for seed in args.first_seed..args.first_seed + args.seeds {
         let mut program = base.clone();
         train_all(&mut program, seed).map_err(|e| e.to_string())?;
         let stage = &program.stages[index];

@@ -21,6 +21,25 @@ sed 's#fitness per action abs(wheels\[0\] + wheels\[1\]) / 2#fitness per action 
   examples/pretrained.bat > $R/forward-only.bat
 grep -q 'max(wheels\[0\] + wheels\[1\], 0)' $R/forward-only.bat
 $B experiment $R/forward-only.bat --seeds $SEEDS --out $R/forward-only --fresh --criterion navigation=0.7 > /dev/null
+# The exploring variant (EXPERIMENTS.md, "An avoid module that turns"):
+# khepera.bat with five changes, each checked: the avoid module's fourth
+# motion turns instead of backing; navigation evolves 100 generations on 3
+# episodes per individual; follow's activation network has 2 hidden units;
+# collect evolves 80 generations, Lamarckian; grip and release learn at
+# CRBP's default rates.
+sed -e 's#outputs sign(2) -> forward | right | left | back#outputs sign(2) -> forward | right | left | right#' \
+  -e 's#evolve { population 100  generations 40  actions 300  seed 1  mutation 0.02 }#evolve { population 100  generations 100  actions 300  seed 1  mutation 0.02  evaluations 3 }#' \
+  -e 's#^    sense light, battery$#    sense light, battery\n    activation evolvable hidden 2#' \
+  -e 's#evolve { generations 40 }#evolve { generations 80  inheritance lamarckian }#' \
+  -e 's#learn crbp(1, 0.5) on activation always#learn crbp(0.5, 0.1) on activation always#' \
+  examples/khepera.bat > $R/khepera-explore.bat
+[ "$(grep -c 'forward | right | left | right' $R/khepera-explore.bat)" = 2 ]
+grep -q 'generations 100  actions 300  seed 1  mutation 0.02  evaluations 3' $R/khepera-explore.bat
+grep -q 'activation evolvable hidden 2' $R/khepera-explore.bat
+grep -q 'generations 80  inheritance lamarckian' $R/khepera-explore.bat
+[ "$(grep -c 'learn crbp(0.5, 0.1) on activation always' $R/khepera-explore.bat)" = 2 ]
+$B experiment $R/khepera-explore.bat --seeds $SEEDS --out $R/khepera-explore --fresh \
+  --criterion navigation=0.7 --criterion collect=3 > /dev/null
 # Shaping against evolution from scratch on the whole task.
 $B experiment examples/scratch-full.bat --seeds $SEEDS --out $R/scratch-full --fresh --criterion full=3 > /dev/null
 
@@ -41,12 +60,16 @@ $B experiment examples/floreano-mondada-1996.bat --seeds $SEEDS --out $R/fm1996 
 : > $R/replays.txt
 for s in $(seq 1 $SEEDS); do
   for r in 101 102 103; do
-    for spec in "khepera navigation" "khepera collect" "pretrained navigation" "forward-only navigation" "scratch-full full"; do
+    for spec in "khepera navigation" "khepera collect" "khepera-explore navigation" "khepera-explore collect" \
+      "pretrained navigation" "forward-only navigation" "scratch-full full"; do
       set -- $spec
       file=examples/$1.bat; [ -f "$file" ] || file=$R/$1.bat
       echo "$1 $2 $s $r learning $($B replay $file --stage $2 --run $R/$1/seed-$s --seed $r --out $R/replay-$1-$2-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
     done
-    echo "khepera collect $s $r nolearning $($B replay examples/khepera.bat --stage collect --run $R/khepera/seed-$s --seed $r --no-learning --out $R/replay-khepera-collect-nl-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
+    for f in khepera khepera-explore; do
+      file=examples/$f.bat; [ -f "$file" ] || file=$R/$f.bat
+      echo "$f collect $s $r nolearning $($B replay $file --stage collect --run $R/$f/seed-$s --seed $r --no-learning --out $R/replay-$f-collect-nl-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
+    done
   done
 done
 
@@ -57,12 +80,14 @@ done
 
 # Figure 11: the collect best of seed 1 over 225 actions.
 $B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 > /dev/null
+$B replay $R/khepera-explore.bat --stage collect --run $R/khepera-explore/seed-1 --actions 225 --seed 101 --out $R/explore-figure11 > /dev/null
 
 # The F&M 1996 best of seed 1 over its 150 actions, for the picture.
 $B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed-1 --seed 101 --out $R/fm1996-replay > /dev/null
 
 for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
-  figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement; do
+  figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement \
+  khepera-explore/fitness-seeds explore-figure11/activations explore-figure11/trajectory khepera-explore/seed-1/bigger/reinforcement; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
 
@@ -71,8 +96,19 @@ done
 # perfect grip and release decisions (docs/experiments/oracle.rs).
 cargo build --release --quiet --example oracle
 target/release/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
+target/release/examples/oracle $R/khepera-explore.bat --run $R/khepera-explore > $R/oracle-explore.txt
 
-for f in khepera pretrained forward-only scratch-full mutation; do
+# The grip script's mechanics alone (docs/experiments/grip.rs): the share of
+# objects it catches when started in front of one, with the four turns that
+# face the object and without them (the script before this report).
+cargo build --release --quiet --example grip
+target/release/examples/grip examples/khepera.bat > $R/grip.txt
+grep -v -E '^      turn (left|right)\((0.5|0.25)\) if ' examples/khepera.bat > $R/khepera-no-facing.bat
+[ "$(grep -c 'turn left(0.5) if' $R/khepera-no-facing.bat)" = 0 ]
+target/release/examples/grip $R/khepera-no-facing.bat > $R/grip-no-facing.txt
+target/release/examples/grip examples/khepera.bat --diameter 25 > $R/grip-25mm.txt
+
+for f in khepera khepera-explore pretrained forward-only scratch-full mutation; do
   echo "== $f"
   cat $R/$f/summary.md
 done
@@ -80,6 +116,14 @@ python3 docs/experiments/analyse.py "$R" "$SEEDS"
 echo "== the ceiling of the collect stage (oracle)"
 grep -E '^(search|decisions|evolved) (random|even): ' $R/oracle.txt
 grep '^decisions random, ' $R/oracle.txt
+echo "== the grip script alone, with the turns that face the object, then without them"
+tail -5 $R/grip.txt
+tail -5 $R/grip-no-facing.txt
+echo "== the same script with stage bigger's 25 mm objects"
+tail -5 $R/grip-25mm.txt
+echo "== the same for the exploring variant"
+grep -E '^(decisions|evolved) (random|even): ' $R/oracle-explore.txt
+grep '^decisions random, ' $R/oracle-explore.txt
 
 # Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.
 times=""
