@@ -3,99 +3,91 @@
 //! script alone, without arbitration or learning.
 //!
 //! ```sh
-//! cargo run --release --example grip -- [FILE] [--diameter 10]
+//! cargo run --release --example grip -- [FILE] [--stage collect] [--diameter D]
 //! ```
 //!
-//! The script is the one of the module `grip` in FILE (default
-//! `examples/khepera.bat`). A one-module stage runs it on a robot at the
-//! centre of the arena, facing east, with one virtual object (10 mm unless
-//! `--diameter` says otherwise: 25 is stage `bigger`'s) whose
-//! centre is GAP mm from the body surface at BEARING degrees from the
-//! heading, for every GAP of 5, 10, 15, 20, 25 mm and BEARING of -80 to 80
-//! degrees in steps of 20, and 20 episode seeds each (wheel and sensor
-//! noise differ). It prints the share of trials rewarded (the object
-//! between the arms when the script judges) per bearing and per gap.
+//! The module `grip` of the stage (default `collect` of
+//! `examples/khepera.bat`) is made to win with the robot in the middle of
+//! the arena, facing east, and one virtual object (the stage's diameter, or
+//! `--diameter` mm: 25 is stage `bigger`'s) whose centre is GAP mm from the
+//! body surface at BEARING degrees from the heading, for GAP from -20 (under
+//! the front of the body) to 25 mm and BEARING from -80 to 80 degrees, 20
+//! episode seeds each (wheel and sensor noise differ); the other objects lie
+//! in a corner (`shaping_runtime::oracle::grip_trial`). It prints the share
+//! of trials rewarded (the object between the arms when the script judges)
+//! per bearing and per gap.
 
 use std::process::ExitCode;
 
-use shaping_runtime::controller::{episode_rngs, Controller};
+use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
-use shaping_runtime::sim::{Pose, Sim};
+use shaping_runtime::oracle::{grip_trial, module};
 
 const GAPS: [f32; 8] = [-20.0, -10.0, 0.0, 5.0, 10.0, 15.0, 20.0, 25.0];
 const BEARINGS: [f32; 9] = [-80.0, -60.0, -40.0, -20.0, 0.0, 20.0, 40.0, 60.0, 80.0];
 const SEEDS: u64 = 20;
 
-/// The body of `behavior script ... { ... }` of `module grip` in `source`.
-fn grip_script(source: &str) -> Option<&str> {
-    let module = source.find("module grip {")?;
-    let open = module + source[module..].find("behavior script")?;
-    let body = open + source[open..].find('{')? + 1;
-    let close = body + source[body..].find('}')?;
-    Some(&source[body..close])
+struct Args {
+    file: String,
+    stage: String,
+    diameter: Option<f32>,
 }
 
-/// A one-module stage around the script: the robot of `khepera.bat`, the
-/// arena, one virtual object of `diameter` mm, no battery.
-fn trial_file(script: &str, diameter: f32) -> String {
-    format!(
-        "robot k {{\n  sensor ir[8] proximity\n  sensor barrier optical\n  actuator wheels[2] speed\n  \
-         actuator arm lift\n  actuator claw grip\n}}\n\
-         stage trials {{\n  world {{ arena 400mm x 600mm  objects 1 diameter {diameter}mm virtual }}\n  \
-         evolve {{ population 2  generations 1 }}\n  fitness per action wheels[0]\n  \
-         module grip {{\n    sense ir, barrier\n    activation fixed 1\n    behavior script commit {{{script}}}\n  }}\n}}\n"
-    )
+fn parse_args() -> Result<Args, String> {
+    let mut a = Args { file: "examples/khepera.bat".into(), stage: "collect".into(), diameter: None };
+    let mut it = std::env::args().skip(1);
+    while let Some(arg) = it.next() {
+        let mut value = |name: &str| it.next().ok_or_else(|| format!("{name} needs a value"));
+        match arg.as_str() {
+            "--stage" => a.stage = value("--stage")?,
+            "--diameter" => {
+                let d: f32 = value("--diameter")?.parse().map_err(|e| format!("--diameter: {e}"))?;
+                if !(d > 0.0 && d < 60.0) {
+                    return Err(format!("--diameter: {d} mm is not between 0 and 60"));
+                }
+                a.diameter = Some(d);
+            }
+            s if s.starts_with("--") => return Err(format!("unknown option `{s}`")),
+            s => a.file = s.into(),
+        }
+    }
+    Ok(a)
 }
 
 fn run() -> Result<(), String> {
-    let (mut file, mut diameter) = ("examples/khepera.bat".to_string(), 10.0f32);
-    let mut args = std::env::args().skip(1);
-    while let Some(arg) = args.next() {
-        match arg.as_str() {
-            "--diameter" => {
-                let v = args.next().ok_or("--diameter needs a value")?;
-                diameter = v.parse().map_err(|e| format!("--diameter: {e}"))?;
-                if !(diameter > 0.0 && diameter < 60.0) {
-                    return Err(format!("--diameter: {diameter} mm is not between 0 and 60"));
-                }
-            }
-            s if s.starts_with("--") => return Err(format!("unknown option `{s}`")),
-            s => file = s.to_string(),
-        }
+    let args = parse_args()?;
+    let source =
+        std::fs::read_to_string(&args.file).map_err(|e| format!("cannot read `{}`: {e}", args.file))?;
+    let mut program = shaping_compiler::compile(&source, &args.file)
+        .map_err(|d| format!("`{}` does not compile ({} errors): run `shaping check`", args.file, d.len()))?;
+    program.validate().map_err(|e| format!("{}: {e}", args.file))?;
+    let index = program
+        .stages
+        .iter()
+        .position(|s| s.name == args.stage)
+        .ok_or_else(|| format!("`{}` has no stage `{}`", args.file, args.stage))?;
+    // The trained weights of other modules bind as in a run of seed 1; they
+    // do not drive once the grip script has started.
+    train_all(&mut program, 1).map_err(|e| e.to_string())?;
+    let mut stage = program.stages[index].clone();
+    let Some(objects) = stage.world.objects.as_mut() else {
+        return Err(format!("stage `{}` has no objects", args.stage));
+    };
+    if let Some(d) = args.diameter {
+        objects.diameter = d;
     }
-    let source = std::fs::read_to_string(&file).map_err(|e| format!("cannot read `{file}`: {e}"))?;
-    let script = grip_script(&source).ok_or_else(|| format!("`{file}` has no scripted module `grip`"))?;
-    let text = trial_file(script, diameter);
-    let program = shaping_compiler::compile(&text, "grip-trials.bat")
-        .map_err(|d| format!("the trial stage does not compile ({} errors)", d.len()))?;
-    let stage = &program.stages[0];
-    println!("the grip script of `{file}`, objects of {diameter} mm:{script}");
+    let diameter = objects.diameter;
+    let grip = module(&stage, "grip")?;
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    println!("the grip module of stage `{}` in `{}`, objects of {diameter} mm", args.stage, args.file);
     let mut by_bearing = vec![(0u32, 0u32); BEARINGS.len()];
     let mut by_gap = vec![(0u32, 0u32); GAPS.len()];
     for (bi, bearing) in BEARINGS.iter().enumerate() {
         for (gi, gap) in GAPS.iter().enumerate() {
             for seed in 1..=SEEDS {
-                let (sim_seed, rng) = episode_rngs(seed);
-                let mut sim = Sim::new(&stage.world, sim_seed);
-                let (x, y) = (200.0, 300.0);
-                let d = stage.world.body.radius + gap;
-                let b = bearing.to_radians();
-                if !(sim.set_pose(Pose { x, y, theta: 0.0 })
-                    && sim.set_object(0, x + d * b.cos(), y + d * b.sin()))
-                {
-                    return Err("cannot place the robot and the object".into());
-                }
-                let mut ctl = Controller::new(stage, &Genome::zeros(0), rng).map_err(|e| e.to_string())?;
-                ctl.start(&mut sim);
-                let mut judged = 0.0;
-                for _ in 0..30 {
-                    let rep = ctl.act(&mut sim);
-                    if rep.reinforcement != 0.0 {
-                        judged = rep.reinforcement;
-                        break;
-                    }
-                }
-                let ok = u32::from(judged > 0.0);
+                let judged =
+                    grip_trial(&stage, &genome, grip, *gap, *bearing, seed).map_err(|e| e.to_string())?;
+                let ok = u32::from(judged.is_some_and(|r| r > 0.0));
                 by_bearing[bi] = (by_bearing[bi].0 + ok, by_bearing[bi].1 + 1);
                 by_gap[gi] = (by_gap[gi].0 + ok, by_gap[gi].1 + 1);
             }
@@ -124,7 +116,7 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            ExitCode::from(2)
         }
     }
 }

@@ -366,3 +366,53 @@ pub fn evenly_spread(n: usize, arena: [f32; 2]) -> Vec<[f32; 2]> {
         })
         .collect()
 }
+
+/// One trial of a scripted module started in front of a floor object (for
+/// the grip module: does its script catch it?). The robot stands in the
+/// middle of the arena facing +x, the stage's first object lies with its
+/// centre `gap` mm from the body surface (negative: under the front of the
+/// body, where a robot driving at full speed may find a virtual object) at
+/// `bearing_deg` from the heading, the other objects in a corner out of
+/// sight; `module` is made to win the first action and its committed script
+/// runs. Returns the first reinforcement it delivers within 30 actions
+/// (`None` if it delivers none). The world must have objects; `genome` is
+/// the stage's (its other modules do not drive once the script has started).
+pub fn grip_trial(
+    stage: &Stage,
+    genome: &Genome,
+    module: usize,
+    gap: f32,
+    bearing_deg: f32,
+    seed: u64,
+) -> Result<Option<f32>, ControllerError> {
+    let count = stage.world.objects.as_ref().map_or(0, |o| o.count as usize);
+    if count == 0 {
+        return Err(ControllerError::Setup(format!("stage `{}` has no objects", stage.name)));
+    }
+    let (sim_seed, rng) = episode_rngs(seed);
+    let mut ctl = Controller::new(stage, genome, rng)?;
+    let mut sim = Sim::new(&stage.world, sim_seed);
+    let [w, d] = stage.world.arena;
+    let (x, y) = (w / 2.0, d / 2.0);
+    let reach = stage.world.body.radius + gap;
+    let b = bearing_deg.to_radians();
+    let corner = stage.world.objects.as_ref().map_or(1.0, |o| o.diameter / 2.0 + 1.0);
+    let placed = sim.set_pose(Pose { x, y, theta: 0.0 })
+        && sim.set_object(0, x + reach * b.cos(), y + reach * b.sin())
+        && (1..count).all(|i| sim.set_object(i, corner, corner));
+    if !placed {
+        return Err(ControllerError::Setup(format!(
+            "cannot put the robot at ({x}, {y}) mm and an object {gap} mm ahead at {bearing_deg} degrees in stage `{}`",
+            stage.name
+        )));
+    }
+    ctl.start(&mut sim);
+    for _ in 0..30 {
+        ctl.force_winner(module);
+        let rep = ctl.act(&mut sim);
+        if rep.winner == module && rep.reinforcement != 0.0 {
+            return Ok(Some(rep.reinforcement));
+        }
+    }
+    Ok(None)
+}
