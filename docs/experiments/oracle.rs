@@ -6,25 +6,28 @@
 //! - `decisions`: each seed's evolved collect best (`RUN/seed-N/STAGE/best.genome`
 //!   of `shaping experiment`) with grip and release made to win exactly when
 //!   they can succeed; `evolved`: the same individual alone, on the same
-//!   episodes.
+//!   episodes; `physical`: the same with physical objects (they block the
+//!   robot and stay outside once thrown out), as in the paper's test.
 //!
 //! ```sh
 //! cargo run --release --example oracle -- [FILE] [--stage collect] [--seeds 10] [--first-seed 1] [--actions 300] [--run DIR]
 //! ```
 //!
-//! For run seeds first-seed.. (seeds of them, from 1 unless told) (the seed of the training stage that teaches the
-//! avoid module, and of the evolved run) and episode seeds 101..=103 (those
-//! of `run.sh`'s replays; the search, which has no architecture, runs
-//! episode seed `1000 * run seed + episode` so that its lives differ), it prints one line per episode, objects at random
-//! as the stage declares and evenly spread (the paper's figure 11: 8 objects
-//! evenly distributed), then the medians. Without `--run`, only `search`.
+//! For `--seeds` run seeds from `--first-seed` (1 unless told; the seed of
+//! the training stage that teaches the avoid module, and of the evolved run)
+//! and episode seeds 101..=103 (those of `run.sh`'s replays; the search,
+//! which has no architecture, runs episode seed `1000 * run seed + episode`
+//! so that its lives differ), it prints one line per episode, objects at
+//! random as the stage declares and evenly spread (the paper's figure 11: 8
+//! objects evenly distributed), then the medians. Without `--run`, only
+//! `search`.
 
 use std::process::ExitCode;
 
 use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult, Trace};
 use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
-use shaping_runtime::oracle::{self, evenly_spread, Decisions, Search};
+use shaping_runtime::oracle::{self, evenly_spread, run_placed, Decisions, Search};
 
 struct Args {
     file: String,
@@ -101,6 +104,10 @@ fn run() -> Result<(), String> {
         let mut program = base.clone();
         train_all(&mut program, seed).map_err(|e| e.to_string())?;
         let stage = &program.stages[index];
+        let mut physical = stage.clone();
+        if let Some(o) = physical.world.objects.as_mut() {
+            o.virtual_ = false;
+        }
         let spread = stage.world.objects.as_ref().map(|o| evenly_spread(o.count as usize, stage.world.arena));
         let best = match &args.run {
             Some(dir) => {
@@ -162,7 +169,13 @@ fn run() -> Result<(), String> {
                     runs.push(("decisions", d));
                     if at.is_none() {
                         runs.push(("evolved", run_episode(stage, g, &opts, None)));
+                    } else {
+                        runs.push(("evolved", run_placed(stage, g, &opts, at).map_err(|e| e.to_string())?));
                     }
+                    // The paper's test of figure 11 used real objects: the
+                    // same episode with physical ones (they block the robot
+                    // and do not come back once thrown out).
+                    runs.push(("physical", run_placed(&physical, g, &opts, at).map_err(|e| e.to_string())?));
                 }
                 for (who, r) in runs {
                     println!(
@@ -174,7 +187,7 @@ fn run() -> Result<(), String> {
             }
         }
     }
-    for who in ["search", "decisions", "evolved"] {
+    for who in ["search", "decisions", "evolved", "physical"] {
         for placement in ["random", "even"] {
             let v: Vec<&EpisodeResult> =
                 all.iter().filter(|(w, p, _)| *w == who && *p == placement).map(|(_, _, r)| r).collect();

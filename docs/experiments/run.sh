@@ -111,7 +111,7 @@ for f in khepera khepera-explore pretrained forward-only scratch-full mutation; 
 done
 python3 docs/experiments/analyse.py "$R" "$SEEDS"
 echo "== the ceiling of the collect stage (oracle)"
-grep -E '^(search|decisions|evolved) (random|even): ' $R/oracle.txt
+grep -E '^(search|decisions|evolved|physical) (random|even): ' $R/oracle.txt
 grep '^decisions random, ' $R/oracle.txt
 echo "== the grip script alone, with the turns that face the object, then without them"
 tail -5 $R/grip.txt
@@ -119,7 +119,7 @@ tail -5 $R/grip-no-facing.txt
 echo "== the same script with stage bigger's 25 mm objects"
 tail -5 $R/grip-25mm.txt
 echo "== the same for the exploring variant"
-grep -E '^(decisions|evolved) (random|even): ' $R/oracle-explore.txt
+grep -E '^(decisions|evolved|physical) (random|even): ' $R/oracle-explore.txt
 grep '^decisions random, ' $R/oracle-explore.txt
 
 # Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.

@@ -152,6 +152,22 @@ impl Decisions {
     }
 }
 
+/// One episode of `genome` on `stage` as evolved (no arbiter), with the
+/// objects put at `objects` (mm) when given: an evolved individual in a
+/// test placement, such as the paper's figure 11 (8 objects evenly spread).
+/// With `objects: None` it is [`crate::controller::run_episode`]'s episode.
+pub fn run_placed(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    objects: Option<&[[f32; 2]]>,
+) -> Result<EpisodeResult, ControllerError> {
+    let (sim_seed, rng) = episode_rngs(opts.seed);
+    let mut ctl = Controller::new(stage, genome, rng)?;
+    let mut sim = world(stage, sim_seed, objects)?;
+    Ok(ctl.run_with(&mut sim, opts, None, |_, _| {}))
+}
+
 /// A blind search with perfect gripping, releasing and recharging, driving
 /// the simulator directly (see the module documentation).
 #[derive(Clone, Copy, Debug, PartialEq)]

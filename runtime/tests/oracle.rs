@@ -4,7 +4,7 @@
 use rand::SeedableRng;
 use shaping_runtime::controller::{run_episode, Controller, EpisodeOptions, Trace};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::oracle::{evenly_spread, Decisions, Search};
+use shaping_runtime::oracle::{evenly_spread, run_placed, Decisions, Search};
 use shaping_runtime::sim::Sim;
 use shaping_runtime::testkit;
 
@@ -99,4 +99,26 @@ fn eight_objects_spread_evenly_over_the_paper_arena_make_two_columns_of_four() {
     bad[0] = [f32::NAN, 0.0];
     let err = Search::default().run_episode(&stage, &opts(1), Some(&bad)).unwrap_err();
     assert!(err.to_string().contains("object 0"), "{err}");
+}
+
+/// `run_placed` without a placement is the stage's own episode; with one,
+/// the objects start where it says (an object placed in the robot's way of
+/// a life differs from the random placement's life), and a placement the
+/// world cannot take is an error that says so.
+#[test]
+fn an_evolved_individual_runs_the_stage_episode_or_the_placement_given() {
+    let stage = testkit::collect();
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    for seed in [3, 7] {
+        let own = run_episode(&stage, &genome, &opts(seed), None);
+        assert_eq!(run_placed(&stage, &genome, &opts(seed), None).unwrap(), own);
+    }
+    let even = evenly_spread(8, stage.world.arena);
+    let lives: Vec<_> =
+        (1..=6).map(|seed| run_placed(&stage, &genome, &opts(seed), Some(&even)).unwrap()).collect();
+    let own: Vec<_> = (1..=6).map(|seed| run_episode(&stage, &genome, &opts(seed), None)).collect();
+    assert_ne!(lives, own, "the placement changed nothing in 6 lives");
+    let outside = [[-50.0f32, 10.0]];
+    let err = run_placed(&stage, &genome, &opts(1), Some(&outside)).unwrap_err();
+    assert!(err.to_string().contains("cannot be put at"), "{err}");
 }

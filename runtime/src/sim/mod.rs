@@ -460,10 +460,13 @@ impl Sim {
     }
 
     /// Moves object `index` (on the floor) to `(x, y)` (for tests and tools).
-    /// Returns false if there is no such object or it is not on the floor.
+    /// Returns false if there is no such object, it is not on the floor, or
+    /// its disc at `(x, y)` would not lie within the arena's walls.
     pub fn set_object(&mut self, index: usize, x: f32, y: f32) -> bool {
+        let r = self.obj_radius;
+        let inside = x >= r && x <= self.width - r && y >= r && y <= self.depth - r;
         match self.objects.get_mut(index) {
-            Some(o) if o.state == ObjectState::Floor && x.is_finite() && y.is_finite() => {
+            Some(o) if o.state == ObjectState::Floor && inside => {
                 o.at = Point2::new(x, y);
                 true
             }
