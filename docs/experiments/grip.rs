@@ -19,6 +19,8 @@
 
 use std::process::ExitCode;
 
+mod common;
+
 use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::oracle::{grip_trial, module};
@@ -56,16 +58,7 @@ fn parse_args() -> Result<Args, String> {
 
 fn run() -> Result<(), String> {
     let args = parse_args()?;
-    let source =
-        std::fs::read_to_string(&args.file).map_err(|e| format!("cannot read `{}`: {e}", args.file))?;
-    let mut program = shaping_compiler::compile(&source, &args.file)
-        .map_err(|d| format!("`{}` does not compile ({} errors): run `shaping check`", args.file, d.len()))?;
-    program.validate().map_err(|e| format!("{}: {e}", args.file))?;
-    let index = program
-        .stages
-        .iter()
-        .position(|s| s.name == args.stage)
-        .ok_or_else(|| format!("`{}` has no stage `{}`", args.file, args.stage))?;
+    let (mut program, index) = common::load(&args.file, &args.stage)?;
     // The trained weights of other modules bind as in a run of seed 1; they
     // do not drive once the grip script has started.
     train_all(&mut program, 1).map_err(|e| e.to_string())?;
@@ -112,11 +105,5 @@ fn run() -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
+    common::exit(run())
 }

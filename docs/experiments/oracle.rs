@@ -24,6 +24,8 @@
 
 use std::process::ExitCode;
 
+mod common;
+
 use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult, Trace};
 use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
@@ -80,16 +82,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn run() -> Result<(), String> {
     let args = parse_args()?;
-    let source =
-        std::fs::read_to_string(&args.file).map_err(|e| format!("cannot read `{}`: {e}", args.file))?;
-    let base = shaping_compiler::compile(&source, &args.file)
-        .map_err(|d| format!("`{}` does not compile ({} errors): run `shaping check`", args.file, d.len()))?;
-    base.validate().map_err(|e| format!("{}: {e}", args.file))?;
-    let index = base
-        .stages
-        .iter()
-        .position(|s| s.name == args.stage)
-        .ok_or_else(|| format!("`{}` has no stage `{}`", args.file, args.stage))?;
+    let (base, index) = common::load(&args.file, &args.stage)?;
     let search = Search::default();
     println!(
         "search: turn above {} front IR, recharge below battery {}, release with a wall within {} mm",
@@ -230,11 +223,5 @@ fn run() -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
+    common::exit(run())
 }

@@ -128,10 +128,7 @@ impl Decisions {
         objects: Option<&[[f32; 2]]>,
         trace: Option<&mut Trace>,
     ) -> Result<EpisodeResult, ControllerError> {
-        let (sim_seed, rng) = episode_rngs(opts.seed);
-        let mut ctl = Controller::new(stage, genome, rng)?;
-        let mut sim = world(stage, sim_seed, objects)?;
-        Ok(ctl.run_with(&mut sim, opts, trace, |ctl, sim| {
+        run_in_world(stage, genome, opts, objects, trace, |ctl, sim| {
             let (grip, release) = if sim.holding() {
                 (false, wall_in_front(sim, self.release_reach).is_some())
             } else {
@@ -148,7 +145,7 @@ impl Decisions {
             if !release {
                 ctl.forbid(self.release);
             }
-        }))
+        })
     }
 }
 
@@ -162,10 +159,23 @@ pub fn run_placed(
     opts: &EpisodeOptions,
     objects: Option<&[[f32; 2]]>,
 ) -> Result<EpisodeResult, ControllerError> {
+    run_in_world(stage, genome, opts, objects, None, |_, _| {})
+}
+
+/// One episode of `genome` on `stage` in [`world`], with `before` called
+/// before every action (the arbiters' hook).
+fn run_in_world(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    objects: Option<&[[f32; 2]]>,
+    trace: Option<&mut Trace>,
+    before: impl FnMut(&mut Controller, &Sim),
+) -> Result<EpisodeResult, ControllerError> {
     let (sim_seed, rng) = episode_rngs(opts.seed);
     let mut ctl = Controller::new(stage, genome, rng)?;
     let mut sim = world(stage, sim_seed, objects)?;
-    Ok(ctl.run_with(&mut sim, opts, None, |_, _| {}))
+    Ok(ctl.run_with(&mut sim, opts, trace, before))
 }
 
 /// A blind search with perfect gripping, releasing and recharging, driving

@@ -362,9 +362,10 @@ fn learning_below_a_threshold_stops_once_performance_is_reached() {
 
 /// One module with a learning activation network over ir[0] and ir[1] whose
 /// reinforcement is `ir[0] > 0.5 ? 1 : -1` after the action.
-fn activation_learning_stage() -> Stage {
-    let r = expr(vec![Op::Chan(0), Op::Const(0.5), Op::Gt, Op::Const(1.0), Op::Const(-1.0), Op::Select]);
-    let m = Module {
+/// A module `grip` on channels 0 and 1 whose activation network (all
+/// weights 0) learns by CRBP at 0.5 / 0.5 from `reinforce`.
+fn learning_grip(behavior: Behavior, reinforce: Expr) -> Module {
+    Module {
         name: "grip".into(),
         stage: 0,
         inputs: vec![0, 1],
@@ -375,11 +376,15 @@ fn activation_learning_stage() -> Stage {
             recurrent: false,
             params: vec![Param::Fixed(0.0); 3],
         },
-        behavior: testkit::script(Action::Wheels { left: 0.0, right: 0.0 }),
+        behavior,
         learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
-        reinforce: Some(r),
-    };
-    stage_of(vec![m], vec![])
+        reinforce: Some(reinforce),
+    }
+}
+
+fn activation_learning_stage() -> Stage {
+    let r = expr(vec![Op::Chan(0), Op::Const(0.5), Op::Gt, Op::Const(1.0), Op::Const(-1.0), Op::Select]);
+    stage_of(vec![learning_grip(testkit::script(Action::Wheels { left: 0.0, right: 0.0 }), r)], vec![])
 }
 
 #[test]
@@ -410,21 +415,7 @@ fn a_reinforce_step_late_in_a_script_trains_the_pattern_the_script_started_on() 
         Step { action: Action::Wheels { left: 1.0, right: 1.0 }, end: StepEnd::Actions(1), when: None },
         Step { action: Action::Reinforce(expr(vec![Op::Const(1.0)])), end: StepEnd::Actions(1), when: None },
     ];
-    let m = Module {
-        name: "grip".into(),
-        stage: 0,
-        inputs: vec![0, 1],
-        activation: Network {
-            inputs: 2,
-            hidden: 0,
-            outputs: 1,
-            recurrent: false,
-            params: vec![Param::Fixed(0.0); 3],
-        },
-        behavior: Behavior::Script(Script { steps, commit: true }),
-        learning: Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 30)),
-        reinforce: Some(expr(vec![Op::Const(1.0)])),
-    };
+    let m = learning_grip(Behavior::Script(Script { steps, commit: true }), expr(vec![Op::Const(1.0)]));
     let s = stage_of(vec![m], vec![]);
     let mut c = controller(&s, 1);
     let mut robot = Puppet::default();
