@@ -73,15 +73,16 @@ for k, v in at.items():
 
 for run in ("khepera", "khepera-explore", "pretrained", "forward-only"):
     print(f"\n== figure 4: {run}, navigation")
-    r25, r40, reach, ever = [], [], [], []
+    r25, r40, rlast, reach, ever = [], [], [], [], []
     for s in SEEDS:
         b = history(run, s, "navigation")
         r = roll3(b)
         r25.append(r[24])
         r40.append(r[39])
+        rlast.append(r[-1])
         reach.append(first_reach(r, 0.70))
         ever.append(max(b))
-    last = f"; at the last ({len(b)}): {spread([roll3(history(run, s, 'navigation'))[-1] for s in SEEDS], 3)}" if len(b) > 40 else ""
+    last = f"; at the last ({len(b)}): {spread(rlast, 3)}" if len(b) > 40 else ""
     print(f"  best, 3-generation rolling mean, at generation 25: {spread(r25, 3)}; at 40: {spread(r40, 3)}{last}")
     print(f"  best ever: {spread(ever, 3)}; generation where the rolling best reaches 0.70: {reach}")
     ok, tot = recharge_share(run, "navigation")
