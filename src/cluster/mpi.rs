@@ -7,7 +7,7 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{mpsc, Arc};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
@@ -58,6 +58,8 @@ pub fn with_mpi(
     signal_hook::flag::register(signal_hook::consts::SIGTERM, Arc::clone(&term))
         .map_err(|e| CliError::io(format!("error: cannot watch for SIGTERM: {e}")))?;
     let host = mpi::environment::processor_name().unwrap_or_default();
+    let watch = Arc::new(Watch { host: host.clone(), ..Watch::default() });
+    watch.spawn();
     let coordinator = Coordinator {
         world,
         size,
@@ -66,6 +68,7 @@ pub fn with_mpi(
         timeout: Duration::from_secs(rank_timeout.max(1)),
         term,
         host,
+        watch,
         state: RefCell::new(State::default()),
     };
     let result = body(&coordinator);
@@ -90,7 +93,87 @@ pub struct Coordinator {
     timeout: Duration,
     term: Arc<AtomicBool>,
     host: String,
+    /// Names a dead rank of this node from a thread of its own.
+    watch: Arc<Watch>,
     state: RefCell<State>,
+}
+
+/// A watcher on rank 0: when a worker rank of this node dies, mpirun ends
+/// the job and may kill rank 0 before its main thread, busy between two
+/// looks (the generation's selection, the checkpoint), names the rank. The
+/// watcher looks every [`WATCH`] and says it at once; the main thread then
+/// only ends the run ([`Coordinator::check_term`]). It never calls MPI.
+#[derive(Default)]
+struct Watch {
+    host: String,
+    seen: Mutex<Seen>,
+    /// The message was printed (by the watcher or the main thread).
+    reported: AtomicBool,
+    /// The run is ending normally: workers leave, stop looking.
+    stop: AtomicBool,
+}
+
+/// What the watcher knows: the workers, what is being evaluated and the
+/// checkpoint to resume from.
+#[derive(Default)]
+struct Seen {
+    workers: Vec<(Rank, u32, String)>,
+    context: String,
+    checkpoint: PathBuf,
+}
+
+/// Pause between two looks of the watcher.
+const WATCH: Duration = Duration::from_millis(10);
+
+impl Watch {
+    fn spawn(self: &Arc<Self>) {
+        let me = Arc::clone(self);
+        std::thread::spawn(move || {
+            while !me.stop.load(Ordering::SeqCst) {
+                if let Some(message) = me.dead_message() {
+                    // One write of the whole message, so that an abort by the
+                    // main thread cannot cut it.
+                    if !me.reported.swap(true, Ordering::SeqCst) {
+                        eprint!("{message}");
+                    }
+                    return;
+                }
+                std::thread::sleep(WATCH);
+            }
+        });
+    }
+
+    fn seen(&self) -> std::sync::MutexGuard<'_, Seen> {
+        self.seen.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The error message naming the workers of this node that are gone, if any.
+    fn dead_message(&self) -> Option<String> {
+        let seen = self.seen();
+        let mut dead: Vec<&(Rank, u32, String)> =
+            seen.workers.iter().filter(|(_, pid, host)| *host == self.host && !alive(*pid)).collect();
+        if dead.is_empty() {
+            return None;
+        }
+        dead.sort_unstable_by_key(|w| w.0);
+        let names: Vec<String> =
+            dead.iter().map(|(rank, pid, host)| format!("rank {rank} (pid {pid} on {host})")).collect();
+        let what = format!("{} died during {}, and mpirun ended the run", names.join(", "), seen.context);
+        Some(error_message(&what, &seen.checkpoint))
+    }
+}
+
+/// `error: WHAT`, and how to resume from `checkpoint` when there is one.
+fn error_message(what: &str, checkpoint: &Path) -> String {
+    let resume = if checkpoint.as_os_str().is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; the checkpoint `{}` is valid: run the same command again (without `--fresh`), with any number of ranks, to resume",
+            checkpoint.display()
+        )
+    };
+    format!("\nerror: {what}{resume}\n")
 }
 
 #[derive(Default)]
@@ -135,8 +218,17 @@ impl Coordinator {
     /// would resume from, for the failure messages.
     pub fn set_context(&self, what: String, checkpoint: &Path) {
         let mut st = self.state.borrow_mut();
+        let mut seen = self.watch.seen();
+        seen.context.clone_from(&what);
+        seen.checkpoint = checkpoint.to_path_buf();
         st.context = what;
         st.checkpoint = checkpoint.to_path_buf();
+    }
+
+    /// A worker said hello: its pid and host, for messages and the watcher.
+    fn hello(&self, st: &mut State, rank: Rank, pid: u32, host: String) {
+        self.watch.seen().workers.push((rank, pid, host.clone()));
+        st.workers.insert(rank, Worker { pid, host, version: 0 });
     }
 
     /// Runs episodes of evolved stage `index` (`actions` actions, learning on)
@@ -332,9 +424,7 @@ impl Coordinator {
                 while let Some((rank, request)) = self.poll(st) {
                     busy = true;
                     match request {
-                        Request::Hello { pid, host } => {
-                            st.workers.insert(rank, Worker { pid, host, version: 0 });
-                        }
+                        Request::Hello { pid, host } => self.hello(st, rank, pid, host),
                         Request::Ready => {}
                         Request::Failed { message } => self.fatal(st, format!("rank {rank}: {message}")),
                         answer => {
@@ -452,9 +542,7 @@ impl Coordinator {
         loop {
             while let Some((rank, request)) = self.poll(&mut st) {
                 match request {
-                    Request::Hello { pid, host } => {
-                        st.workers.insert(rank, Worker { pid, host, version: 0 });
-                    }
+                    Request::Hello { pid, host } => self.hello(&mut st, rank, pid, host),
                     Request::Failed { message } => self.fatal(&st, format!("rank {rank}: {message}")),
                     Request::Ready | Request::Results { .. } | Request::Done { .. } => {}
                 }
@@ -477,6 +565,7 @@ impl Coordinator {
             self.check_term(&st, &HashMap::new());
             std::thread::sleep(POLL);
         }
+        self.watch.stop.store(true, Ordering::SeqCst);
         let idle = std::mem::take(&mut st.idle);
         let stop = Reply::Stop.encode();
         for rank in idle {
@@ -525,6 +614,11 @@ impl Coordinator {
     /// mpirun sends SIGTERM to the surviving ranks when one dies (or when the
     /// job is interrupted): say which rank is gone, if it ran on this node.
     fn check_term(&self, st: &State, outstanding: &HashMap<Rank, (usize, Instant)>) {
+        if self.watch.reported.load(Ordering::SeqCst) {
+            // The watcher named the dead rank: leave it the time to write.
+            std::thread::sleep(10 * WATCH);
+            self.world.abort(1)
+        }
         if !self.term.load(Ordering::SeqCst) {
             return;
         }
@@ -550,15 +644,11 @@ impl Coordinator {
     }
 
     fn fatal(&self, st: &State, what: String) -> ! {
-        let resume = if st.checkpoint.as_os_str().is_empty() {
-            String::new()
+        if !self.watch.reported.swap(true, Ordering::SeqCst) {
+            eprint!("{}", error_message(&what, &st.checkpoint));
         } else {
-            format!(
-                "; the checkpoint `{}` is valid: run the same command again (without `--fresh`), with any number of ranks, to resume",
-                st.checkpoint.display()
-            )
-        };
-        eprintln!("\nerror: {what}{resume}");
+            std::thread::sleep(10 * WATCH);
+        }
         self.world.abort(1)
     }
 }
