@@ -131,11 +131,16 @@ def won_per_life(run, stage):
     return ", ".join(f"{k} {v / lives:.0f}" for k, v in sorted(count.items(), key=lambda kv: -kv[1]))
 
 
-def after_change(run, s):
-    """The grip module's reinforcement signals after the change, in order."""
-    t = rows(f"{R}/{run}/seed-{s}/bigger/trace.csv")
+def bigger_trace(run, s):
+    """The rows of a seed's stage `bigger` and the action where the world changed."""
     with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
         switch = json.load(f)["before"]["actions"]
+    return rows(f"{R}/{run}/seed-{s}/bigger/trace.csv"), switch
+
+
+def after_change(run, s):
+    """The grip module's reinforcement signals after the change, in order."""
+    t, switch = bigger_trace(run, s)
     return [float(r["reinf_grip"]) for r in t[switch:] if float(r["reinf_grip"]) != 0.0]
 
 
@@ -145,9 +150,7 @@ def figure13(run, title):
     print(f"\n== figure 13: {title}")
     drops = recov = 0
     for s in SEEDS:
-        t = rows(f"{R}/{run}/seed-{s}/bigger/trace.csv")
-        with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
-            switch = json.load(f)["before"]["actions"]
+        t, switch = bigger_trace(run, s)
         perf = [float(r["perf_grip"]) for r in t]
         sig = [float(r["reinf_grip"]) for r in t]
         n_before = sum(1 for x in sig[:switch] if x)
@@ -210,7 +213,7 @@ for run in ("khepera", "khepera-explore"):
 # variant's collect bests, 1500 actions in the collect world (the paper's
 # battery), then 1500 with 25 mm objects (f13-long), with 10 mm objects
 # (f13-control: no change) and with 25 mm objects without learning
-# (f13-nolearning). The first halves are the same in the three.
+# (f13-nolearning). The first two share their first half (the same life).
 first30 = {}
 for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control", "objects stay 10 mm, learning"),
                   ("f13-nolearning", "objects 10 -> 25 mm, no learning")):
