@@ -1,4 +1,4 @@
-//! What the experiment examples (`oracle.rs`, `grip.rs`) share: loading a
+//! What the experiment examples (`oracle.rs`, `grip.rs`, `discriminate.rs`) share: loading a
 //! file's stage, and turning a run's error into the exit status.
 
 use std::process::ExitCode;

@@ -119,6 +119,14 @@ cargo build --release --quiet --example oracle
 target/release/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
 target/release/examples/oracle $R/khepera-explore.bat --run $R/khepera-explore > $R/oracle-explore.txt
 
+# What the proximity sensors allow the grip and release decisions
+# (docs/experiments/discriminate.rs): rules fitted on the exploring
+# variant's lives (linear as its activation networks, with 4 hidden units,
+# quadratic) decide in the lives of the other half of the seeds; and how
+# well the real Khepera's readings tell a wall from a 25 mm cylinder.
+cargo build --release --quiet --example discriminate
+target/release/examples/discriminate $R/khepera-explore.bat --run $R/khepera-explore > $R/discriminate.txt
+
 # The grip script's mechanics alone (docs/experiments/grip.rs): the share of
 # objects it catches when started in front of one, with the four turns that
 # face the object and without them (the script before this report).
@@ -145,6 +153,8 @@ tail -5 $R/grip-25mm.txt
 echo "== the same for the exploring variant"
 grep -E '^(decisions|evolved|physical) (random|even): ' $R/oracle-explore.txt
 grep '^decisions random, ' $R/oracle-explore.txt
+echo "== what the proximity sensors allow the decisions (exploring variant)"
+cat $R/discriminate.txt
 
 # Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.
 times=""

@@ -128,7 +128,7 @@ impl Decisions {
         objects: Option<&[[f32; 2]]>,
         trace: Option<&mut Trace>,
     ) -> Result<EpisodeResult, ControllerError> {
-        run_in_world(stage, genome, opts, objects, trace, |ctl, sim| {
+        run_arbitrated(stage, genome, opts, objects, trace, |ctl, sim| {
             let (grip, release) = if sim.holding() {
                 (false, wall_in_front(sim, self.release_reach).is_some())
             } else {
@@ -159,12 +159,14 @@ pub fn run_placed(
     opts: &EpisodeOptions,
     objects: Option<&[[f32; 2]]>,
 ) -> Result<EpisodeResult, ControllerError> {
-    run_in_world(stage, genome, opts, objects, None, |_, _| {})
+    run_arbitrated(stage, genome, opts, objects, None, |_, _| {})
 }
 
-/// One episode of `genome` on `stage` in [`world`], with `before` called
-/// before every action (the arbiters' hook).
-fn run_in_world(
+/// One episode of `genome` on `stage` (the objects put at `objects` when
+/// given), with `before` called before every action: the hook of an arbiter
+/// outside the architecture, which may read the world and the controller
+/// and call [`Controller::force_winner`] or [`Controller::forbid`].
+pub fn run_arbitrated(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
