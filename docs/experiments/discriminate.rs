@@ -98,11 +98,13 @@ struct Sample {
 }
 
 /// The labelled actions of one life, for the grip rule (not holding) and
-/// the release rule (holding), and the evolved winner at each.
+/// the release rule (holding), and the evolved winner at each; the objects
+/// the evolved architecture released outside in it.
 #[derive(Default)]
 struct Life {
     grip: Vec<(Sample, bool)>,
     release: Vec<(Sample, bool)>,
+    released: u32,
 }
 
 fn ir_of(p: &[f32; CHANNELS]) -> [f32; 8] {
@@ -332,14 +334,15 @@ fn run() -> Result<(), String> {
             let opts = EpisodeOptions { actions: 300, learning: true, seed: ep };
             let mut states: Vec<Option<(bool, Sample)>> = Vec::new();
             let mut trace = Trace::default();
-            run_arbitrated(&stage, &g, &opts, None, Some(&mut trace), |c, sim| {
+            // Only records: this is the evolved architecture alone.
+            let alone = run_arbitrated(&stage, &g, &opts, None, Some(&mut trace), |c, sim| {
                 let ir = ir_of(c.percept());
                 states.push(
                     label(sim).filter(|_| seen(&ir)).map(|(holding, yes)| (holding, Sample { ir, yes })),
                 );
             })
             .map_err(|e| e.to_string())?;
-            let mut life = Life::default();
+            let mut life = Life { released: alone.releases_outside, ..Life::default() };
             for (row, state) in trace.rows.iter().zip(&states) {
                 let Some((holding, s)) = state else { continue };
                 if *holding {
@@ -384,7 +387,7 @@ fn run() -> Result<(), String> {
     );
 
     let mut released: Vec<(&str, Vec<u32>)> = KINDS.iter().map(|k| (*k, Vec::new())).collect();
-    let mut evolved = Vec::new();
+    let evolved: Vec<u32> = flat.iter().map(|l| l.released).collect();
     for (fold, (fit_on, test_on)) in folds.iter().enumerate() {
         let (g_train, r_train) = (samples(fit_on.clone(), false), samples(fit_on.clone(), true));
         let (g_test, r_test) = (samples(test_on.clone(), false), samples(test_on.clone(), true));
@@ -421,11 +424,6 @@ fn run() -> Result<(), String> {
                     })
                     .map_err(|e| e.to_string())?;
                     released[k].1.push(res.releases_outside);
-                    if k == 0 {
-                        let alone = run_arbitrated(stage, &genomes[i], &opts, None, None, |_, _| {})
-                            .map_err(|e| e.to_string())?;
-                        evolved.push(alone.releases_outside);
-                    }
                 }
             }
         }
