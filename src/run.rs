@@ -13,7 +13,7 @@ use shaping_runtime::controller::{
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Behavior, Param, Program, Stage, StageRun};
+use shaping_runtime::program::{Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
 use crate::cluster::Coordinator;
@@ -66,14 +66,10 @@ pub fn chain(program: &Program, target: usize) -> Vec<usize> {
     let mut cur = Some(target);
     while let Some(i) = cur {
         need[i] = true;
-        for m in &program.stages[i].modules {
-            if let Behavior::Neural(nb) = &m.behavior {
-                for p in &nb.net.params {
-                    if let Param::Trained { stage, .. } = *p {
-                        if let Some(n) = need.get_mut(stage as usize) {
-                            *n = true;
-                        }
-                    }
+        for (_, p) in program.stages[i].modules.iter().flat_map(|m| m.network_params()) {
+            if let Param::Trained { stage, .. } = *p {
+                if let Some(n) = need.get_mut(stage as usize) {
+                    *n = true;
                 }
             }
         }

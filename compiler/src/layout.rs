@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Program, Stage, StageRun};
+use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Part, Program, Stage, StageRun};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
 fn channel_name(stage: &Stage, c: u16) -> String {
@@ -131,19 +131,21 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
     );
     // Parameters that are not genes: what training stages learned.
     for m in &st.modules {
-        let Behavior::Neural(nb) = &m.behavior else { continue };
-        let Some(Param::Trained { stage: t, .. }) = nb.net.params.first() else { continue };
-        let by = program.stages.get(*t as usize).map(|s| s.name.as_str()).unwrap_or("?");
-        let actions = match program.stages.get(*t as usize).map(|s| &s.run) {
-            Some(StageRun::Train { actions }) => format!(" for {actions} actions"),
-            _ => String::new(),
-        };
-        let _ = writeln!(
-            out,
-            "trained: `{}` behavior, {} weights, learned by stage `{by}`{actions} (not genes)",
-            m.name,
-            nb.net.params.len()
-        );
+        for (part, name) in [(Part::Activation, "activation network"), (Part::Behavior, "behavior")] {
+            let mut params = m.network_params().filter(|(p, _)| *p == part).map(|(_, q)| q);
+            let Some(Param::Trained { stage: t, .. }) = params.next() else { continue };
+            let by = program.stages.get(*t as usize).map(|s| s.name.as_str()).unwrap_or("?");
+            let actions = match program.stages.get(*t as usize).map(|s| &s.run) {
+                Some(StageRun::Train { actions }) => format!(" for {actions} actions"),
+                _ => String::new(),
+            };
+            let _ = writeln!(
+                out,
+                "trained: `{}` {name}, {} weights, learned by stage `{by}`{actions} (not genes)",
+                m.name,
+                params.count() + 1
+            );
+        }
     }
     if let StageRun::Train { actions } = st.run {
         let _ = writeln!(out, "training stage: its modules learn for {actions} actions; nothing is evolved");

@@ -290,10 +290,50 @@ pub enum Param {
     /// Drawn uniformly in `lo..hi` at the start of each episode from the
     /// individual's RNG (e.g. a behavior network that learns from random weights).
     Random { lo: f32, hi: f32 },
-    /// Weight `index` of the behavior network that module `module` of the
-    /// training stage `stage` learned. Bound to `Fixed` by [`bind_trained`]
-    /// once that stage has run; a controller refuses an unbound one.
-    Trained { stage: u16, module: u16, index: u32 },
+    /// Weight `index` of the network `part` (behavior or activation) that
+    /// module `module` of the training stage `stage` learned. Bound to
+    /// `Fixed` by [`bind_trained`] once that stage has run; a controller
+    /// refuses an unbound one.
+    Trained {
+        stage: u16,
+        module: u16,
+        index: u32,
+        /// Absent in programs written before activation networks could be
+        /// trained: a behavior weight.
+        #[serde(default)]
+        part: Part,
+    },
+}
+
+/// The network of a module a weight belongs to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Part {
+    #[default]
+    Behavior,
+    Activation,
+}
+
+impl Module {
+    /// The parameters of the module's networks: the activation network's,
+    /// then the neural behavior's (none for a script), each with its part.
+    pub fn network_params(&self) -> impl Iterator<Item = (Part, &Param)> {
+        let behavior: &[Param] = match &self.behavior {
+            Behavior::Neural(nb) => &nb.net.params,
+            Behavior::Script(_) => &[],
+        };
+        let activation = self.activation.params.iter().map(|p| (Part::Activation, p));
+        activation.chain(behavior.iter().map(|p| (Part::Behavior, p)))
+    }
+
+    /// [`Module::network_params`], mutable.
+    pub fn network_params_mut(&mut self) -> impl Iterator<Item = (Part, &mut Param)> {
+        let behavior: &mut [Param] = match &mut self.behavior {
+            Behavior::Neural(nb) => &mut nb.net.params,
+            Behavior::Script(_) => &mut [],
+        };
+        let activation = self.activation.params.iter_mut().map(|p| (Part::Activation, p));
+        activation.chain(behavior.iter_mut().map(|p| (Part::Behavior, p)))
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -518,7 +558,8 @@ pub enum StageRun {
     },
     /// No evolution and no genes: the stage's modules live one life of
     /// `actions` actions in its world with learning on, and later stages
-    /// start from the behavior weights they learned (`Param::Trained`).
+    /// start from the behavior or activation weights they learned
+    /// (`Param::Trained`).
     Train {
         actions: u32,
     },
@@ -574,18 +615,26 @@ impl Program {
 }
 
 /// Replaces every `Param::Trained` that refers to training stage `stage`
-/// with the weight its module learned: `weights[m]` are the behavior
-/// weights of that stage's module `m` (`Network::params` order). Returns how
-/// many parameters were bound.
-pub fn bind_trained(program: &mut Program, stage: usize, weights: &[Vec<f32>]) -> usize {
+/// with the weight its module learned: `behavior[m]` and `activation[m]`
+/// are the weights of that stage's module `m` (`Network::params` order).
+/// Returns how many parameters were bound.
+pub fn bind_trained(
+    program: &mut Program,
+    stage: usize,
+    behavior: &[Vec<f32>],
+    activation: &[Vec<f32>],
+) -> usize {
     let mut bound = 0;
     for st in &mut program.stages {
         for m in &mut st.modules {
-            let Behavior::Neural(nb) = &mut m.behavior else { continue };
-            for p in &mut nb.net.params {
-                if let Param::Trained { stage: s, module, index } = *p {
+            for (_, p) in m.network_params_mut() {
+                if let Param::Trained { stage: s, module, index, part } = *p {
+                    let learned = match part {
+                        Part::Behavior => behavior,
+                        Part::Activation => activation,
+                    };
                     if s as usize == stage {
-                        if let Some(&w) = weights.get(module as usize).and_then(|w| w.get(index as usize)) {
+                        if let Some(&w) = learned.get(module as usize).and_then(|w| w.get(index as usize)) {
                             *p = Param::Fixed(w);
                             bound += 1;
                         }

@@ -127,23 +127,35 @@ pub fn program(p: &Program) -> R {
 }
 
 /// Weights that a training stage learns (`Param::Trained`) refer to an
-/// earlier training stage, one of its modules with a neural behavior, and
-/// one of that behavior's weights.
+/// earlier training stage, one of its modules with a network of that part
+/// (a neural behavior, or any activation network), and one of its weights.
 fn trained(p: &Program, i: usize) -> R {
     let s = &p.stages[i];
     let at = At { stage: Some(&s.name), path: String::new() };
     for (mi, m) in s.modules.iter().enumerate() {
-        let Behavior::Neural(nb) = &m.behavior else { continue };
-        for (k, q) in nb.net.params.iter().enumerate() {
-            let Param::Trained { stage: t, module, index } = *q else { continue };
-            let at = at.field("modules").index(mi).field("behavior.net.params").index(k);
+        let (mut a, mut b) = (0, 0);
+        for (part, q) in m.network_params() {
+            let (field, k) = match part {
+                Part::Activation => ("activation.params", &mut a),
+                Part::Behavior => ("behavior.net.params", &mut b),
+            };
+            let at = at.field("modules").index(mi).field(field).index(*k);
+            *k += 1;
+            let Param::Trained { stage: t, module, index, part } = *q else { continue };
             let source = p.stages.get(t as usize).filter(|_| (t as usize) < i);
             let Some(source) = source.filter(|x| matches!(x.run, StageRun::Train { .. })) else {
                 return at.err(format!("stage {t} is not a training stage before this one"));
             };
-            let weights = match source.modules.get(module as usize).map(|x| &x.behavior) {
-                Some(Behavior::Neural(trained)) => trained.net.params.len(),
-                _ => return at.err(format!("module {module} of `{}` has no neural behavior", source.name)),
+            let trained = source.modules.get(module as usize);
+            let weights = match (part, trained.map(|x| (&x.activation, &x.behavior))) {
+                (Part::Activation, Some((net, _))) => net.params.len(),
+                (Part::Behavior, Some((_, Behavior::Neural(nb)))) => nb.net.params.len(),
+                (Part::Behavior, _) => {
+                    return at.err(format!("module {module} of `{}` has no neural behavior", source.name))
+                }
+                (Part::Activation, None) => {
+                    return at.err(format!("`{}` has no module {module}", source.name))
+                }
             };
             at.ensure((index as usize) < weights, || {
                 format!("weight {index} of a network of {weights} weights")
@@ -158,14 +170,16 @@ fn trained(p: &Program, i: usize) -> R {
 pub fn bound(s: &Stage) -> R {
     let at = At { stage: Some(&s.name), path: String::new() };
     for (mi, m) in s.modules.iter().enumerate() {
-        if let Behavior::Neural(nb) = &m.behavior {
-            if nb.net.params.iter().any(|q| matches!(q, Param::Trained { .. })) {
-                return at
-                    .field("modules")
-                    .index(mi)
-                    .field("behavior.net.params")
-                    .err("its weights come from a training stage that has not run");
-            }
+        if let Some((part, _)) = m.network_params().find(|(_, q)| matches!(q, Param::Trained { .. })) {
+            let field = match part {
+                Part::Activation => "activation.params",
+                Part::Behavior => "behavior.net.params",
+            };
+            return at
+                .field("modules")
+                .index(mi)
+                .field(field)
+                .err("its weights come from a training stage that has not run");
         }
     }
     Ok(())

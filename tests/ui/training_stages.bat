@@ -20,7 +20,7 @@ stage user {
   fitness per action wheels[0]
   module avoid {
     sense ir[0..5]
-    activation trained practice
+    activation trained practice            // 6 inputs: practice's avoid senses 8
     behavior neural { outputs sign(2) -> forward | right | left | back  weights trained practise }
   }
   module other {
@@ -30,5 +30,10 @@ stage user {
   module avoid2 {
     sense ir
     behavior neural { outputs sign(2) -> forward | right | left | back  weights trained user }
+  }
+  module wander {
+    sense ir
+    activation trained practice hidden 2  // practice has no module `wander`
+    behavior forward
   }
 }

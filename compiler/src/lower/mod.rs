@@ -77,6 +77,8 @@ pub(crate) enum Source {
     Evolvable(Option<(f32, f32)>),
     Fixed(Vec<f32>),
     Random(f32, f32),
+    /// `trained STAGE`: what the module of the same name learned there.
+    Trained(String),
 }
 
 #[derive(Clone, Debug)]
@@ -162,12 +164,13 @@ pub(crate) struct Lower<'a> {
     /// Hardware whose declaration failed: not reported again where used.
     poisoned: std::collections::HashSet<String>,
     /// Training stages lowered so far, by name: their program index and, per
-    /// module, its name and behavior network shape (inputs, hidden, outputs).
+    /// module, its name, its behavior and its activation network's shape.
     trained: HashMap<String, (u16, Vec<TrainedModule>)>,
 }
 
-/// A module of a training stage: its name and its behavior's shape.
-pub(crate) type TrainedModule = (String, TrainedShape);
+/// A module of a training stage: its name, its behavior's shape and its
+/// activation network's.
+pub(crate) type TrainedModule = (String, TrainedShape, Shape);
 
 /// A network's shape: inputs, hidden units, outputs, recurrent.
 pub(crate) type Shape = (u16, u16, u16, bool);
@@ -679,7 +682,8 @@ impl<'a> Lower<'a> {
                             Behavior::Script(sc) if sc.steps.is_empty() => TrainedShape::Failed,
                             Behavior::Script(_) => TrainedShape::Script,
                         };
-                        (m.name.clone(), shape)
+                        let a = &m.activation;
+                        (m.name.clone(), shape, (a.inputs, a.hidden, a.outputs, a.recurrent))
                     })
                     .collect();
                 self.trained.insert(decl.name.text.clone(), (s, shapes));
@@ -1139,13 +1143,18 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
     }
 }
 
-/// The stages named by the `weights trained STAGE` of a stage's modules.
+/// The stages named by the `weights trained STAGE` and `activation trained
+/// STAGE` of a stage's modules.
 fn trained_uses(s: &ast::StageDecl) -> impl Iterator<Item = &ast::Name> {
     s.items
         .iter()
         .filter_map(|item| match item {
             ast::StageItem::Module(m) => Some(m.items.iter().filter_map(|mi| match mi {
                 ast::ModuleItem::Behavior(ast::BehaviorDecl::Neural(n)) => match &n.weights {
+                    Some(ast::WeightSource::Trained(by, _)) => Some(by),
+                    _ => None,
+                },
+                ast::ModuleItem::Activation(a) => match &a.source {
                     Some(ast::WeightSource::Trained(by, _)) => Some(by),
                     _ => None,
                 },

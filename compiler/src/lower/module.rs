@@ -55,6 +55,8 @@ impl Lower<'_> {
         };
         let inherited = existing.is_some();
         let by = self.stage_names[st.stage as usize].clone();
+        // `activation trained STAGE`: the name and where the source was written.
+        let mut trained_at = None;
         // Inputs and activation network: frozen once evolved.
         for item in &m.items {
             match item {
@@ -93,6 +95,9 @@ impl Lower<'_> {
                     st.hidden = hidden;
                     st.recurrent = recurrent;
                     st.source = source;
+                    if let Some(ast::WeightSource::Trained(name, sp)) = &a.source {
+                        trained_at = Some((name.clone(), *sp));
+                    }
                     st.act_span = Some(a.span);
                 }
                 _ => {}
@@ -108,6 +113,14 @@ impl Lower<'_> {
                 Source::Random(lo, hi) => {
                     let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
                     vec![Param::Random { lo: *lo, hi: *hi }; n]
+                }
+                Source::Trained(_) => {
+                    let shape = (st.inputs.len() as u16, st.hidden, 1, st.recurrent);
+                    trained_at
+                        .and_then(|(name, sp)| {
+                            self.trained_params(&name, sp, &st.name, shape, Part::Activation)
+                        })
+                        .unwrap_or_default()
                 }
             };
         }
@@ -228,15 +241,7 @@ impl Lower<'_> {
                 let (lo, hi) = self.range(r)?;
                 Source::Random(lo, hi)
             }
-            Some(ast::WeightSource::Trained(_, sp)) => {
-                self.value_error(
-                    *sp,
-                    "activation networks are not trained by training stages".into(),
-                    "not here",
-                    Some("`weights trained STAGE` is for neural behaviors; an activation network is `evolvable`, `fixed` or `random`".into()),
-                );
-                return None;
-            }
+            Some(ast::WeightSource::Trained(by, _)) => Source::Trained(by.text.clone()),
         };
         if range.is_some() && !matches!(source, Source::Evolvable(_)) {
             self.value_error(
@@ -606,7 +611,7 @@ impl Lower<'_> {
             Some(ast::WeightSource::Evolvable(_)) => (Vec::new(), Some(None)),
             Some(ast::WeightSource::Trained(by, sp)) => {
                 let shape = (inputs.len() as u16, hidden, outputs, recurrent);
-                match self.trained_params(by, *sp, module, shape) {
+                match self.trained_params(by, *sp, module, shape, Part::Behavior) {
                     Some(p) => (p, None),
                     None => return (None, None),
                 }
@@ -616,21 +621,25 @@ impl Lower<'_> {
         (Some(NeuralBehavior { inputs, net, decode }), genes)
     }
 
-    /// `weights trained STAGE`: the behavior weights module `module` of the
-    /// training stage `STAGE` learned, for a network of the same shape.
+    /// `weights trained STAGE` (`part` behavior) or `activation trained
+    /// STAGE`: the weights module `module` of the training stage `STAGE`
+    /// learned for that network, which must have the same shape.
     fn trained_params(
         &mut self,
         by: &ast::Name,
         span: Span,
         module: &str,
         shape: Shape,
+        part: Part,
     ) -> Option<Vec<Param>> {
         let Some((stage, modules)) = self.trained.get(&by.text) else {
             self.untrained(by);
             return None;
         };
         let stage = *stage;
-        let Some((m, (_, found))) = modules.iter().enumerate().find(|(_, (n, _))| n == module) else {
+        let Some((m, (_, behavior, activation))) =
+            modules.iter().enumerate().find(|(_, (n, ..))| n == module)
+        else {
             self.value_error(
                 by.span,
                 format!("training stage `{}` has no module `{module}`", by.text),
@@ -639,29 +648,48 @@ impl Lower<'_> {
             );
             return None;
         };
-        let what = match *found {
-            TrainedShape::Network(s) if s == shape => None,
-            TrainedShape::Failed => return None,
-            TrainedShape::Network((i, h, o, r)) => {
-                Some(format!("{i} inputs, {h} {}hidden and {o} outputs", recurrent_word(r)))
+        let what = match (part, *behavior) {
+            (Part::Activation, _) if *activation == shape => None,
+            (Part::Activation, _) => Some(format!(
+                "an activation network of {}, but this one has {}",
+                activation_shape(*activation),
+                activation_shape(shape)
+            )),
+            (Part::Behavior, TrainedShape::Network(s)) if s == shape => None,
+            (Part::Behavior, TrainedShape::Failed) => return None,
+            (Part::Behavior, found) => {
+                let found = match found {
+                    TrainedShape::Network((i, h, o, r)) => {
+                        format!("{i} inputs, {h} {}hidden and {o} outputs", recurrent_word(r))
+                    }
+                    _ => "a scripted behavior".to_string(),
+                };
+                Some(format!(
+                    "{found}, but this network has {} inputs, {} {}hidden and {} outputs",
+                    shape.0,
+                    shape.1,
+                    recurrent_word(shape.3),
+                    shape.2
+                ))
             }
-            TrainedShape::Script => Some("a scripted behavior".to_string()),
         };
         if let Some(what) = what {
             self.value_error(
                 span,
-                format!(
-                    "module `{module}` of `{}` has {what}, but this network has {} inputs, {} {}hidden and {} outputs",
-                    by.text, shape.0, shape.1, recurrent_word(shape.3), shape.2
-                ),
+                format!("module `{module}` of `{}` has {what}", by.text),
                 "another shape",
-                Some("sense the same inputs and declare the same `hidden` and `outputs`".into()),
+                Some(match part {
+                    Part::Behavior => {
+                        "sense the same inputs and declare the same `hidden` and `outputs`".into()
+                    }
+                    Part::Activation => "sense the same inputs and declare the same `hidden`".into(),
+                }),
             );
             return None;
         }
         let count =
             Network::param_count_of(shape.0 as usize, shape.1 as usize, shape.2 as usize, shape.3) as u32;
-        Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index }).collect())
+        Some((0..count).map(|index| Param::Trained { stage, module: m as u16, index, part }).collect())
     }
 
     /// Reports `weights trained STAGE` where `STAGE` has trained nothing
@@ -766,6 +794,15 @@ impl Lower<'_> {
 }
 
 /// `"recurrent "` for a recurrent network, else nothing.
+/// "8 inputs and 2 hidden units": an activation network's shape in words.
+fn activation_shape((inputs, hidden, _, recurrent): Shape) -> String {
+    match hidden {
+        0 => format!("{inputs} inputs and no hidden units"),
+        1 => format!("{inputs} inputs and 1 {}hidden unit", recurrent_word(recurrent)),
+        h => format!("{inputs} inputs and {h} {}hidden units", recurrent_word(recurrent)),
+    }
+}
+
 fn recurrent_word(recurrent: bool) -> &'static str {
     if recurrent {
         "recurrent "

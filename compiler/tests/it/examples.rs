@@ -39,9 +39,13 @@ fn khepera_has_a_training_stage_and_the_papers_three_stages() {
     let Behavior::Neural(nb) = &nav.modules[1].behavior else { panic!("avoid is neural") };
     assert_eq!(nb.net.outputs, 2);
     // Its weights are what the training stage's avoid module (module 1) learns.
-    assert!(nb.net.params.iter().enumerate().all(
-        |(i, w)| *w == shaping_runtime::program::Param::Trained { stage: 0, module: 1, index: i as u32 }
-    ));
+    use shaping_runtime::program::{Param, Part};
+    assert!(nb
+        .net
+        .params
+        .iter()
+        .enumerate()
+        .all(|(i, w)| *w == Param::Trained { stage: 0, module: 1, index: i as u32, part: Part::Behavior }));
     assert_eq!(nb.decode, Decode::Table(vec![[-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0], [1.0, 1.0]]));
     // collect keeps navigation's genes as a frozen prefix.
     let col = &p.stages[2];

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::{fingerprint, seed, EvolveError, Fingerprint};
 use crate::controller::{episode_rngs, Controller, EpisodeOptions, EpisodeResult, Trace};
 use crate::genome::Genome;
-use crate::program::{bind_trained, Behavior, Program, StageRun};
+use crate::program::{bind_trained, Behavior, Param, Part, Program, StageRun};
 use crate::sim::Sim;
 
 /// What one training stage learned, as written to `trained.json`.
@@ -22,6 +22,11 @@ pub struct Trained {
     /// Behavior weights per module of the stage, in declaration order
     /// (`Network::params` order; empty for a scripted module).
     pub weights: Vec<Vec<f32>>,
+    /// Activation weights per module of the stage, in declaration order
+    /// (`Network::params` order). Empty in files written before activation
+    /// networks could be trained: such a file serves behavior weights only.
+    #[serde(default)]
+    pub activation: Vec<Vec<f32>>,
     /// Performance indicator of each module at the end of the life.
     pub performance: Vec<f32>,
     pub result: EpisodeResult,
@@ -58,17 +63,18 @@ pub fn train_stage(
         fingerprint: fingerprint(program, index),
         run_seed,
         weights: (0..n).map(|m| ctl.behavior_weights(m).to_vec()).collect(),
+        activation: (0..n).map(|m| ctl.activation_weights(m).to_vec()).collect(),
         performance: (0..n).map(|m| ctl.performance(m)).collect(),
         result,
     })
 }
 
 /// Binds what training stage `index` learned into the stages that use it
-/// (`weights trained STAGE`). Refuses a `trained` record of another stage or
+/// (`weights trained STAGE`, `activation trained STAGE`). Refuses a `trained` record of another stage or
 /// of another version of it, and weights that do not fit its modules.
 pub fn bind(program: &mut Program, index: usize, trained: &Trained) -> Result<usize, EvolveError> {
     check(program, index, trained)?;
-    Ok(bind_trained(program, index, &trained.weights))
+    Ok(bind_trained(program, index, &trained.weights, &trained.activation))
 }
 
 /// Checks that `trained` was made by training stage `index` as `program`
@@ -84,23 +90,41 @@ pub fn check(program: &Program, index: usize, trained: &Trained) -> Result<(), E
     if !what.is_empty() {
         return Err(EvolveError::Changed { stage: stage.name.clone(), what: what.join("; ") });
     }
-    if trained.weights.len() != stage.modules.len() {
-        return bad(format!(
-            "weights for {} modules, the stage has {}",
-            trained.weights.len(),
-            stage.modules.len()
-        ));
+    let behavior = |m: &crate::program::Module| match &m.behavior {
+        Behavior::Neural(nb) => nb.net.params.len(),
+        Behavior::Script(_) => 0,
+    };
+    if trained.activation.is_empty() {
+        let used = program.stages.iter().flat_map(|s| &s.modules).flat_map(|m| m.network_params()).any(|(_, p)| {
+            matches!(*p, Param::Trained { stage, part: Part::Activation, .. } if stage as usize == index)
+        });
+        if used {
+            return bad("the file holds no activation weights (it was written before they were saved)".into());
+        }
+    } else {
+        fits(stage, "activation weights", &trained.activation, |m| m.activation.params.len()).or_else(bad)?;
     }
-    for (m, w) in stage.modules.iter().zip(&trained.weights) {
-        let need = match &m.behavior {
-            Behavior::Neural(nb) => nb.net.params.len(),
-            Behavior::Script(_) => 0,
-        };
+    fits(stage, "weights", &trained.weights, behavior).or_else(bad)
+}
+
+/// Says how `lists` (one per module of `stage`, of the `what` of each)
+/// differ from what `need` says each module has, if they do.
+fn fits(
+    stage: &crate::program::Stage,
+    what: &str,
+    lists: &[Vec<f32>],
+    need: impl Fn(&crate::program::Module) -> usize,
+) -> Result<(), String> {
+    if lists.len() != stage.modules.len() {
+        return Err(format!("{what} for {} modules, the stage has {}", lists.len(), stage.modules.len()));
+    }
+    for (m, w) in stage.modules.iter().zip(lists) {
+        let need = need(m);
         if w.len() != need {
-            return bad(format!("{} weights for module `{}`, which has {need}", w.len(), m.name));
+            return Err(format!("{} {what} for module `{}`, which has {need}", w.len(), m.name));
         }
         if let Some(x) = w.iter().find(|x| !x.is_finite()) {
-            return bad(format!("a weight of module `{}` is {x}", m.name));
+            return Err(format!("one of the {what} of module `{}` is {x}", m.name));
         }
     }
     Ok(())
@@ -124,7 +148,7 @@ pub fn train_all(program: &mut Program, run_seed: u64) -> Result<Vec<(usize, Tra
 mod tests {
     use super::*;
     use crate::catalog::CH_IR;
-    use crate::program::{Action, Behavior, LearnTarget, Network, Param, FORMAT_VERSION};
+    use crate::program::{Action, Behavior, LearnTarget, Network, FORMAT_VERSION};
     use crate::testkit;
 
     /// A training stage (wander + a learning avoid module) and a stage whose
@@ -147,7 +171,9 @@ mod tests {
         let mut user = testkit::bare_stage("user", testkit::arena_world());
         let mut uses = avoid;
         let Behavior::Neural(nb) = &mut uses.behavior else { unreachable!() };
-        nb.net.params = (0..18).map(|index| Param::Trained { stage: 0, module: 1, index }).collect();
+        nb.net.params = (0..18)
+            .map(|index| Param::Trained { stage: 0, module: 1, index, part: Part::Behavior })
+            .collect();
         uses.activation.params = vec![Param::Fixed(0.0); 9];
         user.modules = vec![uses];
         Program { format: FORMAT_VERSION, name: "t".into(), stages: vec![train, user] }
@@ -171,6 +197,68 @@ mod tests {
         // The same seed trains the same weights; another does not.
         assert_eq!(train_stage(&program(), 0, 7, None).unwrap(), t);
         assert_ne!(train_stage(&program(), 0, 8, None).unwrap().weights, t.weights);
+    }
+
+    /// The training stage's avoid module also learns on its activation
+    /// network (from random weights), and the using stage starts its
+    /// activation network from what it learned.
+    fn program_with_activation() -> Program {
+        let mut p = program();
+        let avoid = &mut p.stages[0].modules[1];
+        avoid.activation.params = vec![Param::Random { lo: -0.5, hi: 0.5 }; 9];
+        avoid.learning = Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.1, 30));
+        p.stages[1].modules[0].activation.params = (0..9)
+            .map(|index| Param::Trained { stage: 0, module: 1, index, part: Part::Activation })
+            .collect();
+        p
+    }
+
+    #[test]
+    fn trained_activation_weights_reach_the_stage_that_uses_them() {
+        let mut p = program_with_activation();
+        p.validate().unwrap();
+        let t = train_stage(&p, 0, 7, None).unwrap();
+        assert_eq!(t.activation[0].len(), 1, "wander's fixed bias is saved too");
+        assert_eq!(t.activation[1].len(), 9);
+        // The activation network learned: its weights left the random range.
+        assert!(t.activation[1].iter().any(|w| w.abs() > 0.5), "{:?}", t.activation[1]);
+        assert_eq!(bind(&mut p, 0, &t).unwrap(), 18 + 9);
+        let ctl = Controller::new(&p.stages[1], &Genome::zeros(0), episode_rngs(1).1).unwrap();
+        assert_eq!(ctl.activation_weights(0), &t.activation[1][..]);
+        assert_eq!(ctl.behavior_weights(0), &t.weights[1][..]);
+    }
+
+    #[test]
+    fn trained_activation_weights_must_name_a_weight_that_is_learned() {
+        let bad = |stage: u16, module: u16, index: u32| {
+            let mut p = program_with_activation();
+            p.stages[1].modules[0].activation.params[3] =
+                Param::Trained { stage, module, index, part: Part::Activation };
+            p.validate().unwrap_err().to_string()
+        };
+        assert!(bad(0, 1, 9).contains("weight 9 of a network of 9 weights"), "{}", bad(0, 1, 9));
+        assert!(bad(0, 2, 0).contains("has no module 2"), "{}", bad(0, 2, 0));
+        assert!(bad(1, 0, 0).contains("not a training stage before this one"), "{}", bad(1, 0, 0));
+        assert!(bad(0, 0, 1).contains("weight 1 of a network of 1 weights"), "{}", bad(0, 0, 1));
+    }
+
+    #[test]
+    fn a_file_without_activation_weights_serves_behaviors_only() {
+        // As a `trained.json` written before activation weights were saved.
+        let old = |p: &Program| {
+            let mut t = train_stage(p, 0, 7, None).unwrap();
+            t.activation.clear();
+            let json = serde_json::to_string(&t).unwrap().replace(",\"activation\":[]", "");
+            assert!(!json.contains("activation"));
+            serde_json::from_str::<Trained>(&json).unwrap()
+        };
+        let mut p = program();
+        let t = old(&p);
+        assert_eq!(bind(&mut p, 0, &t).unwrap(), 18);
+        let mut p = program_with_activation();
+        let t = old(&p);
+        let e = bind(&mut p, 0, &t).unwrap_err().to_string();
+        assert!(e.contains("no activation weights"), "{e}");
     }
 
     #[test]
