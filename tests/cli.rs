@@ -692,6 +692,76 @@ fn stale_trained_weights_are_refused() {
     assert!(err.contains("trained.json") && err.contains("the settings of `avoidance` changed"), "{err}");
 }
 
+/// An activation network learned in a training stage reaches the stage that
+/// uses it (`activation trained STAGE`): `trained.json` holds it, `layout`
+/// lists it, and a `trained.json` written before activation weights were
+/// saved is refused by `run`, saying so, and retrained by `replay`.
+#[test]
+fn trained_activation_weights_reach_the_next_stage() {
+    let dir = scratch("trained-activation");
+    let file = dir.join("dodge.bat");
+    std::fs::write(
+        &file,
+        "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage practice {
+  world { arena 400mm x 600mm }
+  train for 2000 actions
+  module wander { sense ir  activation fixed -1.5  behavior forward }
+  module dodge {
+    sense ir
+    activation random -0.5..0.5 hidden 2
+    behavior turn left for 2 actions
+    learn crbp(0.5, 0.5) on activation always
+    reinforce max(prev ir[1..4]) > 0.3 ? 1 : -1
+  }
+}
+stage evolved {
+  evolve { population 10  generations 2 }
+  fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir))
+  module wander { sense ir  behavior forward }
+  module dodge { sense ir  activation trained practice hidden 2  behavior turn left for 2 actions }
+  links all evolvable
+}
+",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let first = run_file(&file, &out, &[]);
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    let path = out.join("practice/trained.json");
+    let saved: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    assert_eq!(saved["activation"][1].as_array().map(|w| w.len()), Some(21), "dodge: 2 x (8 + 1) + 3");
+    let layout = run(shaping().arg("layout").arg(&file).args(["--stage", "evolved"]));
+    let table = text(&layout.stdout);
+    assert!(
+        table.contains("trained: `dodge` activation network, 21 weights, learned by stage `practice`"),
+        "{table}"
+    );
+    assert!(!table.contains("dodge   weight"), "trained weights are not genes: {table}");
+    // As written before activation weights were saved.
+    let mut old = saved.clone();
+    old.as_object_mut().unwrap().remove("activation");
+    std::fs::write(&path, serde_json::to_string(&old).unwrap()).unwrap();
+    let refused = run_file(&file, &out, &["--stage", "evolved"]);
+    assert_eq!(refused.status.code(), Some(2), "{}", text(&refused.stderr));
+    let err = text(&refused.stderr);
+    assert!(err.contains("trained.json") && err.contains("no activation weights"), "{err}");
+    let replay = run(shaping()
+        .arg("replay")
+        .arg(&file)
+        .args(["--stage", "evolved", "--run"])
+        .arg(&out)
+        .arg("--out")
+        .arg(dir.join("replay")));
+    assert!(replay.status.success(), "{}", text(&replay.stderr));
+    assert!(
+        text(&replay.stderr).contains("no activation weights")
+            && text(&replay.stderr).contains("training the stage again"),
+        "{}",
+        text(&replay.stderr)
+    );
+}
+
 /// Ctrl-C lets the generation under way finish and be saved, and says where
 /// the run stopped; the same command resumes it, saying so.
 #[cfg(unix)]
