@@ -371,14 +371,7 @@ fn run_rejects_unknown_stage_and_replay_writes_pictures() {
 
     assert!(run_tiny(&dir, &[]).status.success());
     let pics = dir.join("pics");
-    let out = run(shaping()
-        .arg("replay")
-        .arg(tiny())
-        .args(["--stage", "second", "--actions", "80"])
-        .arg("--run")
-        .arg(&dir)
-        .arg("--out")
-        .arg(&pics));
+    let out = replay_run(&tiny(), &dir, &pics, &["--stage", "second", "--actions", "80"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     for f in ["trace.csv", "activations.png", "activations.svg", "trajectory.png", "trajectory.svg"] {
         assert!(pics.join(f).exists(), "{f}");
@@ -500,14 +493,7 @@ fn run_writes_a_report_of_every_stage_and_report_reads_any_directory() {
 
     // The evolved stage's episode is the one `replay` shows by default.
     let rep = dir.join("rep");
-    let out = run(shaping()
-        .arg("replay")
-        .arg(report_bat())
-        .args(["--stage", "collect", "--report"])
-        .arg("--run")
-        .arg(&dir)
-        .arg("--out")
-        .arg(&rep));
+    let out = replay_run(&report_bat(), &dir, &rep, &["--stage", "collect", "--report"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("report: "), "{}", text(&out.stdout));
     let replay = report_data(&rep.join("report.html"));
@@ -612,6 +598,11 @@ fn run_file(file: &Path, out: &Path, extra: &[&str]) -> Output {
     run(shaping().arg("run").arg(file).arg("--out").arg(out).arg("--no-report").args(extra))
 }
 
+/// `shaping replay FILE EXTRA --run RUN --out OUT`.
+fn replay_run(file: &Path, run_dir: &Path, out: &Path, extra: &[&str]) -> Output {
+    run(shaping().arg("replay").arg(file).args(extra).arg("--run").arg(run_dir).arg("--out").arg(out))
+}
+
 /// Editing anything a checkpoint depends on makes the run refuse it, saying
 /// what changed; `--fresh` starts again and shows the new result. Fewer
 /// generations than the checkpoint holds are refused naming both numbers;
@@ -646,8 +637,7 @@ fn an_edited_file_is_not_resumed_from_its_old_checkpoint() {
         assert!(err.contains(what) && err.contains("`--fresh`") && err.contains("`--out`"), "{err}");
     }
     // Nor does `replay` take the run's best for the edited stage.
-    let replay =
-        run(shaping().arg("replay").arg(&file).arg("--run").arg(&out).arg("--out").arg(dir.join("r")));
+    let replay = replay_run(&file, &out, &dir.join("r"), &[]);
     assert_eq!(replay.status.code(), Some(2));
     let err = text(&replay.stderr);
     assert!(err.contains("is not of this program") && err.contains("the world of `s` changed"), "{err}");
@@ -746,13 +736,7 @@ stage evolved {
     assert_eq!(refused.status.code(), Some(2), "{}", text(&refused.stderr));
     let err = text(&refused.stderr);
     assert!(err.contains("trained.json") && err.contains("no activation weights"), "{err}");
-    let replay = run(shaping()
-        .arg("replay")
-        .arg(&file)
-        .args(["--stage", "evolved", "--run"])
-        .arg(&out)
-        .arg("--out")
-        .arg(dir.join("replay")));
+    let replay = replay_run(&file, &out, &dir.join("replay"), &["--stage", "evolved"]);
     assert!(replay.status.success(), "{}", text(&replay.stderr));
     assert!(
         text(&replay.stderr).contains("no activation weights")
@@ -847,13 +831,7 @@ fn replay_of_a_training_stage_replays_its_life() {
     let out = dir.join("out");
     let first = run_file(&file, &out, &["--stage", "avoidance", "--seed", "5"]);
     assert!(first.status.success(), "{}", text(&first.stderr));
-    let life = run(shaping()
-        .arg("replay")
-        .arg(&file)
-        .args(["--stage", "avoidance", "--run"])
-        .arg(&out)
-        .arg("--out")
-        .arg(dir.join("life")));
+    let life = replay_run(&file, &out, &dir.join("life"), &["--stage", "avoidance"]);
     assert!(life.status.success(), "{}", text(&life.stderr));
     let trained: serde_json::Value =
         serde_json::from_slice(&std::fs::read(out.join("avoidance/trained.json")).unwrap()).unwrap();
