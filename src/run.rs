@@ -573,9 +573,14 @@ fn report_generation(args: &RunArgs, bar: &ProgressBar, stats: &GenStats) {
     }
 }
 
+/// The longest part of a training life that `run` records (from its start)
+/// for `trace.csv`, `episode.json` and the pictures.
+pub const RECORDED_TRAINING_ACTIONS: u32 = 20_000;
+
 /// Runs training stage `index` (or reuses the `trained.json` a previous run
 /// of the same stage and seed left in `dir`) and writes its files: the
-/// learned weights, the trace of the training life and its pictures.
+/// learned weights, the trace of the training life (its first
+/// [`RECORDED_TRAINING_ACTIONS`] actions) and its pictures.
 fn train_step(
     program: &Program,
     index: usize,
@@ -605,10 +610,13 @@ fn train_step(
     let trained =
         evolve::train_stage(program, index, seed, None).map_err(|e| CliError::io(format!("error: {e}")))?;
     // The same life recorded again (the same episode seed and genome), for
-    // `trace.csv`, the pictures and `episode.json`.
+    // `trace.csv`, the pictures and `episode.json`: its first
+    // `RECORDED_TRAINING_ACTIONS` actions (`trace.csv` and `episode.json` grow by about 500 bytes
+    // per action, and a training life may last millions).
     let StageRun::Train { actions } = stage.run else { unreachable!("train_step runs training stages") };
     let episode_seed = evolve::train::training_seed(seed, index);
-    let opts = EpisodeOptions { actions, learning: true, seed: episode_seed };
+    let recorded = actions.min(RECORDED_TRAINING_ACTIONS);
+    let opts = EpisodeOptions { actions: recorded, learning: true, seed: episode_seed };
     let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
     let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
@@ -628,8 +636,13 @@ fn train_step(
             .filter(|(m, _)| m.learning.is_some())
             .map(|(m, p)| format!("{} {p:+.2}", m.name))
             .collect();
+        let part = if recorded < actions {
+            format!(" (trace and pictures: its first {recorded} actions)")
+        } else {
+            String::new()
+        };
         eprintln!(
-            "stage {:<12} trained for {} actions, performance {}  -> {}",
+            "stage {:<12} trained for {} actions, performance {}{part}  -> {}",
             stage.name,
             trained.result.actions,
             perf.join(", "),

@@ -1224,3 +1224,40 @@ fn an_experiment_of_one_stage_runs_and_summarises_its_chain() {
     let md = std::fs::read_to_string(dir.join("summary.md")).unwrap();
     assert!(md.contains("| first | 6 |") && !md.contains("| second |"), "{md}");
 }
+
+/// A long training life is trained in full, but `run` records only its
+/// first 20000 actions for the trace and the pictures, and says so: a record
+/// of millions of actions would take gigabytes.
+#[test]
+fn a_long_training_life_records_its_first_actions_only() {
+    let dir = scratch("long-training");
+    let file = dir.join("long.bat");
+    std::fs::write(
+        &file,
+        "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage practice {
+  world { arena 400mm x 600mm }
+  train for 30000 actions
+  module avoid {
+    sense ir
+    activation fixed 1
+    behavior neural {
+      outputs sign(2) -> forward | right | left | back
+      weights random -0.5..0.5
+    }
+    learn crbp(0.5, 0.1) on behavior always over 30 actions
+    reinforce sign(max(prev ir) - max(ir))
+  }
+}
+",
+    )
+    .unwrap();
+    let out = run_file(&file, &dir.join("out"), &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let said = text(&out.stderr);
+    assert!(said.contains("trained for 30000 actions"), "{said}");
+    assert!(said.contains("(trace and pictures: its first 20000 actions)"), "{said}");
+    let trace = std::fs::read_to_string(dir.join("out/practice/trace.csv")).unwrap();
+    assert_eq!(trace.lines().count(), 1 + 20000, "a header and 20000 rows");
+    let _ = std::fs::remove_dir_all(&dir);
+}
