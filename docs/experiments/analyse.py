@@ -167,7 +167,7 @@ def figure13(run, title):
     print(f"  seeds with a drop of 0.2 or more: {drops} of {N}; with recovery within 0.1: {recov} of {N}")
 
 
-for run in ("khepera", "khepera-explore"):
+for run in ("khepera", "khepera-explore", "khepera-practice"):
     print(f"\n== figures 9 and 11: {run} collect, chosen best replays (300 actions)")
     for mode in ("learning", "nolearning"):
         v = sel(run, "collect", mode)

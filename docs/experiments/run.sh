@@ -37,6 +37,16 @@ grep -q 'generations 80  inheritance lamarckian' $R/khepera-explore.bat
 [ "$(grep -c 'learn crbp(0.5, 0.1) on activation always' $R/khepera-explore.bat)" = 2 ]
 $B experiment $R/khepera-explore.bat --seeds $SEEDS --out $R/khepera-explore --fresh \
   --criterion navigation=0.7 --criterion collect=3 > /dev/null
+# The exploring variant with grip and release trained before evolution
+# (EXPERIMENTS.md, "Training before evolution"): the training stage of
+# docs/experiments/practice-stage.txt (the paper's figure 8) appended, and the
+# collect stage's grip and release start their activation networks (4 hidden
+# units) from what they learned in it.
+sed 's#^    sense ir, barrier$#&\n    activation trained practice hidden 4#' $R/khepera-explore.bat > $R/khepera-practice.bat
+[ "$(grep -c '^    activation trained practice hidden 4$' $R/khepera-practice.bat)" = 2 ]
+cat $D/practice-stage.txt >> $R/khepera-practice.bat
+$B experiment $R/khepera-practice.bat --seeds $SEEDS --out $R/khepera-practice --fresh \
+  --criterion navigation=0.7 --criterion collect=3 > /dev/null
 # Figure 13 over long lives (EXPERIMENTS.md, "Figure 13 over long lives"):
 # a diagnostic, not the paper's test. The exploring variant's collect bests
 # (the runs above: only stage bigger runs again) are tested for 1500
@@ -82,12 +92,12 @@ $B experiment examples/floreano-mondada-1996.bat --seeds $SEEDS --out $R/fm1996 
 for s in $(seq 1 $SEEDS); do
   for r in 101 102 103; do
     for spec in "khepera navigation" "khepera collect" "khepera-explore navigation" "khepera-explore collect" \
-      "pretrained navigation" "forward-only navigation" "scratch-full full"; do
+      "khepera-practice navigation" "khepera-practice collect" "pretrained navigation" "forward-only navigation" "scratch-full full"; do
       set -- $spec
       file=examples/$1.bat; [ -f "$file" ] || file=$R/$1.bat
       echo "$1 $2 $s $r learning $($B replay $file --stage $2 --run $R/$1/seed-$s --seed $r --out $R/replay-$1-$2-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
     done
-    for f in khepera khepera-explore; do
+    for f in khepera khepera-explore khepera-practice; do
       file=examples/$f.bat; [ -f "$file" ] || file=$R/$f.bat
       echo "$f collect $s $r nolearning $($B replay $file --stage collect --run $R/$f/seed-$s --seed $r --no-learning --out $R/replay-$f-collect-nl-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
     done
@@ -137,7 +147,7 @@ grep -v -E '^      turn (left|right)\((0.5|0.25)\) if ' examples/khepera.bat > $
 target/release/examples/grip $R/khepera-no-facing.bat > $R/grip-no-facing.txt
 target/release/examples/grip examples/khepera.bat --diameter 25 > $R/grip-25mm.txt
 
-for f in khepera khepera-explore pretrained forward-only scratch-full mutation; do
+for f in khepera khepera-explore khepera-practice pretrained forward-only scratch-full mutation; do
   echo "== $f"
   cat $R/$f/summary.md
 done
