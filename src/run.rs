@@ -626,7 +626,7 @@ fn train_step(
     if args.json {
         println!(
             "{}",
-            serde_json::json!({"stage": stage.name, "trained": trained.result.actions, "performance": trained.performance})
+            serde_json::json!({"stage": stage.name, "trained": trained.result.actions, "recorded": recorded, "performance": trained.performance})
         );
     } else if !args.quiet {
         let perf: Vec<String> = stage

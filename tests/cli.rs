@@ -1259,5 +1259,8 @@ stage practice {
     assert!(said.contains("(trace and pictures: its first 20000 actions)"), "{said}");
     let trace = std::fs::read_to_string(dir.join("out/practice/trace.csv")).unwrap();
     assert_eq!(trace.lines().count(), 1 + 20000, "a header and 20000 rows");
+    let json = run_file(&file, &dir.join("json"), &["--json"]);
+    let line: serde_json::Value = serde_json::from_str(text(&json.stdout).lines().next().unwrap()).unwrap();
+    assert_eq!((line["trained"].as_u64(), line["recorded"].as_u64()), (Some(30000), Some(20000)), "{line}");
     let _ = std::fs::remove_dir_all(&dir);
 }
