@@ -472,7 +472,7 @@ fn summarise(
                     fmt_spread(spread(&perf), 2),
                 );
             }
-            StageRun::Test { actions, learning } => {
+            StageRun::Test { actions, lives, learning } => {
                 let mut fit = Vec::new();
                 let mut grips = Vec::new();
                 let mut rel = Vec::new();
@@ -484,12 +484,18 @@ fn summarise(
                     rel.push(v["releases_outside"].as_f64().unwrap_or(f64::NAN));
                 }
                 json.push(serde_json::json!({
-                    "stage": stage.name, "kind": "test", "actions": actions, "learning": learning,
+                    "stage": stage.name, "kind": "test", "actions": actions, "lives": lives, "learning": learning,
                     "fitness": spread(&fit), "grips": spread(&grips), "releases_outside": spread(&rel),
                 }));
+                let length = match lives {
+                    1 => format!("{actions} actions"),
+                    _ => {
+                        format!("{lives} lives of {actions} actions (fitness: mean per life; events: totals)")
+                    }
+                };
                 let _ = writeln!(
                     md,
-                    "| {} | test, {actions} actions, learning {} | fitness {} | - | grips {} | released outside {} | - |",
+                    "| {} | test, {length}, learning {} | fitness {} | - | grips {} | released outside {} | - |",
                     stage.name,
                     if *learning { "on" } else { "off" },
                     fmt_spread(spread(&fit), 3),

@@ -170,9 +170,11 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
             let s = &program.stages[i];
             match &s.run {
                 StageRun::Evolve(e) => limits::population_bytes(e.population.into(), s.layout.bits.into()),
-                StageRun::Test { actions, .. } | StageRun::Train { actions } => {
-                    limits::trace_bytes((*actions).into(), s.modules.len() as u64)
+                // Every life of both worlds is traced.
+                StageRun::Test { actions, lives, .. } => {
+                    limits::trace_bytes(2 * u64::from(*actions) * u64::from(*lives), s.modules.len() as u64)
                 }
+                StageRun::Train { actions } => limits::trace_bytes((*actions).into(), s.modules.len() as u64),
             }
         })
         .max()

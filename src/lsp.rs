@@ -391,6 +391,7 @@ fn channel(p: &Program, stage: usize, c: u16) -> String {
 /// `syntax::RESERVED`), offered by completion.
 const WORDS: &[&str] = &[
     "train",
+    "lives",
     "trained",
     "error",
     "difference",

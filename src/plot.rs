@@ -201,7 +201,8 @@ pub fn sweep_points(stem: &Path, title: &str, series: &[SweepSeries]) -> Result<
 
 /// Trailing rolling mean (over `window` actions) of reinforcement values in
 /// -1..1, one line per named series, on a fixed -1..1 axis with a zero line
-/// and labelled vertical marks at action indices (figures 5, 10 and 13).
+/// and labelled vertical marks at action indices (figures 5, 10 and 13); a
+/// mark with an empty label is drawn as a light dotted line.
 /// Pass `window = 1` for series that are already smoothed.
 pub fn rolling_reinforcement(
     stem: &Path,

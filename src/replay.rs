@@ -170,7 +170,8 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let stage = &program.stages[index];
     let (actions, learning) = match &stage.run {
         StageRun::Evolve(e) => (e.actions, true),
-        StageRun::Test { actions, learning } => (*actions, *learning),
+        // One life of the test, in the stage's own world.
+        StageRun::Test { actions, learning, .. } => (*actions, *learning),
         StageRun::Train { actions } => (*actions, true),
     };
     let actions = args.actions.unwrap_or(actions);

@@ -215,11 +215,12 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
                 }
                 finals[index] = Some(cp);
             }
-            StageRun::Test { actions, learning } => {
+            StageRun::Test { actions, lives, learning } => {
                 let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
                     CliError::io(format!("error: test stage `{}` extends no evolved stage", stage.name))
                 })?;
-                let summary = test_stage(&program, index, seed, parent, *actions, *learning, &dir, &args)?;
+                let summary =
+                    test_stage(&program, index, seed, parent, *actions, *lives, *learning, &dir, &args)?;
                 results.push(serde_json::json!({"kind": "test", "summary": summary, "stage": stage.name}));
             }
             StageRun::Train { .. } => unreachable!("training stages run above"),
@@ -403,59 +404,103 @@ fn evolve_stage(
     Ok(cp)
 }
 
-/// One life of a test stage's individual: `actions` in the world of the stage
-/// it extends ("before"), then `actions` in the stage's own world ("after"),
-/// with one controller, so what local learning acquired before the change
-/// carries over (the paper's section 4.9).
+/// The lives of a test stage's individual: `lives` lives of at most
+/// `actions` actions in the world of the stage it extends ("before"), then as
+/// many in the stage's own world ("after"), with one controller, so what local
+/// learning acquired (and the performance indicators) carries over from life
+/// to life and across the change (the paper's section 4.9). Every life is a
+/// fresh world (full battery, objects placed anew) with its own simulator
+/// seed, [`evolve::seed::test_life_seed`]; a life ends early when the battery
+/// is empty.
 pub struct BeforeAfter {
+    /// Every life, in order, the action index running on.
     pub trace: Trace,
     /// Index of the first action in the changed world.
     pub switch: u32,
-    pub before: EpisodeResult,
-    pub after: EpisodeResult,
-    /// The changed world at its start, for the trajectory picture.
+    /// What each life before the change produced.
+    pub before: Vec<EpisodeResult>,
+    /// What each life after the change produced.
+    pub after: Vec<EpisodeResult>,
+    /// The changed world at the start of its first life, for the trajectory picture.
     pub scene: Scene,
-    /// The recorded episode, both worlds (`episode.json`).
+    /// The recorded episode, every life a part (`episode.json`).
     pub episode: episode::Episode,
 }
 
+impl BeforeAfter {
+    /// The first action of every life but the first: the boundaries in the trace.
+    pub fn life_starts(&self) -> Vec<u32> {
+        let mut at = 0;
+        let mut out = Vec::new();
+        for r in self.before.iter().chain(&self.after) {
+            if at > 0 {
+                out.push(at);
+            }
+            at += r.actions;
+        }
+        out
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
 pub fn before_after(
     parent: &Stage,
     stage: &Stage,
     genome: &Genome,
     actions: u32,
+    lives: u32,
     learning: bool,
     seed: u64,
 ) -> Result<BeforeAfter, CliError> {
-    let (sim_seed, rng) = episode_rngs(seed);
+    if lives == 0 {
+        return Err(CliError::io(format!("error: test stage `{}` has no life to run", stage.name)));
+    }
+    let (_, rng) = episode_rngs(seed);
     let mut ctl = Controller::new(stage, genome, rng)
         .map_err(|e| CliError::io(format!("error: stage `{}`: {e}", stage.name)))?;
     let opts = EpisodeOptions { actions, learning, seed };
-    let mut first = Trace::default();
-    let mut sim = Sim::new(&parent.world, sim_seed);
-    let first_scene = sim.scene();
-    let mut rec = Recorder::new(&mut sim);
-    let before = ctl.run(&mut rec, &opts, Some(&mut first));
-    let first_frames = rec.frames;
-    let mut second = Trace::default();
-    let after_seed = sim_seed ^ 0x9e37_79b9_7f4a_7c15;
-    let mut sim = Sim::new(&stage.world, after_seed);
-    let scene = sim.scene();
-    let mut rec = Recorder::new(&mut sim);
-    let after = ctl.run(&mut rec, &opts, Some(&mut second));
-    let second_frames = rec.frames;
-    let switch = first.rows.len() as u32;
-    let mut trace = first;
-    trace.rows.extend(second.rows.into_iter().map(|mut r| {
-        r.action += switch;
-        r
-    }));
-    let parts = [
-        Part { stage: &parent.name, scene: first_scene, frames: first_frames },
-        Part { stage: &stage.name, scene: scene.clone(), frames: second_frames },
-    ];
+    let mut trace = Trace::default();
+    let mut life = Trace::default();
+    let mut parts = Vec::new();
+    let mut results = [Vec::new(), Vec::new()];
+    for (half, world) in [parent, stage].into_iter().enumerate() {
+        for k in 0..lives {
+            let mut sim = Sim::new(&world.world, evolve::seed::test_life_seed(seed, half == 1, k));
+            let scene = sim.scene();
+            let mut rec = Recorder::new(&mut sim);
+            results[half].push(ctl.run(&mut rec, &opts, Some(&mut life)));
+            let frames = rec.frames;
+            let from = trace.rows.len() as u32;
+            trace.modules.clone_from(&life.modules);
+            trace.rows.extend(life.rows.drain(..).map(|mut r| {
+                r.action += from;
+                r
+            }));
+            parts.push(Part { stage: &world.name, scene, frames });
+        }
+    }
+    let switch = results[0].iter().map(|r| r.actions).sum();
+    let scene = parts[lives as usize].scene.clone();
     let episode = episode::episode(stage, seed, learning, &trace, &parts);
+    let [before, after] = results;
     Ok(BeforeAfter { trace, switch, before, after, scene, episode })
+}
+
+/// The lives of one world together: actions and events summed, the fitness
+/// the mean per life (comparable with a life's fitness in evolution).
+fn lives_total(lives: &[EpisodeResult]) -> EpisodeResult {
+    let mut t = EpisodeResult::default();
+    let mut fitness = 0.0f64;
+    for r in lives {
+        t.actions += r.actions;
+        t.grips += r.grips;
+        t.releases_outside += r.releases_outside;
+        t.recharges += r.recharges;
+        t.collisions += r.collisions;
+        fitness += f64::from(r.fitness);
+    }
+    t.fitness = (fitness / lives.len().max(1) as f64) as f32;
+    t
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -465,6 +510,7 @@ fn test_stage(
     seed: u64,
     parent: &Checkpoint,
     actions: u32,
+    lives: u32,
     learning: bool,
     dir: &Path,
     args: &RunArgs,
@@ -482,9 +528,12 @@ fn test_stage(
     let outcome = evolve::test_best(program, index, seed, parent, &eval)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
     let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
-    let ba = before_after(parent_stage, stage, &outcome.genome, actions, learning, outcome.seed)?;
-    let mark = [(ba.switch, format!("world of `{}`", stage.name))];
-    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.episode, &ba.scene, &mark)?;
+    let ba = before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed)?;
+    // The change, and the other lives' starts lightly (unlabelled marks).
+    let mut marks: Vec<(u32, String)> =
+        ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
+    marks.push((ba.switch, format!("world of `{}`", stage.name)));
+    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.episode, &ba.scene, &marks)?;
     write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
     let perf = |r: &EpisodeResult| {
@@ -493,20 +542,27 @@ fn test_stage(
             "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
         })
     };
-    let (b, a) = (&ba.before, &ba.after);
+    let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
+    let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
     let summary = serde_json::json!({
         "stage": stage.name, "learning": learning, "seed": outcome.seed,
         "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
         "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
-        "before": perf(b), "after": perf(a),
+        "before": perf(&b), "after": perf(&a),
+        "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
         "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
     });
     write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
     if args.json {
         println!("{summary}");
     } else if !args.quiet {
+        let how = if lives == 1 {
+            String::new()
+        } else {
+            format!(" in {lives} lives each (fitness: mean per life)")
+        };
         eprintln!(
-            "stage {:<12} test of the best, {} actions before and {} after the change: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
+            "stage {:<12} test of the best, {} actions before and {} after the change{how}: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
             stage.name,
             b.actions,
             a.actions,
@@ -520,8 +576,8 @@ fn test_stage(
     Ok(summary)
 }
 
-/// Mean reinforcement of each learning module over the life before the world
-/// changed, the first 100 actions after it, and the rest after it.
+/// Mean reinforcement of each learning module over the lives before the
+/// world changed, the first 100 actions after it, and the rest after it.
 fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json::Value {
     let mean = |v: &[f32]| {
         let xs: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();

@@ -154,6 +154,7 @@ const FIELDS: &[(&str, Kind)] = &[
     ("evolve.selection", Kind::Word(&["truncation", "roulette"])),
     ("evolve.inheritance", Kind::Word(&["darwinian", "lamarckian"])),
     ("test.actions", Kind::Count(Some("actions"))),
+    ("test.lives", Kind::Count(None)),
     ("train.actions", Kind::Count(Some("actions"))),
     ("world.arena", Kind::Arena),
     ("world.charger", Kind::Real(Some("mm"))),
@@ -355,6 +356,10 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
             StageRun::Test { actions, .. } => count(actions),
             _ => Err(format!("stage `{}` is not a test stage", s.name)),
         },
+        "test.lives" => match s.run {
+            StageRun::Test { lives, .. } => count(lives),
+            _ => Err(format!("stage `{}` is not a test stage", s.name)),
+        },
         "train.actions" => match s.run {
             StageRun::Train { actions } => count(actions),
             _ => Err(format!("stage `{}` is not a training stage", s.name)),
@@ -459,6 +464,10 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
         "test.actions" | "train.actions" => match &mut s.run {
             StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions = whole(n)?,
             StageRun::Evolve(_) => return Err(format!("stage `{name}` evolves")),
+        },
+        "test.lives" => match &mut s.run {
+            StageRun::Test { lives, .. } => *lives = whole(n)?,
+            _ => return Err(format!("stage `{name}` is not a test stage")),
         },
         "world.arena" => {
             if let Value::Pair(a, b) = value {

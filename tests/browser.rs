@@ -118,51 +118,65 @@ fn file_url(path: &Path) -> String {
     format!("file://{}", abs.display())
 }
 
-#[test]
-fn report_opens_without_console_messages_and_shows_the_trace_at_an_action() {
-    let Some(browser) = browser_or_skip() else { return };
-    let dir = scratch("run");
+/// Runs `tests/cli/report.bat` into `dir` (with `extra` arguments) and
+/// returns its report and the rows of the test stage's `trace.csv`, with
+/// its header.
+fn report_run(dir: &Path, extra: &[&str]) -> (PathBuf, Vec<String>, Vec<Vec<String>>) {
     let out = shaping()
         .arg("run")
         .arg(root().join("tests/cli/report.bat"))
         .arg("--out")
-        .arg(&dir)
+        .arg(dir)
         .arg("--quiet")
+        .args(extra)
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let page = dir.join("report.html");
     let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
-    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = trace.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let header = trace.lines().next().unwrap().split(',').map(str::to_string).collect();
+    let rows = trace.lines().skip(1).map(|l| l.split(',').map(str::to_string).collect()).collect();
+    (dir.join("report.html"), header, rows)
+}
+
+/// Opens the report at `action` of the test stage: no console message, no
+/// error, and the action, winner and position of `trace.csv`'s row.
+fn shows_the_trace_at(
+    browser: &Path,
+    page: &Path,
+    header: &[String],
+    row: &[String],
+    action: usize,
+    profile: &str,
+) {
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let url = format!("{}#stage=bigger&action={action}", file_url(page));
+    let out = headless(browser, &scratch(profile), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(body_attr(&dom, "data-ready"), Some("1"), "the page's script did not finish");
+    assert_eq!(body_attr(&dom, "data-errors"), None, "the page reported errors: {}", text_of(&dom, "errors"));
+    assert_eq!(text_of(&dom, "r-action"), action.to_string());
+    assert_eq!(body_attr(&dom, "data-stage"), Some("bigger"));
+    assert_eq!(text_of(&dom, "r-winner"), row[col("winner")], "winner at action {action}");
+    for (id, c) in [("r-x", "x"), ("r-y", "y")] {
+        let shown: f64 = text_of(&dom, id).parse().unwrap();
+        let csv: f64 = row[col(c)].parse().unwrap();
+        assert!((shown - csv).abs() <= 0.011, "{c} at action {action}: page {shown}, trace.csv {csv}");
+    }
+}
+
+#[test]
+fn report_opens_without_console_messages_and_shows_the_trace_at_an_action() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("run");
+    let (page, header, rows) = report_run(&dir, &[]);
     assert!(rows.len() > 20, "the test stage lasted {} actions", rows.len());
 
     // Actions in both worlds of the test stage: before and after the change.
     let actions = [rows.len() / 4, rows.len() * 3 / 4, rows.len() - 1];
     for (k, &action) in actions.iter().enumerate() {
-        let url = format!("{}#stage=bigger&action={action}", file_url(&page));
-        let profile = scratch(&format!("profile-{k}"));
-        let out = headless(&browser, &profile, &url, "--dump-dom");
-        let console = console_messages(&out);
-        assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
-        let dom = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(body_attr(&dom, "data-ready"), Some("1"), "the page's script did not finish");
-        assert_eq!(
-            body_attr(&dom, "data-errors"),
-            None,
-            "the page reported errors: {}",
-            text_of(&dom, "errors")
-        );
-        let row = &rows[action];
-        assert_eq!(text_of(&dom, "r-action"), action.to_string());
-        assert_eq!(body_attr(&dom, "data-stage"), Some("bigger"));
-        assert_eq!(text_of(&dom, "r-winner"), row[col("winner")], "winner at action {action}");
-        for (id, c) in [("r-x", "x"), ("r-y", "y")] {
-            let shown: f64 = text_of(&dom, id).parse().unwrap();
-            let csv: f64 = row[col(c)].parse().unwrap();
-            assert!((shown - csv).abs() <= 0.011, "{c} at action {action}: page {shown}, trace.csv {csv}");
-        }
+        shows_the_trace_at(&browser, &page, &header, &rows[action], action, &format!("profile-{k}"));
     }
 
     // A screenshot of the last of them, to look at.
@@ -175,6 +189,27 @@ fn report_opens_without_console_messages_and_shows_the_trace_at_an_action() {
     let png = std::fs::read(&shot).unwrap();
     assert!(png.starts_with(b"\x89PNG") && png.len() > 20_000, "screenshot of {} bytes", png.len());
     eprintln!("screenshot: {}", shot.display());
+}
+
+/// A test stage of several lives: the page shows every life of both worlds.
+#[test]
+fn report_of_a_test_stage_with_lives_shows_every_life() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("lives");
+    let (page, header, rows) = report_run(&dir, &["--set", "bigger.test.lives=3"]);
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("bigger/summary.json")).unwrap()).unwrap();
+    let lives = |key: &str| -> Vec<usize> {
+        summary[key].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as usize).collect()
+    };
+    let (before, after) = (lives("before_lives"), lives("after_lives"));
+    assert_eq!((before.len(), after.len()), (3, 3));
+    let (b, a): (usize, usize) = (before.iter().sum(), after.iter().sum());
+    assert_eq!(rows.len(), b + a);
+    // In the third life before the change, and in the second after it.
+    for (k, action) in [before[0] + before[1] + 1, b + after[0] + 1].into_iter().enumerate() {
+        shows_the_trace_at(&browser, &page, &header, &rows[action], action, &format!("profile-lives-{k}"));
+    }
 }
 
 /// Drives the page's controls in the browser: keys, the scrub bar, a click

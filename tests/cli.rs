@@ -1264,3 +1264,83 @@ stage practice {
     assert_eq!((line["trained"].as_u64(), line["recorded"].as_u64()), (Some(30000), Some(20000)), "{line}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+fn read_json(path: &Path) -> serde_json::Value {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_slice(&bytes).unwrap()
+}
+
+/// A test stage of several lives: `summary.json` says how many and how long
+/// each was, `trace.csv` holds every action of every life (the action index
+/// running on), `episode.json` every life as a part; the same seed gives the
+/// same lives; replay, `--set` and an experiment take them.
+#[test]
+fn a_test_stage_lives_several_lives_in_each_world() {
+    let dir = scratch("lives");
+    let file = dir.join("lives.bat");
+    let stage = "\nstage third extends second {\n  world changes { battery 25 actions }\n  test best for 2 lives of 40 actions with learning\n}\n";
+    std::fs::write(&file, std::fs::read_to_string(tiny()).unwrap() + stage).unwrap();
+    let out = run(shaping().arg("run").arg(&file).arg("--out").arg(dir.join("a")));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stderr).contains("after the change in 2 lives each"), "{}", text(&out.stderr));
+    let summary = read_json(&dir.join("a/third/summary.json"));
+    assert_eq!(summary["lives"], 2);
+    let counts = |key: &str| -> Vec<u64> {
+        summary[key].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect()
+    };
+    let (before, after) = (counts("before_lives"), counts("after_lives"));
+    assert_eq!((before.len(), after.len()), (2, 2), "{summary}");
+    assert!(before.iter().chain(&after).all(|&n| (1..=40).contains(&n)), "{summary}");
+    let (b, a): (u64, u64) = (before.iter().sum(), after.iter().sum());
+    assert_eq!(summary["before"]["actions"].as_u64(), Some(b));
+    assert_eq!(summary["after"]["actions"].as_u64(), Some(a));
+    let trace = std::fs::read_to_string(dir.join("a/third/trace.csv")).unwrap();
+    let actions: Vec<u64> =
+        trace.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
+    assert_eq!(actions, (0..b + a).collect::<Vec<u64>>(), "one row per action of every life");
+    let ep = read_json(&dir.join("a/third/episode.json"));
+    let worlds = ep["worlds"].as_array().unwrap();
+    let parts: Vec<(&str, u64)> =
+        worlds.iter().map(|w| (w["stage"].as_str().unwrap(), w["from"].as_u64().unwrap())).collect();
+    assert_eq!(parts, [("second", 0), ("second", before[0]), ("third", b), ("third", b + after[0])]);
+    let page = report_data(&dir.join("a/report.html"));
+    assert_eq!(page["episodes"][2]["worlds"].as_array().map(Vec::len), Some(4));
+
+    // The same seed, the same lives; `--json` says how many.
+    let json = run_file(&file, &dir.join("b"), &["--json"]);
+    assert!(json.status.success(), "{}", text(&json.stderr));
+    let last: serde_json::Value = serde_json::from_str(text(&json.stdout).lines().last().unwrap()).unwrap();
+    assert_eq!(last["stages"][2]["summary"]["lives"], 2, "{last}");
+    for f in ["trace.csv", "summary.json", "episode.json"] {
+        let same = std::fs::read(dir.join("a/third").join(f)).unwrap()
+            == std::fs::read(dir.join("b/third").join(f)).unwrap();
+        assert!(same, "{f} differs between two runs of the same seed");
+    }
+
+    // `--set STAGE.test.lives`: the first life is the same life.
+    let three = run_file(&file, &dir.join("c"), &["--quiet", "--set", "third.test.lives=3"]);
+    assert!(three.status.success(), "{}", text(&three.stderr));
+    let s3 = read_json(&dir.join("c/third/summary.json"));
+    assert_eq!(s3["lives"], 3);
+    assert_eq!(s3["before_lives"].as_array().map(Vec::len), Some(3));
+    assert_eq!(s3["before_lives"][0], summary["before_lives"][0]);
+    let zero = run_file(&file, &dir.join("d"), &["--quiet", "--set", "third.test.lives=0"]);
+    assert_eq!(zero.status.code(), Some(2), "{}", text(&zero.stderr));
+    assert!(text(&zero.stderr).contains("test.lives"), "{}", text(&zero.stderr));
+
+    // A replay of the test stage: one life in its world.
+    let rep = replay_run(&file, &dir.join("a"), &dir.join("rep"), &["--stage", "third"]);
+    assert!(rep.status.success(), "{}", text(&rep.stderr));
+    let rows = std::fs::read_to_string(dir.join("rep/trace.csv")).unwrap().lines().count() - 1;
+    assert!((1..=40).contains(&rows), "{rows}");
+
+    // An experiment over seeds tables the lives.
+    let exp = run(shaping()
+        .arg("experiment")
+        .arg(&file)
+        .args(["--seeds", "2", "--no-report", "--out"])
+        .arg(dir.join("e")));
+    assert!(exp.status.success(), "{}", text(&exp.stderr));
+    let md = std::fs::read_to_string(dir.join("e/summary.md")).unwrap();
+    assert!(md.contains("| third | test, 2 lives of 40 actions"), "{md}");
+}

@@ -14,7 +14,8 @@
 pub const MAX_POPULATION: u32 = 100_000;
 /// Most generations of a stage.
 pub const MAX_GENERATIONS: u32 = 1_000_000;
-/// Longest life (or test, or replay), in actions.
+/// Longest life (or test, or replay), in actions; also the most actions of
+/// a test stage in one world, all its lives together (lives times actions).
 pub const MAX_ACTIONS: u32 = 10_000_000;
 /// Most episodes averaged per evaluation.
 pub const MAX_EVALUATIONS: u32 = 1_000;

@@ -550,10 +550,16 @@ pub enum Event {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum StageRun {
     Evolve(Evolution),
-    /// No evolution: the best individual of the parent stage lives `actions`
-    /// actions in this stage's world, with local learning on or off.
+    /// No evolution: the best individual of the parent stage lives `lives`
+    /// lives of at most `actions` actions in the parent's world, then as many
+    /// in this stage's world, with one controller throughout and local
+    /// learning on or off.
     Test {
+        /// Most actions of each life.
         actions: u32,
+        /// Lives in each world (1 in programs written before lives existed).
+        #[serde(default = "one_life")]
+        lives: u32,
         learning: bool,
     },
     /// No evolution and no genes: the stage's modules live one life of
@@ -563,6 +569,11 @@ pub enum StageRun {
     Train {
         actions: u32,
     },
+}
+
+/// The lives of a test stage that does not say (`test best for N actions`).
+fn one_life() -> u32 {
+    1
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

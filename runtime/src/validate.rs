@@ -571,8 +571,15 @@ fn fitness(at: &At, f: &Fitness) -> R {
 /// What the stage does: evolution settings within the limits, or a test.
 fn run(at: &At, s: &Stage) -> R {
     match &s.run {
-        StageRun::Test { actions, .. } => {
+        StageRun::Test { actions, lives, .. } => {
             at.field("test.actions").count(*actions, 1, MAX_ACTIONS)?;
+            at.field("test.lives").count(*lives, 1, MAX_ACTIONS)?;
+            let total = u64::from(*lives) * u64::from(*actions);
+            at.field("test.lives").ensure(total <= u64::from(MAX_ACTIONS), || {
+                format!(
+                    "{lives} lives of {actions} actions make {total} actions in each world, more than the limit of {MAX_ACTIONS}"
+                )
+            })?;
             at.ensure(s.parent.is_some(), || "a test stage must extend the stage it tests".into())
         }
         StageRun::Train { actions } => {

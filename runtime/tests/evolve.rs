@@ -518,7 +518,7 @@ fn test_stage_runs_the_parents_best() {
         "check",
         Some(0),
         layout(10, 10),
-        StageRun::Test { actions: 50, learning: false },
+        StageRun::Test { actions: 50, lives: 1, learning: false },
     ));
     let mut cp = start_stage(&program, 0, 8, None).unwrap();
     run_stage(&program, &mut cp, &ones);
@@ -535,6 +535,32 @@ fn test_stage_runs_the_parents_best() {
     // Misuse is reported.
     assert!(matches!(test_best(&program, 0, 8, &cp, &ones), Err(EvolveError::NotTest { .. })));
     assert!(matches!(start_stage(&program, 1, 8, Some(&cp)), Err(EvolveError::NotEvolved { .. })));
+}
+
+/// A test stage lives at least one life in each world, and its lives
+/// together are no longer than the longest life; a program saved before
+/// lives existed has one.
+#[test]
+fn a_test_stage_has_at_least_one_life_and_old_programs_have_one() {
+    use shaping_runtime::limits::MAX_ACTIONS;
+    let mut st = shaping_runtime::testkit::navigation();
+    st.parent = Some(0);
+    let check = |st: &Stage, actions: u32, lives: u32| {
+        let mut st = st.clone();
+        st.run = StageRun::Test { actions, lives, learning: true };
+        shaping_runtime::validate::stage(&st).map_err(|e| e.to_string())
+    };
+    assert_eq!(check(&st, 300, 10), Ok(()));
+    let err = check(&st, 300, 0).unwrap_err();
+    assert!(err.contains("`run.test.lives`: 0 is not between 1 and"), "{err}");
+    let err = check(&st, MAX_ACTIONS, 2).unwrap_err();
+    assert!(err.contains("`run.test.lives`: 2 lives of 10000000 actions make 20000000 actions"), "{err}");
+    assert_eq!(check(&st, MAX_ACTIONS / 4, 4), Ok(()));
+
+    let now = StageRun::Test { actions: 50, lives: 1, learning: true };
+    let old = serde_json::to_string(&now).unwrap().replace(",\"lives\":1", "");
+    assert!(!old.contains("lives"), "{old}");
+    assert_eq!(serde_json::from_str::<StageRun>(&old).unwrap(), now);
 }
 
 #[test]

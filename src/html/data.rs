@@ -395,8 +395,12 @@ fn run_text(st: &Stage) -> String {
         StageRun::Train { actions } => format!(
             "trained: one life of {actions} actions with learning on; the stages that use it start from the behavior weights learned"
         ),
-        StageRun::Test { actions, learning } => format!(
+        StageRun::Test { actions, lives: 1, learning } => format!(
             "test of the parent's best: {actions} actions in the parent's world, then {actions} in this one, learning {}",
+            if *learning { "on" } else { "off" }
+        ),
+        StageRun::Test { actions, lives, learning } => format!(
+            "test of the parent's best: {lives} lives of {actions} actions in the parent's world, then {lives} in this one, one controller throughout, learning {}",
             if *learning { "on" } else { "off" }
         ),
     }

@@ -99,7 +99,14 @@
       return seen;
     });
     const learners = ep.modules.map((_, m) => m).filter((m) => c.reinforcement[m].some((v) => v !== 0));
-    ep._ = { n, world, objs, perfSeen, learners };
+    // A test stage's lives: [life, lives] of each world among the consecutive worlds of its stage.
+    const life = ep.worlds.map((w, wi) => {
+      let first = wi, last = wi;
+      while (first > 0 && ep.worlds[first - 1].stage === w.stage) first--;
+      while (last + 1 < ep.worlds.length && ep.worlds[last + 1].stage === w.stage) last++;
+      return [wi - first + 1, last - first + 1];
+    });
+    ep._ = { n, world, objs, perfSeen, learners, life };
   }
 
   function worldBox(ep) {
@@ -299,10 +306,14 @@
     }
     // World changes (a test stage) and action ticks.
     g.strokeStyle = '#38414d'; g.setLineDash([4, 3]); g.fillStyle = '#38414d'; g.textBaseline = 'top';
-    for (const w of ep.worlds.slice(1)) {
+    // A test stage's lives in one world: light lines, the change labelled.
+    ep.worlds.forEach((w, wi) => {
+      if (wi === 0) return;
+      const change = w.stage !== ep.worlds[wi - 1].stage;
+      g.strokeStyle = change ? '#38414d' : '#b8bec7'; g.setLineDash(change ? [4, 3] : [1, 3]);
       g.beginPath(); g.moveTo(X(w.from), 2); g.lineTo(X(w.from), L.height - 14); g.stroke();
-      g.fillText('world of ' + w.stage + ' →', X(w.from) + 4, 4);
-    }
+      if (change) g.fillText('world of ' + w.stage + ' →', X(w.from) + 4, 4);
+    });
     g.setLineDash([]);
     g.fillStyle = '#5f6b7a'; g.textBaseline = 'alphabetic';
     const step = niceStep(n / 8);
@@ -331,7 +342,8 @@
     const ep = R.ep, c = ep.actions, a = R.a, w = ep.worlds[ep._.world[a]];
     $('r-action').textContent = String(a);
     $('r-total').textContent = String(ep._.n - 1);
-    $('r-world').textContent = w.stage + (ep.worlds.length > 1 ? ' (part ' + (ep._.world[a] + 1) + ' of ' + ep.worlds.length + ')' : '') +
+    const [life, lives] = ep._.life[ep._.world[a]];
+    $('r-world').textContent = w.stage + (lives > 1 ? ' (life ' + life + ' of ' + lives + ')' : ep.worlds.length > 1 ? ' (part ' + (ep._.world[a] + 1) + ' of ' + ep.worlds.length + ')' : '') +
       ' · seed ' + ep.seed + ', learning ' + (ep.learning ? 'on' : 'off');
     const win = c.winner[a];
     $('r-winner').textContent = ep.modules[win] || '–';
@@ -619,7 +631,7 @@
         const r = st.results, b = r.before || {}, a = r.after || {};
         text = 'fitness ' + fmt(b.fitness, 3) + ' → ' + fmt(a.fitness, 3) + ', grips ' + b.grips + ' → ' + a.grips +
           ', released outside ' + b.releases_outside + ' → ' + a.releases_outside + ', recharges ' + b.recharges + ' → ' + a.recharges +
-          ' (before → after the change)' + (D.shown_seed !== null && D.shown_seed !== undefined ? ', run seed ' + D.shown_seed : '');
+          ' (before → after the change' + (r.lives > 1 ? '; ' + r.lives + ' lives in each world: fitness the mean per life, events the totals' : '') + ')' + (D.shown_seed !== null && D.shown_seed !== undefined ? ', run seed ' + D.shown_seed : '');
       }
       tb.append(el('tr', {}, el('td', { text: st.name }), el('td', { text: st.run }), el('td', { text: text || '–' })));
     }

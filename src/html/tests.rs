@@ -11,7 +11,7 @@ use shaping_runtime::program::{Param, Program, StageRun};
 use super::data::{self, parse_generations, seed_series, stage_view, GenRow, ReportData};
 use super::{embedded_json, page};
 use crate::episode::{run_recorded, Episode};
-use crate::run::before_after;
+use crate::run::{before_after, BeforeAfter};
 
 fn program() -> Program {
     let src = include_str!("../../tests/cli/report.bat");
@@ -107,14 +107,23 @@ fn object_changes_rebuild_the_recorded_objects_at_every_action() {
     panic!("none of {tried} random genomes gripped an object");
 }
 
-#[test]
-fn a_test_stage_episode_has_both_worlds_and_the_objects_grow() {
+/// The test stage `bigger` of a random individual with episode seed 5, its
+/// index, and its lives `(actions, lives)` as given or else as declared.
+fn bigger(lives: Option<(u32, u32)>) -> (usize, BeforeAfter) {
     let p = program();
     let (i, stage) = p.stage("bigger").unwrap();
     let parent = &p.stages[stage.parent.unwrap()];
     let genome = random_genome(stage.layout.bits, 3);
-    let StageRun::Test { actions, learning } = stage.run else { panic!("bigger is a test stage") };
-    let ba = before_after(parent, stage, &genome, actions, learning, 5).unwrap();
+    let StageRun::Test { actions, lives: declared, learning } = stage.run else {
+        panic!("bigger is a test stage")
+    };
+    let (actions, lives) = lives.unwrap_or((actions, declared));
+    (i, before_after(parent, stage, &genome, actions, lives, learning, 5).unwrap())
+}
+
+#[test]
+fn a_test_stage_episode_has_both_worlds_and_the_objects_grow() {
+    let (i, ba) = bigger(None);
     let ep = &ba.episode;
     assert_eq!(i, 2);
     assert_eq!(ep.worlds.len(), 2);
@@ -128,6 +137,31 @@ fn a_test_stage_episode_has_both_worlds_and_the_objects_grow() {
     let s = ba.switch as usize;
     assert!(rebuilt[..s].iter().flatten().all(|o| o[2] < 6.0));
     assert!(rebuilt[s..].iter().flatten().all(|o| o[2] > 12.0));
+}
+
+/// Every life of a test stage is a part of its episode, in its world, and
+/// the first life of each world is the one-life test's.
+#[test]
+fn a_test_stage_with_lives_records_every_life_as_a_part() {
+    let (_, ba) = bigger(Some((40, 3)));
+    let ep = &ba.episode;
+    let names: Vec<&str> = ep.worlds.iter().map(|w| w.stage.as_str()).collect();
+    assert_eq!(names, ["collect", "collect", "collect", "bigger", "bigger", "bigger"]);
+    let starts: Vec<u32> = ep.worlds.iter().skip(1).map(|w| w.from).collect();
+    assert_eq!(starts, ba.life_starts());
+    assert_eq!(ep.worlds[3].from, ba.switch);
+    assert_eq!((ba.before.len(), ba.after.len()), (3, 3));
+    let total: u32 = ba.before.iter().chain(&ba.after).map(|r| r.actions).sum();
+    assert_eq!(ba.trace.rows.len(), total as usize);
+    assert_eq!(ep.actions.x.len(), total as usize);
+    assert!(ba.trace.rows.iter().enumerate().all(|(i, r)| r.action as usize == i));
+    // Each life starts in a fresh world: objects placed anew.
+    assert_ne!(ep.worlds[0].objects, ep.worlds[1].objects);
+    assert!(ep.worlds[4].objects.iter().all(|o| (o[2] - 12.5).abs() < 1e-3));
+    let (_, one) = bigger(Some((40, 1)));
+    assert_eq!(one.before[0], ba.before[0]);
+    assert_eq!(one.episode.worlds[0], ep.worlds[0]);
+    assert_eq!(one.episode.worlds[1].objects, ep.worlds[3].objects);
 }
 
 #[test]

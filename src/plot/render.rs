@@ -179,6 +179,8 @@ pub(super) const GRID_BOLD: RGBColor = RGBColor(215, 215, 215);
 pub(super) const GRID_LIGHT: RGBColor = RGBColor(240, 240, 240);
 pub(super) const INK: RGBColor = RGBColor(40, 40, 40);
 pub(super) const MARK: RGBColor = RGBColor(110, 110, 110);
+/// Unlabelled marks (life boundaries), fainter than [`MARK`].
+pub(super) const LIGHT_MARK: RGBColor = RGBColor(185, 185, 185);
 
 /// A categorical palette (Tableau 10 order), repeated if needed.
 pub(super) fn palette(i: usize) -> RGBColor {
@@ -263,6 +265,8 @@ pub(super) fn dash(points: &[(i32, i32)], pattern: &[f64]) -> Vec<Vec<(i32, i32)
 pub(super) const DASH_DOT: [f64; 4] = [10.0, 4.0, 2.5, 4.0];
 /// A plain dashed pattern for markers.
 pub(super) const DASHED: [f64; 2] = [6.0, 4.0];
+/// A dotted pattern for light markers.
+pub(super) const DOTTED: [f64; 2] = [2.0, 4.0];
 
 /// Draws a polyline in backend pixels with a dash pattern on `root` (which
 /// must be the unsplit root area, whose pixels are the backend's).

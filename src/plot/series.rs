@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::render::{self, palette, runs, span, DrawResult, Figure, DASHED, MARK};
+use super::render::{self, palette, runs, span, DrawResult, Figure, DASHED, DOTTED, LIGHT_MARK, MARK};
 
 pub(super) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
@@ -110,7 +110,8 @@ pub(super) struct MarkLine<'a> {
 }
 
 /// Dashed vertical lines across the plot with their label at the top,
-/// drawn in backend pixels on the unsplit `root`.
+/// drawn in backend pixels on the unsplit `root`; a mark with an empty label
+/// is a light dotted line (the start of a life within a test stage's world).
 pub(super) fn marks<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     chart: &Chart<'_, DB>,
@@ -125,8 +126,12 @@ pub(super) fn marks<DB: DrawingBackend>(
     for m in marks.iter().filter(|m| m.x.is_finite() && m.x >= x0 && m.x <= x1) {
         let top = chart.backend_coord(&(m.x, y1));
         let bottom = chart.backend_coord(&(m.x, y0));
+        if m.label.is_empty() {
+            render::draw_dashed(root, &[top, bottom], &DOTTED, LIGHT_MARK.stroke_width(1))?;
+            continue;
+        }
         render::draw_dashed(root, &[top, bottom], &DASHED, MARK.stroke_width(2))?;
-        if text && !m.label.is_empty() {
+        if text {
             // Put the label left of the line when it would run past the plot.
             let (w, _) = root.estimate_text_size(m.label, &left)?;
             if top.0 + 6 + w as i32 > right_edge {

@@ -39,3 +39,5 @@ stage t extends s {
   world changes { objects 5 virtual }
   test best for 100 actions without learning
 }
+stage lives extends s { test best for 10 lives of 300 actions }
+stage of extends s { test best for 1 life of 20 actions with learning }

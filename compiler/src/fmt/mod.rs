@@ -629,8 +629,13 @@ impl F<'_> {
                 let items = settings.iter().map(|s| self.item(s.span, Doc::Text(self.setting(s)))).collect();
                 self.item(*span, self.block("evolve".into(), *span, items))
             }
-            StageItem::Test { actions, learning, span } => {
-                let mut t = format!("test best for {}", self.qty(actions));
+            StageItem::Test { lives, actions, learning, span } => {
+                let mut t = "test best for ".to_string();
+                if let Some(l) = lives {
+                    let word = if l.value == 1.0 { "life" } else { "lives" };
+                    t += &format!("{} {word} of ", self.qty(l));
+                }
+                t += &self.qty(actions);
                 if self.lx.tokens_in(*span).iter().any(|t| self.text(t.span) == "learning") {
                     t += if *learning { " with learning" } else { " without learning" };
                 }

@@ -1,4 +1,4 @@
-//! What a stage does (evolve or test), the evolution settings and the fitness.
+//! What a stage does (evolve, test or train), the evolution settings and the fitness.
 
 use shaping_runtime::catalog::ActuatorKind;
 use shaping_runtime::expr::{Expr, Op};
@@ -47,7 +47,7 @@ impl Lower<'_> {
                     self.evolve(st, settings);
                     st.run = StageRun::Evolve(st.evolution.clone());
                 }
-                I::Test { actions, learning, span } => {
+                I::Test { lives, actions, learning, span } => {
                     if let Some(e) = evolve_span.or(test_span) {
                         self.conflict_run(*span, e);
                     }
@@ -65,8 +65,26 @@ impl Lower<'_> {
                             ),
                         );
                     }
-                    if let Some(n) = self.count_in(actions, "the test length", 1, MAX_ACTIONS.into()) {
-                        st.run = StageRun::Test { actions: n as u32, learning: *learning };
+                    let n = self.count_in(actions, "the test length", 1, MAX_ACTIONS.into());
+                    let k = match lives {
+                        Some(q) => self.count_in(q, "the number of lives", 1, MAX_ACTIONS.into()),
+                        None => Some(1),
+                    };
+                    if let (Some(n), Some(k)) = (n, k) {
+                        if n * k > u64::from(MAX_ACTIONS) {
+                            self.value_error(
+                                *span,
+                                format!(
+                                    "{k} lives of {n} actions make {} actions in each world, more than the limit of {MAX_ACTIONS}",
+                                    n * k
+                                ),
+                                "too long",
+                                Some("this limit keeps a run within the memory and time of one machine: fewer lives or shorter ones".into()),
+                            );
+                        } else {
+                            st.run =
+                                StageRun::Test { actions: n as u32, lives: k as u32, learning: *learning };
+                        }
                     }
                 }
                 _ => {}

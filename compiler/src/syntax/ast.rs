@@ -104,8 +104,17 @@ pub enum StageItem {
     Genome(GenomeBlock),
     World(WorldBlock),
     Evolve(Vec<Setting>, Span),
-    Test { actions: Quantity, learning: bool, span: Span },
-    Train { actions: Quantity, span: Span },
+    /// `test best for [LIVES lives of] ACTIONS [with|without learning]`.
+    Test {
+        lives: Option<Quantity>,
+        actions: Quantity,
+        learning: bool,
+        span: Span,
+    },
+    Train {
+        actions: Quantity,
+        span: Span,
+    },
     Fitness(FitnessDecl),
     Module(ModuleDecl),
     LinksAll(LinkKind, Span),

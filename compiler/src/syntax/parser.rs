@@ -266,6 +266,9 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::train_run => "`train`",
         Rule::k_trained => "`trained`",
         Rule::test_learning => "`with learning` or `without learning`",
+        Rule::test_lives => "a number of lives",
+        Rule::k_lives => "`lives`",
+        Rule::k_of => "`of`",
         Rule::fitness => "`fitness`",
         Rule::fitness_mode => "`adds`",
         Rule::per_action => "`per action`",
@@ -651,11 +654,16 @@ impl Builder {
                     items.push(StageItem::Train { actions, span: csp });
                 }
                 Rule::test_run => {
-                    let mut ti = c.into_inner();
+                    let mut ti = c.into_inner().peekable();
+                    // `10 lives of`: the number, as a quantity with no unit.
+                    let lives = ti.next_if(|p| p.as_rule() == Rule::test_lives).and_then(|p| {
+                        let n = p.into_inner().next()?;
+                        Some(Quantity { value: num(&n), unit: None, span: span(&n) })
+                    });
                     let actions =
                         ti.next().map(quantity).unwrap_or(Quantity { value: 0.0, unit: None, span: csp });
                     let learning = ti.next().map(|l| !l.as_str().starts_with("without")).unwrap_or(true);
-                    items.push(StageItem::Test { actions, learning, span: csp });
+                    items.push(StageItem::Test { lives, actions, learning, span: csp });
                 }
                 Rule::fitness => {
                     let fit = self.fitness(c);

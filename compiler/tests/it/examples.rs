@@ -58,6 +58,6 @@ fn khepera_has_a_training_stage_and_the_papers_three_stages() {
     assert_eq!(col.links.len(), 30);
     assert_eq!(col.world.objects.as_ref().map(|o| o.diameter), Some(10.0));
     assert_eq!(p.stages[3].world.objects.as_ref().map(|o| o.diameter), Some(25.0));
-    assert_eq!(p.stages[3].run, StageRun::Test { actions: 300, learning: true });
+    assert_eq!(p.stages[3].run, StageRun::Test { actions: 300, lives: 1, learning: true });
     assert_eq!(col.fitness.bonuses.len(), 2);
 }

@@ -143,6 +143,35 @@ stage s {
     assert_eq!(out, expected);
 }
 
+/// The lives of a test stage: spacing normalised, `life` for
+/// one and `lives` otherwise, and the program unchanged.
+#[test]
+fn test_lives_are_formatted_and_keep_their_meaning() {
+    let head = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+                stage s { fitness per action wheels[0]  module m { sense ir  behavior forward } }\n";
+    for (test, expected) in [
+        ("test best  for 10   lives\n of 300 actions", "test best for 10 lives of 300 actions"),
+        (
+            "test best for 1 lives of 20 actions with learning",
+            "test best for 1 life of 20 actions with learning",
+        ),
+        ("test best for 3 life of 20 without learning", "test best for 3 lives of 20 without learning"),
+        ("test best for 300 actions", "test best for 300 actions"),
+    ] {
+        let src = format!("{head}stage t extends s {{ {test} }}\n");
+        let out = format(&src, "x.bat").unwrap();
+        assert!(
+            out.lines().any(|l| l
+                .trim_start()
+                .trim_start_matches("stage t extends s { ")
+                .trim_end_matches(" }")
+                == expected),
+            "{out}"
+        );
+        assert_eq!(compile(&out, "x.bat").unwrap(), compile(&src, "x.bat").unwrap());
+    }
+}
+
 #[test]
 fn long_conditionals_break_before_each_colon() {
     let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\nstage s {\n  fitness per action wheels[0]\n  module m {\n    sense ir\n    behavior forward\n    learn crbp on activation always\n    reinforce max(ir) > max(prev ir) + 0.02 ? -1 : max(ir) < max(prev ir) - 0.02 ? 1 : max(ir) > 0.5 ? -1 : max(ir) < 0.1 ? sign(wheels[0] + wheels[1]) : 0\n  }\n}\n";
@@ -164,6 +193,7 @@ fn generated(choices: &[u8], spaces: &[u8]) -> String {
         "stage b extends a { evolve { generations 3 selection roulette } module k { sense ir[0..3], battery activation fixed [0.5, -1, 1, 2, 3, 4] behavior script commit { back(0.5) until max(ir) < 0.2 within 5 actions; wait if not (battery > 0.5 or prev battery < 0.1) } } links all evolvable range -2..2 }",
         "stage c extends b { module n { sense ir behavior neural { sense ir[2] hidden 2 outputs sign(2) -> forward | right | turn left(0.5) | back weights random -0.5..0.5 } learn crbp(0.1, 0.01) on behavior when performance < 0.5 over 20 actions reinforce -max(ir) + 1 < 0.3 ? 1 : -(1 - 2) } link n -> m fixed -1 }",
         "stage d extends c { test best for 300 actions without learning }",
+        "stage e extends c { test best for 4 lives of 300 actions with learning }",
     ];
     let mut src = String::new();
     for (i, w) in words.iter().enumerate() {

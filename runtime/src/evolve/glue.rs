@@ -18,11 +18,13 @@ pub struct EvalOptions {
 impl EvalOptions {
     /// What the stage declares: an evolved stage lives `Evolution::actions`
     /// actions with learning on (modules without `learning` never learn); a
-    /// test stage as declared in `StageRun::Test`.
+    /// test stage one life as declared in `StageRun::Test`.
     pub fn of(stage: &Stage) -> EvalOptions {
         match &stage.run {
             StageRun::Evolve(evo) => EvalOptions { actions: evo.actions, learning: true },
-            StageRun::Test { actions, learning } => EvalOptions { actions: *actions, learning: *learning },
+            StageRun::Test { actions, learning, .. } => {
+                EvalOptions { actions: *actions, learning: *learning }
+            }
             StageRun::Train { actions } => EvalOptions { actions: *actions, learning: true },
         }
     }

@@ -572,7 +572,8 @@ pub struct TestOutcome {
     pub genome: Genome,
     /// Its fitness in the parent stage.
     pub parent_fitness: f32,
-    /// The episode seed used.
+    /// The episode seed used; the lives of the test in both worlds take
+    /// their simulator seeds from it ([`seed::test_life_seed`]).
     pub seed: u64,
     pub evaluation: Evaluation,
 }

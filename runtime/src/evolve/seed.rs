@@ -17,6 +17,11 @@ const DOMAIN_BREED: u64 = 0x0042_5245_4544; // "BREED"
 const DOMAIN_EVAL: u64 = 0x4556_414c; // "EVAL"
 const DOMAIN_TEST: u64 = 0x5445_5354; // "TEST"
 const DOMAIN_VALIDATE: u64 = 0x5641_4c49_4441_5445; // "VALIDATE"
+const DOMAIN_LIFE: u64 = 0x4c49_4645; // "LIFE"
+
+/// What the simulator seed of a test stage's first life in its own world
+/// differs from the episode seed by (xor): the one-life test's derivation.
+const AFTER_CHANGE: u64 = 0x9e37_79b9_7f4a_7c15;
 
 /// One SplitMix64 step: a bijective 64-bit mixer.
 pub fn splitmix64(x: u64) -> u64 {
@@ -54,6 +59,21 @@ pub fn test_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
     mix(run_seed, &[DOMAIN_TEST, stage as u64, episode as u64])
 }
 
+/// Simulator seed of life `life` (0-based) of a test stage whose episode
+/// seed is `episode_seed` (from [`test_seed`]), in the parent's world
+/// (`after` false) or in the stage's own world (`after` true). Life 0 is the
+/// one-life test's: the episode seed itself before the change, and the
+/// episode seed xor `0x9e37_79b9_7f4a_7c15` after it. Life `k > 0` of a world
+/// is `mix(s0, [LIFE, k])`, `s0` being that world's life-0 seed.
+pub fn test_life_seed(episode_seed: u64, after: bool, life: u32) -> u64 {
+    let first = if after { episode_seed ^ AFTER_CHANGE } else { episode_seed };
+    if life == 0 {
+        first
+    } else {
+        mix(first, &[DOMAIN_LIFE, life as u64])
+    }
+}
+
 /// Seed of episode `episode` of the re-evaluation that picks a stage's best.
 pub fn validate_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
     mix(run_seed, &[DOMAIN_VALIDATE, stage as u64, episode as u64])
@@ -84,5 +104,17 @@ mod tests {
         assert_ne!(a, episode_seed(2, 0, 0, 0, 0));
         assert_ne!(breed_seed(1, 0, 1), init_seed(1, 0));
         assert_eq!(a, episode_seed(1, 0, 0, 0, 0));
+    }
+
+    #[test]
+    fn test_lives_keep_the_one_life_seeds_and_differ() {
+        let e = test_seed(1, 3, 0);
+        assert_eq!(test_life_seed(e, false, 0), e);
+        assert_eq!(test_life_seed(e, true, 0), e ^ 0x9e37_79b9_7f4a_7c15);
+        let mut all: Vec<u64> =
+            (0..50).flat_map(|k| [test_life_seed(e, false, k), test_life_seed(e, true, k)]).collect();
+        all.sort_unstable();
+        all.dedup();
+        assert_eq!(all.len(), 100, "every life of both worlds has its own seed");
     }
 }
