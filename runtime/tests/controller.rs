@@ -185,6 +185,38 @@ fn scripts_advance_while_winning_wrap_around_and_reset_when_preempted() {
 }
 
 #[test]
+fn a_new_life_starts_scripts_and_links_afresh() {
+    // A life that ends in the middle of the script's second step: the next
+    // life (`start` on a fresh robot) starts the script at its first step.
+    let s = script_stage();
+    let mut c = controller(&s, 1);
+    let mut robot = Puppet::default();
+    c.start(&mut robot);
+    let first: Vec<f32> = (0..2).map(|_| c.act(&mut robot).command.wheels[0]).collect();
+    assert_eq!(first, vec![1.0, 2.0]);
+    assert_eq!(c.script_position(0), Some(1));
+    let mut robot = Puppet::default();
+    c.start(&mut robot);
+    assert_eq!(c.script_position(0), Some(0));
+    assert_eq!(c.activations(), &[0.0, 0.0]);
+    let next: Vec<f32> = (0..3).map(|_| c.act(&mut robot).command.wheels[0]).collect();
+    assert_eq!(next, vec![1.0, 2.0, 2.0]);
+
+    // The activations the links read are the new life's: b wins the first
+    // action of every life, as it does in a fresh controller, before a's
+    // inhibition reaches it.
+    let links = vec![Link { from: 0, to: 1, weight: Param::Fixed(-10.0) }];
+    let s = stage_of(vec![constant_module("a", 2.0, 0.1), constant_module("b", 3.0, 0.2)], links);
+    let mut c = controller(&s, 1);
+    for _ in 0..2 {
+        let mut robot = Puppet::default();
+        c.start(&mut robot);
+        assert_eq!(c.act(&mut robot).winner, 1);
+        assert_eq!(c.act(&mut robot).winner, 0);
+    }
+}
+
+#[test]
 fn until_steps_end_on_their_condition_or_bound_and_reinforce_steps_take_no_time() {
     // Step 0: wheels 1 until ir[0] > 0.5 within 3; step 1: reinforce ir[0] > 0.5 ? 1 : -1
     // (takes no time); step 2: wheels 2.

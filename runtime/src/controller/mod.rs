@@ -403,8 +403,32 @@ impl<'s> Controller<'s> {
         self.learning = on;
     }
 
-    /// Senses the initial percept; call once before the first [`Controller::act`].
+    /// Starts a life: forgets what belonged to the previous one (a script
+    /// under way, the activations the links read, a recurrent network's
+    /// context, what the gripper held) and senses the initial percept; call
+    /// once before the first [`Controller::act`] of each life. What learning
+    /// changed in the weights, the performance indicators and the random
+    /// stream carry over, so one controller can live several lives (a test
+    /// stage's lives, before and after its world changes).
     pub fn start<R: Robot>(&mut self, sim: &mut R) {
+        for m in &mut self.mods {
+            m.reset_script();
+            m.activation.forget();
+            if let Gen::Neural { net, bits, .. } = &mut m.gen {
+                net.forget();
+                bits.fill(0);
+            }
+            m.decided = [0.0; CHANNELS];
+            m.decided_link = 0.0;
+        }
+        self.act.fill(0.0);
+        self.prev_act.fill(0.0);
+        self.reinf.fill(0.0);
+        self.slots = [0.0; ACT_SLOTS];
+        self.last_winner = None;
+        self.forced = None;
+        self.forbidden.fill(false);
+        self.holding = false;
         sim.sense(&mut self.now);
         self.before = self.now;
     }

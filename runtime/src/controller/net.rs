@@ -105,6 +105,13 @@ impl Net {
         &self.z
     }
 
+    /// Forgets the last forward pass: a recurrent network's next context is
+    /// zero again, as in a fresh network (the weights stay).
+    pub fn forget(&mut self) {
+        self.h.fill(0.0);
+        self.ctx.fill(0.0);
+    }
+
     /// Forward pass on a percept; `extra` is added to every output neuron's net
     /// input (the link term of an activation network).
     #[inline]
