@@ -208,25 +208,37 @@ for run in ("khepera", "khepera-explore", "khepera-practice"):
 
     figure13(run, f"{run} bigger (test of the collect best; objects 10 -> 25 mm, learning only)")
 
-# Figure 13 over long lives (a diagnostic: a battery of 3000 actions in the
-# second half, which the paper's robot did not have): the exploring
-# variant's collect bests, 1500 actions in the collect world (the paper's
-# battery), then 1500 with 25 mm objects (f13-long), with 10 mm objects
+# Figure 13 over many lives: khepera-practice's collect bests, 10 lives of
+# 300 actions in the collect world (the paper's battery: a life ends when it
+# runs out), then 10 lives with 25 mm objects (f13-long), with 10 mm objects
 # (f13-control: no change) and with 25 mm objects without learning
-# (f13-nolearning). The first two share their first half (the same life).
-first30 = {}
+# (f13-nolearning); one controller throughout. The first two share their
+# first half (the same lives).
+def before_change(run, s):
+    """The grip module's reinforcement signals before the change, in order."""
+    t, switch = bigger_trace(run, s)
+    return [float(r["reinf_grip"]) for r in t[:switch] if float(r["reinf_grip"]) != 0.0]
+
+
+mean_or_none = lambda v: statistics.mean(v) if v else None
+first30, last30 = {}, {}
 for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control", "objects stay 10 mm, learning"),
                   ("f13-nolearning", "objects 10 -> 25 mm, no learning")):
-    figure13(run, f"{run}: 1500 + 1500 actions, battery of 3000 actions after the change; {what}")
+    figure13(run, f"{run}: 10 + 10 lives of 300 actions, the paper's battery; {what}")
     sigs = [after_change(run, s) for s in SEEDS]
-    first = first30[run] = [statistics.mean(v[:30]) if v else None for v in sigs]
-    last = [statistics.mean(v[-30:]) if v else None for v in sigs]
+    pre = [mean_or_none(before_change(run, s)[-30:]) for s in SEEDS]
+    first = first30[run] = [mean_or_none(v[:30]) for v in sigs]
+    last = last30[run] = [mean_or_none(v[-30:]) for v in sigs]
     up = sum(1 for a, b in zip(first, last) if a is not None and b > a)
-    print(f"  grip signals after the change {spread([len(v) for v in sigs], 0)}; mean of the first 30 {spread(first)}, "
-          f"of the last 30 {spread(last)}; the last 30 above the first 30 on {up} of {N} seeds")
-pairs = [(a, b) for a, b in zip(first30["f13-long"], first30["f13-control"]) if a is not None and b is not None]
-print(f"  paired by seed, mean of the first 30 signals after the change, 25 mm minus 10 mm: {spread([a - b for a, b in pairs])}; "
-      f"lower with 25 mm on {sum(1 for a, b in pairs if a < b)} of {len(pairs)} seeds")
+    print(f"  grip signals before the change {spread([len(before_change(run, s)) for s in SEEDS], 0)}, after it {spread([len(v) for v in sigs], 0)}")
+    print(f"  mean of the last 30 signals before the change {spread([x for x in pre if x is not None])} (mean over seeds {statistics.mean([x for x in pre if x is not None]):+.2f}); "
+          f"of the first 30 after {spread([x for x in first if x is not None])} ({statistics.mean([x for x in first if x is not None]):+.2f}); "
+          f"of the last 30 {spread([x for x in last if x is not None])} ({statistics.mean([x for x in last if x is not None]):+.2f}); "
+          f"the last 30 above the first 30 on {up} of {N} seeds")
+for name, table in (("first", first30), ("last", last30)):
+    pairs = [(a, b) for a, b in zip(table["f13-long"], table["f13-control"]) if a is not None and b is not None]
+    print(f"  paired by seed, mean of the {name} 30 signals after the change, 25 mm minus 10 mm: {spread([a - b for a, b in pairs])}; "
+          f"lower with 25 mm on {sum(1 for a, b in pairs if a < b)} of {len(pairs)} seeds")
 
 print("\n== shaping vs evolution from scratch, whole task (criterion: best of a generation >= 3.0)")
 sh, sc = [], []
