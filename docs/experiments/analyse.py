@@ -138,10 +138,11 @@ def bigger_trace(run, s):
     return rows(f"{R}/{run}/seed-{s}/bigger/trace.csv"), switch
 
 
-def after_change(run, s):
-    """The grip module's reinforcement signals after the change, in order."""
+def grip_signals_around_change(run, s):
+    """The grip module's reinforcement signals before and after the change, in order."""
     t, switch = bigger_trace(run, s)
-    return [float(r["reinf_grip"]) for r in t[switch:] if float(r["reinf_grip"]) != 0.0]
+    sig = lambda part: [float(r["reinf_grip"]) for r in part if float(r["reinf_grip"]) != 0.0]
+    return sig(t[:switch]), sig(t[switch:])
 
 
 def figure13(run, title):
@@ -214,26 +215,21 @@ for run in ("khepera", "khepera-explore", "khepera-practice"):
 # (f13-control: no change) and with 25 mm objects without learning
 # (f13-nolearning); one controller throughout. The first two share their
 # first half (the same lives).
-def before_change(run, s):
-    """The grip module's reinforcement signals before the change, in order."""
-    t, switch = bigger_trace(run, s)
-    return [float(r["reinf_grip"]) for r in t[:switch] if float(r["reinf_grip"]) != 0.0]
-
-
 mean_or_none = lambda v: statistics.mean(v) if v else None
 first30, last30 = {}, {}
 for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control", "objects stay 10 mm, learning"),
                   ("f13-nolearning", "objects 10 -> 25 mm, no learning")):
     figure13(run, f"{run}: 10 + 10 lives of 300 actions, the paper's battery; {what}")
-    sigs = [after_change(run, s) for s in SEEDS]
-    pre = [mean_or_none(before_change(run, s)[-30:]) for s in SEEDS]
+    around = [grip_signals_around_change(run, s) for s in SEEDS]
+    sigs = [a for _, a in around]
+    pre = [mean_or_none(b[-30:]) for b, _ in around]
     first = first30[run] = [mean_or_none(v[:30]) for v in sigs]
     last = last30[run] = [mean_or_none(v[-30:]) for v in sigs]
     up = sum(1 for a, b in zip(first, last) if a is not None and b > a)
-    print(f"  grip signals before the change {spread([len(before_change(run, s)) for s in SEEDS], 0)}, after it {spread([len(v) for v in sigs], 0)}")
-    print(f"  mean of the last 30 signals before the change {spread([x for x in pre if x is not None])} (mean over seeds {statistics.mean([x for x in pre if x is not None]):+.2f}); "
-          f"of the first 30 after {spread([x for x in first if x is not None])} ({statistics.mean([x for x in first if x is not None]):+.2f}); "
-          f"of the last 30 {spread([x for x in last if x is not None])} ({statistics.mean([x for x in last if x is not None]):+.2f}); "
+    print(f"  grip signals before the change {spread([len(b) for b, _ in around], 0)}, after it {spread([len(v) for v in sigs], 0)}")
+    with_mean = lambda v: f"{spread(v)} (mean over seeds {statistics.mean([x for x in v if x is not None]):+.2f})"
+    print(f"  mean of the last 30 signals before the change {with_mean(pre)}; of the first 30 after {with_mean(first)}; "
+          f"of the last 30 {with_mean(last)}; "
           f"the last 30 above the first 30 on {up} of {N} seeds")
 for name, table in (("first", first30), ("last", last30)):
     pairs = [(a, b) for a, b in zip(table["f13-long"], table["f13-control"]) if a is not None and b is not None]
