@@ -186,7 +186,7 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     create_dir(&out)?;
     let scene = Sim::new(&stage.world, seed).scene();
-    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
     let err = |e: serde_json::Error| CliError::io(format!("error: cannot serialise: {e}"));
     write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).map_err(err)?.as_bytes())?;
     write_atomic(&out.join("program.json"), serde_json::to_string(&program).map_err(err)?.as_bytes())?;

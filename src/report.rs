@@ -1,6 +1,7 @@
 //! Turning runtime results into files: CSV tables and pictures.
 
 use std::fmt::Write as _;
+use std::ops::Range;
 use std::path::Path;
 
 use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT};
@@ -180,6 +181,10 @@ pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
 /// Writes `trace.csv` and the pictures of one episode into `dir`:
 /// `activations` (figure 11), `reinforcement` (figures 5, 10, 13) for every
 /// learning module, and `trajectory`.
+///
+/// `path`: the rows the trajectory picture draws, and what they are (for its
+/// title), when it is not the whole trace: a test stage draws its first life
+/// in the changed world, over that life's scene.
 #[allow(clippy::too_many_arguments)]
 pub fn episode_files(
     dir: &Path,
@@ -189,6 +194,7 @@ pub fn episode_files(
     episode: &Episode,
     scene: &Scene,
     marks: &[(u32, String)],
+    path: Option<(Range<usize>, &str)>,
 ) -> Result<(), CliError> {
     let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
     write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
@@ -225,8 +231,14 @@ pub fn episode_files(
         .map_err(to_err)?;
     }
 
-    let scene = trajectory_scene(scene, trace);
-    plot::trajectory(&dir.join("trajectory"), &format!("{title}: trajectory"), &scene).map_err(to_err)
+    let (scene, what) = match path {
+        Some((rows, what)) => {
+            let part = Trace { modules: trace.modules.clone(), rows: trace.rows[rows].to_vec() };
+            (trajectory_scene(scene, &part), format!("{title}: trajectory, {what}"))
+        }
+        None => (trajectory_scene(scene, trace), format!("{title}: trajectory")),
+    };
+    plot::trajectory(&dir.join("trajectory"), &what, &scene).map_err(to_err)
 }
 
 /// Modules that learn (or at least receive reinforcement), with their index.

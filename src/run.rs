@@ -533,7 +533,24 @@ fn test_stage(
     let mut marks: Vec<(u32, String)> =
         ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
     marks.push((ba.switch, format!("world of `{}`", stage.name)));
-    report::episode_files(dir, &stage.name, stage, &ba.trace, &ba.episode, &ba.scene, &marks)?;
+    // The trajectory: the first life in the changed world, over its scene
+    // (the lives before it ran in other worlds).
+    let first = ba.switch as usize..(ba.switch + ba.after[0].actions) as usize;
+    let what = if lives == 1 {
+        "the life after the change".to_string()
+    } else {
+        format!("the first of the {lives} lives after the change")
+    };
+    report::episode_files(
+        dir,
+        &stage.name,
+        stage,
+        &ba.trace,
+        &ba.episode,
+        &ba.scene,
+        &marks,
+        Some((first, &what)),
+    )?;
     write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
     write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
     let perf = |r: &EpisodeResult| {
@@ -676,7 +693,7 @@ fn train_step(
     let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
     let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
-    report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
     write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
     write_atomic(&path, to_json(&trained)?.as_bytes())?;
     if args.json {

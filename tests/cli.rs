@@ -1298,6 +1298,9 @@ fn a_test_stage_lives_several_lives_in_each_world() {
     let actions: Vec<u64> =
         trace.lines().skip(1).map(|l| l.split(',').next().unwrap().parse().unwrap()).collect();
     assert_eq!(actions, (0..b + a).collect::<Vec<u64>>(), "one row per action of every life");
+    // The trajectory draws one life, over its own world.
+    let svg = std::fs::read_to_string(dir.join("a/third/trajectory.svg")).unwrap();
+    assert!(svg.contains("third: trajectory, the first of the 2 lives after the change"), "{svg}");
     let ep = read_json(&dir.join("a/third/episode.json"));
     let worlds = ep["worlds"].as_array().unwrap();
     let parts: Vec<(&str, u64)> =

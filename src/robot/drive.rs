@@ -131,7 +131,7 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     create_dir(&out)?;
     let parts = [Part { stage: &stage.name, scene: scene.clone(), frames }];
     let ep = episode::episode(stage, seed, learning, &trace, &parts);
-    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[])?;
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
     write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).unwrap_or_default().as_bytes())?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     let done = trace.rows.len();
