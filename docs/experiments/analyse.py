@@ -138,11 +138,15 @@ def bigger_trace(run, s):
     return rows(f"{R}/{run}/seed-{s}/bigger/trace.csv"), switch
 
 
-def grip_signals_around_change(run, s):
-    """The grip module's reinforcement signals before and after the change, in order."""
-    t, switch = bigger_trace(run, s)
-    sig = lambda part: [float(r["reinf_grip"]) for r in part if float(r["reinf_grip"]) != 0.0]
-    return sig(t[:switch]), sig(t[switch:])
+def grip_signals_by_life(run, s):
+    """The grip module's reinforcement signals of a seed's many-lives test, as
+    (life, signal) in order; lives 0..L-1 before the change, L..2L-1 after."""
+    with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
+        sm = json.load(f)
+    life = [i for i, n in enumerate(sm["before_lives"] + sm["after_lives"]) for _ in range(n)]
+    t = rows(f"{R}/{run}/seed-{s}/bigger/trace.csv")
+    assert len(t) == len(life), f"{run} seed {s}: {len(t)} rows, lives add up to {len(life)}"
+    return [(life[i], float(r["reinf_grip"])) for i, r in enumerate(t) if float(r["reinf_grip"]) != 0.0], len(sm["before_lives"])
 
 
 def figure13(run, title):
@@ -209,28 +213,66 @@ for run in ("khepera", "khepera-explore", "khepera-practice"):
 
     figure13(run, f"{run} bigger (test of the collect best; objects 10 -> 25 mm, learning only)")
 
-# Figure 13 over many lives: khepera-practice's collect bests, 10 lives of
+# Figure 13 over many lives: khepera-practice's collect bests, 40 lives of
 # 300 actions in the collect world (the paper's battery: a life ends when it
-# runs out), then 10 lives with 25 mm objects (f13-long), with 10 mm objects
+# runs out), then 40 lives with 25 mm objects (f13-long), with 10 mm objects
 # (f13-control: no change) and with 25 mm objects without learning
 # (f13-nolearning); one controller throughout. The first two share their
-# first half (the same lives).
+# first half (the same lives). f13-at25: the same architecture with 25 mm
+# objects from its training stage on, tested the same way (80 lives, all
+# with 25 mm objects); f13-at25-to10: its bests with the objects going from
+# 25 to 10 mm (its first half is f13-at25's).
 mean_or_none = lambda v: statistics.mean(v) if v else None
-first30, last30 = {}, {}
+with_mean = lambda v: f"{spread(v)} (mean over seeds {statistics.mean([x for x in v if x is not None]):+.2f})"
+BLOCK = 10
+first30, last30, per_block = {}, {}, {}
 for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control", "objects stay 10 mm, learning"),
-                  ("f13-nolearning", "objects 10 -> 25 mm, no learning")):
-    figure13(run, f"{run}: 10 + 10 lives of 300 actions, the paper's battery; {what}")
-    around = [grip_signals_around_change(run, s) for s in SEEDS]
-    sigs = [a for _, a in around]
-    pre = [mean_or_none(b[-30:]) for b, _ in around]
-    first = first30[run] = [mean_or_none(v[:30]) for v in sigs]
-    last = last30[run] = [mean_or_none(v[-30:]) for v in sigs]
-    up = sum(1 for a, b in zip(first, last) if a is not None and b > a)
-    print(f"  grip signals before the change {spread([len(b) for b, _ in around], 0)}, after it {spread([len(v) for v in sigs], 0)}")
-    with_mean = lambda v: f"{spread(v)} (mean over seeds {statistics.mean([x for x in v if x is not None]):+.2f})"
+                  ("f13-nolearning", "objects 10 -> 25 mm, no learning"),
+                  ("f13-at25", "25 mm objects from the training stage on, no change, learning"),
+                  ("f13-at25-to10", "f13-at25's bests, objects 25 -> 10 mm, learning")):
+    figure13(run, f"{run}: 40 + 40 lives of 300 actions, the paper's battery; {what}")
+    by_life = [grip_signals_by_life(run, s) for s in SEEDS]
+    lives = by_life[0][1]
+    before = [[x for l, x in sig if l < lives] for sig, _ in by_life]
+    after = [[x for l, x in sig if l >= lives] for sig, _ in by_life]
+    pre = [mean_or_none(v[-30:]) for v in before]
+    first = first30[run] = [mean_or_none(v[:30]) for v in after]
+    last = last30[run] = [mean_or_none(v[-30:]) for v in after]
+    up = sum(1 for a, b in zip(first, last) if a is not None and b is not None and b > a)
+    print(f"  grip signals before the change {spread([len(v) for v in before], 0)}, after it {spread([len(v) for v in after], 0)}")
     print(f"  mean of the last 30 signals before the change {with_mean(pre)}; of the first 30 after {with_mean(first)}; "
-          f"of the last 30 {with_mean(last)}; "
-          f"the last 30 above the first 30 on {up} of {N} seeds")
+          f"of the last 30 {with_mean(last)}; the last 30 above the first 30 on {up} of {N} seeds")
+    # Per seed, the mean of the signals of each block of 10 lives; then the mean over seeds.
+    per_seed = [[mean_or_none([x for l, x in sig if k * BLOCK <= l < (k + 1) * BLOCK]) for k in range(2 * lives // BLOCK)]
+                for sig, _ in by_life]
+    counts = [[sum(1 for l, _ in sig if k * BLOCK <= l < (k + 1) * BLOCK) for k in range(2 * lives // BLOCK)]
+              for sig, _ in by_life]
+    nb, half = 2 * lives // BLOCK, lives // BLOCK
+    per_block[run] = (per_seed, half)
+    fmt = lambda x: "  -  " if x is None else f"{x:+.2f}"
+    print(f"  per seed, the mean of the grip signals in each block of {BLOCK} lives (signals in brackets), "
+          f"{half} blocks before the change | {nb - half} after:")
+    for s, p, c in zip(SEEDS, per_seed, counts):
+        cells = [f"{fmt(p[k])} ({c[k]:3d})" for k in range(nb)]
+        print(f"    seed {s:2d}: {' '.join(cells[:half])} | {' '.join(cells[half:])}")
+    for name, f in (("median", statistics.median), ("mean", statistics.mean)):
+        col = [f([p[k] for p in per_seed if p[k] is not None]) for k in range(nb)]
+        print(f"    {name} over seeds: {' '.join(f'{x:+.2f}' for x in col[:half])} | {' '.join(f'{x:+.2f}' for x in col[half:])}")
+    out_per_life = []
+    for s in SEEDS:
+        with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
+            sm = json.load(f)
+        out_per_life.append((sm["before"]["releases_outside"] / len(sm["before_lives"]),
+                             sm["after"]["releases_outside"] / len(sm["after_lives"])))
+    print(f"  released outside per life, before the change {spread([a for a, _ in out_per_life])}, "
+          f"after it {spread([b for _, b in out_per_life])}")
+for run in ("f13-long", "f13-nolearning"):
+    (test, half), (control, _) = per_block[run], per_block["f13-control"]
+    cells = []
+    for k in range(half, len(test[0])):
+        d = [a[k] - b[k] for a, b in zip(test, control) if a[k] is not None and b[k] is not None]
+        cells.append(f"{statistics.median(d):+.2f} (lower on {sum(1 for x in d if x < 0)} of {len(d)})")
+    print(f"  paired by seed, each block of {BLOCK} lives after the change, {run} minus f13-control (median): {'; '.join(cells)}")
 for name, table in (("first", first30), ("last", last30)):
     pairs = [(a, b) for a, b in zip(table["f13-long"], table["f13-control"]) if a is not None and b is not None]
     print(f"  paired by seed, mean of the {name} 30 signals after the change, 25 mm minus 10 mm: {spread([a - b for a, b in pairs])}; "
