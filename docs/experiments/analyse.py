@@ -140,13 +140,14 @@ def bigger_trace(run, s):
 
 def grip_signals_by_life(run, s):
     """The grip module's reinforcement signals of a seed's many-lives test, as
-    (life, signal) in order; lives 0..L-1 before the change, L..2L-1 after."""
+    (life, signal) in order (lives 0..L-1 before the change, L..2L-1 after),
+    and the test's summary.json."""
     with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
         sm = json.load(f)
     life = [i for i, n in enumerate(sm["before_lives"] + sm["after_lives"]) for _ in range(n)]
     t = rows(f"{R}/{run}/seed-{s}/bigger/trace.csv")
     assert len(t) == len(life), f"{run} seed {s}: {len(t)} rows, lives add up to {len(life)}"
-    return [(life[i], float(r["reinf_grip"])) for i, r in enumerate(t) if float(r["reinf_grip"]) != 0.0], len(sm["before_lives"])
+    return [(life[i], float(r["reinf_grip"])) for i, r in enumerate(t) if float(r["reinf_grip"]) != 0.0], sm
 
 
 def figure13(run, title):
@@ -232,7 +233,7 @@ for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control",
                   ("f13-at25-to10", "f13-at25's bests, objects 25 -> 10 mm, learning")):
     figure13(run, f"{run}: 40 + 40 lives of 300 actions, the paper's battery; {what}")
     by_life = [grip_signals_by_life(run, s) for s in SEEDS]
-    lives = by_life[0][1]
+    lives = len(by_life[0][1]["before_lives"])
     before = [[x for l, x in sig if l < lives] for sig, _ in by_life]
     after = [[x for l, x in sig if l >= lives] for sig, _ in by_life]
     pre = [mean_or_none(v[-30:]) for v in before]
@@ -242,7 +243,7 @@ for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control",
     print(f"  grip signals before the change {spread([len(v) for v in before], 0)}, after it {spread([len(v) for v in after], 0)}")
     print(f"  mean of the last 30 signals before the change {with_mean(pre)}; of the first 30 after {with_mean(first)}; "
           f"of the last 30 {with_mean(last)}; the last 30 above the first 30 on {up} of {N} seeds")
-    # Per seed, the mean of the signals of each block of 10 lives; then the mean over seeds.
+    # Per seed, the mean of the signals of each block of 10 lives; then the median and the mean over seeds.
     per_seed = [[mean_or_none([x for l, x in sig if k * BLOCK <= l < (k + 1) * BLOCK]) for k in range(2 * lives // BLOCK)]
                 for sig, _ in by_life]
     counts = [[sum(1 for l, _ in sig if k * BLOCK <= l < (k + 1) * BLOCK) for k in range(2 * lives // BLOCK)]
@@ -258,12 +259,8 @@ for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control",
     for name, f in (("median", statistics.median), ("mean", statistics.mean)):
         col = [f([p[k] for p in per_seed if p[k] is not None]) for k in range(nb)]
         print(f"    {name} over seeds: {' '.join(f'{x:+.2f}' for x in col[:half])} | {' '.join(f'{x:+.2f}' for x in col[half:])}")
-    out_per_life = []
-    for s in SEEDS:
-        with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
-            sm = json.load(f)
-        out_per_life.append((sm["before"]["releases_outside"] / len(sm["before_lives"]),
-                             sm["after"]["releases_outside"] / len(sm["after_lives"])))
+    out_per_life = [(sm["before"]["releases_outside"] / len(sm["before_lives"]),
+                     sm["after"]["releases_outside"] / len(sm["after_lives"])) for _, sm in by_life]
     print(f"  released outside per life, before the change {spread([a for a, _ in out_per_life])}, "
           f"after it {spread([b for _, b in out_per_life])}")
 for run in ("f13-long", "f13-nolearning"):
