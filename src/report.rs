@@ -184,7 +184,8 @@ pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
 ///
 /// `path`: the rows the trajectory picture draws, and what they are (for its
 /// title), when it is not the whole trace: a test stage draws its first life
-/// in the changed world, over that life's scene.
+/// in the changed world, over that life's scene (rows out of range or none:
+/// the whole trace).
 #[allow(clippy::too_many_arguments)]
 pub fn episode_files(
     dir: &Path,
@@ -233,7 +234,8 @@ pub fn episode_files(
 
     let (scene, what) = match path {
         Some((rows, what)) => {
-            let part = Trace { modules: trace.modules.clone(), rows: trace.rows[rows].to_vec() };
+            let rows = trace.rows.get(rows).filter(|r| !r.is_empty()).unwrap_or(&trace.rows);
+            let part = Trace { modules: trace.modules.clone(), rows: rows.to_vec() };
             (trajectory_scene(scene, &part), format!("{title}: trajectory, {what}"))
         }
         None => (trajectory_scene(scene, trace), format!("{title}: trajectory")),
