@@ -174,7 +174,11 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
                 StageRun::Test { actions, lives, .. } => {
                     limits::trace_bytes(2 * u64::from(*actions) * u64::from(*lives), s.modules.len() as u64)
                 }
-                StageRun::Train { actions } => limits::trace_bytes((*actions).into(), s.modules.len() as u64),
+                // A training life is traced for its first actions only.
+                StageRun::Train { actions } => limits::trace_bytes(
+                    (*actions).min(crate::run::RECORDED_TRAINING_ACTIONS).into(),
+                    s.modules.len() as u64,
+                ),
             }
         })
         .max()
@@ -284,5 +288,16 @@ mod tests {
             err.contains("needs about 6.5 GiB of memory (stage `navigation`), but only 4.0 GiB"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn a_training_stage_is_estimated_by_the_actions_it_traces() {
+        let mut p = program(100, 10);
+        let modules = p.stages[0].modules.len() as u64;
+        p.stages[0].run = StageRun::Train { actions: 10_000_000 };
+        let traced = u64::from(crate::run::RECORDED_TRAINING_ACTIONS);
+        assert_eq!(memory_estimate(&p, &[0]), limits::trace_bytes(traced, modules));
+        p.stages[0].run = StageRun::Train { actions: 1000 };
+        assert_eq!(memory_estimate(&p, &[0]), limits::trace_bytes(1000, modules));
     }
 }
