@@ -275,6 +275,77 @@ for name, table in (("first", first30), ("last", last30)):
     print(f"  paired by seed, mean of the {name} 30 signals after the change, 25 mm minus 10 mm: {spread([a - b for a, b in pairs])}; "
           f"lower with 25 mm on {sum(1 for a, b in pairs if a < b)} of {len(pairs)} seeds")
 
+
+# The same bests with grip and release networks trained with 25 mm objects,
+# and with the test learning at other CRBP rates (docs/experiments/lives.rs:
+# one line per life, `key value` pairs).
+def lives_of(name):
+    by_seed = {}
+    with open(f"{R}/{name}.txt") as f:
+        for line in f:
+            w = line.split()
+            x = dict(zip(w[0::2], w[1::2]))
+            by_seed.setdefault(int(x["seed"]), []).append(x)
+    return [by_seed[s] for s in SEEDS]
+
+
+def block_means(lives):
+    """Per seed, the mean grip signal of each block of BLOCK lives (None without signals)."""
+    out = []
+    for ls in lives:
+        row = []
+        for k in range(0, len(ls), BLOCK):
+            n = sum(int(x["signals"]) for x in ls[k:k + BLOCK])
+            row.append(sum(float(x["sum"]) for x in ls[k:k + BLOCK]) / n if n else None)
+        out.append(row)
+    return out
+
+
+# The tool runs the f13 tests' own lives: it must agree with them life by life.
+for v in ("long", "control", "nolearning"):
+    for s, ls in zip(SEEDS, lives_of(f"lives-{v}")):
+        sig, sm = grip_signals_by_life(f"f13-{v}", s)
+        for i, x in enumerate(ls):
+            mine = [y for l, y in sig if l == i]
+            assert (int(x["actions"]), int(x["signals"]), float(x["sum"])) == \
+                ((sm["before_lives"] + sm["after_lives"])[i], len(mine), sum(mine)), f"lives-{v} seed {s} life {i}"
+print(f"\n== figure 13: what learning in the test does (lives.rs; the f13 tests' lives, which it reproduces, and variants)")
+print(f"  median over seeds of the mean grip signal per block of {BLOCK} lives, 4 before the change | 4 after; "
+      f"signals per seed and block; released outside per life before / after")
+lives_blocks = {}
+for name, what in (("lives-long", "f13-long: 10 -> 25 mm, CRBP 0.5 / 0.1 (collect's)"),
+                   ("lives-control", "f13-control: stays 10 mm, 0.5 / 0.1"),
+                   ("lives-nolearning", "f13-nolearning: 10 -> 25 mm, no learning"),
+                   ("lives-long-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, 0.5 / 0.1"),
+                   ("lives-control-practice25", "networks trained with 25 mm objects, stays 10 mm, 0.5 / 0.1"),
+                   ("lives-nolearning-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, no learning"),
+                   ("lives-long-0.25", "10 -> 25 mm, the test learns at 0.5 / 0.25"),
+                   ("lives-control-0.25", "stays 10 mm, 0.5 / 0.25"),
+                   ("lives-long-0.5", "10 -> 25 mm, the test learns at 0.5 / 0.5"),
+                   ("lives-control-0.5", "stays 10 mm, 0.5 / 0.5")):
+    lives = lives_of(name)
+    per_seed = lives_blocks[name] = block_means(lives)
+    nb = len(per_seed[0])
+    col = [statistics.median([p[k] for p in per_seed if p[k] is not None]) for k in range(nb)]
+    n = [statistics.mean([sum(int(x["signals"]) for x in ls[k * BLOCK:(k + 1) * BLOCK]) for ls in lives]) for k in range(nb)]
+    half = len(lives[0]) // 2
+    out = [statistics.mean([sum(int(x["out"]) for x in ls[h * half:(h + 1) * half]) / half for ls in lives]) for h in (0, 1)]
+    print(f"  {what}:\n    {' '.join(f'{x:+.2f}' for x in col[:nb // 2])} | {' '.join(f'{x:+.2f}' for x in col[nb // 2:])}"
+          f"; signals {' '.join(f'{x:.0f}' for x in n)}; released outside per life {out[0]:.2f} / {out[1]:.2f}")
+print("  per seed, a drop (the last block before minus the first after >= 0.2), and back (the last block after within 0.1 "
+      "below the last before, or above it):")
+for name in ("lives-long", "lives-nolearning", "lives-long-practice25", "lives-long-0.25", "lives-long-0.5",
+             "lives-control", "lives-control-0.25", "lives-control-0.5"):
+    drops = back = 0
+    for p in lives_blocks[name]:
+        h = len(p) // 2
+        if None in (p[h - 1], p[h], p[-1]):
+            continue
+        if p[h - 1] - p[h] >= 0.2:
+            drops += 1
+            back += p[-1] >= p[h - 1] - 0.1
+    print(f"    {name}: drop on {drops} of {N} seeds, back on {back}")
+
 print("\n== shaping vs evolution from scratch, whole task (criterion: best of a generation >= 3.0)")
 sh, sc = [], []
 for s in SEEDS:

@@ -177,6 +177,33 @@ grep -v -E '^      turn (left|right)\((0.5|0.25)\) if ' examples/khepera.bat > $
 target/release/examples/grip $R/khepera-no-facing.bat > $R/grip-no-facing.txt
 target/release/examples/grip examples/khepera.bat --diameter 25 > $R/grip-25mm.txt
 
+# What learning in the test does, and whether the architecture holds a grip
+# network that copes with 25 mm objects (docs/experiments/lives.rs):
+# khepera-practice's collect bests in the 40 + 40 lives of the f13 tests,
+# (a) with grip and release networks trained by the practice stage with
+# 25 mm objects instead of 10 mm (the same evolved links), and (b) with the
+# test learning at CRBP 0.5 / 0.25 and 0.5 / 0.5 instead of collect's
+# 0.5 / 0.1. The f13 files themselves (the lives of f13-long, f13-control
+# and f13-nolearning, which the tool reproduces) are the reference.
+cargo build --release --quiet --example lives
+for v in long control nolearning; do
+  sed 's#objects 8 diameter 10mm virtual }  // as in collect#objects 8 diameter 25mm virtual }  // as in collect#' \
+    $R/f13-$v.bat > $R/lives-$v-practice25.bat
+  grep -q 'objects 8 diameter 25mm virtual }  // as in collect' $R/lives-$v-practice25.bat
+  [ "$(grep -c 'diameter 10mm virtual' $R/lives-$v-practice25.bat)" = 1 ]
+  target/release/examples/lives $R/f13-$v.bat --run $R/khepera-practice > $R/lives-$v.txt
+  target/release/examples/lives $R/lives-$v-practice25.bat --run $R/khepera-practice > $R/lives-$v-practice25.txt
+done
+for v in long control; do
+  for r in 0.25 0.5; do
+    sed "s#^    learn crbp(0.5, 0.1) on activation always\$#    learn crbp(0.5, $r) on activation always#" \
+      $R/f13-$v.bat > $R/lives-$v-$r.bat
+    [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' $R/f13-$v.bat)" = 2 ]
+    [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' $R/lives-$v-$r.bat)" = 0 ]
+    target/release/examples/lives $R/lives-$v-$r.bat --run $R/khepera-practice > $R/lives-$v-$r.txt
+  done
+done
+
 for f in khepera khepera-explore khepera-practice pretrained forward-only scratch-full mutation; do
   echo "== $f"
   cat $R/$f/summary.md
