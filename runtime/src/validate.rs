@@ -78,6 +78,18 @@ impl At<'_> {
         self.ensure(v.is_finite(), || format!("{v} is not a finite number"))
     }
 
+    /// A value range `lo..hi`: finite bounds, `lo <= hi`, and a finite
+    /// width (genes decode to `lo + (hi - lo) * u`, random weights are drawn
+    /// from it: a width beyond `f32::MAX` gives infinities and NaN).
+    fn value_range(&self, lo: f32, hi: f32) -> R {
+        self.field("lo").finite(lo)?;
+        self.field("hi").finite(hi)?;
+        self.ensure(lo <= hi, || format!("the range {lo}..{hi} is empty"))?;
+        self.ensure((hi - lo).is_finite(), || {
+            format!("the range {lo}..{hi} is too wide: its width is not a finite 32-bit number")
+        })
+    }
+
     fn within(&self, v: f32, lo: f32, hi: f32) -> R {
         self.ensure(v >= lo && v <= hi, || format!("{v} is not between {lo} and {hi}"))
     }
@@ -383,9 +395,7 @@ fn layout(at: &At, s: &Stage) -> R {
         })?;
         at.field("bits")
             .ensure((1..=16).contains(&g.bits), || format!("{} is not between 1 and 16", g.bits))?;
-        at.field("lo").finite(g.lo)?;
-        at.field("hi").finite(g.hi)?;
-        at.ensure(g.lo <= g.hi, || format!("the range {}..{} is empty", g.lo, g.hi))?;
+        at.value_range(g.lo, g.hi)?;
         at.field("module").ensure((g.module as usize) < s.modules.len(), || {
             format!("module {} does not exist", g.module)
         })?;
@@ -486,11 +496,7 @@ fn param(at: &At, s: &Stage, p: &Param) -> R {
             at.ensure((g as usize) < s.layout.genes.len(), || format!("gene {g} does not exist"))
         }
         Param::Fixed(v) => at.finite(v),
-        Param::Random { lo, hi } => {
-            at.field("lo").finite(lo)?;
-            at.field("hi").finite(hi)?;
-            at.ensure(lo <= hi, || format!("the range {lo}..{hi} is empty"))
-        }
+        Param::Random { lo, hi } => at.value_range(lo, hi),
         // Checked against the program in `trained`.
         Param::Trained { .. } => Ok(()),
     }

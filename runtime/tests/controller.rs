@@ -557,6 +557,32 @@ fn lamarckian_inheritance_writes_learned_activation_genes_back() {
     assert_eq!(lam.learned.expect("lamarckian result carries a genome").bits.len(), 12);
 }
 
+/// A range whose width `hi - lo` is beyond `f32::MAX` (each bound finite) is
+/// refused: a random weight drawn from it panics in `rand`, a gene decoded in
+/// it is infinite or NaN. A hand-edited program.json could hold one.
+#[test]
+fn ranges_wider_than_f32_are_refused() {
+    let s = testkit::navigation();
+    let g = Genome::zeros(s.layout.bits as usize);
+    let opts = EpisodeOptions { actions: 10, learning: true, seed: 1 };
+    let mut bad = s.clone();
+    bad.modules[0].activation.params[0] = Param::Random { lo: -2e38, hi: 2e38 };
+    let e = try_run_episode(&bad, &g, &opts, None).unwrap_err().to_string();
+    assert!(
+        e.contains("`modules[0].activation.params[0]`: the range -200000000000000000000000000000000000000..200000000000000000000000000000000000000 is too wide"),
+        "{e}"
+    );
+    let mut bad = s.clone();
+    bad.layout.genes[1].lo = -3e38;
+    bad.layout.genes[1].hi = 3e38;
+    let e = try_run_episode(&bad, &g, &opts, None).unwrap_err().to_string();
+    assert!(e.contains("`layout.genes[1]`: the range") && e.contains("is too wide"), "{e}");
+    // The widest range that is still finite runs.
+    let mut wide = s.clone();
+    wide.modules[0].activation.params[0] = Param::Random { lo: -1.7e38, hi: 1.7e38 };
+    assert!(try_run_episode(&wide, &g, &opts, None).is_ok());
+}
+
 #[test]
 fn invalid_stages_are_errors_not_panics() {
     let s = testkit::navigation();

@@ -448,7 +448,29 @@ impl<'a> Lower<'a> {
             });
             return None;
         }
-        Some((r.lo as f32, r.hi as f32))
+        // Checked as the runtime will hold it: in 32-bit floats, a gene is
+        // decoded as `lo + (hi - lo) * u` and a random weight drawn from a
+        // range of width `hi - lo`, so that width must be a finite number.
+        let (lo, hi) = (r.lo as f32, r.hi as f32);
+        if !(hi - lo).is_finite() {
+            self.value_error(
+                r.span,
+                "the range is too wide: `hi - lo` must be at most about 3.4e38".into(),
+                "too wide",
+                Some("the runtime computes in 32-bit floats; narrow the range, as in `-1e38..1e38`".into()),
+            );
+            return None;
+        }
+        if lo >= hi {
+            self.errors.push(Error::BadRange {
+                span: r.span.into(),
+                range: format!("{}..{}", r.lo, r.hi),
+                why: "empty",
+                help: Some("its bounds are the same 32-bit number (the runtime computes in 32-bit floats); write bounds further apart".into()),
+            });
+            return None;
+        }
+        Some((lo, hi))
     }
 
     // ------------------------------------------------------------ program
