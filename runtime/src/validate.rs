@@ -40,6 +40,53 @@ impl std::error::Error for Invalid {}
 
 type R = Result<(), Invalid>;
 
+/// The reserved words of the language (the `keyword` rule of
+/// `grammar/shaping.pest`; a compiler test keeps the two equal): no name is
+/// one of them.
+pub const RESERVED: [&str; 30] = [
+    "robot",
+    "sensor",
+    "actuator",
+    "genome",
+    "stage",
+    "extends",
+    "module",
+    "sense",
+    "activation",
+    "behavior",
+    "learn",
+    "reinforce",
+    "links",
+    "link",
+    "world",
+    "evolve",
+    "test",
+    "fitness",
+    "and",
+    "or",
+    "not",
+    "prev",
+    "until",
+    "within",
+    "for",
+    "uses",
+    "per",
+    "adds",
+    "changes",
+    "if",
+];
+
+/// A name as the language writes one (`ident` in the grammar): ASCII
+/// letters, digits and `_`, starting with a letter or `_`, and not a
+/// reserved word. Stage names become directories and module and hardware
+/// names columns of `trace.csv`, so a program may hold no other name.
+pub fn is_name(s: &str) -> bool {
+    let mut chars = s.chars();
+    chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && !RESERVED.contains(&s)
+}
+
 /// Where a check is: the stage and the field path so far.
 #[derive(Clone)]
 struct At<'a> {
@@ -90,6 +137,18 @@ impl At<'_> {
         })
     }
 
+    /// A name of the language ([`is_name`]); the message quotes it escaped.
+    fn name(&self, s: &str) -> R {
+        self.ensure(is_name(s), || {
+            let why = if RESERVED.contains(&s) {
+                "it is a reserved word"
+            } else {
+                "a name is made of ASCII letters, digits and `_`, and starts with a letter or `_`"
+            };
+            format!("{s:?} is not a name: {why}")
+        })
+    }
+
     fn within(&self, v: f32, lo: f32, hi: f32) -> R {
         self.ensure(v >= lo && v <= hi, || format!("{v} is not between {lo} and {hi}"))
     }
@@ -128,6 +187,8 @@ pub fn program(p: &Program) -> R {
         format!("{} stages, more than the limit of {MAX_STAGES}", p.stages.len())
     })?;
     for (i, s) in p.stages.iter().enumerate() {
+        // Before anything names the stage: its name is a directory of a run.
+        stages.index(i).field("name").name(&s.name)?;
         if let Some(j) = p.stages[..i].iter().position(|t| t.name == s.name) {
             return stages.index(i).field("name").err(format!("`{}` is also the name of stage {j}", s.name));
         }
@@ -255,6 +316,10 @@ fn extension(p: &Program, i: usize) -> R {
 fn hardware(at: &At, s: &Stage) -> R {
     for (i, d) in s.sensors.iter().enumerate() {
         let at = at.field("sensors").index(i);
+        at.field("name").name(&d.name)?;
+        if let Some(j) = s.sensors[..i].iter().position(|e| e.name == d.name) {
+            return at.field("name").err(format!("`{}` is also the name of sensor {j}", d.name));
+        }
         let info = catalog::sensor_info(d.kind);
         at.field("count").ensure(d.count >= 1 && (d.count as usize) <= info.max_count, || {
             format!("{} is not between 1 and {}", d.count, info.max_count)
@@ -263,7 +328,16 @@ fn hardware(at: &At, s: &Stage) -> R {
             format!("{} is not the first channel of its kind ({})", d.channel, info.channel)
         })?;
     }
-    let _ = &s.actuators;
+    for (i, d) in s.actuators.iter().enumerate() {
+        let at = at.field("actuators").index(i);
+        at.field("name").name(&d.name)?;
+        let taken = s.sensors.iter().map(|e| &e.name).chain(s.actuators[..i].iter().map(|e| &e.name));
+        if taken.into_iter().any(|n| *n == d.name) {
+            return at
+                .field("name")
+                .err(format!("`{}` is also the name of another sensor or actuator", d.name));
+        }
+    }
     Ok(())
 }
 
@@ -323,6 +397,18 @@ fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
         at.index(0).within(p[0], -MAX_LENGTH_MM, MAX_LENGTH_MM)?;
         at.index(1).within(p[1], -MAX_LENGTH_MM, MAX_LENGTH_MM)
     };
+    let named = |what: &str, names: &mut dyn Iterator<Item = &Option<String>>| -> R {
+        for (i, n) in names.enumerate() {
+            if let Some(n) = n {
+                at.field(what).index(i).field("name").name(n)?;
+            }
+        }
+        Ok(())
+    };
+    named("walls", &mut it.walls.iter().map(|w| &w.name))?;
+    named("cylinders", &mut it.cylinders.iter().map(|c| &c.name))?;
+    named("lamps", &mut it.lamps.iter().map(|l| &l.name))?;
+    named("zones", &mut it.zones.iter().map(|z| &z.name))?;
     for (i, w) in it.walls.iter().enumerate() {
         let at = at.field("walls").index(i);
         point(&at.field("from"), w.from)?;
@@ -413,6 +499,7 @@ fn modules(at: &At, s: &Stage) -> R {
     })?;
     for (i, m) in s.modules.iter().enumerate() {
         let at = at.field("modules").index(i);
+        at.field("name").name(&m.name)?;
         if let Some(j) = s.modules[..i].iter().position(|n| n.name == m.name) {
             return at.field("name").err(format!("`{}` is also the name of module {j}", m.name));
         }
@@ -505,6 +592,7 @@ fn param(at: &At, s: &Stage, p: &Param) -> R {
 /// A script's steps: speeds in -1..1, channels in range, well-formed
 /// expressions, bounded steps.
 fn script(at: &At, sc: &Script) -> R {
+    at.field("steps").ensure(!sc.steps.is_empty(), || "a script has at least one step".into())?;
     for (i, st) in sc.steps.iter().enumerate() {
         let at = at.field("steps").index(i);
         let action = at.field("action");

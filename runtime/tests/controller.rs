@@ -583,6 +583,51 @@ fn ranges_wider_than_f32_are_refused() {
     assert!(try_run_episode(&wide, &g, &opts, None).is_ok());
 }
 
+/// Names in a program are names of the language: a stage's name is a
+/// directory of a run (`../escaped`, `/tmp/x`, `` or `.` would write outside
+/// its place), a module's or a sensor's a column of `trace.csv`.
+#[test]
+fn names_in_a_program_are_names_of_the_language() {
+    let program = |s: Stage| Program { format: FORMAT_VERSION, name: "p".into(), stages: vec![s] };
+    let refused = |s: Stage| program(s).validate().unwrap_err().to_string();
+    assert_eq!(program(testkit::navigation()).validate(), Ok(()));
+    for bad in ["../escaped", "/tmp/x", "", ".", "a b", "1st", "é", "stage"] {
+        let mut s = testkit::navigation();
+        s.name = bad.into();
+        let e = refused(s);
+        assert!(e.starts_with(&format!("`stages[0].name`: {bad:?} is not a name: ")), "{e}");
+    }
+    let mut s = testkit::navigation();
+    s.name = "stage".into();
+    assert!(refused(s).ends_with("it is a reserved word"));
+    let mut s = testkit::navigation();
+    s.name = "_ok_2".into();
+    assert_eq!(program(s).validate(), Ok(()));
+
+    let mut s = testkit::navigation();
+    s.modules[0].name = "a,b\nc".into();
+    let e = refused(s);
+    assert!(e.contains("`modules[0].name`: \"a,b\\nc\" is not a name"), "{e}");
+    let mut s = testkit::navigation();
+    s.sensors[0].name = "ir,x".into();
+    assert!(refused(s).contains("`sensors[0].name`: \"ir,x\" is not a name"));
+    let mut s = testkit::collect();
+    s.actuators[0].name = "wheels\"".into();
+    assert!(refused(s).contains("`actuators[0].name`: \"wheels\\\"\" is not a name"));
+    let mut s = testkit::collect();
+    s.actuators[1].name = s.sensors[0].name.clone();
+    assert!(refused(s).contains("`actuators[1].name`: `ir` is also the name of another sensor or actuator"));
+    let mut s = testkit::navigation();
+    s.world.items.walls.push(InnerWall { name: Some("w-1".into()), from: [10.0, 10.0], to: [20.0, 20.0] });
+    assert!(refused(s).contains("`world.items.walls[0].name`: \"w-1\" is not a name"));
+
+    // A script has at least one step, as in the language.
+    let mut s = testkit::navigation();
+    let Behavior::Script(script) = &mut s.modules[0].behavior else { panic!("a scripted module") };
+    script.steps.clear();
+    assert!(refused(s).contains("`modules[0].behavior.steps`: a script has at least one step"));
+}
+
 #[test]
 fn invalid_stages_are_errors_not_panics() {
     let s = testkit::navigation();

@@ -27,3 +27,24 @@ fn test_stages_lower_to_their_lives() {
     assert_eq!(run("lives"), Some(StageRun::Test { actions: 300, lives: 10, learning: true }));
     assert_eq!(run("of"), Some(StageRun::Test { actions: 20, lives: 1, learning: true }));
 }
+
+/// The runtime's list of reserved words (which `Program::validate` refuses
+/// as names in a `program.json`) is the grammar's `keyword` rule.
+#[test]
+fn the_runtimes_reserved_words_are_the_grammars_keywords() {
+    let grammar = std::fs::read_to_string(crate::root().join("grammar/shaping.pest")).unwrap();
+    let rule = grammar.split("\nkeyword = @{").nth(1).expect("a `keyword` rule").split("\n}").next().unwrap();
+    let mut words: Vec<&str> = rule.split('"').skip(1).step_by(2).collect();
+    let mut reserved = shaping_runtime::validate::RESERVED.to_vec();
+    words.sort_unstable();
+    reserved.sort_unstable();
+    assert_eq!(words, reserved);
+    for w in shaping_runtime::validate::RESERVED {
+        let src = format!(
+            "robot r {{ sensor ir[8] proximity  actuator wheels[2] speed }}\nstage {w} {{ fitness per action 1  module m {{ sense ir behavior forward }} }}\n"
+        );
+        assert!(shaping_compiler::compile(&src, "k.bat").is_err(), "`{w}` is a name");
+        assert!(!shaping_runtime::validate::is_name(w));
+    }
+    assert!(shaping_runtime::validate::is_name("robots"));
+}
