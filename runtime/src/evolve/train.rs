@@ -104,7 +104,44 @@ pub fn check(program: &Program, index: usize, trained: &Trained) -> Result<(), E
     } else {
         fits(stage, "activation weights", &trained.activation, |m| m.activation.params.len()).or_else(bad)?;
     }
-    fits(stage, "weights", &trained.weights, behavior).or_else(bad)
+    fits(stage, "weights", &trained.weights, behavior).or_else(bad)?;
+    performance(stage, trained).or_else(bad)
+}
+
+/// The performance indicators (one per module, each the mean of
+/// reinforcement signs, so in -1..1) and the life's result (a finite
+/// fitness, no more actions than the stage's life) are what a training life
+/// of `stage` can have made.
+fn performance(stage: &crate::program::Stage, trained: &Trained) -> Result<(), String> {
+    let p = &trained.performance;
+    if p.len() != stage.modules.len() {
+        return Err(format!(
+            "performance indicators for {} modules, the stage has {}",
+            p.len(),
+            stage.modules.len()
+        ));
+    }
+    for (m, x) in stage.modules.iter().zip(p) {
+        if !(x.is_finite() && (-1.0..=1.0).contains(x)) {
+            return Err(format!(
+                "the performance indicator of module `{}` is {x}, not a number in -1..1",
+                m.name
+            ));
+        }
+    }
+    let r = &trained.result;
+    if !r.fitness.is_finite() {
+        return Err(format!("the fitness of the training life is {}", r.fitness));
+    }
+    if let StageRun::Train { actions } = stage.run {
+        if r.actions > actions {
+            return Err(format!(
+                "the training life has {} actions, the stage's life at most {actions}",
+                r.actions
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Says how `lists` (one per module of `stage`, of the `what` of each)
@@ -259,6 +296,34 @@ mod tests {
         let t = old(&p);
         let e = bind(&mut p, 0, &t).unwrap_err().to_string();
         assert!(e.contains("no activation weights"), "{e}");
+    }
+
+    #[test]
+    fn performance_indicators_and_result_must_fit_the_stage() {
+        let p = program();
+        let t = train_stage(&p, 0, 7, None).unwrap();
+        check(&p, 0, &t).unwrap();
+        let refused = |f: &dyn Fn(&mut Trained)| {
+            let mut bad = t.clone();
+            f(&mut bad);
+            check(&p, 0, &bad).unwrap_err().to_string()
+        };
+        let e = refused(&|t| t.performance.clear());
+        assert!(e.contains("performance indicators for 0 modules, the stage has 2"), "{e}");
+        let e = refused(&|t| t.performance = vec![0.0, 5.0]);
+        assert!(e.contains("the performance indicator of module `avoid` is 5, not a number in -1..1"), "{e}");
+        let e = refused(&|t| t.performance[0] = f32::NAN);
+        assert!(e.contains("module `wander` is NaN"), "{e}");
+        let e = refused(&|t| t.result.fitness = f32::INFINITY);
+        assert!(e.contains("the fitness of the training life is inf"), "{e}");
+        let e = refused(&|t| t.result.actions = 301);
+        assert!(e.contains("the training life has 301 actions, the stage's life at most 300"), "{e}");
+        // From the file's text: a number where the list belongs is not read.
+        let json = serde_json::to_string(&t).unwrap();
+        let at = json.find("\"performance\":").unwrap() + "\"performance\":".len();
+        let end = at + json[at..].find(']').unwrap() + 1;
+        let five = format!("{}5{}", &json[..at], &json[end..]);
+        assert!(serde_json::from_str::<Trained>(&five).is_err());
     }
 
     #[test]
