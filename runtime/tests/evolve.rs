@@ -309,44 +309,45 @@ fn a_checkpoint_is_refused_when_anything_it_depends_on_changed_saying_what() {
     check_resume(&longer, &cp1).unwrap();
 
     // Everything else of the stage, and all of the stage it extends, counts.
-    assert_eq!(changed(&|p| p.stages[1].fitness.bonuses.push(bonus())), "the fitness of `second`");
+    assert_eq!(changed(&|p| p.stages[1].fitness.bonuses.push(bonus())), "the fitness of `second` changed");
     assert_eq!(
         changed(&|p| {
             p.stages[1].world.arena = [800.0, 800.0];
             p.stages[1].fitness.bonuses.push(bonus());
         }),
-        "the world and fitness of `second`"
+        "the world and fitness of `second` changed"
     );
     assert_eq!(
         changed(&|p| if let StageRun::Evolve(evo) = &mut p.stages[1].run {
             evo.population = 12;
         }),
-        "the settings of `second`"
+        "the settings of `second` changed"
     );
     assert_eq!(
         changed(&|p| p.stages[0].layout.genes[3].hi = 2.0),
-        "the genes of `first`, which `second` extends"
+        "the genes of `first`, which `second` extends, changed"
     );
     // The parent's generations decide the population the stage started from.
     assert_eq!(
         changed(&|p| if let StageRun::Evolve(evo) = &mut p.stages[0].run {
             evo.generations = 3;
         }),
-        "the generations of `first`, which `second` extends"
+        "the generations of `first`, which `second` extends, changed"
     );
     assert_eq!(
         changed(&|p| {
             p.stages[0].world.body.wheel_noise = 0.5;
             p.stages[1].world.body.wheel_noise = 0.5;
         }),
-        "the world of `second`; the world of `first`, which `second` extends"
+        "the world of `second` changed; the world of `first`, which `second` extends, changed"
     );
     // A stage inserted before it moves it (its seeds depend on its place).
     let mut moved = program.clone();
     moved.stages.insert(0, stage("zero", None, layout(1, 0), StageRun::Train { actions: 5 }));
     moved.stages[2].parent = Some(1);
     let err = evolve::resume(&moved, 2, &mut cp1.clone()).unwrap_err().to_string();
-    assert!(err.contains("the position of `second`; the position of `first`, which"), "{err}");
+    assert!(err.contains("the definition of stage `second` changed since it was saved: the position of `second` changed; the position of `first`, which `second` extends, changed"), "{err}");
+    assert!(!err.contains("another version"), "{err}");
 
     // A stage removed.
     assert!(matches!(

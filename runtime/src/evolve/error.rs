@@ -52,7 +52,11 @@ pub enum EvolveError {
     #[error("checkpoint format {found} is not supported (expected {expected})")]
     CheckpointFormat { found: u32, expected: u32 },
 
-    #[error("it was made by another version of the program: {what} changed")]
+    /// A saved result (checkpoint, trained weights) of stage `stage` does not
+    /// fit the program: the stage, or a stage it extends, is not defined as
+    /// it was when the result was saved. `what` says what changed, one
+    /// sentence per stage ([`super::fingerprint::changes`]).
+    #[error("the definition of stage `{stage}` changed since it was saved: {what}")]
     Changed { stage: String, what: String },
 
     #[error("it holds {done} generations of stage `{stage}`, which now declares {declared}")]

@@ -135,9 +135,10 @@ pub fn digest(print: &[StagePrint]) -> u64 {
     hash(&print)
 }
 
-/// What differs between a saved fingerprint and the program's, in words:
-/// empty when the saved result still belongs to the program. The result's
-/// own `generations` is not compared.
+/// What differs between a saved fingerprint and the program's, in words,
+/// one sentence per stage ("the fitness of `s` changed"): empty when the
+/// saved result still belongs to the program. The result's own
+/// `generations` is not compared.
 pub fn changes(saved: &[StagePrint], now: &[StagePrint]) -> Vec<String> {
     let mut out = Vec::new();
     let (Some(own_saved), Some(own_now)) = (saved.first(), now.first()) else {
@@ -147,7 +148,7 @@ pub fn changes(saved: &[StagePrint], now: &[StagePrint]) -> Vec<String> {
         return out;
     };
     if own_saved.stage != own_now.stage {
-        out.push(format!("it was made for stage `{}`, not `{}`", own_saved.stage, own_now.stage));
+        out.push(format!("it was saved for stage `{}`, not `{}`", own_saved.stage, own_now.stage));
         return out;
     }
     let parts = |a: &StagePrint, b: &StagePrint, skip: Option<&str>| -> Vec<&'static str> {
@@ -155,7 +156,7 @@ pub fn changes(saved: &[StagePrint], now: &[StagePrint]) -> Vec<String> {
     };
     let own = parts(own_saved, own_now, Some(OWN_FREE));
     if !own.is_empty() {
-        out.push(format!("the {} of `{}`", join(&own), own_now.stage));
+        out.push(format!("the {} of `{}` changed", join(&own), own_now.stage));
     }
     for dep in &now[1..] {
         match saved[1..].iter().find(|s| s.stage == dep.stage) {
@@ -164,7 +165,7 @@ pub fn changes(saved: &[StagePrint], now: &[StagePrint]) -> Vec<String> {
                 let diff = parts(old, dep, None);
                 if !diff.is_empty() {
                     out.push(format!(
-                        "the {} of `{}`, which `{}` extends",
+                        "the {} of `{}`, which `{}` extends, changed",
                         join(&diff),
                         dep.stage,
                         own_now.stage

@@ -15,7 +15,7 @@ use crate::sim::Sim;
 pub struct Trained {
     pub stage: String,
     /// [`fingerprint()`](super::fingerprint()) of the training stage: a
-    /// `trained.json` made by another version of the stage is not reused.
+    /// `trained.json` saved from another definition of the stage is not reused.
     pub fingerprint: Fingerprint,
     /// The run seed the life was derived from.
     pub run_seed: u64,
@@ -71,7 +71,7 @@ pub fn train_stage(
 
 /// Binds what training stage `index` learned into the stages that use it
 /// (`weights trained STAGE`, `activation trained STAGE`). Refuses a `trained` record of another stage or
-/// of another version of it, and weights that do not fit its modules.
+/// of another definition of it, and weights that do not fit its modules.
 pub fn bind(program: &mut Program, index: usize, trained: &Trained) -> Result<usize, EvolveError> {
     check(program, index, trained)?;
     Ok(bind_trained(program, index, &trained.weights, &trained.activation))
