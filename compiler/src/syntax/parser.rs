@@ -12,38 +12,10 @@ use crate::diag::Error;
 #[grammar = "../../grammar/shaping.pest"]
 pub(super) struct BatParser;
 
-/// The reserved words of the grammar's `keyword` rule.
-pub const RESERVED: [&str; 29] = [
-    "robot",
-    "sensor",
-    "actuator",
-    "genome",
-    "stage",
-    "extends",
-    "module",
-    "sense",
-    "activation",
-    "behavior",
-    "learn",
-    "reinforce",
-    "links",
-    "link",
-    "world",
-    "evolve",
-    "test",
-    "fitness",
-    "and",
-    "or",
-    "not",
-    "prev",
-    "until",
-    "within",
-    "for",
-    "uses",
-    "per",
-    "adds",
-    "changes",
-];
+/// The reserved words of the grammar's `keyword` rule: the runtime's list,
+/// which `Program::validate` refuses as names (one list, checked against
+/// the grammar by the tests).
+pub use shaping_runtime::validate::RESERVED;
 
 /// Deepest nesting of brackets (and `? :`) accepted before parsing.
 const MAX_NESTING: usize = 48;
