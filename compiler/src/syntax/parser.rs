@@ -45,6 +45,17 @@ pub fn parse_recovering(src: &str) -> (Option<File>, Vec<Error>) {
 }
 
 fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) {
+    // A byte order mark some editors put at the start of a UTF-8 file is no
+    // part of the text: read as three spaces, so every span stays the place
+    // of the same bytes of the file.
+    let unmarked;
+    let src = match src.strip_prefix('\u{feff}') {
+        Some(rest) => {
+            unmarked = format!("   {rest}");
+            unmarked.as_str()
+        }
+        None => src,
+    };
     if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
         return (None, vec![err]);
     }

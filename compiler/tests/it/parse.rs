@@ -48,3 +48,27 @@ fn the_runtimes_reserved_words_are_the_grammars_keywords() {
     }
     assert!(shaping_runtime::validate::is_name("robots"));
 }
+
+/// A UTF-8 byte order mark at the start of a file (some editors write one)
+/// is skipped: the file compiles as without it, its diagnostics point at the
+/// same text, and the formatter drops the mark.
+#[test]
+fn a_leading_byte_order_mark_is_skipped() {
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n";
+    let marked = format!("\u{feff}{src}");
+    assert_eq!(
+        shaping_compiler::compile(&marked, "b.bat").unwrap(),
+        shaping_compiler::compile(src, "b.bat").unwrap()
+    );
+    assert_eq!(shaping_compiler::fmt::format(&marked, "b.bat").unwrap(), src);
+
+    let bad = format!("\u{feff}{}", src.replace("behavior forward", "behavior forwrd"));
+    let d = shaping_compiler::compile(&bad, "b.bat").unwrap_err();
+    let text = crate::render(&d);
+    assert!(text.contains("[b.bat:4:33]") && !text.contains("found \u{feff}"), "{text}");
+    // A syntax error at the first word names that word, not the mark.
+    let syntax = format!("\u{feff}{}", src.replacen("robot", "robt", 1));
+    let d = shaping_compiler::compile(&syntax, "b.bat").unwrap_err();
+    assert_eq!(d.errors().len(), 1);
+    assert_eq!(d.errors()[0].to_string(), "expected `genome`, `robot`, `stage` or end of file, found `robt`");
+}
