@@ -116,8 +116,9 @@ fn pratt() -> PrattParser<Rule> {
 }
 
 /// Rejects the first number a 32-bit float cannot hold (the runtime computes
-/// in `f32`, so `1e39` would become infinite), and the first unknown unit
-/// glued to a number (`0.25s`).
+/// in `f32`, so `1e39` would become infinite), the first index or count too
+/// large to read (it would be reported as another number), and the first
+/// unknown unit glued to a number (`0.25s`).
 fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
     pairs.clone().flatten().find_map(|p| match p.as_rule() {
         Rule::number | Rule::unsigned => {
@@ -129,6 +130,15 @@ fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
                 help: Some(format!("numbers are at most {:e} in magnitude", f32::MAX)),
             })
         }
+        // An index or a hardware count: whole, and read as a `u64`.
+        Rule::integer if p.as_str().parse::<u64>().is_err() => Some(Error::Value {
+            span: span(&p).into(),
+            message: format!("the number `{}` is too large", p.as_str()),
+            label: "too large".into(),
+            help: Some(
+                "an index or a count of elements is a small whole number (`ir[3]`, `sensor ir[8]`)".into(),
+            ),
+        }),
         Rule::unknown_unit => Some(Error::Value {
             span: span(&p).into(),
             message: format!("unknown unit `{}`", p.as_str()),
