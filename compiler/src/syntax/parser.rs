@@ -416,10 +416,34 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
         Some(format!("`{word}` is a reserved word; choose another name"))
     } else if pos == src.len() {
         Some("the file ends too early: is a `}` or `)` missing?".to_string())
+    } else if expected == "`(`" {
+        table_entry_help(src, pos, word)
     } else {
         None
     };
     Error::Syntax { span: span.into(), expected, found, help }
+}
+
+/// A decoding table's entry that is no wheel motion (`sign(2) -> forward |
+/// arm down`) reads as the start of `NAME(l, r)`, so the parse expects `(`:
+/// say what a table holds. `pos` is where `(` was expected, `word` what is
+/// there.
+fn table_entry_help(src: &str, pos: usize, word: &str) -> Option<String> {
+    let before = src[..pos].trim_end();
+    let start = before.rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_')).map_or(0, |i| i + 1);
+    let name = &before[start..];
+    let after = before[..start].trim_end();
+    if name.is_empty() || !(after.ends_with('|') || after.ends_with("->")) {
+        return None;
+    }
+    let entry = if !word.is_empty() && word.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        format!("{name} {word}")
+    } else {
+        name.to_string()
+    };
+    Some(format!(
+        "a decoding table holds only wheel motions: `forward`, `back`, `left`, `right`, `turn left`, `turn right`, `stop` (each with an optional speed) or the two speeds of the `speed` actuator, as in `wheels(1, -0.5)`; `{entry}` is not one"
+    ))
 }
 
 /// `a`, `a or b`, `a, b or c`.
