@@ -173,6 +173,18 @@ impl At<'_> {
     fn channels(&self, cs: &[u16]) -> R {
         cs.iter().enumerate().try_for_each(|(i, &c)| self.index(i).channel(c))
     }
+
+    /// A network's inputs: channels that exist, each once (as a `sense`
+    /// clause lists them).
+    fn inputs(&self, cs: &[u16]) -> R {
+        self.channels(cs)?;
+        for (i, c) in cs.iter().enumerate() {
+            if let Some(j) = cs[..i].iter().position(|d| d == c) {
+                return self.index(i).err(format!("channel {c} is also input {j}"));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// Validates a whole program: its format, its stages and how they extend
@@ -503,7 +515,7 @@ fn modules(at: &At, s: &Stage) -> R {
         if let Some(j) = s.modules[..i].iter().position(|n| n.name == m.name) {
             return at.field("name").err(format!("`{}` is also the name of module {j}", m.name));
         }
-        at.field("inputs").channels(&m.inputs)?;
+        at.field("inputs").inputs(&m.inputs)?;
         let act = at.field("activation");
         network(&act, s, &m.activation, m.inputs.len())?;
         act.field("outputs")
@@ -511,7 +523,7 @@ fn modules(at: &At, s: &Stage) -> R {
         match &m.behavior {
             Behavior::Neural(nb) => {
                 let at = at.field("behavior");
-                at.field("inputs").channels(&nb.inputs)?;
+                at.field("inputs").inputs(&nb.inputs)?;
                 network(&at.field("net"), s, &nb.net, nb.inputs.len())?;
                 let outputs = nb.net.outputs;
                 match &nb.decode {

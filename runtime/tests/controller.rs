@@ -621,6 +621,17 @@ fn names_in_a_program_are_names_of_the_language() {
     s.world.items.walls.push(InnerWall { name: Some("w-1".into()), from: [10.0, 10.0], to: [20.0, 20.0] });
     assert!(refused(s).contains("`world.items.walls[0].name`: \"w-1\" is not a name"));
 
+    // A network's inputs are channels listed once, as `sense` lists them.
+    let mut s = testkit::navigation();
+    let first = s.modules[0].inputs[0];
+    s.modules[0].inputs.push(first);
+    let n = s.modules[0].inputs.len() - 1;
+    let e = refused(s);
+    assert!(
+        e.contains(&format!("`modules[0].inputs[{n}]`: channel ")) && e.contains("is also input 0"),
+        "{e}"
+    );
+
     // A script has at least one step, as in the language.
     let mut s = testkit::navigation();
     let Behavior::Script(script) = &mut s.modules[0].behavior else { panic!("a scripted module") };

@@ -61,7 +61,7 @@ impl Lower<'_> {
         for item in &m.items {
             match item {
                 ModuleItem::Sense(refs, span) => {
-                    let Some(channels) = self.sensor_refs(hw, refs) else { continue };
+                    let Some(channels) = self.sensed(hw, refs) else { continue };
                     if inherited {
                         if channels != st.inputs {
                             self.errors.push(Error::Frozen {
@@ -195,6 +195,45 @@ impl Lower<'_> {
                 );
             }
         }
+    }
+
+    /// Resolves the inputs of a `sense` clause, `ir, light[0..3]`, to percept
+    /// channels: each at most once (`sense ir, ir` would silently give the
+    /// network every input twice).
+    fn sensed(&mut self, hw: &Hw, refs: &[ast::SensorRef]) -> Option<Vec<u16>> {
+        let mut first: Vec<(u16, Span)> = Vec::new();
+        let mut ok = true;
+        for r in refs {
+            let Some(channels) = self.sensor_refs(hw, std::slice::from_ref(r)) else {
+                ok = false;
+                continue;
+            };
+            if let Some(&(c, at)) = channels.iter().find_map(|c| first.iter().find(|(f, _)| f == c)) {
+                let name =
+                    hw.sensors
+                        .iter()
+                        .find(|s| s.channel <= c && c < s.channel + s.count)
+                        .map(|s| {
+                            if s.count == 1 {
+                                s.name.clone()
+                            } else {
+                                format!("{}[{}]", s.name, c - s.channel)
+                            }
+                        })
+                        .unwrap_or_default();
+                self.errors.push(Error::Conflict {
+                    span: r.span.into(),
+                    other: at.into(),
+                    message: format!("`{name}` is sensed twice: a `sense` list names each input once"),
+                    label: "sensed again here".into(),
+                    other_label: "first sensed here".into(),
+                });
+                ok = false;
+                continue;
+            }
+            first.extend(channels.into_iter().map(|c| (c, r.span)));
+        }
+        ok.then(|| first.into_iter().map(|(c, _)| c).collect())
     }
 
     /// Resolves `ir, light[0..3]` to percept channels.
@@ -527,7 +566,7 @@ impl Lower<'_> {
         module: &str,
     ) -> (Option<NeuralBehavior>, Option<Option<(f32, f32)>>) {
         let inputs = match &n.sense {
-            Some((refs, _)) => match self.sensor_refs(hw, refs) {
+            Some((refs, _)) => match self.sensed(hw, refs) {
                 Some(c) => c,
                 None => return (None, None),
             },
