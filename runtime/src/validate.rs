@@ -16,6 +16,7 @@ use crate::catalog::{self, ACT_SLOTS, CHANNELS};
 use crate::expr::{Expr, Op};
 use crate::limits::*;
 use crate::program::*;
+use crate::sim::{crowded, Blocker, Crowded};
 
 /// Why a program was refused: the stage (when the problem is in one), the
 /// field (a path like `modules[1] (avoid).activation.params[3]`) and what is
@@ -388,7 +389,23 @@ fn world(at: &At, w: &World) -> R {
         at.field("count").count(o.count, 0, MAX_OBJECTS)?;
         at.field("diameter").length(o.diameter)?;
     }
-    items(at, &w.items, [width, depth], w.body.radius)
+    items(at, &w.items, [width, depth], w.body.radius)?;
+    let item = |b: Blocker| match b {
+        Blocker::Wall(i) => format!("inner wall {i}"),
+        Blocker::Cylinder(i) => format!("cylinder {i}"),
+    };
+    match crowded(w) {
+        None => Ok(()),
+        Some(Crowded::Objects { need, room }) => at.field("objects").err(format!(
+            "the objects do not fit in the arena: they need {need:.0} mm² of floor and find {room:.0} mm²"
+        )),
+        Some(Crowded::ObjectsCovered(b)) => {
+            at.field("items").err(format!("{} covers every place an object can be put", item(b)))
+        }
+        Some(Crowded::StartCovered(b)) => {
+            at.field("items").err(format!("{} covers every place the robot can start", item(b)))
+        }
+    }
 }
 
 /// The world's items: within the limits, finite, walls and cylinders inside

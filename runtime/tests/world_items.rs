@@ -173,3 +173,56 @@ fn the_lamp_distance_channel_reads_metres_to_the_nearest_lamp() {
     let mut dark = Sim::new(&world(Items::default()), 1);
     assert_eq!(percept(&mut dark)[CH_LAMP_DISTANCE], 1.0);
 }
+
+/// Worlds whose objects or robot can never be placed, whatever the seed
+/// (the simulator would keep its last try, overlapping): `crowded` says
+/// why, and the validation refuses them. A world that only may be crowded
+/// is not refused.
+#[test]
+fn worlds_that_can_never_be_placed_are_refused() {
+    use shaping_runtime::program::Objects;
+    use shaping_runtime::sim::{crowded, Crowded};
+    use shaping_runtime::testkit;
+    let objects = |count, diameter| Some(Objects { count, diameter, virtual_: false });
+    let cylinder =
+        |at, diameter| Items { cylinders: vec![Cylinder { name: None, at, diameter }], ..Items::default() };
+    assert_eq!(crowded(&world(Items::default())), None);
+
+    let huge = world(cylinder([200.0, 300.0], 100_000.0));
+    assert_eq!(crowded(&huge), Some(Crowded::StartCovered(Blocker::Cylinder(0))));
+    // A large cylinder that leaves the corners free is no certain failure.
+    assert_eq!(crowded(&world(cylinder([200.0, 300.0], 400.0))), None);
+
+    let mut many = world(Items::default());
+    many.objects = objects(100, 60.0);
+    assert!(matches!(crowded(&many), Some(Crowded::Objects { .. })), "{:?}", crowded(&many));
+    let mut small = world(Items::default());
+    small.arena = [120.0, 120.0];
+    small.objects = objects(50, 30.0);
+    assert!(matches!(crowded(&small), Some(Crowded::Objects { .. })));
+    // Crowded for random placement, perhaps, but not certainly impossible.
+    let mut dense = world(Items::default());
+    dense.objects = objects(40, 60.0);
+    assert_eq!(crowded(&dense), None);
+    // The paper's worlds: 8 objects of 10 or 25 mm.
+    for d in [10.0, 25.0] {
+        let mut paper = world(Items::default());
+        paper.objects = objects(8, d);
+        assert_eq!(crowded(&paper), None);
+    }
+
+    let mut covered = world(cylinder([200.0, 300.0], 700.0));
+    covered.objects = objects(3, 20.0);
+    assert_eq!(crowded(&covered), Some(Crowded::ObjectsCovered(Blocker::Cylinder(0))));
+
+    let check = |w: World| {
+        let mut s = testkit::navigation();
+        s.world = w;
+        shaping_runtime::validate::stage(&s).err().map(|e| e.to_string())
+    };
+    let e = check(huge).unwrap();
+    assert!(e.contains("`world.items`: cylinder 0 covers every place the robot can start"), "{e}");
+    let e = check(many).unwrap();
+    assert!(e.contains("`world.objects`: the objects do not fit in the arena"), "{e}");
+    assert_eq!(check(dense), None);
+}

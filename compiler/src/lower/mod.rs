@@ -956,6 +956,7 @@ impl<'a> Lower<'a> {
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span);
         self.check_items(&st.world, decl.span);
+        self.check_crowded(&st.world, decl.span);
         self.run(&mut st, decl, parent.is_some());
         let hw = Hw {
             stage: sname.clone(),

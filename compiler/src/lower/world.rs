@@ -4,7 +4,7 @@
 
 use shaping_runtime::limits::{MAX_ITEMS, MAX_OBJECTS};
 use shaping_runtime::program::*;
-use shaping_runtime::sim::{blocker, Blocker};
+use shaping_runtime::sim::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
 
 use super::*;
 use crate::diag::{did_you_mean, Error};
@@ -409,6 +409,75 @@ impl Lower<'_> {
             label: "the body overlaps it here".into(),
             other_label: "declared here".into(),
         });
+    }
+
+    /// A world whose objects or robot can never be placed, whatever the
+    /// seed ([`crowded`]): reported in the stage that declares one of the
+    /// parts it comes from (`decl` its span), so an inherited world's error
+    /// is reported once.
+    pub(super) fn check_crowded(&mut self, ws: &WorldSt, decl: Span) {
+        let world = &ws.world;
+        let [w, d] = world.arena;
+        if 2.0 * world.body.radius >= w.min(d) {
+            return; // `check_fit` says so
+        }
+        let Some(why) = crowded(world) else { return };
+        if matches!(why, Crowded::StartCovered(_))
+            && world.items.start.as_ref().is_some_and(|s| s.from == s.to)
+        {
+            return; // a fixed start: `check_items` names what it overlaps
+        }
+        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
+        let item = |b: Blocker| match b {
+            Blocker::Wall(i) => (
+                format!("the wall{}", item_name(&world.items.walls[i].name)),
+                ws.item_spans.get("wall").and_then(|s| s.get(i)).copied(),
+            ),
+            Blocker::Cylinder(i) => (
+                format!("the cylinder{}", item_name(&world.items.cylinders[i].name)),
+                ws.item_spans.get("cylinder").and_then(|s| s.get(i)).copied(),
+            ),
+        };
+        let spans = |keys: &[&str]| keys.iter().filter_map(|k| ws.spans.get(k).copied()).collect::<Vec<_>>();
+        let (mut at, message, label, help) = match why {
+            Crowded::Objects { need, room } => {
+                let o = world.objects.as_ref().map(|o| (o.count, o.diameter)).unwrap_or_default();
+                (
+                    spans(&["objects", "arena", "body"]),
+                    format!("{} objects {} mm wide do not fit in an arena of {w} x {d} mm", o.0, o.1),
+                    "too many or too large".to_string(),
+                    format!(
+                        "side by side they need {need:.0} mm² of floor and find {room:.0} mm² (objects keep {OBJECT_CLEARANCE} mm from the walls, and leave room for the robot): place fewer or smaller objects, or make the arena larger"
+                    ),
+                )
+            }
+            Crowded::ObjectsCovered(b) => {
+                let (what, sp) = item(b);
+                (
+                    sp.into_iter().chain(spans(&["objects", "arena"])).collect(),
+                    format!("{what} covers every place an object can be put"),
+                    "leaves no room for the objects".to_string(),
+                    format!("objects are placed at least {OBJECT_CLEARANCE} mm from the walls, off walls and cylinders"),
+                )
+            }
+            Crowded::StartCovered(b) => {
+                let (what, sp) = item(b);
+                (
+                    sp.into_iter().chain(spans(&["start", "arena", "body"])).collect(),
+                    format!("{what} covers every place the robot can start"),
+                    "leaves no room for the robot".to_string(),
+                    if world.items.start.is_some() {
+                        "the robot starts in the `start` region, off walls and cylinders".to_string()
+                    } else {
+                        format!("without `start`, the robot starts at least {START_CLEARANCE} mm from the arena's walls, off walls and cylinders")
+                    },
+                )
+            }
+        };
+        at.retain(here);
+        if let Some(sp) = at.first() {
+            self.value_error(*sp, message, &label, Some(help));
+        }
     }
 
     /// The charger must fit on its wall.
