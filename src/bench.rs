@@ -13,6 +13,7 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::sim::{Command, Sim};
 
 use crate::load::{self, CliError};
+use crate::out::outln;
 
 pub struct BenchArgs {
     pub file: PathBuf,
@@ -74,6 +75,6 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
         "modules": stage.modules.len(),
         "genome_bits": stage.layout.bits,
     });
-    println!("{line}");
+    outln!("{line}")?;
     Ok(())
 }

@@ -8,6 +8,7 @@ use shaping_runtime::evolve::{Checkpoint, GenStats};
 use shaping_runtime::program::{Program, StageRun};
 
 use crate::load::{self, write_atomic, CliError};
+use crate::out::out;
 use crate::sweep::{self, Assignment, Set};
 use crate::{plot, report, run};
 
@@ -200,7 +201,7 @@ impl Plan {
             let (md, stages) = summarise(program, &self.stages, &heading, &dir, &self.seeds, &self.criteria)?;
             write_atomic(&dir.join("summary.md"), md.as_bytes())?;
             if self.args.sets.is_empty() {
-                print!("{md}");
+                out!("{md}")?;
             }
             let settings: serde_json::Map<String, serde_json::Value> =
                 point.iter().map(|(t, v)| (t.clone(), serde_json::Value::String(v.clone()))).collect();
@@ -223,7 +224,7 @@ impl Plan {
         if !self.args.sets.is_empty() {
             let md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
             write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
-            print!("{md}");
+            out!("{md}")?;
             sweep_plot(&self.out.join("sweep"), &title, &table)?;
         }
         if !self.args.no_report {

@@ -1,12 +1,13 @@
 //! `shaping fmt`: formats files in place, or stdin to stdout.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::PathBuf;
 
 use shaping_compiler::fmt::{format, FormatError};
 
 use crate::diag::{self, ErrorFormat};
 use crate::load::{self, CliError};
+use crate::out::{out, outln};
 
 /// Formats the files (stdin to stdout when there are none). With `check`,
 /// writes nothing and names the files that would change (exit 1).
@@ -24,8 +25,7 @@ pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<
             }
             changed += 1;
             if check {
-                println!("{}", file.display());
-                Ok(())
+                outln!("{}", file.display())
             } else {
                 load::write_atomic(file, out.as_bytes())?;
                 eprintln!("formatted {}", file.display());
@@ -58,14 +58,12 @@ fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
     let out = format_one(&src, "<stdin>", error_format)?;
     if check {
         if out != src {
-            println!("<stdin>");
+            outln!("<stdin>")?;
             return Err(CliError::Diagnostics("standard input would be reformatted by `shaping fmt`".into()));
         }
         return Ok(());
     }
-    std::io::stdout()
-        .write_all(out.as_bytes())
-        .map_err(|e| CliError::io(format!("error: cannot write standard output: {e}")))
+    out!("{out}")
 }
 
 fn format_one(src: &str, name: &str, error_format: ErrorFormat) -> Result<String, CliError> {

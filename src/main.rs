@@ -9,6 +9,7 @@ mod fmt;
 mod html;
 mod load;
 mod lsp;
+mod out;
 mod plot;
 mod replay;
 mod report;
@@ -23,6 +24,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 
 use diag::ErrorFormat;
 use load::CliError;
+use out::{out, outln};
 
 /// Most worker threads `--jobs` accepts.
 const MAX_JOBS: u64 = 1024;
@@ -339,11 +341,11 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;
             match format {
-                LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index)),
+                LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index))?,
                 LayoutFormat::Json => {
                     let json = serde_json::to_string_pretty(&program.stages[index].layout)
                         .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
-                    println!("{json}");
+                    outln!("{json}")?;
                 }
             }
             Ok(())
@@ -351,8 +353,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
         Command::Graph { file, stage, error_format } => {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;
-            print_text(&shaping_compiler::render_graph(&program, index));
-            Ok(())
+            print_text(&shaping_compiler::render_graph(&program, index))
         }
         Command::Run {
             file,
@@ -559,11 +560,11 @@ fn single_values(sets: Vec<sweep::Set>) -> Result<Vec<sweep::Assignment>, CliErr
 }
 
 /// Prints text to stdout, ending it with a newline.
-fn print_text(text: &str) {
+fn print_text(text: &str) -> Result<(), CliError> {
     if text.ends_with('\n') {
-        print!("{text}");
+        out!("{text}")
     } else {
-        println!("{text}");
+        outln!("{text}")
     }
 }
 
@@ -574,7 +575,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     for file in files {
         let result = load::load_program_warnings(file, format);
         if format == ErrorFormat::Json {
-            println!("{}", check_json(file, &result));
+            outln!("{}", check_json(file, &result))?;
         }
         match result {
             Ok((program, warnings)) => {
@@ -585,7 +586,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
                     }
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();
-                    println!("{}: ok ({})", file.display(), genes.join(", "));
+                    outln!("{}: ok ({})", file.display(), genes.join(", "))?;
                 }
             }
             Err(e) => {

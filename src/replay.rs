@@ -9,6 +9,7 @@ use shaping_runtime::program::{Program, StageRun};
 use shaping_runtime::sim::Sim;
 
 use crate::load::{self, create_dir, write_atomic, CliError};
+use crate::out::outln;
 use crate::{episode, html, report, run};
 
 pub struct ReplayArgs {
@@ -190,7 +191,7 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let err = |e: serde_json::Error| CliError::io(format!("error: cannot serialise: {e}"));
     write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).map_err(err)?.as_bytes())?;
     write_atomic(&out.join("program.json"), serde_json::to_string(&program).map_err(err)?.as_bytes())?;
-    println!(
+    outln!(
         "{}: {} actions, fitness {:.3}, {} grips, {} released outside, {} recharges, {} collisions -> {}",
         stage.name,
         r.actions,
@@ -200,11 +201,11 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
         r.recharges,
         r.collisions,
         out.display()
-    );
+    )?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     if args.report {
         let path = html::write(&out, None)?;
-        println!("report: {}", path.display());
+        outln!("report: {}", path.display())?;
     }
     Ok(())
 }

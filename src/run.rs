@@ -1,7 +1,6 @@
 //! `shaping run`: evolves the stages in order, with checkpoints, statistics,
 //! a progress bar and pictures.
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -19,6 +18,7 @@ use shaping_runtime::sim::{Scene, Sim};
 use crate::cluster::Coordinator;
 use crate::episode::{self, Part, Recorder};
 use crate::load::{self, create_dir, write_atomic, CliError};
+use crate::out::outln;
 use crate::{html, report};
 
 pub struct RunArgs {
@@ -233,7 +233,7 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
             "seconds": started.elapsed().as_secs_f64(), "stages": results,
             "report": report.as_ref().map(|p| p.display().to_string()),
         });
-        println!("{line}");
+        outln!("{line}")?;
     }
     if !args.quiet && !args.json {
         eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), out.display());
@@ -356,7 +356,7 @@ fn evolve_stage(
         let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
-        report_generation(args, &bar, &stats);
+        report_generation(args, &bar, &stats)?;
         if interrupted.is_some_and(|f| f.load(Ordering::Relaxed)) && !evolve::is_finished(program, &cp) {
             bar.abandon();
             return Err(CliError::io(format!(
@@ -571,7 +571,7 @@ fn test_stage(
     });
     write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
     if args.json {
-        println!("{summary}");
+        outln!("{summary}")?;
     } else if !args.quiet {
         let how = if lives == 1 {
             String::new()
@@ -635,15 +635,13 @@ fn progress_bar(args: &RunArgs, stage: &Stage, generations: u32, done: u32) -> P
     bar
 }
 
-fn report_generation(args: &RunArgs, bar: &ProgressBar, stats: &GenStats) {
+fn report_generation(args: &RunArgs, bar: &ProgressBar, stats: &GenStats) -> Result<(), CliError> {
     bar.set_message(format!("best {:.3} mean {:.3}", stats.best, stats.mean));
     bar.inc(1);
     if args.json {
-        if let Ok(line) = serde_json::to_string(stats) {
-            let mut out = std::io::stdout().lock();
-            let _ = writeln!(out, "{line}");
-        }
+        outln!("{}", compact_json(stats)?)?;
     }
+    Ok(())
 }
 
 /// The longest part of a training life that `run` records (from its start)
@@ -697,10 +695,10 @@ fn train_step(
     write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
     write_atomic(&path, to_json(&trained)?.as_bytes())?;
     if args.json {
-        println!(
+        outln!(
             "{}",
             serde_json::json!({"stage": stage.name, "trained": trained.result.actions, "recorded": recorded, "performance": trained.performance})
-        );
+        )?;
     } else if !args.quiet {
         let perf: Vec<String> = stage
             .modules

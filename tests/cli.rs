@@ -1347,3 +1347,52 @@ fn a_test_stage_lives_several_lives_in_each_world() {
     let md = std::fs::read_to_string(dir.join("e/summary.md")).unwrap();
     assert!(md.contains("| third | test, 2 lives of 40 actions"), "{md}");
 }
+
+/// A file whose layout, graph and JSON outputs are each larger than a pipe's
+/// buffer (64 KiB), so that writing them always meets a closed reader.
+fn wide_bat(dir: &Path) -> PathBuf {
+    let modules: String = (0..250)
+        .map(|i| format!("  module m{i}_{} {{ sense ir behavior forward }}\n", "x".repeat(300)))
+        .collect();
+    let path = dir.join("wide.bat");
+    std::fs::write(
+        &path,
+        format!(
+            "robot r {{ sensor ir[8] proximity  sensor battery level  actuator wheels[2] speed }}\n\
+             stage explore {{ evolve {{ population 4 generations 2 actions 30 }} fitness per action wheels[0]\n{modules}}}\n"
+        ),
+    )
+    .unwrap();
+    path
+}
+
+/// `shaping layout f.bat | head -c 10`: the reader goes away; the command
+/// ends as it would have (exit 0 here), without a panic or a message.
+#[test]
+fn a_closed_standard_output_is_not_a_panic() {
+    let dir = scratch("pipe");
+    let wide = wide_bat(&dir);
+    let many: Vec<&Path> = vec![wide.as_path(); 1000];
+    let commands: Vec<Vec<std::ffi::OsString>> = vec![
+        vec!["layout".into(), wide.clone().into()],
+        vec!["layout".into(), "--format".into(), "json".into(), wide.clone().into()],
+        vec!["graph".into(), wide.clone().into()],
+        std::iter::once("check".into())
+            .chain(["--error-format".into(), "json".into()])
+            .chain(many.iter().map(|p| p.as_os_str().to_owned()))
+            .collect(),
+        std::iter::once("check".into()).chain(many.iter().map(|p| p.as_os_str().to_owned())).collect(),
+    ];
+    for args in commands {
+        let mut child = shaping().args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        // Read a little, as `head -c 10` does, then close the pipe.
+        let mut first = [0u8; 10];
+        std::io::Read::read_exact(child.stdout.as_mut().unwrap(), &mut first).unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let what = format!("{:?}", &args[..2]);
+        assert!(!text(&out.stderr).contains("panicked"), "{what}: {}", text(&out.stderr));
+        assert!(out.status.success(), "{what}: {:?} {}", out.status, text(&out.stderr));
+        assert!(text(&out.stderr).trim().is_empty(), "{what}: {}", text(&out.stderr));
+    }
+}

@@ -13,6 +13,7 @@ use shaping_runtime::robot::{RobotError, SerialRobot};
 use super::port::{interrupt_flag, SerialPort};
 use crate::episode::{self, Part, Recorder};
 use crate::load::{create_dir, write_atomic, CliError};
+use crate::out::outln;
 use crate::{replay, report, run};
 
 pub struct DriveArgs {
@@ -159,7 +160,7 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
         )));
     }
     let r = result.unwrap_or_default();
-    println!(
+    outln!(
         "{}: {} actions, fitness {:.3}, {} grips, {} released outside, {} recharges, {} collisions, {:.1} actions/s -> {}",
         stage.name,
         r.actions,
@@ -170,6 +171,6 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
         r.collisions,
         rate,
         out.display()
-    );
+    )?;
     Ok(())
 }
