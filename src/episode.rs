@@ -8,6 +8,8 @@
 //! senses. It draws no random number of its own, so a recorded episode is
 //! the same episode as an unrecorded one with the same seed.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use serde::{Deserialize, Serialize};
 use shaping_runtime::catalog::{
     ActuatorKind, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, SENSOR_BEARING_DEG,
@@ -53,6 +55,47 @@ impl Shown for Sim {
 impl<L: Link> Shown for SerialRobot<L> {
     fn scene(&self) -> Scene {
         self.host().scene()
+    }
+}
+
+/// A robot that stops acting, as an empty battery makes it, once `stop` is
+/// set (Ctrl-C during a long life of a test stage: the life ends at the
+/// next action). Until then it is the robot it wraps, call for call.
+pub struct Stoppable<'a, R> {
+    pub robot: R,
+    stop: Option<&'a AtomicBool>,
+}
+
+impl<'a, R> Stoppable<'a, R> {
+    pub fn new(robot: R, stop: Option<&'a AtomicBool>) -> Stoppable<'a, R> {
+        Stoppable { robot, stop }
+    }
+}
+
+impl<R: Robot> Robot for Stoppable<'_, R> {
+    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
+        self.robot.sense(out);
+    }
+    fn step(&mut self, cmd: &Command) -> Outcome {
+        self.robot.step(cmd)
+    }
+    fn alive(&self) -> bool {
+        !self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) && self.robot.alive()
+    }
+    fn battery(&self) -> f32 {
+        self.robot.battery()
+    }
+    fn pose(&self) -> Pose {
+        self.robot.pose()
+    }
+    fn holding(&self) -> Option<bool> {
+        self.robot.holding()
+    }
+}
+
+impl<R: Shown> Shown for Stoppable<'_, R> {
+    fn scene(&self) -> Scene {
+        self.robot.scene()
     }
 }
 

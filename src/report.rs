@@ -197,11 +197,33 @@ pub fn episode_files(
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
 ) -> Result<(), CliError> {
+    episode_files_until(dir, title, stage, trace, episode, scene, marks, path, &|| false)
+}
+
+/// The error [`episode_files_until`] stops with when `stop` says so.
+pub const STOPPED: &str = "stopped";
+
+/// [`episode_files`], stopping between files once `stop()` is true (with the
+/// error [`STOPPED`]): Ctrl-C during a long test stage's files.
+#[allow(clippy::too_many_arguments)]
+pub fn episode_files_until(
+    dir: &Path,
+    title: &str,
+    stage: &Stage,
+    trace: &Trace,
+    episode: &Episode,
+    scene: &Scene,
+    marks: &[(u32, String)],
+    path: Option<(Range<usize>, &str)>,
+    stop: &dyn Fn() -> bool,
+) -> Result<(), CliError> {
     let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
+    let check = || if stop() { Err(CliError::io(STOPPED)) } else { Ok(()) };
     write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());
     }
+    check()?;
     let act = plot::ActivationTrace {
         modules: trace.modules.clone(),
         activations: trace.rows.iter().map(|r| r.activations.clone()).collect(),
@@ -211,6 +233,7 @@ pub fn episode_files(
     };
     plot::activation_trace(&dir.join("activations"), &format!("{title}: module activations"), &act)
         .map_err(to_err)?;
+    check()?;
 
     // The performance indicator the controller keeps: the rolling mean of the
     // module's last `window` reinforcement signals (the paper's figures 5, 10
@@ -230,6 +253,7 @@ pub fn episode_files(
             marks,
         )
         .map_err(to_err)?;
+        check()?;
     }
 
     let (scene, what) = match path {

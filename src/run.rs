@@ -12,11 +12,11 @@ use shaping_runtime::controller::{
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Param, Program, Stage, StageRun};
+use shaping_runtime::program::{Inheritance, Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
 use crate::cluster::Coordinator;
-use crate::episode::{self, Part, Recorder};
+use crate::episode::{self, Part, Recorder, Stoppable};
 use crate::load::{self, create_dir, write_atomic, CliError};
 use crate::out::outln;
 use crate::{html, report};
@@ -219,12 +219,28 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
                 let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
                     CliError::io(format!("error: test stage `{}` extends no evolved stage", stage.name))
                 })?;
-                let summary =
-                    test_stage(&program, index, seed, parent, *actions, *lives, *learning, &dir, &args)?;
+                let summary = test_stage(
+                    &program,
+                    index,
+                    seed,
+                    parent,
+                    *actions,
+                    *lives,
+                    *learning,
+                    &dir,
+                    &args,
+                    interrupted.as_deref(),
+                )?;
                 results.push(serde_json::json!({"kind": "test", "summary": summary, "stage": stage.name}));
             }
             StageRun::Train { .. } => unreachable!("training stages run above"),
         }
+    }
+    if interrupted.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+        return Err(CliError::io(format!(
+            "interrupted: every stage is done and saved in `{0}`, but not `report.html` (`shaping report {0}` writes it)",
+            out.display()
+        )));
     }
     let report = if args.no_report { None } else { Some(html::write(&out, None)?) };
     if args.json {
@@ -451,6 +467,7 @@ pub fn before_after(
     lives: u32,
     learning: bool,
     seed: u64,
+    stop: Option<&AtomicBool>,
 ) -> Result<BeforeAfter, CliError> {
     if lives == 0 {
         return Err(CliError::io(format!("error: test stage `{}` has no life to run", stage.name)));
@@ -465,10 +482,15 @@ pub fn before_after(
     let mut results = [Vec::new(), Vec::new()];
     for (half, world) in [parent, stage].into_iter().enumerate() {
         for k in 0..lives {
-            let mut sim = Sim::new(&world.world, evolve::seed::test_life_seed(seed, half == 1, k));
+            let sim = Sim::new(&world.world, evolve::seed::test_life_seed(seed, half == 1, k));
             let scene = sim.scene();
-            let mut rec = Recorder::new(&mut sim);
+            let mut robot = Stoppable::new(sim, stop);
+            let mut rec = Recorder::new(&mut robot);
             results[half].push(ctl.run(&mut rec, &opts, Some(&mut life)));
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                // The life was cut short: nothing of this test is a result.
+                return Err(interrupted_test(stage, half == 1, k, lives));
+            }
             let frames = rec.frames;
             let from = trace.rows.len() as u32;
             trace.modules.clone_from(&life.modules);
@@ -484,6 +506,19 @@ pub fn before_after(
     let episode = episode::episode(stage, seed, learning, &trace, &parts);
     let [before, after] = results;
     Ok(BeforeAfter { trace, switch, before, after, scene, episode })
+}
+
+/// Ctrl-C during a test stage: the life under way stopped at its next
+/// action, and nothing of the test is written (its files, if any, are
+/// those of an earlier run).
+fn interrupted_test(stage: &Stage, after: bool, life: u32, lives: u32) -> CliError {
+    let world = if after { "its own world" } else { "the world before the change" };
+    CliError::io(format!(
+        "interrupted: test stage `{}` stopped in life {} of {lives} in {world}; nothing of it was written \
+         (the stages before it are saved), and the same command runs it again",
+        stage.name,
+        life + 1
+    ))
 }
 
 /// The lives of one world together: actions and events summed, the fitness
@@ -514,62 +549,67 @@ fn test_stage(
     learning: bool,
     dir: &Path,
     args: &RunArgs,
+    stop: Option<&AtomicBool>,
 ) -> Result<serde_json::Value, CliError> {
     let stage = &program.stages[index];
+    // `run_episode`, stopping at the next action on Ctrl-C.
     let eval = |genome: &Genome, episode: u64| {
-        Evaluation::of_episode(run_episode(
-            stage,
-            genome,
-            &EpisodeOptions { actions, learning, seed: episode },
-            None,
-        ))
+        let (sim_seed, rng) = episode_rngs(episode);
+        let result = Controller::new(stage, genome, rng).map(|mut ctl| {
+            let mut robot = Stoppable::new(Sim::new(&stage.world, sim_seed), stop);
+            let mut result = ctl.run(&mut robot, &EpisodeOptions { actions, learning, seed: episode }, None);
+            if stage.inheritance == Inheritance::Lamarckian {
+                result.learned = Some(ctl.write_back(genome));
+            }
+            result
+        });
+        Evaluation::of_episode(result.unwrap_or_default())
     };
     // Checks that the parent fits and picks its best individual and the episode seed.
     let outcome = evolve::test_best(program, index, seed, parent, &eval)
         .map_err(|e| CliError::io(format!("error: {e}")))?;
+    if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+        return Err(interrupted_test(stage, false, 0, lives));
+    }
     let parent_stage = &program.stages[stage.parent.unwrap_or(parent.stage)];
-    let ba = before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed)?;
-    // The change, and the other lives' starts lightly (unlabelled marks).
-    let mut marks: Vec<(u32, String)> =
-        ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
-    marks.push((ba.switch, format!("world of `{}`", stage.name)));
-    // The trajectory: the first life in the changed world, over its scene
-    // (the lives before it ran in other worlds).
-    let first = ba.switch as usize..(ba.switch + ba.after[0].actions) as usize;
-    let what = if lives == 1 {
-        "the life after the change".to_string()
-    } else {
-        format!("the first of the {lives} lives after the change")
+    let ba =
+        before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed, stop)?;
+    // Every file is written into `.writing/` first and moved into `dir`
+    // once all are: Ctrl-C (or a failure) on the way leaves the files of an
+    // earlier run of the stage, if any, as they were.
+    let staging = dir.join(".writing");
+    let _ = std::fs::remove_dir_all(&staging);
+    create_dir(&staging)?;
+    let written = test_files(&staging, stage, parent_stage, &outcome, &ba, lives, learning, stop);
+    let summary = match written {
+        Ok(summary) => summary,
+        Err(e) => {
+            let _ = std::fs::remove_dir_all(&staging);
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return Err(CliError::io(format!(
+                    "interrupted: test stage `{}` stopped while its files were written; nothing of it was written \
+                     (the stages before it are saved), and the same command runs it again",
+                    stage.name
+                )));
+            }
+            return Err(e);
+        }
     };
-    report::episode_files(
-        dir,
-        &stage.name,
-        stage,
-        &ba.trace,
-        &ba.episode,
-        &ba.scene,
-        &marks,
-        Some((first, &what)),
-    )?;
-    write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
-    write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
-    let perf = |r: &EpisodeResult| {
-        serde_json::json!({
-            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
-            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
-        })
-    };
-    let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
-    let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
-    let summary = serde_json::json!({
-        "stage": stage.name, "learning": learning, "seed": outcome.seed,
-        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
-        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
-        "before": perf(&b), "after": perf(&a),
-        "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
-        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
+    let moved = std::fs::read_dir(&staging).and_then(|entries| {
+        for entry in entries {
+            let entry = entry?;
+            std::fs::rename(entry.path(), dir.join(entry.file_name()))?;
+        }
+        std::fs::remove_dir(&staging)
     });
-    write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
+    moved.map_err(|e| {
+        CliError::io(format!(
+            "error: cannot move the files of `{}` into `{}`: {e}",
+            staging.display(),
+            dir.display()
+        ))
+    })?;
+    let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
     if args.json {
         outln!("{summary}")?;
     } else if !args.quiet {
@@ -590,6 +630,70 @@ fn test_stage(
             dir.display()
         );
     }
+    Ok(summary)
+}
+
+/// Writes a test stage's files into `dir` (`trace.csv`, the pictures,
+/// `episode.json`, `best.genome`, then `summary.json`), stopping between
+/// them once `stop` is set; returns the summary.
+#[allow(clippy::too_many_arguments)]
+fn test_files(
+    dir: &Path,
+    stage: &Stage,
+    parent_stage: &Stage,
+    outcome: &evolve::TestOutcome,
+    ba: &BeforeAfter,
+    lives: u32,
+    learning: bool,
+    stop: Option<&AtomicBool>,
+) -> Result<serde_json::Value, CliError> {
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let check = || if stopped() { Err(CliError::io(report::STOPPED)) } else { Ok(()) };
+    // The change, and the other lives' starts lightly (unlabelled marks).
+    let mut marks: Vec<(u32, String)> =
+        ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
+    marks.push((ba.switch, format!("world of `{}`", stage.name)));
+    // The trajectory: the first life in the changed world, over its scene
+    // (the lives before it ran in other worlds).
+    let first = ba.switch as usize..(ba.switch + ba.after[0].actions) as usize;
+    let what = if lives == 1 {
+        "the life after the change".to_string()
+    } else {
+        format!("the first of the {lives} lives after the change")
+    };
+    report::episode_files_until(
+        dir,
+        &stage.name,
+        stage,
+        &ba.trace,
+        &ba.episode,
+        &ba.scene,
+        &marks,
+        Some((first, &what)),
+        &stopped,
+    )?;
+    check()?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
+    check()?;
+    write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
+    let perf = |r: &EpisodeResult| {
+        serde_json::json!({
+            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
+            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
+        })
+    };
+    let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
+    let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
+    let summary = serde_json::json!({
+        "stage": stage.name, "learning": learning, "seed": outcome.seed,
+        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
+        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
+        "before": perf(&b), "after": perf(&a),
+        "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
+        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
+    });
+    check()?;
+    write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
     Ok(summary)
 }
 

@@ -1396,3 +1396,60 @@ fn a_closed_standard_output_is_not_a_panic() {
         assert!(text(&out.stderr).trim().is_empty(), "{what}: {}", text(&out.stderr));
     }
 }
+
+/// Ctrl-C during a long test stage stops it at once (within its life),
+/// says so, exits 2 as an interrupted evolution does, and writes nothing of
+/// the test: no `summary.json`, `trace.csv` or `episode.json` that could
+/// pass for its result.
+#[test]
+fn ctrl_c_stops_a_test_stage_and_writes_nothing_of_it() {
+    let dir = scratch("ctrl-c-test");
+    let file = dir.join("t.bat");
+    std::fs::write(
+        &file,
+        "robot r { sensor ir[8] proximity  sensor battery level  actuator wheels[2] speed }\n\
+         stage explore { evolve { population 4 generations 2 actions 30 } fitness per action wheels[0] \
+         module m { sense ir behavior forward } }\n\
+         stage long extends explore { test best for 1 lives of 1000000 actions with learning }\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let child = shaping()
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .arg("--no-report")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    // The evolved stage is done: the test is under way.
+    while !out.join("explore/episode.json").exists() {
+        assert!(start.elapsed() < Duration::from_secs(120), "the explore stage did not end");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let kill = run(Command::new("kill").args(["-INT", &child.id().to_string()]));
+    assert!(kill.status.success());
+    let sent = Instant::now();
+    let pid = child.id();
+    let done = std::thread::spawn(move || child.wait_with_output().unwrap());
+    while !done.is_finished() {
+        if sent.elapsed() > Duration::from_secs(10) {
+            let _ = Command::new("kill").args(["-KILL", &pid.to_string()]).status();
+            panic!("Ctrl-C did not stop the test stage within 10 s");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let done = done.join().unwrap();
+    let err = text(&done.stderr);
+    assert_eq!(done.status.code(), Some(2), "{err}");
+    assert!(err.contains("interrupted: test stage `long` stopped in life 1 of 1"), "{err}");
+    assert!(err.contains("nothing of it was written"), "{err}");
+    for name in ["summary.json", "trace.csv", "episode.json", "best.genome"] {
+        assert!(!out.join("long").join(name).exists(), "{name} was written: {err}");
+    }
+    assert!(!out.join("report.html").exists());
+}

@@ -118,7 +118,7 @@ fn bigger(lives: Option<(u32, u32)>) -> (usize, BeforeAfter) {
         panic!("bigger is a test stage")
     };
     let (actions, lives) = lives.unwrap_or((actions, declared));
-    (i, before_after(parent, stage, &genome, actions, lives, learning, 5).unwrap())
+    (i, before_after(parent, stage, &genome, actions, lives, learning, 5, None).unwrap())
 }
 
 #[test]
