@@ -10,6 +10,7 @@
 //! never stops the server.
 
 use std::collections::HashMap;
+use std::io::{BufRead as _, Read as _};
 
 use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::{self as lt, Uri};
@@ -24,10 +25,88 @@ use crate::load::CliError;
 
 /// Runs the server on stdin and stdout until the client says `exit`.
 pub fn lsp() -> Result<(), CliError> {
-    let (conn, io) = Connection::stdio();
-    serve(&conn).map_err(|e| CliError::io(format!("error: language server: {e}")))?;
+    let (conn, io) = stdio();
+    let served = serve(&conn);
     drop(conn);
-    io.join().map_err(|e| CliError::io(format!("error: language server I/O: {e}")))
+    // An input the server cannot read ends it; what was wrong with it says
+    // more than the closed channel the server then found.
+    io.join().map_err(|e| CliError::io(format!("error: language server: {e}")))?;
+    served.map_err(|e| CliError::io(format!("error: language server: {e}")))
+}
+
+/// The largest message the server reads: a document is at most a few MiB;
+/// a `Content-Length` above this is refused before anything is allocated.
+pub const MAX_MESSAGE_BYTES: usize = 64 << 20;
+
+/// The reader and writer threads of [`stdio`].
+struct Io {
+    reader: std::thread::JoinHandle<std::io::Result<()>>,
+    writer: std::thread::JoinHandle<std::io::Result<()>>,
+}
+
+impl Io {
+    fn join(self) -> std::io::Result<()> {
+        let thread = |_| std::io::Error::other("an I/O thread of the server panicked");
+        self.reader.join().map_err(thread)??;
+        self.writer.join().map_err(thread)?
+    }
+}
+
+/// `lsp_server::Connection::stdio`, reading messages with [`read_message`]
+/// (which refuses one larger than [`MAX_MESSAGE_BYTES`]).
+fn stdio() -> (Connection, Io) {
+    let (server, client) = Connection::memory();
+    let Connection { sender: to_server, receiver: from_server } = client;
+    let reader = std::thread::spawn(move || {
+        let mut stdin = std::io::stdin().lock();
+        while let Some(msg) = read_message(&mut stdin)? {
+            let exit = matches!(&msg, Message::Notification(n) if n.method == "exit");
+            if to_server.send(msg).is_err() || exit {
+                break;
+            }
+        }
+        Ok(())
+    });
+    let writer = std::thread::spawn(move || {
+        let mut stdout = std::io::stdout().lock();
+        from_server.into_iter().try_for_each(|msg| msg.write(&mut stdout))
+    });
+    (server, Io { reader, writer })
+}
+
+/// One message of the base protocol (`Content-Length: N` and other headers,
+/// an empty line, N bytes of JSON); `None` at the end of the input.
+fn read_message(input: &mut impl std::io::BufRead) -> std::io::Result<Option<Message>> {
+    let bad = |what: String| std::io::Error::new(std::io::ErrorKind::InvalidData, what);
+    let mut size = None;
+    loop {
+        let mut line = String::new();
+        // A header line is short; a longer one is not a header.
+        if (&mut *input).take(1024).read_line(&mut line)? == 0 {
+            return Ok(None);
+        }
+        let Some(line) = line.strip_suffix("\r\n") else {
+            return Err(bad(format!("malformed header {line:?} (a header line ends with CR LF)")));
+        };
+        if line.is_empty() {
+            break;
+        }
+        let (name, value) = line.split_once(": ").ok_or_else(|| bad(format!("malformed header {line:?}")))?;
+        if name.eq_ignore_ascii_case("Content-Length") {
+            let n: u64 = value.parse().map_err(|e| bad(format!("bad Content-Length {value:?}: {e}")))?;
+            if n > MAX_MESSAGE_BYTES as u64 {
+                return Err(bad(format!(
+                    "a message of {n} bytes (its Content-Length) is larger than the {} MiB the server reads",
+                    MAX_MESSAGE_BYTES >> 20
+                )));
+            }
+            size = Some(n as usize);
+        }
+    }
+    let size = size.ok_or_else(|| bad("a message without Content-Length".into()))?;
+    let mut body = vec![0; size];
+    input.read_exact(&mut body)?;
+    serde_json::from_slice(&body).map(Some).map_err(|e| bad(format!("malformed message: {e}")))
 }
 
 fn capabilities() -> lt::ServerCapabilities {

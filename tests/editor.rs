@@ -566,3 +566,35 @@ fn textmate_grammar_is_valid() {
     walk(&g, &mut n);
     assert!(n > 10);
 }
+
+/// A `Content-Length` far beyond any document is refused with an error
+/// naming it, before anything is allocated: no abort for want of memory.
+#[test]
+fn an_oversized_message_is_an_error_not_an_abort() {
+    for before in [false, true] {
+        let mut c = shaping()
+            .arg("lsp")
+            .stdin(Stdio::piped())
+            .stderr(Stdio::piped())
+            .stdout(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut stdin = c.stdin.take().unwrap();
+        if before {
+            // After a good message too.
+            let body = json!({ "jsonrpc": "2.0", "id": 1, "method": "initialize", "params": { "capabilities": {} } })
+                .to_string();
+            write!(stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).unwrap();
+        }
+        write!(stdin, "Content-Length: 99999999999\r\n\r\n{{}}").unwrap();
+        drop(stdin);
+        let out = c.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("a message of 99999999999 bytes (its Content-Length) is larger than the 64 MiB"),
+            "{err}"
+        );
+        assert!(!err.contains("memory allocation"), "{err}");
+    }
+}
