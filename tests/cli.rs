@@ -1453,3 +1453,32 @@ fn ctrl_c_stops_a_test_stage_and_writes_nothing_of_it() {
     }
     assert!(!out.join("report.html").exists());
 }
+
+/// The report says the seed a stage ran with (`--seed`, an experiment's
+/// seed), not the seed the file declares.
+#[test]
+fn the_report_shows_the_seed_the_run_used() {
+    let dir = scratch("report-seed");
+    let out = run(shaping().arg("run").arg(tiny()).arg("--out").arg(&*dir).args(["--quiet", "--seed", "99"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let data = report_data(&dir.join("report.html"));
+    for stage in data["stages"].as_array().unwrap() {
+        let how = stage["run"].as_str().unwrap();
+        assert!(how.ends_with("seed 99"), "{how}");
+    }
+    let exp = scratch("report-seed-exp");
+    let out = run(shaping()
+        .arg("experiment")
+        .arg(tiny())
+        .args(["--seeds", "2", "--first-seed", "11"])
+        .arg("--out")
+        .arg(&*exp));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let data = report_data(&exp.join("report.html"));
+    let shown = data["shown_seed"].as_u64().unwrap();
+    assert!(shown == 11 || shown == 12, "{shown}");
+    for stage in data["stages"].as_array().unwrap() {
+        let how = stage["run"].as_str().unwrap();
+        assert!(how.ends_with(&format!("seed {shown}")), "{how}");
+    }
+}

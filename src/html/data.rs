@@ -386,11 +386,20 @@ fn fitness_parts(st: &Stage) -> Vec<String> {
     parts
 }
 
-fn run_text(st: &Stage) -> String {
+/// How stage `st` runs, in words; `seed`: the seed it ran with, where known
+/// (the run's `--seed`, an experiment's seed), else the declared one is said
+/// as such.
+fn run_text(st: &Stage, seed: Option<u64>) -> String {
     match &st.run {
         StageRun::Evolve(e) => format!(
-            "evolved: {} generations of {}, {} actions per life, seed {}",
-            e.generations, e.population, e.actions, e.seed
+            "evolved: {} generations of {}, {} actions per life, {}",
+            e.generations,
+            e.population,
+            e.actions,
+            match seed {
+                Some(s) => format!("seed {s}"),
+                None => format!("declared seed {}", e.seed),
+            }
         ),
         StageRun::Train { actions } => format!(
             "trained: one life of {actions} actions with learning on; the stages that use it start from the behavior weights learned"
@@ -515,7 +524,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
     StageView {
         name: st.name.clone(),
         parent: st.parent.map(|p| program.stages[p].name.clone()),
-        run: run_text(st),
+        run: run_text(st, None),
         world: world_parts(&st.world).join("; "),
         fitness: fitness_parts(st).join(", "),
         added: added(program, index),
@@ -610,6 +619,11 @@ fn run_stages(
         let genome = read_genome(&dir.join("best.genome"), st.layout.bits);
         let src = format!("{}/best.genome", st.name);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
+        // The seed the stage ran with is its checkpoint's (`--seed`, an
+        // experiment's seed), not necessarily the one the file declares.
+        if let Some(seed) = checkpoint_seed(&dir.join("checkpoint.json"))? {
+            view.run = run_text(st, Some(seed));
+        }
         view.results = read_summary(&dir.join("summary.json"));
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
@@ -630,6 +644,21 @@ fn run_stages(
         }
     }
     Ok((views, episodes))
+}
+
+/// The run seed a stage's checkpoint records (`None` without a checkpoint).
+fn checkpoint_seed(path: &Path) -> Result<Option<u64>, CliError> {
+    #[derive(serde::Deserialize)]
+    struct Seed {
+        seed: u64,
+    }
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = read_text(path)?;
+    serde_json::from_str::<Seed>(&text)
+        .map(|s| Some(s.seed))
+        .map_err(|e| CliError::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
 }
 
 /// The nearest ancestor of evolved stage `index` that evolved (test stages
