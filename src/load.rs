@@ -312,6 +312,43 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), CliError> {
         .map_err(|e| CliError::io(format!("error: cannot write `{}`: {e}", path.display())))
 }
 
+/// Writing `output` (a new file renamed over its directory entry) would
+/// replace `input`: the same directory entry, or the file `input` names
+/// through symbolic links. (A symbolic link at `output` is replaced itself,
+/// not what it points to.)
+pub fn same_entry(input: &Path, output: &Path) -> bool {
+    let entry = |p: &Path| -> Option<PathBuf> {
+        let parent = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(std::fs::canonicalize(parent).ok()?.join(p.file_name()?))
+    };
+    let Some(out) = entry(output) else { return false };
+    entry(input).is_some_and(|e| e == out) || std::fs::canonicalize(input).is_ok_and(|real| real == out)
+}
+
+/// `build -o FILE`: FILE is new or an earlier built program (a JSON object
+/// with `format` and `stages`); anything else there would be lost: refused.
+pub fn replaceable_program(out: &Path) -> Result<(), CliError> {
+    let Ok(meta) = std::fs::metadata(out) else { return Ok(()) };
+    let built = meta.is_file()
+        && std::fs::read(out)
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+            .is_some_and(|v| {
+                v.get("format").is_some() && v.get("stages").is_some_and(serde_json::Value::is_array)
+            });
+    if built {
+        return Ok(());
+    }
+    Err(CliError::io(format!(
+        "error: `{}` exists and is not a program `shaping build` wrote; `build -o` replaces only such a file \
+         (choose a new file, e.g. one ending in `.json`)",
+        out.display()
+    )))
+}
+
 /// Creates a directory and its parents.
 pub fn create_dir(path: &Path) -> Result<(), CliError> {
     std::fs::create_dir_all(path)

@@ -85,7 +85,7 @@ enum Command {
     /// Compile to a `Program` (JSON) that `run`, `replay` and `bench` also accept.
     Build {
         file: PathBuf,
-        /// Output file.
+        /// Output file: new, or a program `build` wrote before (nothing else is replaced).
         #[arg(short, long)]
         output: PathBuf,
         #[arg(long, value_enum, default_value = "human")]
@@ -291,7 +291,8 @@ enum Command {
     Report {
         /// The directory a `run`, `experiment` or `replay` wrote.
         dir: PathBuf,
-        /// Output file (default: `DIR/report.html`).
+        /// Output file (default: `DIR/report.html`): new, or an earlier report
+        /// (nothing else is replaced).
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
@@ -515,6 +516,14 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             bench::bench(bench::BenchArgs { file, stage, runs, error_format })
         }
         Command::Build { file, output, error_format } => {
+            if load::same_entry(&file, &output) {
+                return Err(CliError::io(format!(
+                    "error: `{}` is the file being built; give `-o` another file (e.g. `{}`)",
+                    output.display(),
+                    file.with_extension("json").display()
+                )));
+            }
+            load::replaceable_program(&output)?;
             let program = load::load_program(&file, error_format)?;
             let json = serde_json::to_string_pretty(&program)
                 .map_err(|e| CliError::io(format!("error: cannot serialise the program: {e}")))?;

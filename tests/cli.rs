@@ -1482,3 +1482,47 @@ fn the_report_shows_the_seed_the_run_used() {
         assert!(how.ends_with(&format!("seed {shown}")), "{how}");
     }
 }
+
+/// `build -o` and `report -o` never replace a file they did not write: the
+/// source being built, another source, a run's program, checkpoint or genome.
+#[test]
+fn build_and_report_do_not_overwrite_what_they_did_not_write() {
+    let dir = scratch("clobber");
+    let src = dir.join("t.bat");
+    std::fs::copy(tiny(), &src).unwrap();
+    let original = std::fs::read(&src).unwrap();
+    let other = dir.join("other.bat");
+    std::fs::write(&other, "// another source\n").unwrap();
+    for out in [src.clone(), dir.join(".").join("t.bat"), other.clone()] {
+        let r = run(shaping().arg("build").arg(&src).arg("-o").arg(&out));
+        assert_eq!(r.status.code(), Some(2), "{}", text(&r.stderr));
+        assert!(text(&r.stderr).contains(&format!("`{}`", out.display())), "{}", text(&r.stderr));
+    }
+    assert_eq!(std::fs::read(&src).unwrap(), original);
+    assert_eq!(std::fs::read_to_string(&other).unwrap(), "// another source\n");
+    // A new file, then the same again: fine.
+    let built = dir.join("t.json");
+    for _ in 0..2 {
+        let r = run(shaping().arg("build").arg(&src).arg("-o").arg(&built));
+        assert!(r.status.success(), "{}", text(&r.stderr));
+    }
+
+    let runs = dir.join("run");
+    assert!(run_tiny(&runs, &[]).status.success());
+    for name in ["program.json", "first/checkpoint.json", "first/best.genome", "first/generations.csv"] {
+        let path = runs.join(name);
+        let before = std::fs::read(&path).unwrap();
+        let r = run(shaping().arg("report").arg(&runs).arg("-o").arg(&path));
+        assert_eq!(r.status.code(), Some(2), "{name}");
+        assert!(text(&r.stderr).contains("exists and is not a report"), "{}", text(&r.stderr));
+        assert_eq!(std::fs::read(&path).unwrap(), before, "{name} was changed");
+    }
+    let r = run(shaping().arg("report").arg(&runs).arg("-o").arg(runs.join("first")));
+    assert_eq!(r.status.code(), Some(2));
+    assert!(text(&r.stderr).contains("is a directory"), "{}", text(&r.stderr));
+    // An earlier report is replaced.
+    for _ in 0..2 {
+        let r = run(shaping().arg("report").arg(&runs).arg("-o").arg(runs.join("again.html")));
+        assert!(r.status.success(), "{}", text(&r.stderr));
+    }
+}

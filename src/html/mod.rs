@@ -57,9 +57,43 @@ pub fn page(data: &ReportData) -> Result<String, CliError> {
 /// Writes the report of `dir` to `out` (default `dir/report.html`) and
 /// returns the path written.
 pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, CliError> {
+    if let Some(out) = out {
+        replaceable(out)?;
+    }
     let data = collect(dir)?;
     let html = page(&data)?;
     let path = out.map_or_else(|| dir.join(FILE_NAME), Path::to_path_buf);
     write_atomic(&path, html.as_bytes())?;
     Ok(path)
+}
+
+/// `report -o FILE`: FILE is new or an earlier report. Anything else there
+/// (a run's `program.json`, a checkpoint, a genome, a source file) would be
+/// lost: refused.
+fn replaceable(out: &Path) -> Result<(), CliError> {
+    let Ok(meta) = std::fs::metadata(out) else { return Ok(()) };
+    if meta.is_dir() {
+        return Err(CliError::io(format!(
+            "error: `{}` is a directory; give `-o` the file to write (e.g. `{}`)",
+            out.display(),
+            out.join(FILE_NAME).display()
+        )));
+    }
+    let mut head = Vec::new();
+    let read = std::fs::File::open(out)
+        .and_then(|f| std::io::Read::read_to_end(&mut std::io::Read::take(f, 64 << 10), &mut head));
+    let head = String::from_utf8_lossy(&head);
+    if read.is_ok() && is_report(&head) {
+        return Ok(());
+    }
+    Err(CliError::io(format!(
+        "error: `{}` exists and is not a report; `shaping report -o` replaces only an earlier report \
+         (choose a new file, e.g. one ending in `.html`)",
+        out.display()
+    )))
+}
+
+/// The beginning of a page [`page`] made.
+fn is_report(head: &str) -> bool {
+    head.starts_with("<!doctype html>") && head.contains(" · shaping report</title>")
 }
