@@ -66,6 +66,12 @@ fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Cl
             let v: f32 = value
                 .parse()
                 .map_err(|_| CliError::io(format!("error: criterion `{c}`: `{value}` is not a number")))?;
+            // `nan`, `inf` and numbers beyond f32 parse, but no fitness reaches them.
+            if !v.is_finite() {
+                return Err(CliError::io(format!(
+                    "error: criterion `{c}`: `{value}` is not a finite number (a fitness to reach, e.g. `{stage}=0.5`)"
+                )));
+            }
             Ok((stage.to_string(), v))
         })
         .collect()

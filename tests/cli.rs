@@ -1526,3 +1526,26 @@ fn build_and_report_do_not_overwrite_what_they_did_not_write() {
         assert!(r.status.success(), "{}", text(&r.stderr));
     }
 }
+
+/// A criterion no fitness can reach (`nan`, `inf`, beyond f32) is refused
+/// before anything runs, as a word is; so are non-finite `--set` values.
+#[test]
+fn non_finite_criteria_and_settings_are_refused() {
+    let dir = scratch("nan");
+    for value in ["nan", "NaN", "inf", "-inf", "infinity", "1e40", "abc"] {
+        let out =
+            experiment_tiny(&dir.join("x"), &["--seeds", "1", "--criterion", &format!("first={value}")]);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{value}: {err}");
+        assert!(err.contains(&format!("criterion `first={value}`: `{value}` is not a")), "{value}: {err}");
+        assert!(!dir.join("x").exists(), "{value}: files written before the error");
+    }
+    for value in ["nan", "inf", "-inf", "1e40"] {
+        let out = experiment_tiny(
+            &dir.join("x"),
+            &["--seeds", "1", "--set", &format!("first.evolve.mutation={value}")],
+        );
+        assert_eq!(out.status.code(), Some(2), "{value}: {}", text(&out.stderr));
+        assert!(!dir.join("x").exists());
+    }
+}
