@@ -1549,3 +1549,35 @@ fn non_finite_criteria_and_settings_are_refused() {
         assert!(!dir.join("x").exists());
     }
 }
+
+/// `report` names a damaged file and what is wrong with it (exit 2) rather
+/// than showing a stage with its genes or results silently empty.
+#[test]
+fn report_names_a_damaged_genome_summary_or_checkpoint() {
+    let dir = scratch("report-damaged");
+    let out = run(shaping().arg("run").arg(report_bat()).arg("--out").arg(&*dir).arg("--quiet"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let cases: [(&str, &str, &str); 6] = [
+        ("navigation/best.genome", "1111\n", "is not a genome of stage `navigation`: it has 4 bits"),
+        (
+            "navigation/best.genome",
+            "10x1\n",
+            "is not a genome of stage `navigation`: it is not a string of 0 and 1",
+        ),
+        ("bigger/summary.json", "{}", "is not a test stage's summary: no `before.fitness`"),
+        ("bigger/summary.json", "[1]", "is not a test stage's summary: it is not a JSON object"),
+        ("bigger/summary.json", "{", "is not a test stage's summary"),
+        ("navigation/checkpoint.json", "{}", "is not a checkpoint"),
+    ];
+    for (file, content, wanted) in cases {
+        let path = dir.join(file);
+        let good = std::fs::read(&path).unwrap();
+        std::fs::write(&path, content).unwrap();
+        let out = run(shaping().arg("report").arg(&*dir));
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{file} = {content:?}: {err}");
+        assert!(err.contains(&format!("`{}` {wanted}", path.display())), "{file} = {content:?}: {err}");
+        std::fs::write(&path, good).unwrap();
+    }
+    assert!(run(shaping().arg("report").arg(&*dir)).status.success());
+}

@@ -213,9 +213,26 @@ fn read_episode(path: &Path) -> Result<Episode, CliError> {
     Ok(ep)
 }
 
-fn read_genome(path: &Path, bits: u32) -> Option<Genome> {
-    let text = std::fs::read_to_string(path).ok()?;
-    Genome::from_bitstring(text.trim()).filter(|g| g.bits.len() == bits as usize)
+/// The genome in `path` (`None` when there is no such file: the stage has
+/// not run); one that is not a genome of `stage` is an error naming it.
+fn read_genome(path: &Path, stage: &Stage) -> Result<Option<Genome>, CliError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let text = read_text(path)?;
+    let bad = |what: String| {
+        CliError::io(format!("error: `{}` is not a genome of stage `{}`: {what}", path.display(), stage.name))
+    };
+    let genome =
+        Genome::from_bitstring(text.trim()).ok_or_else(|| bad("it is not a string of 0 and 1".into()))?;
+    if genome.bits.len() != stage.layout.bits as usize {
+        return Err(bad(format!(
+            "it has {} bits, the stage's genome {}",
+            genome.bits.len(),
+            stage.layout.bits
+        )));
+    }
+    Ok(Some(genome))
 }
 
 fn sensor_list(stage: &Stage, channels: &[u16]) -> Vec<String> {
@@ -598,9 +615,49 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
     s
 }
 
-fn read_summary(path: &Path) -> Option<serde_json::Value> {
-    let bytes = std::fs::read(path).ok()?;
-    serde_json::from_slice(&bytes).ok()
+/// A test stage's `summary.json` (`None` when there is none); one without
+/// what the page shows (the lives, and per world the fitness and events)
+/// is an error naming the file and what is missing.
+fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, CliError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bad = |what: String| {
+        CliError::io(format!("error: `{}` is not a test stage's summary: {what}", path.display()))
+    };
+    let v: serde_json::Value = serde_json::from_str(&read_text(path)?).map_err(|e| bad(e.to_string()))?;
+    if !v.is_object() {
+        return Err(bad("it is not a JSON object".into()));
+    }
+    // Runs before `N lives of` wrote no `lives`: one life.
+    if v.get("lives").is_some_and(|n| n.as_u64().is_none_or(|n| n == 0)) {
+        return Err(bad("`lives` is not a whole number of 1 or more".into()));
+    }
+    for world in ["before", "after"] {
+        let w = &v[world];
+        // A fitness that was not a number is written as `null`.
+        if !(w["fitness"].is_number() || w.get("fitness").is_some_and(serde_json::Value::is_null)) {
+            return Err(bad(format!("no `{world}.fitness`")));
+        }
+        for count in ["actions", "grips", "releases_outside", "recharges"] {
+            if w[count].as_u64().is_none() {
+                return Err(bad(format!("no `{world}.{count}` (a whole number)")));
+            }
+        }
+    }
+    Ok(Some(v))
+}
+
+/// The checkpoint in `path` (`None` when there is none); one that does not
+/// read is an error naming it.
+fn read_checkpoint(path: &Path) -> Result<Option<Checkpoint>, CliError> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bytes = load::read_bytes(path)?;
+    serde_json::from_slice(&bytes)
+        .map(Some)
+        .map_err(|e| CliError::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
 }
 
 /// The stages of one run directory, with genomes, results and episodes.
@@ -616,24 +673,20 @@ fn run_stages(
         if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
             continue;
         }
-        let genome = read_genome(&dir.join("best.genome"), st.layout.bits);
+        let genome = read_genome(&dir.join("best.genome"), st)?;
         let src = format!("{}/best.genome", st.name);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
         // The seed the stage ran with is its checkpoint's (`--seed`, an
         // experiment's seed), not necessarily the one the file declares.
-        if let Some(seed) = checkpoint_seed(&dir.join("checkpoint.json"))? {
-            view.run = run_text(st, Some(seed));
+        if let Some(cp) = read_checkpoint(&dir.join("checkpoint.json"))? {
+            view.run = run_text(st, Some(cp.seed));
         }
-        view.results = read_summary(&dir.join("summary.json"));
+        view.results = read_summary(&dir.join("summary.json"))?;
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
             let pdir = run.join(&pst.name);
-            // A checkpoint that does not read is reported by `run`; here it only means no provenance.
-            let cp = std::fs::read(pdir.join("checkpoint.json"))
-                .ok()
-                .and_then(|b| serde_json::from_slice::<Checkpoint>(&b).ok());
-            if let Some(cp) = cp {
-                let parent_best = read_genome(&pdir.join("best.genome"), pst.layout.bits);
+            if let Some(cp) = read_checkpoint(&pdir.join("checkpoint.json"))? {
+                let parent_best = read_genome(&pdir.join("best.genome"), pst)?;
                 provenance(program, i, a, g, &cp, parent_best.as_ref(), &mut view);
             }
         }
@@ -644,21 +697,6 @@ fn run_stages(
         }
     }
     Ok((views, episodes))
-}
-
-/// The run seed a stage's checkpoint records (`None` without a checkpoint).
-fn checkpoint_seed(path: &Path) -> Result<Option<u64>, CliError> {
-    #[derive(serde::Deserialize)]
-    struct Seed {
-        seed: u64,
-    }
-    if !path.exists() {
-        return Ok(None);
-    }
-    let text = read_text(path)?;
-    serde_json::from_str::<Seed>(&text)
-        .map(|s| Some(s.seed))
-        .map_err(|e| CliError::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
 }
 
 /// The nearest ancestor of evolved stage `index` that evolved (test stages
@@ -870,7 +908,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
                 ))
             })?;
             let st = &program.stages[index];
-            let genome = read_genome(&dir.join("genome"), st.layout.bits);
+            let genome = read_genome(&dir.join("genome"), st)?;
             let mut data = base("replay", &program, dir);
             data.stages.push(stage_view(&program, index, genome.as_ref().map(|g| (g, "genome".to_string()))));
             data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
