@@ -121,6 +121,39 @@ fn interrupt_flag(exit_on_second: bool) -> Option<Arc<AtomicBool>> {
     .clone()
 }
 
+/// The saved stages a run would resume (`stages` in `out`: checkpoints and
+/// trained weights) belong to one seed. Stages of two seeds (one of them
+/// started again with `--fresh --stage S --seed N`) cannot be resumed by one
+/// run with either seed: say which stage has which, and what to do.
+fn one_seed(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Result<(), CliError> {
+    let mut saved: Vec<(&str, u64)> = Vec::new();
+    for &i in stages {
+        let st = &program.stages[i];
+        let dir = out.join(&st.name);
+        let found = match st.run {
+            StageRun::Evolve(_) => read_checkpoint(&ckpt_path(&dir))?.map(|cp| cp.seed),
+            StageRun::Train { .. } => read_trained(&dir.join("trained.json"))?.map(|t| t.run_seed),
+            StageRun::Test { .. } => None,
+        };
+        if let Some(s) = found {
+            saved.push((&st.name, s));
+        }
+    }
+    let mut seeds: Vec<u64> = saved.iter().map(|&(_, s)| s).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    if seeds.len() < 2 {
+        return Ok(());
+    }
+    let which: Vec<String> = saved.iter().map(|(name, s)| format!("`{name}` seed {s}")).collect();
+    Err(CliError::io(format!(
+        "error: `{}` holds stages of different seeds ({}); one run resumes stages of one seed: \
+         pass `--fresh` to run every stage again with seed {seed}, or choose another `--out`",
+        out.display(),
+        which.join(", ")
+    )))
+}
+
 fn ckpt_path(dir: &Path) -> PathBuf {
     dir.join("checkpoint.json")
 }
@@ -163,6 +196,9 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
         .num_threads(args.jobs.unwrap_or(0))
         .build()
         .map_err(|e| CliError::io(format!("error: cannot start worker threads: {e}")))?;
+    if !args.fresh {
+        one_seed(&program, &stages, &out, seed)?;
+    }
     create_dir(&out)?;
     let interrupted = if cluster.is_none() { interrupt_flag(args.robot.is_none()) } else { None };
     // The compiled program, for `shaping report` (and `shaping run program.json`).

@@ -1581,3 +1581,26 @@ fn report_names_a_damaged_genome_summary_or_checkpoint() {
     }
     assert!(run(shaping().arg("report").arg(&*dir)).status.success());
 }
+
+/// A directory whose stages ran with two seeds (one started again with
+/// `--fresh --stage S --seed N`) cannot be resumed with either seed: the
+/// error says which stage has which seed and what to do, not `--seed` advice
+/// that fails on another stage.
+#[test]
+fn stages_of_two_seeds_in_one_directory_are_named() {
+    let dir = scratch("two-seeds");
+    assert!(run_tiny(&dir, &["--no-report"]).status.success());
+    let out = run_tiny(&dir, &["--no-report", "--fresh", "--stage", "first", "--seed", "99"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for (extra, seed) in [(&["--seed", "99"][..], 99), (&[][..], 3)] {
+        let out = run_tiny(&dir, &[&["--no-report"][..], extra].concat());
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains("holds stages of different seeds (`first` seed 99, `second` seed 3)"), "{err}");
+        assert!(err.contains(&format!("pass `--fresh` to run every stage again with seed {seed}")), "{err}");
+        assert!(!err.contains("pass `--seed"), "{err}");
+    }
+    // The stage alone still resumes; `--fresh` starts everything again.
+    assert!(run_tiny(&dir, &["--no-report", "--stage", "first", "--seed", "99"]).status.success());
+    assert!(run_tiny(&dir, &["--no-report", "--fresh"]).status.success());
+}
