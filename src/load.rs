@@ -283,6 +283,35 @@ fn check_memory_within(
     }
 }
 
+/// Refuses, before it starts, a recorded episode of `actions` actions of
+/// `stage` (`replay`: a training stage's life may be millions of actions)
+/// that would need more memory than the machine has available.
+pub fn check_recording(stage: &shaping_runtime::program::Stage, actions: u32) -> Result<(), CliError> {
+    check_recording_within(stage, actions, available_memory())
+}
+
+fn check_recording_within(
+    stage: &shaping_runtime::program::Stage,
+    actions: u32,
+    available: Option<u64>,
+) -> Result<(), CliError> {
+    let (objects, items) = world_size(&stage.world);
+    let need = recording_bytes(actions.into(), 1, stage.modules.len() as u64, objects, items);
+    match available {
+        Some(have) if need > have => {
+            let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+            Err(CliError::io(format!(
+                "error: recording {actions} actions of stage `{}` needs about {:.1} GiB of memory, but only {:.1} GiB \
+                 are available; pass fewer `--actions`",
+                stage.name,
+                gib(need),
+                gib(have)
+            )))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Resolves `--stage NAME` to a stage index; without a name, the last stage.
 pub fn stage_index(program: &Program, stage: Option<&str>) -> Result<usize, CliError> {
     match stage {
@@ -443,6 +472,18 @@ mod tests {
                  estimate {estimate} bytes, {ratio:.2} times the measured peak"
             );
         }
+    }
+
+    #[test]
+    fn a_replay_larger_than_the_available_memory_is_refused() {
+        let p = test_program(1, 10, 3, 0, "");
+        let stage = &p.stages[0];
+        let need = recording_bytes(10_000_000, 1, 3, 0, 0);
+        assert!(check_recording_within(stage, 10_000_000, Some(need)).is_ok());
+        assert!(check_recording_within(stage, 10_000_000, None).is_ok());
+        let err = check_recording_within(stage, 10_000_000, Some(need - 1)).unwrap_err().to_string();
+        assert!(err.contains("recording 10000000 actions of stage `explore` needs about 7.7 GiB"), "{err}");
+        assert!(err.contains("pass fewer `--actions`"), "{err}");
     }
 
     #[test]

@@ -182,6 +182,7 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
         Some(run_seed) => evolve::train::training_seed(run_seed, index),
         None => run::run_seed(&program, None),
     });
+    load::check_recording(stage, actions)?;
     let (r, trace, ep) = episode::run_recorded(stage, &genome, &EpisodeOptions { actions, learning, seed })
         .map_err(|e| CliError::io(format!("error: {e}")))?;
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
