@@ -475,7 +475,6 @@ const WORDS: &[&str] = &[
     "error",
     "difference",
     "squared",
-    "if",
     "script",
     "commit",
     "neural",

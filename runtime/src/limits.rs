@@ -49,8 +49,3 @@ pub const CHECKPOINT_BYTES_PER_BIT: u64 = 12;
 pub fn population_bytes(population: u64, bits: u64) -> u64 {
     population.saturating_mul(bits).saturating_mul(2 + CHECKPOINT_BYTES_PER_BIT)
 }
-
-/// Bytes a trace of `actions` actions with `modules` modules needs.
-pub fn trace_bytes(actions: u64, modules: u64) -> u64 {
-    actions.saturating_mul(96 + 4 * modules)
-}
