@@ -91,6 +91,9 @@ impl<R: Robot> Robot for Stoppable<'_, R> {
     fn holding(&self) -> Option<bool> {
         self.robot.holding()
     }
+    fn placement_failures(&self) -> u32 {
+        self.robot.placement_failures()
+    }
 }
 
 impl<R: Shown> Shown for Stoppable<'_, R> {
@@ -163,6 +166,9 @@ impl<R: Shown> Robot for Recorder<'_, R> {
     }
     fn holding(&self) -> Option<bool> {
         self.robot.holding()
+    }
+    fn placement_failures(&self) -> u32 {
+        self.robot.placement_failures()
     }
 }
 

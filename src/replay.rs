@@ -186,6 +186,11 @@ pub fn replay(args: ReplayArgs) -> Result<(), CliError> {
     let (r, trace, ep) = episode::run_recorded(stage, &genome, &EpisodeOptions { actions, learning, seed })
         .map_err(|e| CliError::io(format!("error: {e}")))?;
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
+    let mut crowding = run::Crowding::default();
+    crowding.add(r.placement_failures);
+    if let Some(w) = crowding.warning(&stage.name, &out, ("episode", "episodes")) {
+        eprintln!("{w}");
+    }
     create_dir(&out)?;
     let scene = Sim::new(&stage.world, seed).scene();
     report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;

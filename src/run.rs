@@ -90,6 +90,52 @@ pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evalua
     }
 }
 
+/// Episodes whose world could not be placed apart: some placement (an
+/// object, the robot's start, a virtual object coming back) ran out of
+/// tries and kept an overlapping one, so the episode is not the declared
+/// world and its fitness is not that world's. Worlds that can never be
+/// placed are refused before a run (`sim::crowded`); one that is only
+/// crowded runs, and this says how often it did not fit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Crowding {
+    /// Episodes (or lives) counted.
+    pub episodes: u64,
+    /// Those with a placement that overlaps.
+    pub crowded: u64,
+    /// Placements that overlap, over all of them.
+    pub placements: u64,
+}
+
+impl Crowding {
+    /// Counts one episode with `placement_failures` overlapping placements.
+    pub fn add(&mut self, placement_failures: u32) {
+        self.episodes += 1;
+        self.crowded += u64::from(placement_failures > 0);
+        self.placements += u64::from(placement_failures);
+    }
+
+    /// The warning for stage `stage`, whose files are in `dir`, if any of
+    /// its episodes was crowded; `what` names them, one and several
+    /// (`("episode", "episodes")`).
+    pub fn warning(&self, stage: &str, dir: &Path, what: (&str, &str)) -> Option<String> {
+        (self.crowded > 0).then(|| {
+            let (n, m, p) = (self.crowded, self.episodes, self.placements);
+            let (which, those) = if m == 1 {
+                (format!("in its {}", what.0), format!("its {}", what.0))
+            } else {
+                (format!("in {n} of {m} {}", what.1), format!("those {}", what.1))
+            };
+            let places = if p == 1 { "1 placement".to_string() } else { format!("{p} placements") };
+            format!(
+                "warning: the world of stage `{stage}` is too crowded: {which} objects (or the robot) could not be \
+                 placed apart and overlap ({places} kept an overlapping last try), so the fitness of {those} is not \
+                 of the world as declared; fewer or smaller objects, or a larger arena, give them room (results in `{}`)",
+                dir.display()
+            )
+        })
+    }
+}
+
 /// The error for a saved result (checkpoint or trained weights) that does
 /// not belong to the program as it is now.
 fn stale(path: &Path, e: &evolve::EvolveError) -> CliError {
@@ -394,10 +440,22 @@ fn evolve_stage(
     let fail = |e| {
         args.robot.as_ref().and_then(|r| r.failure()).unwrap_or_else(|| CliError::io(format!("error: {e}")))
     };
-    let many = |jobs: &[(&Genome, u64)]| match cluster {
-        Some(c) => c.evaluate(program, index, evo.actions, jobs),
-        None => evolve::evaluate_many(eval, jobs),
+    // The episodes this process runs for the stage, for the warning about
+    // a crowded world (the generations' are in their statistics too).
+    let run_now = std::cell::Cell::new(Crowding::default());
+    let many = |jobs: &[(&Genome, u64)]| {
+        let evaluations = match cluster {
+            Some(c) => c.evaluate(program, index, evo.actions, jobs),
+            None => evolve::evaluate_many(eval, jobs),
+        };
+        let mut tally = run_now.get();
+        for ev in &evaluations {
+            tally.add(ev.placement_failures);
+        }
+        run_now.set(tally);
+        evaluations
     };
+    let mut warned = false;
     let context = |what: String| {
         if let Some(c) = cluster {
             c.set_context(what, &path);
@@ -409,6 +467,18 @@ fn evolve_stage(
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
         write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
         report_generation(args, &bar, &stats)?;
+        if stats.crowded_episodes > 0 && !warned {
+            // Said at once (a long run may be stopped), and again with the
+            // totals at the end of the stage.
+            warned = true;
+            bar.suspend(|| {
+                eprintln!(
+                    "warning: the world of stage `{}` is too crowded: in generation {}, {} episodes placed objects \
+                     (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
+                    stage.name, stats.stage_generation, stats.crowded_episodes
+                )
+            });
+        }
         if interrupted.is_some_and(|f| f.load(Ordering::Relaxed)) && !evolve::is_finished(program, &cp) {
             bar.abandon();
             return Err(CliError::io(format!(
@@ -421,6 +491,7 @@ fn evolve_stage(
         }
     }
     bar.finish_and_clear();
+    let generations_now = run_now.get();
     if !cp.validated {
         // Pick the stage's best by its mean over fresh episodes, not by its
         // luckiest single evaluation.
@@ -434,6 +505,17 @@ fn evolve_stage(
         )
         .map_err(fail)?;
         write_atomic(&path, to_json(&cp)?.as_bytes())?;
+    }
+    let now = run_now.get();
+    let choice = Crowding {
+        episodes: now.episodes - generations_now.episodes,
+        crowded: now.crowded - generations_now.crowded,
+        placements: now.placements - generations_now.placements,
+    };
+    if let Some(w) =
+        stage_crowding(&cp, &stage.name, evo, choice).warning(&stage.name, dir, ("episode", "episodes"))
+    {
+        eprintln!("{w}");
     }
     let (genome, fitness) = evolve::best_of(&cp)
         .ok_or_else(|| CliError::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
@@ -454,6 +536,25 @@ fn evolve_stage(
         );
     }
     Ok(cp)
+}
+
+/// The crowded episodes of evolved stage `name`: its generations in the
+/// checkpoint's history (those of an earlier, resumed run too) and the
+/// choice of its best (`choice`, when this process made it).
+fn stage_crowding(
+    cp: &Checkpoint,
+    name: &str,
+    evo: &shaping_runtime::program::Evolution,
+    choice: Crowding,
+) -> Crowding {
+    let per_generation = u64::from(evo.population) * u64::from(evo.evaluations.max(1));
+    let mut c = choice;
+    for h in cp.history.iter().filter(|h| h.stage == name) {
+        c.episodes += per_generation;
+        c.crowded += u64::from(h.crowded_episodes);
+        c.placements += u64::from(h.placement_failures);
+    }
+    c
 }
 
 /// The lives of a test stage's individual: `lives` lives of at most
@@ -557,6 +658,15 @@ fn interrupted_test(stage: &Stage, after: bool, life: u32, lives: u32) -> CliErr
     ))
 }
 
+/// The crowded lives of a test, in both worlds.
+fn lives_crowding(ba: &BeforeAfter) -> Crowding {
+    let mut c = Crowding::default();
+    for r in ba.before.iter().chain(&ba.after) {
+        c.add(r.placement_failures);
+    }
+    c
+}
+
 /// The lives of one world together: actions and events summed, the fitness
 /// the mean per life (comparable with a life's fitness in evolution).
 fn lives_total(lives: &[EpisodeResult]) -> EpisodeResult {
@@ -568,6 +678,7 @@ fn lives_total(lives: &[EpisodeResult]) -> EpisodeResult {
         t.releases_outside += r.releases_outside;
         t.recharges += r.recharges;
         t.collisions += r.collisions;
+        t.placement_failures = t.placement_failures.saturating_add(r.placement_failures);
         fitness += f64::from(r.fitness);
     }
     t.fitness = (fitness / lives.len().max(1) as f64) as f32;
@@ -646,6 +757,9 @@ fn test_stage(
         ))
     })?;
     let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
+    if let Some(w) = lives_crowding(&ba).warning(&stage.name, dir, ("life", "lives")) {
+        eprintln!("{w}");
+    }
     if args.json {
         outln!("{summary}")?;
     } else if !args.quiet {
@@ -720,7 +834,7 @@ fn test_files(
     };
     let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
     let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
-    let summary = serde_json::json!({
+    let mut summary = serde_json::json!({
         "stage": stage.name, "learning": learning, "seed": outcome.seed,
         "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
         "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
@@ -728,6 +842,13 @@ fn test_files(
         "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
         "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
     });
+    // Only when a world was too crowded to place apart: the lives that
+    // overlap and their overlapping placements (absent: none).
+    let crowding = lives_crowding(ba);
+    if crowding.crowded > 0 {
+        summary["crowded_lives"] = serde_json::json!(crowding.crowded);
+        summary["placement_failures"] = serde_json::json!(crowding.placements);
+    }
     check()?;
     write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
     Ok(summary)
@@ -815,11 +936,13 @@ fn train_step(
             if !args.quiet && !args.json {
                 eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
             }
+            warn_training(stage, &t, dir);
             return Ok(t);
         }
     }
     let trained =
         evolve::train_stage(program, index, seed, None).map_err(|e| CliError::io(format!("error: {e}")))?;
+    warn_training(stage, &trained, dir);
     // The same life recorded again (the same episode seed and genome), for
     // `trace.csv`, the pictures and `episode.json`: its first
     // `RECORDED_TRAINING_ACTIONS` actions (`trace.csv` and `episode.json` grow by about 500 bytes
@@ -861,6 +984,16 @@ fn train_step(
         );
     }
     Ok(trained)
+}
+
+/// Warns when the training life of `stage` had a world too crowded to place
+/// apart (its weights were learned there).
+fn warn_training(stage: &Stage, trained: &evolve::Trained, dir: &Path) {
+    let mut life = Crowding::default();
+    life.add(trained.result.placement_failures);
+    if let Some(w) = life.warning(&stage.name, dir, ("training life", "training lives")) {
+        eprintln!("{w}");
+    }
 }
 
 /// A `trained.json`, if there is one (a corrupt one is an error).

@@ -1604,3 +1604,57 @@ fn stages_of_two_seeds_in_one_directory_are_named() {
     assert!(run_tiny(&dir, &["--no-report", "--stage", "first", "--seed", "99"]).status.success());
     assert!(run_tiny(&dir, &["--no-report", "--fresh"]).status.success());
 }
+
+/// A world crowded for the random placement (not certainly impossible, so
+/// it runs) is no silent source of wrong numbers: `run` warns on stderr,
+/// even with `--quiet`, naming the stage and how many episodes overlapped
+/// (at the first crowded generation and with the totals at the end), a
+/// test stage names its crowded lives and records them in `summary.json`,
+/// the checkpoint's statistics count them, and `replay` warns too. A world
+/// with room enough says nothing and writes none of it.
+#[test]
+fn a_crowded_world_is_warned_about_and_counted() {
+    let dir = scratch("crowded");
+    let file = root().join("tests/cli/crowded.bat");
+    let out = dir.join("out");
+    let ran = run_file(&file, &out, &["--quiet"]);
+    assert!(ran.status.success(), "{}", text(&ran.stderr));
+    let err = text(&ran.stderr);
+    assert!(err.contains("warning: the world of stage `crowded` is too crowded: in generation 0,"), "{err}");
+    let total = regex_lite_count(&err, "warning: the world of stage `crowded` is too crowded: in ", " of ");
+    assert!(total.is_some_and(|(n, m)| n > 0 && n <= m && m >= 12), "{err}");
+    assert!(err.contains("could not be placed apart and overlap"), "{err}");
+    assert!(err.contains("warning: the world of stage `tested` is too crowded: in "), "{err}");
+    assert!(err.contains(" of 4 lives "), "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("tested/summary.json")).unwrap()).unwrap();
+    assert!(summary["crowded_lives"].as_u64().is_some_and(|n| (1..=4).contains(&n)), "{summary}");
+    assert!(summary["placement_failures"].as_u64().is_some_and(|n| n >= 1), "{summary}");
+    let checkpoint = std::fs::read_to_string(out.join("crowded/checkpoint.json")).unwrap();
+    assert!(checkpoint.contains("\"crowded_episodes\""), "{checkpoint}");
+
+    let replayed = replay_run(&file, &out, &dir.join("replay"), &["--stage", "crowded"]);
+    assert!(replayed.status.success(), "{}", text(&replayed.stderr));
+    let err = text(&replayed.stderr);
+    assert!(err.contains("warning: the world of stage `crowded` is too crowded: in its episode"), "{err}");
+
+    // The same file with room enough: no warning, no count in any file.
+    let roomy = dir.join("roomy.bat");
+    let src = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&roomy, src.replace("objects 30 diameter 60mm", "objects 8 diameter 25mm")).unwrap();
+    let ran = run_file(&roomy, &dir.join("roomy"), &["--quiet"]);
+    assert!(ran.status.success(), "{}", text(&ran.stderr));
+    assert!(text(&ran.stderr).trim().is_empty(), "{}", text(&ran.stderr));
+    let checkpoint = std::fs::read_to_string(dir.join("roomy/crowded/checkpoint.json")).unwrap();
+    assert!(!checkpoint.contains("crowded_episodes"), "{checkpoint}");
+    let summary = std::fs::read_to_string(dir.join("roomy/tested/summary.json")).unwrap();
+    assert!(!summary.contains("crowded_lives"), "{summary}");
+}
+
+/// The two numbers of `{prefix}N{between}M` in `text`.
+fn regex_lite_count(text: &str, prefix: &str, between: &str) -> Option<(u64, u64)> {
+    let rest = &text[text.rfind(prefix)? + prefix.len()..];
+    let (n, rest) = rest.split_once(between)?;
+    let m: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    Some((n.parse().ok()?, m.parse().ok()?))
+}

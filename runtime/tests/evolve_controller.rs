@@ -100,3 +100,56 @@ fn collect_stage_starts_from_navigation_and_keeps_its_genes() {
     assert_eq!(cp1.history[2].stage, "collect");
     assert_eq!(cp1.history[2].generation, 2);
 }
+
+/// An episode in a world too crowded to place apart says so in its result,
+/// and a generation counts its crowded episodes; a world with room enough
+/// counts none, and saved results without the counts are as before.
+#[test]
+fn crowded_episodes_are_counted_from_the_episode_to_the_generation() {
+    use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult};
+    use shaping_runtime::genome::Genome;
+    use shaping_runtime::program::Objects;
+    let mut stage = testkit::navigation();
+    if let StageRun::Evolve(evo) = &mut stage.run {
+        evo.population = 30;
+        evo.generations = 1;
+        evo.selection = shaping_runtime::program::Selection::Truncation { keep: 4 };
+        evo.actions = 5;
+    }
+    stage.world.objects = Some(Objects { count: 25, diameter: 60.0, virtual_: false });
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let episode = |stage: &shaping_runtime::program::Stage, seed| {
+        run_episode(stage, &genome, &EpisodeOptions { actions: 5, learning: false, seed }, None)
+    };
+    // The simulator's seed is the episode seed: 13 fails (runtime/tests/sim.rs).
+    assert!(episode(&stage, 13).placement_failures > 0);
+    assert_eq!(episode(&stage, 0).placement_failures, 0);
+
+    let run = |stage: shaping_runtime::program::Stage, seed| {
+        let program = Program { format: FORMAT_VERSION, name: "crowded".into(), stages: vec![stage] };
+        let eval = evaluate_with_controller(&program.stages[0], EvalOptions::of(&program.stages[0])).unwrap();
+        let mut cp = start_stage(&program, 0, seed, None).unwrap();
+        let stats = step_generation(&program, &mut cp, &eval).unwrap();
+        (stats, cp)
+    };
+    let mut crowded = stage.clone();
+    crowded.world.objects = Some(Objects { count: 30, diameter: 60.0, virtual_: false });
+    let (stats, cp) = run(crowded, 5);
+    assert!(stats.crowded_episodes > 0 && stats.crowded_episodes < 30, "{stats:?}");
+    assert!(stats.placement_failures >= stats.crowded_episodes, "{stats:?}");
+    let json = serde_json::to_string(&cp).unwrap();
+    assert!(json.contains("\"crowded_episodes\""), "{json}");
+
+    let mut roomy = stage;
+    roomy.world.objects = Some(Objects { count: 8, diameter: 25.0, virtual_: false });
+    let (stats, cp) = run(roomy, 5);
+    assert_eq!((stats.crowded_episodes, stats.placement_failures), (0, 0));
+    let json = serde_json::to_string(&cp).unwrap();
+    assert!(!json.contains("crowded") && !json.contains("placement"), "{json}");
+    let old: EpisodeResult = serde_json::from_str(
+        r#"{"fitness":1.5,"actions":3,"grips":0,"releases_outside":0,"recharges":0,"collisions":1,"learned":null}"#,
+    )
+    .unwrap();
+    assert_eq!(old.placement_failures, 0);
+    assert!(!serde_json::to_string(&old).unwrap().contains("placement"));
+}

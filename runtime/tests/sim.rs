@@ -631,3 +631,99 @@ fn regripping_a_dropped_object_is_not_a_new_grip() {
     assert!(sim.holding(), "the dropped object is in the catch zone and is gripped again");
     assert_eq!(again.grips, 0, "the same object gripped twice counts once");
 }
+
+/// Seeds of `w` (of `0..n`) whose placement at the start of an episode
+/// fell back on an overlapping try, and the placements that did.
+fn failed_placements(w: &World, n: u64) -> (Vec<u64>, u32) {
+    let (mut seeds, mut total) = (Vec::new(), 0);
+    for seed in 0..n {
+        let failures = Sim::new(w, seed).placement_failures();
+        if failures > 0 {
+            seeds.push(seed);
+        }
+        total += failures;
+    }
+    (seeds, total)
+}
+
+/// A world crowded for the random placement but not certainly impossible
+/// (`sim::crowded` does not refuse it) says, episode by episode, when its
+/// objects could not be placed apart: 25 objects of 60 mm in the paper's
+/// arena fail now and then (seed 13), 40 always. The counts are what the
+/// seed draws, like everything else.
+#[test]
+fn a_crowded_world_counts_the_placements_that_overlap() {
+    use shaping_runtime::sim::crowded;
+    for virtual_ in [false, true] {
+        let some = with_objects(25, 60.0, virtual_);
+        assert_eq!(crowded(&some), None);
+        let (seeds, total) = failed_placements(&some, 200);
+        assert!(seeds.contains(&13), "{seeds:?}");
+        assert!(!seeds.is_empty() && seeds.len() < 20, "{seeds:?}");
+        assert!(total as usize >= seeds.len());
+        // Seed 13 overlaps: some object's disc meets another's.
+        let scene = Sim::new(&some, 13).scene();
+        let overlap = scene.objects.iter().enumerate().any(|(i, a)| {
+            scene.objects[i + 1..].iter().any(|b| (a.x - b.x).hypot(a.y - b.y) < a.radius + b.radius)
+                || a.x < 30.0 + a.radius
+                || a.x > 400.0 - 30.0 - a.radius
+                || a.y < 30.0 + a.radius
+                || a.y > 600.0 - 30.0 - a.radius
+                || (a.x - scene.pose.x).hypot(a.y - scene.pose.y) < a.radius + scene.body_radius
+        });
+        assert!(overlap, "seed 13 reports a failed placement but nothing overlaps");
+        assert_eq!(Sim::new(&some, 13).placement_failures(), Sim::new(&some, 13).placement_failures());
+
+        let full = with_objects(40, 60.0, virtual_);
+        assert_eq!(crowded(&full), None);
+        let (seeds, _) = failed_placements(&full, 20);
+        assert_eq!(seeds.len(), 20);
+    }
+}
+
+/// The paper's worlds (8 objects of 10 or 25 mm in 400 x 600 mm, physical
+/// or virtual) always place everything apart: the objects and the start,
+/// and a virtual object thrown out comes back apart from the others and
+/// from the robot.
+#[test]
+fn the_papers_worlds_place_everything_apart() {
+    for diameter in [10.0, 25.0] {
+        for virtual_ in [false, true] {
+            let w = with_objects(8, diameter, virtual_);
+            assert_eq!(failed_placements(&w, 2000), (vec![], 0), "{diameter} mm, virtual {virtual_}");
+        }
+        let w = with_objects(8, diameter, true);
+        for seed in 0..300u64 {
+            let mut sim = Sim::new(&w, seed);
+            // At the west wall (19.5 mm), facing it, an object in the catch
+            // zone (7 mm ahead).
+            let y = 60.0 + (seed % 48) as f32 * 10.0;
+            assert!(sim.set_pose(Pose { x: 47.0, y, theta: std::f32::consts::PI }));
+            assert!(sim.set_object(0, 12.5, y));
+            sim.step(&Command { arm: Some(true), ..Command::default() });
+            sim.step(&Command { claw: Some(true), ..Command::default() });
+            assert!(sim.holding(), "seed {seed}");
+            let out = sim.step(&Command { claw: Some(false), ..Command::default() });
+            assert_eq!(out.releases_outside, 1, "seed {seed}");
+            assert_eq!(sim.placement_failures(), 0, "seed {seed}, {diameter} mm");
+        }
+    }
+}
+
+/// A virtual object thrown out that finds no place apart from the robot
+/// counts too: in a 110 mm arena every place of an object is within reach
+/// of a body at the west wall (and of one at the start, in the middle).
+#[test]
+fn a_virtual_object_coming_back_onto_the_robot_counts() {
+    let w = World { arena: [110.0, 110.0], charger: None, battery: None, ..with_objects(1, 10.0, true) };
+    assert_eq!(shaping_runtime::sim::crowded(&w), None);
+    let mut sim = Sim::new(&w, 3);
+    assert_eq!(sim.placement_failures(), 1, "the start overlaps the object");
+    assert!(sim.set_pose(Pose { x: 47.5, y: 55.0, theta: std::f32::consts::PI }));
+    assert!(sim.set_object(0, 47.5 - 27.5 - 12.0, 55.0));
+    sim.step(&Command { arm: Some(true), ..Command::default() });
+    assert_eq!(sim.step(&Command { claw: Some(true), ..Command::default() }).grips, 1);
+    let out = sim.step(&Command { claw: Some(false), ..Command::default() });
+    assert_eq!(out.releases_outside, 1);
+    assert_eq!(sim.placement_failures(), 2);
+}

@@ -115,6 +115,7 @@ impl Request {
                     w.u32(ev.events.grips);
                     w.u32(ev.events.releases_outside);
                     w.u32(ev.events.recharges);
+                    w.u32(ev.placement_failures);
                     match &ev.learned {
                         Some(g) => {
                             w.u8(1);
@@ -149,12 +150,13 @@ impl Request {
                 for _ in 0..n {
                     let fitness = f32::from_bits(r.u32()?);
                     let events = Events { grips: r.u32()?, releases_outside: r.u32()?, recharges: r.u32()? };
+                    let placement_failures = r.u32()?;
                     let learned = match r.u8()? {
                         0 => None,
                         1 => Some(Genome { bits: r.bytes()?.to_vec() }),
                         k => return Err(format!("unknown learned-genome flag {k}")),
                     };
-                    evaluations.push(Evaluation { fitness, learned, events });
+                    evaluations.push(Evaluation { fitness, learned, events, placement_failures });
                 }
                 Request::Results { batch, evaluations }
             }
@@ -276,11 +278,17 @@ mod tests {
             Request::Results {
                 batch: u64::MAX - 3,
                 evaluations: vec![
-                    Evaluation { fitness: -0.0, learned: None, events: Events::default() },
+                    Evaluation {
+                        fitness: -0.0,
+                        learned: None,
+                        events: Events::default(),
+                        placement_failures: 0,
+                    },
                     Evaluation {
                         fitness: odd,
                         learned: Some(Genome { bits: vec![1, 0, 1, 1] }),
                         events: Events { grips: 3, releases_outside: 2, recharges: 1 },
+                        placement_failures: 5,
                     },
                 ],
             },

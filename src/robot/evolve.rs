@@ -40,6 +40,14 @@ struct Episode {
     /// logs written before it was recorded: those are not reused).
     #[serde(default)]
     program: Option<u64>,
+    /// Placements of the virtual objects that kept an overlapping try (a
+    /// too crowded world); left out while 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    placement_failures: u32,
+}
+
+fn is_zero(n: &u32) -> bool {
+    *n == 0
 }
 
 struct State {
@@ -137,7 +145,15 @@ impl RobotRun {
                             )));
                         }
                         let learned = e.learned.as_deref().and_then(Genome::from_bitstring);
-                        st.done.insert(e.seed, Evaluation { fitness: e.fitness, learned, events: e.events });
+                        st.done.insert(
+                            e.seed,
+                            Evaluation {
+                                fitness: e.fitness,
+                                learned,
+                                events: e.events,
+                                placement_failures: e.placement_failures,
+                            },
+                        );
                         st.pose = Some(Pose { x: e.pose[0], y: e.pose[1], theta: e.pose[2] });
                     }
                 }
@@ -213,6 +229,7 @@ impl RobotRun {
             pose: [pose.x, pose.y, pose.theta],
             events: ev.events,
             program: Some(st.program),
+            placement_failures: ev.placement_failures,
         };
         if let Some(log) = st.log.clone() {
             if let Err(e) = append_line(&log, &line) {

@@ -123,6 +123,19 @@ pub struct EpisodeResult {
     pub collisions: u32,
     /// Lamarckian: the genome with learned activation weights written back
     pub learned: Option<Genome>,
+    /// Placements of objects or of the robot's start that found no free
+    /// place and kept an overlapping one ([`Robot::placement_failures`]):
+    /// 0 unless the world is too crowded, and then this episode is not the
+    /// declared world. Left out of files when 0 (files written before it
+    /// existed read as 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub placement_failures: u32,
+}
+
+/// For `skip_serializing_if`: counts added to saved results are left out
+/// while 0, so files without them stay as they were.
+pub(crate) fn is_zero(n: &u32) -> bool {
+    *n == 0
 }
 
 /// Per-action record of an episode (for replays, plots and tests).
@@ -198,6 +211,12 @@ pub trait Robot {
     fn holding(&self) -> Option<bool> {
         None
     }
+    /// Placements of the world so far (objects, the start, virtual objects
+    /// coming back) that ran out of tries and kept an overlapping one
+    /// ([`Sim::placement_failures`]); read once, at the end of an episode.
+    fn placement_failures(&self) -> u32 {
+        0
+    }
 }
 
 impl Robot for Sim {
@@ -220,6 +239,9 @@ impl Robot for Sim {
     }
     fn holding(&self) -> Option<bool> {
         Some(Sim::holding(self))
+    }
+    fn placement_failures(&self) -> u32 {
+        Sim::placement_failures(self)
     }
 }
 
@@ -733,6 +755,7 @@ impl<'s> Controller<'s> {
         }
         add_bonuses(self.stage, &res, &mut fitness);
         res.fitness = fitness as f32;
+        res.placement_failures = sim.placement_failures();
         res
     }
 

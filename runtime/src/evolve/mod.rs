@@ -89,6 +89,11 @@ pub struct Evaluation {
     /// selects on `fitness`).
     #[serde(default)]
     pub events: Events,
+    /// Placements of the episode's world that found no free place and kept
+    /// an overlapping one ([`crate::controller::EpisodeResult::placement_failures`]):
+    /// 0 unless the world is too crowded.
+    #[serde(default, skip_serializing_if = "crate::controller::is_zero")]
+    pub placement_failures: u32,
 }
 
 impl Evaluation {
@@ -102,6 +107,7 @@ impl Evaluation {
                 recharges: result.recharges,
             },
             learned: result.learned,
+            placement_failures: result.placement_failures,
         }
     }
 }
@@ -149,6 +155,14 @@ pub struct GenStats {
     pub best_grips: u32,
     #[serde(default)]
     pub best_releases_outside: u32,
+    /// Episodes of this generation whose world could not be placed apart
+    /// (some placement kept an overlapping try: the world is too crowded),
+    /// and the placements that did, over all of them. Left out of files
+    /// while 0.
+    #[serde(default, skip_serializing_if = "crate::controller::is_zero")]
+    pub crowded_episodes: u32,
+    #[serde(default, skip_serializing_if = "crate::controller::is_zero")]
+    pub placement_failures: u32,
 }
 
 /// Everything needed to continue a run: plain data, serde (JSON) friendly.
@@ -334,6 +348,8 @@ pub fn step_generation_with(
             what: format!("{} results for {} episodes", evaluations.len(), jobs.len()),
         });
     }
+    let crowded_episodes = evaluations.iter().filter(|ev| ev.placement_failures > 0).count() as u32;
+    let placement_failures = evaluations.iter().fold(0u32, |n, ev| n.saturating_add(ev.placement_failures));
     let mut evaluations = evaluations.into_iter();
     let results: Vec<(f32, Option<Genome>, Events)> = (0..population.len())
         .map(|_| {
@@ -406,6 +422,8 @@ pub fn step_generation_with(
         best_recharges: events_all[best_index].recharges,
         best_grips: events_all[best_index].grips,
         best_releases_outside: events_all[best_index].releases_outside,
+        crowded_episodes,
+        placement_failures,
     };
     cp.population = population;
     cp.fitness = fitness;

@@ -265,4 +265,10 @@ impl<L: Link> Robot for SerialRobot<L> {
     fn holding(&self) -> Option<bool> {
         Some(self.host.holding())
     }
+
+    /// The virtual objects' placements on the host (the robot stands where
+    /// it is put).
+    fn placement_failures(&self) -> u32 {
+        self.host.placement_failures()
+    }
 }

@@ -184,6 +184,9 @@ pub struct Sim {
     arm_down: bool,
     claw_closed: bool,
     held: Option<usize>,
+    /// Placements (objects, the robot's start, virtual objects coming back)
+    /// that ran out of tries and kept their last, overlapping, try.
+    placement_failures: u32,
 }
 
 /// A physical cylinder with its IR constants.
@@ -366,12 +369,14 @@ impl Sim {
             arm_down: false,
             claw_closed: false,
             held: None,
+            placement_failures: 0,
         };
         // Objects first, then the robot somewhere free.
         let mut budget = PLACE_BUDGET;
         for _ in 0..count {
-            let (at, used) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
+            let (at, used, free) = sim.free_spot(&mut rng, None, budget.min(PLACE_TRIES));
             budget = budget.saturating_sub(used);
+            sim.placement_failures = sim.placement_failures.saturating_add(u32::from(!free));
             sim.objects.push(Obj { at, state: ObjectState::Floor, gripped: false });
         }
         let margin = radius + START_CLEARANCE;
@@ -383,6 +388,7 @@ impl Sim {
             None => (Point2::new(margin, margin), Point2::new(width - margin, depth - margin)),
         };
         let mut centre = Point2::new(width / 2.0, depth / 2.0);
+        let mut placed = false;
         for _ in 0..PLACE_TRIES {
             let x = uniform(&mut rng, lo.x, hi.x);
             let y = uniform(&mut rng, lo.y, hi.y);
@@ -391,9 +397,11 @@ impl Sim {
             if sim.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d)
                 && sim.clear_of_items(&centre, radius + 2.0)
             {
+                placed = true;
                 break;
             }
         }
+        sim.placement_failures = sim.placement_failures.saturating_add(u32::from(!placed));
         let theta = match items.start.as_ref().and_then(|s| s.heading) {
             Some(h) => finite_or(h, 0.0),
             None => uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI),
@@ -407,8 +415,13 @@ impl Sim {
     /// from the walls and not overlapping other floor objects (nor the robot
     /// when the robot's centre `robot` is given). Gives up after `tries` (at
     /// least one) and returns the last try; also returns the number of tries
-    /// used.
-    fn free_spot(&self, rng: &mut ChaCha8Rng, robot: Option<Point2<f32>>, tries: u32) -> (Point2<f32>, u32) {
+    /// used and whether the spot is free (false: the last try, overlapping).
+    fn free_spot(
+        &self,
+        rng: &mut ChaCha8Rng,
+        robot: Option<Point2<f32>>,
+        tries: u32,
+    ) -> (Point2<f32>, u32, bool) {
         let r = self.obj_radius;
         let m = r + OBJECT_CLEARANCE;
         let mut spot = Point2::new(self.width / 2.0, self.depth / 2.0);
@@ -427,10 +440,21 @@ impl Sim {
                 (p - spot).norm_squared() >= d * d
             });
             if clear_objects && clear_robot && self.clear_of_items(&spot, r + 2.0) {
-                break;
+                return (spot, used, true);
             }
         }
-        (spot, used)
+        (spot, used, false)
+    }
+
+    /// How many placements of this episode so far ran out of tries and kept
+    /// their last try, which overlaps another object, the robot, an inner
+    /// wall or cylinder, or the walls' clearance: the objects at the start,
+    /// the robot's start, and virtual objects coming back after a release
+    /// outside. 0 in a world with room enough; otherwise the episode is not
+    /// the world as declared, and its results should not be trusted (the
+    /// CLI warns).
+    pub fn placement_failures(&self) -> u32 {
+        self.placement_failures
     }
 
     fn set_pose_unchecked(&mut self, pose: Pose) {
@@ -788,8 +812,9 @@ impl Sim {
             out.releases_outside += 1;
             if self.obj_virtual {
                 let mut rng = self.rng.clone();
-                let (at, _) = self.free_spot(&mut rng, Some(self.centre()), PLACE_TRIES);
+                let (at, _, free) = self.free_spot(&mut rng, Some(self.centre()), PLACE_TRIES);
                 self.rng = rng;
+                self.placement_failures = self.placement_failures.saturating_add(u32::from(!free));
                 self.objects[i] = Obj { at, state: ObjectState::Floor, gripped: false };
             } else {
                 self.objects[i].state = ObjectState::Outside;
