@@ -128,7 +128,7 @@ impl Crowding {
             let places = if p == 1 { "1 placement".to_string() } else { format!("{p} placements") };
             format!(
                 "warning: the world of stage `{stage}` is too crowded: {which} objects (or the robot) could not be \
-                 placed apart and overlap ({places} kept an overlapping last try), so the fitness of {those} is not \
+                 placed apart and overlap ({places} kept an overlapping last try), so the results of {those} are not \
                  of the world as declared; fewer or smaller objects, or a larger arena, give them room (results in `{}`)",
                 dir.display()
             )

@@ -1632,6 +1632,12 @@ fn a_crowded_world_is_warned_about_and_counted() {
     assert!(summary["placement_failures"].as_u64().is_some_and(|n| n >= 1), "{summary}");
     let checkpoint = std::fs::read_to_string(out.join("crowded/checkpoint.json")).unwrap();
     assert!(checkpoint.contains("\"crowded_episodes\""), "{checkpoint}");
+    // The report's table of results says it for both stages.
+    let reported = run(shaping().arg("report").arg(&out));
+    assert!(reported.status.success(), "{}", text(&reported.stderr));
+    let page = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(page.matches("the world was too crowded: in ").count() >= 2, "no note in the report");
+    assert!(page.contains(" episodes of its generations objects"), "no note for the evolved stage");
 
     let replayed = replay_run(&file, &out, &dir.join("replay"), &["--stage", "crowded"]);
     assert!(replayed.status.success(), "{}", text(&replayed.stderr));
@@ -1649,6 +1655,9 @@ fn a_crowded_world_is_warned_about_and_counted() {
     assert!(!checkpoint.contains("crowded_episodes"), "{checkpoint}");
     let summary = std::fs::read_to_string(dir.join("roomy/tested/summary.json")).unwrap();
     assert!(!summary.contains("crowded_lives"), "{summary}");
+    assert!(run(shaping().arg("report").arg(dir.join("roomy"))).status.success());
+    let page = std::fs::read_to_string(dir.join("roomy/report.html")).unwrap();
+    assert!(!page.contains("too crowded"), "a note in the report of a world with room enough");
 }
 
 /// The two numbers of `{prefix}N{between}M` in `text`.

@@ -70,6 +70,11 @@ pub struct StageView {
     /// Where the frozen genes of the best individual come from: which
     /// individual of the parent stage's final population (see [`provenance`]).
     pub frozen_from: Option<String>,
+    /// When the stage's world was too crowded to place apart in some of its
+    /// episodes (`checkpoint.json`'s statistics, a test's `summary.json`, a
+    /// training stage's `trained.json`): how many, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crowded: Option<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -569,6 +574,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
         genome: genome.map(|(_, src)| src),
         results: None,
         frozen_from: None,
+        crowded: None,
     }
 }
 
@@ -680,8 +686,18 @@ fn run_stages(
         // experiment's seed), not necessarily the one the file declares.
         if let Some(cp) = read_checkpoint(&dir.join("checkpoint.json"))? {
             view.run = run_text(st, Some(cp.seed));
+            view.crowded = crowded_generations(st, &cp);
         }
         view.results = read_summary(&dir.join("summary.json"))?;
+        if let Some(r) = &view.results {
+            if let (Some(n), Some(p)) = (r["crowded_lives"].as_u64(), r["placement_failures"].as_u64()) {
+                let lives = 2 * r["lives"].as_u64().unwrap_or(1);
+                view.crowded = Some(crowded_text(n, lives, p, "lives"));
+            }
+        }
+        if matches!(st.run, StageRun::Train { .. }) {
+            view.crowded = crowded_training(&dir.join("trained.json"));
+        }
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
             let pdir = run.join(&pst.name);
@@ -697,6 +713,38 @@ fn run_stages(
         }
     }
     Ok((views, episodes))
+}
+
+/// The words for `n` of `m` episodes (or lives) whose placement overlapped,
+/// `p` placements in all.
+fn crowded_text(n: u64, m: u64, p: u64, what: &str) -> String {
+    crowded_words(&format!("in {n} of {m} {what}"), p)
+}
+
+fn crowded_words(which: &str, p: u64) -> String {
+    let places = if p == 1 { "1 placement".to_string() } else { format!("{p} placements") };
+    format!(
+        "the world was too crowded: {which} objects (or the robot) could not be placed apart and overlapped \
+         ({places}), and the results there are not of the world as declared"
+    )
+}
+
+/// The crowded episodes of an evolved stage's generations, if any.
+fn crowded_generations(st: &shaping_runtime::program::Stage, cp: &Checkpoint) -> Option<String> {
+    let StageRun::Evolve(evo) = &st.run else { return None };
+    let own: Vec<_> = cp.history.iter().filter(|h| h.stage == st.name).collect();
+    let n: u64 = own.iter().map(|h| u64::from(h.crowded_episodes)).sum();
+    let p: u64 = own.iter().map(|h| u64::from(h.placement_failures)).sum();
+    let m = own.len() as u64 * u64::from(evo.population) * u64::from(evo.evaluations.max(1));
+    (n > 0).then(|| crowded_text(n, m, p, "episodes of its generations"))
+}
+
+/// The training life's overlapping placements, if any (`trained.json`
+/// that does not read is left to the commands that use it).
+fn crowded_training(path: &Path) -> Option<String> {
+    let t: shaping_runtime::evolve::Trained = serde_json::from_slice(&std::fs::read(path).ok()?).ok()?;
+    let p = u64::from(t.result.placement_failures);
+    (p > 0).then(|| crowded_words("in its training life", p))
 }
 
 /// The nearest ancestor of evolved stage `index` that evolved (test stages

@@ -633,6 +633,7 @@
           ', released outside ' + b.releases_outside + ' → ' + a.releases_outside + ', recharges ' + b.recharges + ' → ' + a.recharges +
           ' (before → after the change' + (r.lives > 1 ? '; ' + r.lives + ' lives in each world: fitness the mean per life, events the totals' : '') + ')' + (D.shown_seed !== null && D.shown_seed !== undefined ? ', run seed ' + D.shown_seed : '');
       }
+      if (st.crowded) text = (text ? text + '. ' : '') + 'Warning: ' + st.crowded + '.';
       tb.append(el('tr', {}, el('td', { text: st.name }), el('td', { text: st.run }), el('td', { text: text || '–' })));
     }
   }
