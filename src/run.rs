@@ -473,9 +473,12 @@ fn evolve_stage(
             warned = true;
             bar.suspend(|| {
                 eprintln!(
-                    "warning: the world of stage `{}` is too crowded: in generation {}, {} episodes placed objects \
-                     (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
-                    stage.name, stats.stage_generation, stats.crowded_episodes
+                    "warning: the world of stage `{}` is too crowded: in generation {}, {} of {} episodes placed \
+                     objects (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
+                    stage.name,
+                    stats.stage_generation,
+                    stats.crowded_episodes,
+                    u64::from(evo.population) * u64::from(evo.evaluations.max(1))
                 )
             });
         }
