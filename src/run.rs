@@ -8,11 +8,11 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use shaping_runtime::controller::{
-    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace,
+    episode_rngs, run_episode, run_episode_on, Controller, EpisodeOptions, EpisodeResult, Trace,
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Inheritance, Param, Program, Stage, StageRun};
+use shaping_runtime::program::{Param, Program, Stage, StageRun};
 use shaping_runtime::sim::{Scene, Sim};
 
 use crate::cluster::Coordinator;
@@ -702,18 +702,10 @@ fn test_stage(
     stop: Option<&AtomicBool>,
 ) -> Result<serde_json::Value, CliError> {
     let stage = &program.stages[index];
-    // `run_episode`, stopping at the next action on Ctrl-C.
+    // Stopping at the next action on Ctrl-C.
     let eval = |genome: &Genome, episode: u64| {
-        let (sim_seed, rng) = episode_rngs(episode);
-        let result = Controller::new(stage, genome, rng).map(|mut ctl| {
-            let mut robot = Stoppable::new(Sim::new(&stage.world, sim_seed), stop);
-            let mut result = ctl.run(&mut robot, &EpisodeOptions { actions, learning, seed: episode }, None);
-            if stage.inheritance == Inheritance::Lamarckian {
-                result.learned = Some(ctl.write_back(genome));
-            }
-            result
-        });
-        Evaluation::of_episode(result.unwrap_or_default())
+        let opts = EpisodeOptions { actions, learning, seed: episode };
+        Evaluation::of_episode(run_episode_on(stage, genome, &opts, None, |sim| Stoppable::new(sim, stop)))
     };
     // Checks that the parent fits and picks its best individual and the episode seed.
     let outcome = evolve::test_best(program, index, seed, parent, &eval)

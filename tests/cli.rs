@@ -746,6 +746,35 @@ stage evolved {
     );
 }
 
+/// Starts `shaping run FILE --out OUT ARGS` (standard error piped) and
+/// waits, 120 s at most, until `ready` exists.
+#[cfg(unix)]
+fn start_run_until(file: &Path, out: &Path, args: &[&str], ready: &Path) -> std::process::Child {
+    let child = shaping()
+        .arg("run")
+        .arg(file)
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !ready.exists() {
+        assert!(start.elapsed() < Duration::from_secs(120), "`{}` was not written", ready.display());
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child
+}
+
+/// Ctrl-C (SIGINT) to `child`.
+#[cfg(unix)]
+fn ctrl_c(child: &std::process::Child) {
+    let kill = run(Command::new("kill").args(["-INT", &child.id().to_string()]));
+    assert!(kill.status.success());
+}
+
 /// Ctrl-C lets the generation under way finish and be saved, and says where
 /// the run stopped; the same command resumes it, saying so.
 #[cfg(unix)]
@@ -755,23 +784,8 @@ fn ctrl_c_says_where_the_run_stopped_and_it_resumes() {
     let file = dir.join("s.bat");
     std::fs::write(&file, EDITED.replace("generations 5", "generations 1000")).unwrap();
     let out = dir.join("out");
-    let child = shaping()
-        .arg("run")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
-        .args(["--no-report", "--jobs", "1"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !out.join("s/checkpoint.json").exists() {
-        assert!(start.elapsed() < Duration::from_secs(120), "no checkpoint");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let kill = run(Command::new("kill").args(["-INT", &child.id().to_string()]));
-    assert!(kill.status.success());
+    let child = start_run_until(&file, &out, &["--no-report", "--jobs", "1"], &out.join("s/checkpoint.json"));
+    ctrl_c(&child);
     let done = child.wait_with_output().unwrap();
     assert_eq!(done.status.code(), Some(2));
     let err = text(&done.stderr);
@@ -1401,6 +1415,7 @@ fn a_closed_standard_output_is_not_a_panic() {
 /// says so, exits 2 as an interrupted evolution does, and writes nothing of
 /// the test: no `summary.json`, `trace.csv` or `episode.json` that could
 /// pass for its result.
+#[cfg(unix)]
 #[test]
 fn ctrl_c_stops_a_test_stage_and_writes_nothing_of_it() {
     let dir = scratch("ctrl-c-test");
@@ -1414,25 +1429,10 @@ fn ctrl_c_stops_a_test_stage_and_writes_nothing_of_it() {
     )
     .unwrap();
     let out = dir.join("out");
-    let child = shaping()
-        .arg("run")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
-        .arg("--no-report")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    // The evolved stage is done: the test is under way.
-    while !out.join("explore/episode.json").exists() {
-        assert!(start.elapsed() < Duration::from_secs(120), "the explore stage did not end");
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    // The evolved stage is done once its episode is written: the test is under way.
+    let child = start_run_until(&file, &out, &["--no-report"], &out.join("explore/episode.json"));
     std::thread::sleep(Duration::from_millis(300));
-    let kill = run(Command::new("kill").args(["-INT", &child.id().to_string()]));
-    assert!(kill.status.success());
+    ctrl_c(&child);
     let sent = Instant::now();
     let pid = child.id();
     let done = std::thread::spawn(move || child.wait_with_output().unwrap());

@@ -850,15 +850,37 @@ pub fn try_run_episode(
     episode(stage, genome, opts, trace)
 }
 
+/// [`run_episode`] on the robot `robot` makes of the episode's simulator
+/// (a wrapper that watches or stops it: Ctrl-C during a test stage).
+pub fn run_episode_on<R: Robot>(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    trace: Option<&mut Trace>,
+    robot: impl FnOnce(Sim) -> R,
+) -> EpisodeResult {
+    episode_on(stage, genome, opts, trace, robot).unwrap_or_default()
+}
+
 fn episode(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
     trace: Option<&mut Trace>,
 ) -> Result<EpisodeResult, ControllerError> {
+    episode_on(stage, genome, opts, trace, |sim| sim)
+}
+
+fn episode_on<R: Robot>(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    trace: Option<&mut Trace>,
+    robot: impl FnOnce(Sim) -> R,
+) -> Result<EpisodeResult, ControllerError> {
     let (sim_seed, rng) = episode_rngs(opts.seed);
     let mut ctl = Controller::new(stage, genome, rng)?;
-    let mut sim = Sim::new(&stage.world, sim_seed);
+    let mut sim = robot(Sim::new(&stage.world, sim_seed));
     let mut res = ctl.run(&mut sim, opts, trace);
     if stage.inheritance == Inheritance::Lamarckian {
         res.learned = Some(ctl.write_back(genome));

@@ -1093,19 +1093,24 @@ pub enum Blocker {
 /// The first inner wall or cylinder of `items` that a disc of `radius`
 /// centred at `at` overlaps (what the simulator's collision test finds).
 pub fn blocker(items: &Items, at: [f32; 2], radius: f32) -> Option<Blocker> {
-    let p = Point2::new(at[0], at[1]);
+    blocking_all(items, &[at], radius)
+}
+
+/// The first inner wall or cylinder of `items` that overlaps a disc of
+/// `radius` centred at each of `centres`.
+fn blocking_all(items: &Items, centres: &[[f32; 2]], radius: f32) -> Option<Blocker> {
     let pt = |q: [f32; 2]| Point2::new(q[0], q[1]);
-    if let Some(i) =
-        items.walls.iter().position(|w| segment_distance2(&p, &pt(w.from), &pt(w.to)) < radius * radius)
-    {
+    if let Some(i) = items.walls.iter().position(|w| {
+        centres.iter().all(|&c| segment_distance2(&pt(c), &pt(w.from), &pt(w.to)) < radius * radius)
+    }) {
         return Some(Blocker::Wall(i));
     }
     items
         .cylinders
         .iter()
-        .position(|c| {
-            let d = radius + c.diameter / 2.0;
-            (pt(c.at) - p).norm_squared() < d * d
+        .position(|cyl| {
+            let reach = radius + cyl.diameter / 2.0;
+            centres.iter().all(|&c| (pt(cyl.at) - pt(c)).norm_squared() < reach * reach)
         })
         .map(Blocker::Cylinder)
 }
@@ -1172,21 +1177,7 @@ pub fn crowded(world: &World) -> Option<Crowded> {
 /// The first inner wall or cylinder of `items` that a disc of `radius`
 /// overlaps wherever in the rectangle `x` by `y` its centre is.
 fn covering(items: &Items, x: (f32, f32), y: (f32, f32), radius: f32) -> Option<Blocker> {
-    let corners = [[x.0, y.0], [x.0, y.1], [x.1, y.0], [x.1, y.1]];
-    let pt = |q: [f32; 2]| Point2::new(q[0], q[1]);
-    if let Some(i) = items.walls.iter().position(|w| {
-        corners.iter().all(|&c| segment_distance2(&pt(c), &pt(w.from), &pt(w.to)) < radius * radius)
-    }) {
-        return Some(Blocker::Wall(i));
-    }
-    items
-        .cylinders
-        .iter()
-        .position(|cyl| {
-            let reach = radius + cyl.diameter / 2.0;
-            corners.iter().all(|&c| (pt(cyl.at) - pt(c)).norm_squared() < reach * reach)
-        })
-        .map(Blocker::Cylinder)
+    blocking_all(items, &[[x.0, y.0], [x.0, y.1], [x.1, y.0], [x.1, y.1]], radius)
 }
 
 /// The bar's end points: centred on `wall`, flush with it.
