@@ -12,8 +12,9 @@ use shaping_runtime::controller::{run_episode, EpisodeOptions};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::sim::{Command, Sim};
 
-use crate::load::{self, CliError};
+use crate::load;
 use crate::out::outln;
+use crate::CliError;
 
 pub struct BenchArgs {
     pub file: PathBuf,
@@ -31,7 +32,7 @@ pub fn bench(args: BenchArgs) -> Result<(), CliError> {
     let mut program = load::load_program(&args.file, args.error_format)?;
     let index = load::stage_index(&program, args.stage.as_deref())?;
     let seed = crate::run::run_seed(&program, None);
-    crate::run::bind_training(&mut program, None, seed)?;
+    shaping_engine::run::bind_training(&mut program, None, seed, &shaping_engine::run::Silent)?;
     let stage = &program.stages[index];
     let runs = args.runs.max(1);
     let mut rng = ChaCha8Rng::seed_from_u64(7);

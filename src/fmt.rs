@@ -5,9 +5,9 @@ use std::path::PathBuf;
 
 use shaping_compiler::fmt::{format, FormatError};
 
-use crate::diag::{self, ErrorFormat};
-use crate::load::{self, CliError};
+use crate::load;
 use crate::out::{out, outln};
+use crate::{diag, exit_code, CliError, ErrorFormat};
 
 /// Formats the files (stdin to stdout when there are none). With `check`,
 /// writes nothing and names the files that would change (exit 1).
@@ -34,15 +34,14 @@ pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<
         });
         if let Err(e) = result {
             eprintln!("{e}");
-            if worst.as_ref().is_none_or(|w| w.exit_code() < e.exit_code()) {
+            if worst.as_ref().is_none_or(|w| exit_code(w) < exit_code(&e)) {
                 worst = Some(e);
             }
         }
     }
     match worst {
-        Some(CliError::Io(_)) => Err(CliError::Io(String::new())),
-        Some(CliError::Diagnostics(_)) => Err(CliError::Diagnostics(String::new())),
-        None if check && changed > 0 => Err(CliError::Diagnostics(format!(
+        Some(e) => Err(CliError::new(e.kind(), String::new())),
+        None if check && changed > 0 => Err(CliError::diagnostics(format!(
             "{changed} file{} would be reformatted by `shaping fmt`",
             if changed == 1 { "" } else { "s" }
         ))),
@@ -59,7 +58,7 @@ fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
     if check {
         if out != src {
             outln!("<stdin>")?;
-            return Err(CliError::Diagnostics("standard input would be reformatted by `shaping fmt`".into()));
+            return Err(CliError::diagnostics("standard input would be reformatted by `shaping fmt`"));
         }
         return Ok(());
     }
@@ -68,7 +67,7 @@ fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
 
 fn format_one(src: &str, name: &str, error_format: ErrorFormat) -> Result<String, CliError> {
     format(src, name).map_err(|e| match e {
-        FormatError::Syntax(d) => CliError::Diagnostics(format!(
+        FormatError::Syntax(d) => CliError::diagnostics(format!(
             "{}\n{name}: not formatted (it does not parse)",
             diag::render(&d, error_format).trim_end()
         )),

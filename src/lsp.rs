@@ -21,7 +21,7 @@ use shaping_compiler::lower::lower_partial;
 use shaping_compiler::syntax::{self, ast, parse_recovering};
 use shaping_compiler::{render_layout, Program};
 
-use crate::load::CliError;
+use crate::CliError;
 
 /// Runs the server on stdin and stdout until the client says `exit`.
 pub fn lsp() -> Result<(), CliError> {

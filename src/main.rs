@@ -2,29 +2,25 @@
 
 mod bench;
 mod cluster;
-mod diag;
-mod episode;
 mod experiment;
 mod fmt;
-mod html;
 mod load;
 mod lsp;
 mod out;
-mod plot;
 mod replay;
-mod report;
 mod robot;
 mod run;
-mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use diag::ErrorFormat;
-use load::CliError;
 use out::{out, outln};
+pub use shaping_engine::diag::{self as diag, ErrorFormat};
+/// Every command's error: the engine's, printed as it is.
+pub use shaping_engine::Error as CliError;
+use shaping_engine::{html, sweep};
 
 /// Most worker threads `--jobs` accepts.
 const MAX_JOBS: u64 = 1024;
@@ -47,7 +43,7 @@ enum Command {
         /// `.bat` files to check.
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Format architecture files in place (standard input to standard output
@@ -58,7 +54,7 @@ enum Command {
         /// Change nothing; name the files that would change and exit 1 if any.
         #[arg(long)]
         check: bool,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Run the language server on standard input and output (for editors).
@@ -71,7 +67,7 @@ enum Command {
         stage: Option<String>,
         #[arg(long, value_enum, default_value = "text")]
         format: LayoutFormat,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Print the module graph of a stage as Graphviz DOT.
@@ -79,7 +75,7 @@ enum Command {
         file: PathBuf,
         #[arg(long)]
         stage: Option<String>,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Compile to a `Program` (JSON) that `run`, `replay` and `bench` also accept.
@@ -88,7 +84,7 @@ enum Command {
         /// Output file: new, or a program `build` wrote before (nothing else is replaced).
         #[arg(short, long)]
         output: PathBuf,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Evolve the stages in order, resuming from checkpoints; writes statistics,
@@ -140,7 +136,7 @@ enum Command {
         /// Longest wait for an answer of the robot, ms.
         #[arg(long, default_value_t = 1000, requires = "robot")]
         timeout: u64,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Run one individual on a Khepera over its serial port; writes the same
@@ -180,7 +176,7 @@ enum Command {
         /// Switch local learning off.
         #[arg(long)]
         no_learning: bool,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// An emulated Khepera: answers the serial protocol from the simulator on
@@ -206,7 +202,7 @@ enum Command {
         /// Inject a fault at the N-th request: `drop@N` (no answer), `garbage@N`, `close@N`.
         #[arg(long, value_parser = robot::emulate::parse_fault)]
         fault: Option<robot::emulate::Fault>,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Run one individual with a trace; writes `trace.csv` and the pictures
@@ -237,7 +233,7 @@ enum Command {
         /// Also write `report.html`: the episode animated in a web page.
         #[arg(long)]
         report: bool,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Run every stage over several seeds, or a sweep of settings (`--set`),
@@ -282,7 +278,7 @@ enum Command {
         /// before it ends the run, naming the rank.
         #[arg(long, value_name = "SECONDS", default_value_t = cluster::DEFAULT_RANK_TIMEOUT)]
         rank_timeout: u64,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
     /// Write one self-contained HTML page (no network needed) for a run, stage,
@@ -304,7 +300,7 @@ enum Command {
         /// Timed runs; the median is reported.
         #[arg(long, default_value_t = 5, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
         runs: usize,
-        #[arg(long, value_enum, default_value = "human")]
+        #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
 }
@@ -315,11 +311,30 @@ enum LayoutFormat {
     Json,
 }
 
+/// The exit status of a failed command: 1 for diagnostics about the
+/// user's file, 2 for everything else (usage, I/O, a refused run).
+pub fn exit_code(e: &CliError) -> i32 {
+    match e.kind() {
+        shaping_engine::ErrorKind::Diagnostics => 1,
+        _ => 2,
+    }
+}
+
+/// `--error-format human|plain|json`.
+fn error_format() -> impl clap::builder::TypedValueParser<Value = ErrorFormat> {
+    use clap::builder::TypedValueParser as _;
+    clap::builder::PossibleValuesParser::new(["human", "plain", "json"]).map(|s| match s.as_str() {
+        "plain" => ErrorFormat::Plain,
+        "json" => ErrorFormat::Json,
+        _ => ErrorFormat::Human,
+    })
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Err(e) = refuse_without_mpi(&cli.command) {
         eprintln!("{e}");
-        return ExitCode::from(e.exit_code() as u8);
+        return ExitCode::from(exit_code(&e) as u8);
     }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
@@ -328,7 +343,7 @@ fn main() -> ExitCode {
             if !msg.is_empty() {
                 eprintln!("{msg}");
             }
-            ExitCode::from(e.exit_code() as u8)
+            ExitCode::from(exit_code(&e) as u8)
         }
     }
 }
@@ -457,18 +472,20 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             no_learning,
             report,
             error_format,
-        } => replay::replay(replay::ReplayArgs {
-            file,
-            stage,
-            genome,
-            run,
-            actions,
-            out,
-            seed,
-            no_learning,
-            report,
+        } => replay::replay(
+            shaping_engine::replay::ReplayOptions {
+                file,
+                stage,
+                genome,
+                run,
+                actions,
+                out,
+                seed,
+                no_learning,
+                report,
+            },
             error_format,
-        }),
+        ),
         Command::Experiment {
             file,
             seeds,
@@ -483,28 +500,31 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             rank_timeout,
             error_format,
         } => {
-            let plan = experiment::Plan::new(experiment::ExperimentArgs {
-                file,
-                seeds,
-                first_seed,
-                out,
-                jobs,
-                criterion,
-                sets,
-                stage,
-                fresh,
-                no_report,
-                error_format,
-            })?;
+            let program = load::load_program(&file, error_format)?;
+            let plan = shaping_engine::experiment::Plan::new(
+                program,
+                shaping_engine::experiment::ExperimentOptions {
+                    file,
+                    seeds,
+                    first_seed,
+                    out,
+                    jobs,
+                    criterion,
+                    sets,
+                    stage,
+                    fresh,
+                    no_report,
+                },
+            )?;
             #[cfg(feature = "mpi")]
             if cluster::launcher().is_some() {
-                let task = |task, threads| plan.run_task(task, Some(threads), true, None);
+                let task = |task, threads| experiment::run_task(&plan, task, Some(threads), true, None);
                 return cluster::with_mpi(jobs, rank_timeout, false, Some(&task), |c| {
-                    experiment::experiment(&plan, Some(c))
+                    experiment::experiment(&plan, jobs, Some(c))
                 });
             }
             let _ = rank_timeout;
-            experiment::experiment(&plan, None)
+            experiment::experiment(&plan, jobs, None)
         }
         Command::Report { dir, output } => {
             let path = html::write(&dir, output.as_deref())?;
@@ -582,7 +602,7 @@ fn print_text(text: &str) -> Result<(), CliError> {
 fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     let mut worst: Option<CliError> = None;
     for file in files {
-        let result = load::load_program_warnings(file, format);
+        let result = shaping_engine::load::load_program(file, format);
         if format == ErrorFormat::Json {
             outln!("{}", check_json(file, &result))?;
         }
@@ -603,7 +623,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
                     eprintln!("{e}");
                 }
                 // I/O problems (exit 2) outrank diagnostics (exit 1).
-                if worst.as_ref().is_none_or(|w| w.exit_code() < e.exit_code()) {
+                if worst.as_ref().is_none_or(|w| exit_code(w) < exit_code(&e)) {
                     worst = Some(e);
                 }
             }
@@ -612,8 +632,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     match worst {
         None => Ok(()),
         // Already printed above: exit with its code and an empty message.
-        Some(CliError::Diagnostics(_)) => Err(CliError::Diagnostics(String::new())),
-        Some(CliError::Io(_)) => Err(CliError::Io(String::new())),
+        Some(e) => Err(CliError::new(e.kind(), String::new())),
     }
 }
 
@@ -640,16 +659,19 @@ fn check_json(
             }
             v
         }
-        Err(CliError::Diagnostics(text)) => match serde_json::from_str::<serde_json::Value>(text) {
+        Err(e) if e.kind() == shaping_engine::ErrorKind::Diagnostics => match serde_json::from_str::<
+            serde_json::Value,
+        >(e.message())
+        {
             Ok(serde_json::Value::Object(mut diagnostic)) => {
                 diagnostic.insert("file".into(), name.into());
                 diagnostic.insert("ok".into(), false.into());
                 serde_json::Value::Object(diagnostic)
             }
-            _ => serde_json::json!({"file": name, "ok": false, "severity": "error", "message": text.trim()}),
+            _ => serde_json::json!({"file": name, "ok": false, "severity": "error", "message": e.message()}),
         },
-        Err(CliError::Io(msg)) => {
-            let msg = msg.trim().strip_prefix("error: ").unwrap_or(msg.trim());
+        Err(e) => {
+            let msg = e.message().strip_prefix("error: ").unwrap_or(e.message());
             serde_json::json!({"file": name, "ok": false, "severity": "error", "message": msg})
         }
     };

@@ -8,7 +8,7 @@
 use std::io::{ErrorKind, Write as _};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::load::CliError;
+use crate::CliError;
 
 /// Set when a write found standard output closed; later writes are skipped.
 static CLOSED: AtomicBool = AtomicBool::new(false);

@@ -52,8 +52,25 @@ pub fn evaluate_local(
     actions: u32,
     jobs: &[(&Genome, u64)],
 ) -> Vec<Evaluation> {
-    let eval = crate::run::evaluator(stage, actions);
+    let eval = shaping_engine::run::evaluator(stage, actions);
     shaping_runtime::evolve::evaluate_many(&eval, jobs)
+}
+
+/// Rank 0's coordinator evaluates a generation's episodes over the ranks.
+impl shaping_engine::run::Evaluate for Coordinator {
+    fn evaluate(
+        &self,
+        program: &shaping_runtime::program::Program,
+        index: usize,
+        actions: u32,
+        jobs: &[(&Genome, u64)],
+    ) -> Vec<Evaluation> {
+        Coordinator::evaluate(self, program, index, actions, jobs)
+    }
+
+    fn context(&self, what: String, checkpoint: &std::path::Path) {
+        self.set_context(what, checkpoint);
+    }
 }
 
 /// Without the `mpi` feature there is no coordinator: `Option<&Coordinator>`
@@ -81,9 +98,9 @@ impl Coordinator {
     pub fn run_tasks(
         &self,
         _: &[(u32, u64)],
-        _: &(dyn Fn((u32, u64), usize) -> Result<(), crate::load::CliError> + Sync + '_),
+        _: &(dyn Fn((u32, u64), usize) -> Result<(), crate::CliError> + Sync + '_),
         _: &(dyn Fn((u32, u64)) -> String + Sync),
-    ) -> Result<(), crate::load::CliError> {
+    ) -> Result<(), crate::CliError> {
         match *self {}
     }
 }

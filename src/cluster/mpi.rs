@@ -18,7 +18,7 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
 use super::wire::{self, Reply, Request};
-use crate::load::CliError;
+use crate::CliError;
 
 const TAG_REQUEST: i32 = 1;
 const TAG_REPLY: i32 = 2;

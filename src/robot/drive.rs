@@ -11,10 +11,13 @@ use shaping_runtime::program::Stage;
 use shaping_runtime::robot::{RobotError, SerialRobot};
 
 use super::port::{interrupt_flag, SerialPort};
-use crate::episode::{self, Part, Recorder};
-use crate::load::{create_dir, write_atomic, CliError};
+use crate::load::{create_dir, write_atomic};
 use crate::out::outln;
-use crate::{replay, report, run};
+use crate::CliError;
+use shaping_engine::episode::{self, Part, Recorder};
+use shaping_engine::{replay, report};
+
+use crate::run;
 
 pub struct DriveArgs {
     pub file: PathBuf,
@@ -68,12 +71,14 @@ pub fn failure(err: &RobotError, stopped: &Result<(), RobotError>) -> String {
 }
 
 pub fn drive(args: DriveArgs) -> Result<(), CliError> {
+    let program = crate::load::load_program(&args.file, args.error_format)?;
     let chosen = replay::choose(
+        program,
         &args.file,
         args.stage.as_deref(),
         args.genome.as_deref(),
         args.run.as_deref(),
-        args.error_format,
+        &run::Terminal::new(true, false),
     )?;
     let replay::Chosen { program, index, genome, training_seed } = chosen;
     let stage = &program.stages[index];

@@ -49,8 +49,8 @@ pub struct EmulateArgs {
 
 /// The emulator needs a pseudo-terminal, which Windows does not have.
 #[cfg(not(unix))]
-pub fn emulate(args: EmulateArgs) -> Result<(), crate::load::CliError> {
-    Err(crate::load::CliError::io(format!(
+pub fn emulate(args: EmulateArgs) -> Result<(), crate::CliError> {
+    Err(crate::CliError::io(format!(
         "error: `shaping emulate` needs a Unix pseudo-terminal and cannot make `{}` here; \
          drive a real robot's port, or run the emulator on Linux or macOS",
         args.port.display()
@@ -75,8 +75,9 @@ mod pty {
     use shaping_runtime::robot::Emulator;
 
     use super::{EmulateArgs, Fault, BITS_PER_BYTE};
-    use crate::load::{self, CliError};
+    use crate::load;
     use crate::robot::port::interrupt_flag;
+    use crate::CliError;
 
     /// The paper's architecture, used when no file is given.
     const DEFAULT_FILE: &str = include_str!("../../examples/khepera.bat");

@@ -13,16 +13,19 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 use serde::{Deserialize, Serialize};
+use shaping_engine::run::Evaluate;
+use shaping_engine::ErrorKind;
 use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions};
 use shaping_runtime::evolve::{Evaluation, Events};
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Inheritance, Stage};
+use shaping_runtime::program::{Inheritance, Program, Stage};
 use shaping_runtime::robot::SerialRobot;
 use shaping_runtime::sim::Pose;
 
 use super::drive::{check_robot_world, failure, has_gripper, period};
 use super::port::{interrupt_flag, SerialPort};
-use crate::load::{self, CliError};
+use crate::load;
+use crate::CliError;
 
 /// One episode done on the robot, as a line of `robot-episodes.jsonl`.
 #[derive(Serialize, Deserialize)]
@@ -98,27 +101,27 @@ impl RobotRun {
     fn lock(&self) -> MutexGuard<'_, State> {
         self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
+}
 
-    /// The failure that stopped the evaluations, if any.
-    pub fn failure(&self) -> Option<CliError> {
-        self.lock().error.clone().map(CliError::io)
-    }
-
-    /// The evaluation of one genome on the robot for `stage`, whose
-    /// directory is `dir`: episodes already in its log are taken from there,
-    /// if they were run for the stage as it is (`program`, the digest of its
-    /// fingerprint; else the run is refused). With `fresh`, an existing log
-    /// is moved aside to `robot-episodes.jsonl.old` and not used.
-    /// After a failure every evaluation gives NaN, so the generation fails
-    /// and its checkpoint is not written; [`RobotRun::failure`] says why.
-    pub fn evaluator<'a>(
-        &'a self,
-        stage: &'a Stage,
-        actions: u32,
+/// The individuals of an evolved stage evaluated on the robot, one after
+/// another in the order of the generation (the robot's pose carries from
+/// episode to episode). After a failure every evaluation gives NaN, so the
+/// generation fails and its checkpoint is not written; `failure` says why.
+impl Evaluate for RobotRun {
+    /// Opens the stage's episode log in `dir`: episodes already in it are
+    /// taken from there, if they were run for the stage as it is (`program`,
+    /// the digest of its fingerprint; else the run is refused). With
+    /// `fresh`, an existing log is moved aside to `robot-episodes.jsonl.old`
+    /// and not used.
+    fn begin_stage(
+        &self,
+        programs: &Program,
+        index: usize,
         dir: &Path,
         program: u64,
         fresh: bool,
-    ) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + 'a, CliError> {
+    ) -> Result<(), CliError> {
+        let stage = &programs.stages[index];
         check_robot_world(stage)?;
         let log = dir.join("robot-episodes.jsonl");
         if fresh && log.exists() {
@@ -168,10 +171,27 @@ impl RobotRun {
             }
             st.log = Some(log);
         }
-        Ok(move |genome: &Genome, seed: u64| self.evaluate(stage, actions, genome, seed))
+        Ok(())
     }
 
-    fn evaluate(&self, stage: &Stage, actions: u32, genome: &Genome, seed: u64) -> Evaluation {
+    fn evaluate(
+        &self,
+        program: &Program,
+        index: usize,
+        actions: u32,
+        jobs: &[(&Genome, u64)],
+    ) -> Vec<Evaluation> {
+        let stage = &program.stages[index];
+        jobs.iter().map(|&(genome, seed)| self.evaluate_one(stage, actions, genome, seed)).collect()
+    }
+
+    fn failure(&self) -> Option<CliError> {
+        self.lock().error.clone().map(|e| CliError::new(ErrorKind::Evaluation, e))
+    }
+}
+
+impl RobotRun {
+    fn evaluate_one(&self, stage: &Stage, actions: u32, genome: &Genome, seed: u64) -> Evaluation {
         let nan = Evaluation { fitness: f32::NAN, ..Evaluation::default() };
         let mut st = self.lock();
         if st.error.is_some() {

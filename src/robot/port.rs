@@ -14,7 +14,7 @@ use serialport::{ClearBuffer, DataBits, FlowControl, Parity, StopBits};
 use shaping_runtime::robot::protocol::LineBuffer;
 use shaping_runtime::robot::{Link, LinkError};
 
-use crate::load::CliError;
+use crate::CliError;
 
 /// Sets up the Ctrl-C (and SIGTERM) flag.
 pub fn interrupt_flag() -> Result<Arc<AtomicBool>, CliError> {

@@ -13,8 +13,9 @@ use shaping_runtime::program::{
 };
 
 use crate::episode::{Episode, EPISODE_FORMAT};
+use crate::error::Error;
 use crate::experiment::spread;
-use crate::load::{self, CliError};
+use crate::load;
 
 /// Version of the data embedded in a report.
 pub const REPORT_FORMAT: u32 = 1;
@@ -150,12 +151,12 @@ pub struct GenRow {
 }
 
 /// Parses `generations.csv` (columns found by name).
-pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, CliError> {
+pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, Error> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
     let col = |name: &str| {
         header.iter().position(|h| *h == name).ok_or_else(|| {
-            CliError::io(format!("error: `{}` has no column `{name}` in its header", path.display()))
+            Error::io(format!("error: `{}` has no column `{name}` in its header", path.display()))
         })
     };
     let (cs, cg, csg, cb, cm) =
@@ -166,7 +167,7 @@ pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, CliErro
             continue;
         }
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let bad = |what: &str| CliError::io(format!("error: `{}` line {}: {what}", path.display(), i + 2));
+        let bad = |what: &str| Error::io(format!("error: `{}` line {}: {what}", path.display(), i + 2));
         let cell = |c: usize| cells.get(c).copied().ok_or_else(|| bad(&format!("has {} cells", cells.len())));
         let int =
             |c: usize| cell(c)?.parse::<u32>().map_err(|_| bad(&format!("`{}` is not a count", cells[c])));
@@ -183,19 +184,18 @@ pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, CliErro
     Ok(rows)
 }
 
-fn read_text(path: &Path) -> Result<String, CliError> {
-    let bytes = load::read_bytes(path)?;
-    String::from_utf8(bytes)
-        .map_err(|_| CliError::io(format!("error: `{}` is not UTF-8 text", path.display())))
+fn read_text(path: &Path) -> Result<String, Error> {
+    let bytes = crate::files::read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|_| Error::io(format!("error: `{}` is not UTF-8 text", path.display())))
 }
 
-fn read_episode(path: &Path) -> Result<Episode, CliError> {
-    let bytes = load::read_bytes(path)?;
+fn read_episode(path: &Path) -> Result<Episode, Error> {
+    let bytes = crate::files::read_bytes(path)?;
     let ep: Episode = serde_json::from_slice(&bytes).map_err(|e| {
-        CliError::io(format!("error: `{}` is not an episode written by shaping: {e}", path.display()))
+        Error::io(format!("error: `{}` is not an episode written by shaping: {e}", path.display()))
     })?;
     if ep.format != EPISODE_FORMAT {
-        return Err(CliError::io(format!(
+        return Err(Error::io(format!(
             "error: `{}` has episode format {}, this shaping reads format {EPISODE_FORMAT}; replay the stage again",
             path.display(),
             ep.format
@@ -210,7 +210,7 @@ fn read_episode(path: &Path) -> Result<Episode, CliError> {
         && c.performance.len() == ep.modules.len()
         && c.activation.iter().chain(&c.reinforcement).chain(&c.performance).all(|v| v.len() == n);
     if per_action.iter().any(|&k| k != n) || !per_module || ep.worlds.is_empty() {
-        return Err(CliError::io(format!(
+        return Err(Error::io(format!(
             "error: `{}` is inconsistent (columns of different lengths, or no world)",
             path.display()
         )));
@@ -220,13 +220,13 @@ fn read_episode(path: &Path) -> Result<Episode, CliError> {
 
 /// The genome in `path` (`None` when there is no such file: the stage has
 /// not run); one that is not a genome of `stage` is an error naming it.
-fn read_genome(path: &Path, stage: &Stage) -> Result<Option<Genome>, CliError> {
+fn read_genome(path: &Path, stage: &Stage) -> Result<Option<Genome>, Error> {
     if !path.exists() {
         return Ok(None);
     }
     let text = read_text(path)?;
     let bad = |what: String| {
-        CliError::io(format!("error: `{}` is not a genome of stage `{}`: {what}", path.display(), stage.name))
+        Error::io(format!("error: `{}` is not a genome of stage `{}`: {what}", path.display(), stage.name))
     };
     let genome =
         Genome::from_bitstring(text.trim()).ok_or_else(|| bad("it is not a string of 0 and 1".into()))?;
@@ -579,7 +579,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
 }
 
 /// Per evolved stage, its own rows of one run's `generations.csv` files.
-fn run_fitness(program: &Program, run: &Path) -> Result<Vec<Vec<GenRow>>, CliError> {
+fn run_fitness(program: &Program, run: &Path) -> Result<Vec<Vec<GenRow>>, Error> {
     let mut out = vec![Vec::new(); program.stages.len()];
     for (i, st) in program.stages.iter().enumerate() {
         let path = run.join(&st.name).join("generations.csv");
@@ -624,12 +624,12 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
 /// A test stage's `summary.json` (`None` when there is none); one without
 /// what the page shows (the lives, and per world the fitness and events)
 /// is an error naming the file and what is missing.
-fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, CliError> {
+fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, Error> {
     if !path.exists() {
         return Ok(None);
     }
     let bad = |what: String| {
-        CliError::io(format!("error: `{}` is not a test stage's summary: {what}", path.display()))
+        Error::io(format!("error: `{}` is not a test stage's summary: {what}", path.display()))
     };
     let v: serde_json::Value = serde_json::from_str(&read_text(path)?).map_err(|e| bad(e.to_string()))?;
     if !v.is_object() {
@@ -656,14 +656,14 @@ fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, CliError> {
 
 /// The checkpoint in `path` (`None` when there is none); one that does not
 /// read is an error naming it.
-fn read_checkpoint(path: &Path) -> Result<Option<Checkpoint>, CliError> {
+fn read_checkpoint(path: &Path) -> Result<Option<Checkpoint>, Error> {
     if !path.exists() {
         return Ok(None);
     }
-    let bytes = load::read_bytes(path)?;
+    let bytes = crate::files::read_bytes(path)?;
     serde_json::from_slice(&bytes)
         .map(Some)
-        .map_err(|e| CliError::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
+        .map_err(|e| Error::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
 }
 
 /// The stages of one run directory, with genomes, results and episodes.
@@ -671,7 +671,7 @@ fn run_stages(
     program: &Program,
     run: &Path,
     only: Option<usize>,
-) -> Result<(Vec<StageView>, Vec<Episode>), CliError> {
+) -> Result<(Vec<StageView>, Vec<Episode>), Error> {
     let mut views = Vec::new();
     let mut episodes = Vec::new();
     for (i, st) in program.stages.iter().enumerate() {
@@ -901,7 +901,7 @@ fn sweep_summary(dir: &Path) -> Option<serde_json::Value> {
 
 /// A sweep's directory: the experiment report of its best point (by the
 /// median chosen best of the last evolved stage), listing every point.
-fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, CliError> {
+fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, Error> {
     let points = summary["points"].as_array().cloned().unwrap_or_default();
     let score = |p: &serde_json::Value| {
         p["stages"]
@@ -916,15 +916,12 @@ fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, CliError>
         _ => Some(p),
     });
     let Some(best) = best else {
-        return Err(CliError::io(format!("error: the sweep in `{}` has no points", dir.display())));
+        return Err(Error::io(format!("error: the sweep in `{}` has no points", dir.display())));
     };
     let point_dir = dir.join(best["dir"].as_str().unwrap_or_default());
     let seeds = seed_dirs(&point_dir);
     if seeds.is_empty() {
-        return Err(CliError::io(format!(
-            "error: the point `{}` has no seed directories",
-            point_dir.display()
-        )));
+        return Err(Error::io(format!("error: the point `{}` has no seed directories", point_dir.display())));
     }
     let mut data = experiment(&point_dir, &seeds)?;
     data.kind = "sweep";
@@ -937,9 +934,9 @@ fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, CliError>
 }
 
 /// Gathers a report's data from a run, stage, experiment or replay directory.
-pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
+pub fn collect(dir: &Path) -> Result<ReportData, Error> {
     if !dir.is_dir() {
-        return Err(CliError::io(format!("error: `{}` is not a directory", dir.display())));
+        return Err(Error::io(format!("error: `{}` is not a directory", dir.display())));
     }
     let here = dir.join("program.json");
     if here.exists() {
@@ -948,7 +945,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
             // A replay: one episode of one stage.
             let ep = read_episode(&dir.join("episode.json"))?;
             let (index, _) = program.stage(&ep.stage).ok_or_else(|| {
-                CliError::io(format!(
+                Error::io(format!(
                     "error: `{}` replays stage `{}`, which `{}` does not have",
                     dir.display(),
                     ep.stage,
@@ -1002,13 +999,13 @@ pub fn collect(dir: &Path) -> Result<ReportData, CliError> {
             return Ok(data);
         }
     }
-    Err(CliError::io(format!(
+    Err(Error::io(format!(
         "error: `{}` is not a run, stage, experiment, sweep or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
         dir.display()
     )))
 }
 
-fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, CliError> {
+fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, Error> {
     let program = load::load_built(&seeds[0].1.join("program.json"))?;
     let mut per_seed = Vec::new();
     for (_, run) in seeds {

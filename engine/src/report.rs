@@ -11,7 +11,8 @@ use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
 use crate::episode::{Episode, EpisodeColumns};
-use crate::load::{write_atomic, CliError};
+use crate::error::Error;
+use crate::files::write_atomic;
 use crate::plot;
 
 /// `generations.csv`: one row per generation of the stage and its ancestors.
@@ -54,13 +55,13 @@ pub fn fitness_points(history: &[GenStats]) -> (Vec<plot::GenPoint>, Vec<(u32, S
 }
 
 /// Draws `fitness.{svg,png}` into `dir`.
-pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(), CliError> {
+pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(), Error> {
     if history.is_empty() {
         return Ok(());
     }
     let (points, starts) = fitness_points(history);
     plot::fitness_curves(&dir.join("fitness"), title, &points, &starts, false)
-        .map_err(|e| CliError::io(format!("error: {e}")))
+        .map_err(|e| Error::io(format!("error: {e}")))
 }
 
 /// Where the value of one declared sensor or actuator element comes from in
@@ -196,7 +197,7 @@ pub fn episode_files(
     scene: &Scene,
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
-) -> Result<(), CliError> {
+) -> Result<(), Error> {
     episode_files_until(dir, title, stage, trace, episode, scene, marks, path, &|| false)
 }
 
@@ -216,9 +217,9 @@ pub fn episode_files_until(
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
     stop: &dyn Fn() -> bool,
-) -> Result<(), CliError> {
-    let to_err = |e: plot::PlotError| CliError::io(format!("error: {e}"));
-    let check = || if stop() { Err(CliError::io(STOPPED)) } else { Ok(()) };
+) -> Result<(), Error> {
+    let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
+    let check = || if stop() { Err(Error::io(STOPPED)) } else { Ok(()) };
     write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());

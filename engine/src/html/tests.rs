@@ -14,7 +14,7 @@ use crate::episode::{run_recorded, Episode};
 use crate::run::{before_after, BeforeAfter};
 
 fn program() -> Program {
-    let src = include_str!("../../tests/cli/report.bat");
+    let src = include_str!("../../../tests/cli/report.bat");
     shaping_compiler::compile(src, "report.bat").expect("the report test architecture compiles")
 }
 
@@ -341,7 +341,7 @@ fn episode_json_round_trips() {
 
 #[test]
 fn a_training_stage_episode_is_the_training_life() {
-    let src = include_str!("../../examples/khepera.bat");
+    let src = include_str!("../../../examples/khepera.bat");
     let p = shaping_compiler::compile(src, "khepera.bat").expect("the example compiles");
     let (i, stage) = p
         .stages

@@ -1,4 +1,4 @@
-//! Rendering diagnostics for the terminal (`--error-format human|plain|json`).
+//! Rendering diagnostics as text (`--error-format human|plain|json`).
 
 use std::io::IsTerminal;
 
@@ -6,9 +6,10 @@ use miette::{
     Diagnostic, GraphicalReportHandler, GraphicalTheme, JSONReportHandler, ThemeCharacters, ThemeStyles,
 };
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorFormat {
-    /// Coloured (on a terminal) with source snippets and labels.
+    /// Coloured (when standard error is a terminal) with source snippets
+    /// and labels.
     Human,
     /// The same without colour, ASCII only.
     Plain,

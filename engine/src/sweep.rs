@@ -15,7 +15,7 @@ use shaping_runtime::program::{
     Evolution, Inheritance, LearnWhen, Module, Program, Selection, Stage, StageRun, World,
 };
 
-use crate::load::CliError;
+use crate::error::Error;
 
 /// One `--set TARGET=V1,V2,...`, as written: `TARGET` is `STAGE.PATH`.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,23 +71,23 @@ pub fn point_name(point: &[Assignment]) -> String {
 }
 
 /// Checks the sets of an experiment: a target set twice is an error.
-pub fn check_sets(sets: &[Set]) -> Result<(), CliError> {
+pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
     for (i, s) in sets.iter().enumerate() {
         if sets[..i].iter().any(|t| t.target == s.target) {
-            return Err(CliError::io(format!("error: `--set {}` is given twice", s.target)));
+            return Err(Error::io(format!("error: `--set {}` is given twice", s.target)));
         }
         if let Some(v) = s.values.iter().enumerate().find_map(|(k, v)| s.values[..k].contains(v).then_some(v))
         {
-            return Err(CliError::io(format!("error: `--set {}`: the value `{v}` is given twice", s.target)));
+            return Err(Error::io(format!("error: `--set {}`: the value `{v}` is given twice", s.target)));
         }
     }
     Ok(())
 }
 
 /// Applies a point's settings to `program` and validates the result.
-pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), CliError> {
+pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
     for (target, text) in point {
-        let fail = |m: String| CliError::io(format!("error: `--set {target}={text}`: {m}"));
+        let fail = |m: String| Error::io(format!("error: `--set {target}={text}`: {m}"));
         let (stage, path) = target.split_once('.').ok_or_else(|| fail("no stage in the target".into()))?;
         let indices: Vec<usize> = if stage == "*" {
             let having: Vec<usize> =
@@ -116,7 +116,7 @@ pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), CliError
             set(program, i, path, &value).map_err(fail)?;
         }
     }
-    program.validate().map_err(|e| CliError::io(format!("error: `--set {}`: {e}", point_name(point))))
+    program.validate().map_err(|e| Error::io(format!("error: `--set {}`: {e}", point_name(point))))
 }
 
 /// The value kinds of the settings.

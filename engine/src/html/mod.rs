@@ -10,7 +10,8 @@ mod tests;
 
 use std::path::{Path, PathBuf};
 
-use crate::load::{write_atomic, CliError};
+use crate::error::Error;
+use crate::files::write_atomic;
 
 pub use data::{collect, ReportData};
 
@@ -27,14 +28,14 @@ fn escape_html(s: &str) -> String {
 
 /// The data as JSON that is safe inside a `<script>` element: every `<` is
 /// escaped, so no `</script>` or `<!--` can end it early.
-pub fn embedded_json(data: &ReportData) -> Result<String, CliError> {
+pub fn embedded_json(data: &ReportData) -> Result<String, Error> {
     let json = serde_json::to_string(data)
-        .map_err(|e| CliError::io(format!("error: cannot serialise the report's data: {e}")))?;
+        .map_err(|e| Error::io(format!("error: cannot serialise the report's data: {e}")))?;
     Ok(json.replace('<', "\\u003c"))
 }
 
 /// The page for `data`.
-pub fn page(data: &ReportData) -> Result<String, CliError> {
+pub fn page(data: &ReportData) -> Result<String, Error> {
     let title = escape_html(&format!("{} · shaping report", data.title));
     let json = embedded_json(data)?;
     // The data go in last, so nothing in them is taken for a placeholder.
@@ -44,7 +45,7 @@ pub fn page(data: &ReportData) -> Result<String, CliError> {
         [("{{title}}", title.as_str()), ("{{style}}", STYLE), ("{{data}}", &json), ("{{script}}", SCRIPT)]
     {
         let Some(at) = rest.find(mark) else {
-            return Err(CliError::io(format!("error: the report template has no `{mark}`")));
+            return Err(Error::io(format!("error: the report template has no `{mark}`")));
         };
         out.push_str(&rest[..at]);
         out.push_str(value);
@@ -56,7 +57,7 @@ pub fn page(data: &ReportData) -> Result<String, CliError> {
 
 /// Writes the report of `dir` to `out` (default `dir/report.html`) and
 /// returns the path written.
-pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, CliError> {
+pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, Error> {
     if let Some(out) = out {
         replaceable(out)?;
     }
@@ -70,10 +71,10 @@ pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, CliError> {
 /// `report -o FILE`: FILE is new or an earlier report. Anything else there
 /// (a run's `program.json`, a checkpoint, a genome, a source file) would be
 /// lost: refused.
-fn replaceable(out: &Path) -> Result<(), CliError> {
+fn replaceable(out: &Path) -> Result<(), Error> {
     let Ok(meta) = std::fs::metadata(out) else { return Ok(()) };
     if meta.is_dir() {
-        return Err(CliError::io(format!(
+        return Err(Error::io(format!(
             "error: `{}` is a directory; give `-o` the file to write (e.g. `{}`)",
             out.display(),
             out.join(FILE_NAME).display()
@@ -86,7 +87,7 @@ fn replaceable(out: &Path) -> Result<(), CliError> {
     if read.is_ok() && is_report(&head) {
         return Ok(());
     }
-    Err(CliError::io(format!(
+    Err(Error::io(format!(
         "error: `{}` exists and is not a report; `shaping report -o` replaces only an earlier report \
          (choose a new file, e.g. one ending in `.html`)",
         out.display()

@@ -1,0 +1,80 @@
+//! The one error type of the engine: a kind a caller can match and the
+//! message a user sees.
+
+use std::fmt;
+
+/// What went wrong, for a caller that acts on it (an exit status, a retry,
+/// a hint); the message says it to a person.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// Diagnostics about the user's source file (rendered in the message).
+    Diagnostics,
+    /// A file or directory could not be read or written.
+    Io,
+    /// A saved file is damaged: it does not parse, or its checksum does not
+    /// match its contents, or it disagrees with the file it was derived from.
+    Corrupt,
+    /// A saved result belongs to another program, seed or setting than the
+    /// run's.
+    Stale,
+    /// The run was stopped by the interruption flag it was given.
+    Interrupted,
+    /// The run would need more memory than is available.
+    Memory,
+    /// A setting, an argument or a program that cannot be used.
+    Invalid,
+    /// The run directory is in use by another process.
+    Locked,
+    /// Evaluation failed (a robot link, a rank of a cluster).
+    Evaluation,
+}
+
+/// An error of the engine: its [`ErrorKind`] and the message users see.
+#[derive(Debug)]
+pub struct Error {
+    kind: ErrorKind,
+    message: String,
+}
+
+impl Error {
+    pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
+        Error { kind, message: message.into() }
+    }
+
+    /// A file-system failure (also the kind of messages not classified).
+    pub fn io(message: impl Into<String>) -> Error {
+        Error::new(ErrorKind::Io, message)
+    }
+
+    /// Rendered diagnostics about a source file.
+    pub fn diagnostics(message: impl Into<String>) -> Error {
+        Error::new(ErrorKind::Diagnostics, message)
+    }
+
+    pub fn kind(&self) -> ErrorKind {
+        self.kind
+    }
+
+    /// The message, as printed (without a trailing newline).
+    pub fn message(&self) -> &str {
+        self.message.trim_end()
+    }
+
+    /// The same error with `hint` appended to its message (`; hint`).
+    pub fn with_hint(mut self, hint: &str) -> Error {
+        self.message = format!("{}; {hint}", self.message.trim_end());
+        self
+    }
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.message())
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// The engine's result.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

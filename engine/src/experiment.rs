@@ -1,0 +1,547 @@
+//! Experiments: the same architecture over several seeds (and the points
+//! of a sweep), with the statistics the paper's figures are judged by
+//! (median and range). The program is compiled once, by the caller; each
+//! task (a point's seed) is a run of it with the point's settings.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use shaping_runtime::evolve::{Checkpoint, GenStats};
+use shaping_runtime::program::{Program, StageRun};
+
+use crate::error::{Error, ErrorKind};
+use crate::files::{write_atomic, DirLock};
+use crate::load;
+use crate::rundir;
+use crate::sweep::{self, Assignment, Set};
+use crate::{plot, report, run};
+
+/// What an experiment runs.
+#[derive(Clone, Debug, Default)]
+pub struct ExperimentOptions {
+    /// The architecture file (its stem titles the summaries).
+    pub file: PathBuf,
+    pub seeds: u64,
+    pub first_seed: u64,
+    pub out: Option<PathBuf>,
+    pub jobs: Option<usize>,
+    pub criterion: Vec<String>,
+    /// `--set`: the sweep's settings (one point without any).
+    pub sets: Vec<Set>,
+    /// Run only this stage and the stages it needs.
+    pub stage: Option<String>,
+    pub fresh: bool,
+    /// Write no `report.html` at the end.
+    pub no_report: bool,
+}
+
+/// Median, minimum and maximum.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Spread {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+pub fn spread(values: &[f64]) -> Option<Spread> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    let median = if n % 2 == 1 { v[n / 2] } else { (v[n / 2 - 1] + v[n / 2]) / 2.0 };
+    Some(Spread { median, min: v[0], max: v[n - 1] })
+}
+
+fn fmt_spread(s: Option<Spread>, digits: usize) -> String {
+    match s {
+        Some(s) => format!("{:.d$} ({:.d$} .. {:.d$})", s.median, s.min, s.max, d = digits),
+        None => "-".into(),
+    }
+}
+
+/// Parses `STAGE=VALUE` criteria (`navigation=0.7`).
+fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Error> {
+    args.iter()
+        .map(|c| {
+            let (stage, value) = c.split_once('=').ok_or_else(|| {
+                Error::new(ErrorKind::Invalid, format!("error: criterion `{c}` is not of the form STAGE=FITNESS"))
+            })?;
+            load::stage_index(program, Some(stage))?;
+            let v: f32 = value
+                .parse()
+                .map_err(|_| Error::new(ErrorKind::Invalid, format!("error: criterion `{c}`: `{value}` is not a number")))?;
+            // `nan`, `inf` and numbers beyond f32 parse, but no fitness reaches them.
+            if !v.is_finite() {
+                return Err(Error::new(ErrorKind::Invalid, format!(
+                    "error: criterion `{c}`: `{value}` is not a finite number (a fitness to reach, e.g. `{stage}=0.5`)"
+                )));
+            }
+            Ok((stage.to_string(), v))
+        })
+        .collect()
+}
+
+/// What an experiment runs, checked before anything runs (on every rank
+/// of an MPI run alike): the program, the criteria, the seeds and the points
+/// of the sweep, each point's program validated.
+pub struct Plan {
+    args: ExperimentOptions,
+    program: Program,
+    criteria: Vec<(String, f32)>,
+    seeds: Vec<u64>,
+    points: Vec<Vec<Assignment>>,
+    /// The stages run (and summarised), in program order.
+    stages: Vec<usize>,
+    out: PathBuf,
+}
+
+/// One task of an experiment: a point of the sweep (its index) and a seed.
+pub type Task = (u32, u64);
+
+impl Plan {
+    /// Checks `args` against `program` (the file's, compiled once).
+    pub fn new(program: Program, args: ExperimentOptions) -> Result<Plan, Error> {
+        let criteria = criteria(&program, &args.criterion)?;
+        if args.seeds == 0 {
+            return Err(Error::new(ErrorKind::Invalid, "error: `--seeds` must be at least 1"));
+        }
+        let end = args.first_seed.checked_add(args.seeds).ok_or_else(|| {
+            Error::new(
+                ErrorKind::Invalid,
+                format!(
+                    "error: `--first-seed {}` plus `--seeds {}` is past the largest seed",
+                    args.first_seed, args.seeds
+                ),
+            )
+        })?;
+        sweep::check_sets(&args.sets)?;
+        let points = sweep::points(&args.sets);
+        if points.len() > MAX_POINTS {
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!("error: the sweep has {} points, more than the limit of {MAX_POINTS}", points.len()),
+            ));
+        }
+        for point in &points {
+            sweep::apply(&mut program.clone(), point)?;
+        }
+        let stages = match args.stage.as_deref() {
+            Some(name) => run::chain(&program, load::stage_index(&program, Some(name))?),
+            None => (0..program.stages.len()).collect(),
+        };
+        if let Some((stage, _)) =
+            criteria.iter().find(|(c, _)| !stages.iter().any(|&i| program.stages[i].name == *c))
+        {
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!(
+                    "error: `--criterion {stage}=...`: stage `{stage}` is not run with `--stage {}`",
+                    args.stage.as_deref().unwrap_or_default()
+                ),
+            ));
+        }
+        let out = args.out.clone().unwrap_or_else(|| run::default_out(&args.file).join("experiment"));
+        Ok(Plan { seeds: (args.first_seed..end).collect(), args, program, criteria, points, stages, out })
+    }
+
+    /// Every (point, seed), point after point.
+    pub fn tasks(&self) -> Vec<Task> {
+        (0..self.points.len() as u32).flat_map(|p| self.seeds.iter().map(move |&s| (p, s))).collect()
+    }
+
+    /// The directory of a point: the experiment's without `--set`.
+    fn point_dir(&self, point: usize) -> PathBuf {
+        if self.args.sets.is_empty() {
+            self.out.clone()
+        } else {
+            self.out.join(sweep::point_name(&self.points[point]))
+        }
+    }
+
+    /// The experiment's directory.
+    pub fn out(&self) -> &Path {
+        &self.out
+    }
+
+    /// Locks the experiment's directory (created if missing) for this
+    /// process while it runs: a second experiment into it is refused.
+    pub fn lock(&self) -> Result<DirLock, Error> {
+        DirLock::acquire(&self.out)
+    }
+
+    /// Runs one seed of one point, as `shaping run` with the point's `--set`
+    /// values would (the same files, byte for byte), with `jobs` threads
+    /// (the runner's evaluator, if it has one, evaluates instead).
+    pub fn run_task(
+        &self,
+        (point, seed): Task,
+        jobs: Option<usize>,
+        runner: &run::Runner<'_>,
+    ) -> Result<run::RunOutcome, Error> {
+        let assignments = self.points.get(point as usize).ok_or_else(|| {
+            Error::new(
+                ErrorKind::Invalid,
+                format!("error: point {point} of a sweep of {} points", self.points.len()),
+            )
+        })?;
+        let opts = run::RunOptions {
+            stage: self.args.stage.clone(),
+            seed: Some(seed),
+            out: rundir::seed_dir(&self.point_dir(point as usize), seed),
+            jobs,
+            fresh: self.args.fresh,
+            // One report per point, written at the end.
+            no_report: true,
+            sets: assignments.clone(),
+        };
+        runner.run(self.program.clone(), &opts)
+    }
+
+    /// Names a task in progress lines: `seed 3` or `seed 3 of mutation=0.01`.
+    pub fn describe(&self, (point, seed): Task) -> String {
+        match self.points.get(point as usize) {
+            Some(p) if !p.is_empty() => format!("seed {seed} of {}", sweep::point_name(p)),
+            _ => format!("seed {seed}"),
+        }
+    }
+
+    /// The summaries (`summary.md`, `summary.json`), the pictures and the
+    /// reports, from the files the tasks wrote.
+    pub fn finish(&self) -> Result<Finished, Error> {
+        let mut finished = Finished::default();
+        let program = &self.program;
+        // Titled by the file: several files may share a robot (and so a program name).
+        let title = self
+            .args
+            .file
+            .file_stem()
+            .map_or_else(|| program.name.clone(), |s| s.to_string_lossy().into_owned());
+        let mut points = Vec::new();
+        let mut table = Vec::new();
+        for (i, point) in self.points.iter().enumerate() {
+            let dir = self.point_dir(i);
+            let name = sweep::point_name(point);
+            let heading = if point.is_empty() { title.clone() } else { format!("{title}, {name},") };
+            // The point's program: the values that ran, not the file's.
+            let mut ran = program.clone();
+            sweep::apply(&mut ran, point)?;
+            let (md, stages) = summarise(&ran, &self.stages, &heading, &dir, &self.seeds, &self.criteria)?;
+            write_atomic(&dir.join("summary.md"), md.as_bytes())?;
+            if self.args.sets.is_empty() {
+                finished.summary.push_str(&md);
+            }
+            let settings: serde_json::Map<String, serde_json::Value> =
+                point.iter().map(|(t, v)| (t.clone(), serde_json::Value::String(v.clone()))).collect();
+            let dir_name = if point.is_empty() { ".".to_string() } else { name.clone() };
+            points.push(
+                serde_json::json!({ "name": name, "dir": dir_name, "settings": settings, "stages": stages }),
+            );
+            table.push((point.clone(), stages));
+        }
+        let sets: Vec<serde_json::Value> = self
+            .args
+            .sets
+            .iter()
+            .map(|s| serde_json::json!({ "target": s.target, "values": s.values }))
+            .collect();
+        let json = serde_json::json!({ "file": title, "seeds": self.seeds, "sets": sets, "points": points });
+        let text = serde_json::to_string_pretty(&json)
+            .map_err(|e| Error::io(format!("error: cannot serialise the summary: {e}")))?;
+        write_atomic(&self.out.join("summary.json"), format!("{text}\n").as_bytes())?;
+        if !self.args.sets.is_empty() {
+            let md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
+            write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
+            finished.summary.push_str(&md);
+            sweep_plot(&self.out.join("sweep"), &title, &table)?;
+        }
+        if !self.args.no_report {
+            // After `summary.json`: a point's report lists the sweep's points.
+            for i in 0..self.points.len() {
+                finished.reports.push(crate::html::write(&self.point_dir(i), None)?);
+            }
+            if !self.args.sets.is_empty() {
+                finished.reports.push(crate::html::write(&self.out, None)?);
+            }
+        }
+        Ok(finished)
+    }
+}
+
+/// What an experiment's end wrote: the summary to show (the `summary.md`
+/// of its point, or the sweep's table) and the reports.
+#[derive(Clone, Debug, Default)]
+pub struct Finished {
+    pub summary: String,
+    pub reports: Vec<PathBuf>,
+}
+
+/// Most points a sweep runs.
+const MAX_POINTS: usize = 10_000;
+
+/// `sweep.svg`/`.png`: each evolved stage's chosen best per point.
+fn sweep_plot(
+    stem: &Path,
+    title: &str,
+    table: &[(Vec<Assignment>, Vec<serde_json::Value>)],
+) -> Result<(), Error> {
+    let Some((_, first)) = table.first() else { return Ok(()) };
+    let series: Vec<plot::SweepSeries> = first
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s["kind"] == "evolve")
+        .map(|(k, s)| plot::SweepSeries {
+            stage: s["stage"].as_str().unwrap_or("").to_string(),
+            values: table
+                .iter()
+                .map(|(_, stages)| {
+                    let c = &stages[k]["chosen_best"];
+                    Some((c["median"].as_f64()?, c["min"].as_f64()?, c["max"].as_f64()?))
+                })
+                .collect(),
+        })
+        .collect();
+    if series.is_empty() {
+        return Ok(());
+    }
+    plot::sweep_points(stem, &format!("{title}: chosen best per point over the seeds"), &series)
+        .map_err(|e| Error::io(format!("error: {e}")))
+}
+
+/// The sweep's `summary.md`: one row per point, the median (min .. max)
+/// over seeds of each evolved stage's final best, chosen best and the
+/// generation reaching its criterion.
+fn sweep_table(
+    title: &str,
+    sets: &[Set],
+    seeds: &[u64],
+    table: &[(Vec<Assignment>, Vec<serde_json::Value>)],
+) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# {title}: a sweep of {} points over {} seeds ({:?})\n",
+        table.len(),
+        seeds.len(),
+        seeds
+    );
+    let _ =
+        writeln!(md, "Median (min .. max) over seeds; each point's own `summary.md` is in its directory.\n");
+    let mut head: Vec<String> = vec!["point".to_string()];
+    head.extend(sets.iter().map(|s| format!("`{}`", s.target)));
+    let evolved: Vec<(String, bool)> = table.first().map_or_else(Vec::new, |(_, stages)| {
+        stages
+            .iter()
+            .filter(|s| s["kind"] == "evolve")
+            .map(|s| (s["stage"].as_str().unwrap_or("").to_string(), !s["criterion"].is_null()))
+            .collect()
+    });
+    for (stage, criterion) in &evolved {
+        head.push(format!("{stage} final best"));
+        head.push(format!("{stage} chosen best"));
+        if *criterion {
+            head.push(format!("{stage} generation reaching criterion"));
+        }
+    }
+    let _ = writeln!(md, "| {} |", head.join(" | "));
+    let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
+    let cell = |v: &serde_json::Value, digits: usize| match (
+        v["median"].as_f64(),
+        v["min"].as_f64(),
+        v["max"].as_f64(),
+    ) {
+        (Some(m), Some(a), Some(b)) => fmt_spread(Some(Spread { median: m, min: a, max: b }), digits),
+        _ => "-".to_string(),
+    };
+    for (i, (point, stages)) in table.iter().enumerate() {
+        let mut row: Vec<String> = vec![(i + 1).to_string()];
+        row.extend(point.iter().map(|(_, v)| v.clone()));
+        for s in stages.iter().filter(|s| s["kind"] == "evolve") {
+            row.push(cell(&s["final_best"], 3));
+            row.push(cell(&s["chosen_best"], 3));
+            if !s["criterion"].is_null() {
+                let c = &s["criterion"];
+                let never = c["unreached"].as_u64().unwrap_or(0);
+                row.push(format!(
+                    "{}{}",
+                    cell(&c["generation"], 0),
+                    if never > 0 { format!("; {never} seeds never") } else { String::new() }
+                ));
+            }
+        }
+        let _ = writeln!(md, "| {} |", row.join(" | "));
+    }
+    let _ =
+        writeln!(md, "\nPicture: `sweep.svg` / `sweep.png` (each evolved stage's chosen best per point).");
+    md
+}
+
+fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Error> {
+    let bytes = crate::files::read_bytes(path)?;
+    serde_json::from_slice(&bytes)
+        .map_err(|e| Error::new(ErrorKind::Corrupt, format!("error: cannot read `{}`: {e}", path.display())))
+}
+
+/// A file that a seed's run must have written.
+fn missing(path: &Path) -> Error {
+    Error::new(
+        ErrorKind::Io,
+        format!("error: cannot read `{}`: the seed's run did not write it", path.display()),
+    )
+}
+
+/// Builds the Markdown summary and the multi-seed fitness picture.
+/// Returns the Markdown and, per stage, its figures as JSON (`summary.json`).
+fn summarise(
+    program: &Program,
+    stages: &[usize],
+    title: &str,
+    out: &Path,
+    seeds: &[u64],
+    criteria: &[(String, f32)],
+) -> Result<(String, Vec<serde_json::Value>), Error> {
+    let mut json = Vec::new();
+    let mut md = String::new();
+    let _ = writeln!(md, "# {title} over {} seeds ({:?})\n", seeds.len(), seeds);
+    let _ = writeln!(md, "Median (min .. max) over seeds.\n");
+    let _ = writeln!(
+        md,
+        "| stage | generations | final best | chosen best | final mean | best ever | generation reaching criterion |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
+    let mut histories: Vec<Vec<GenStats>> = vec![Vec::new(); seeds.len()];
+    for stage in stages.iter().map(|&i| &program.stages[i]) {
+        match &stage.run {
+            StageRun::Evolve(evo) => {
+                let mut chosen = Vec::new();
+                let mut best = Vec::new();
+                let mut mean = Vec::new();
+                let mut ever = Vec::new();
+                let mut reach = Vec::new();
+                let mut unreached = 0;
+                let criterion = criteria.iter().find(|(s, _)| *s == stage.name).map(|c| c.1);
+                for &seed in seeds {
+                    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
+                    let cp: Checkpoint = rundir::read_checkpoint(&dir)?
+                        .ok_or_else(|| missing(&rundir::checkpoint_path(&dir)))?;
+                    let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
+                    if let Some(last) = own.last() {
+                        best.push(last.best as f64);
+                        mean.push(last.mean as f64);
+                    }
+                    if let Some((_, f)) = shaping_runtime::evolve::best_of(&cp) {
+                        chosen.push(f as f64);
+                    }
+                    ever.push(own.iter().map(|h| h.best as f64).fold(f64::NEG_INFINITY, f64::max));
+                    if let Some(c) = criterion {
+                        match own.iter().find(|h| h.best >= c) {
+                            Some(h) => reach.push(h.stage_generation as f64 + 1.0),
+                            None => unreached += 1,
+                        }
+                    }
+                    // Per seed, keep the longest history (the deepest evolved stage's).
+                    let slot = seeds.iter().position(|&s| s == seed).unwrap_or(0);
+                    if cp.history.len() > histories[slot].len() {
+                        histories[slot] = cp.history;
+                    }
+                }
+                let reach_text = match criterion {
+                    None => "-".to_string(),
+                    Some(c) => format!(
+                        "{} to reach {c}{}",
+                        fmt_spread(spread(&reach), 0),
+                        if unreached > 0 { format!("; {unreached} seeds never") } else { String::new() }
+                    ),
+                };
+                json.push(serde_json::json!({
+                    "stage": stage.name, "kind": "evolve", "generations": evo.generations,
+                    "final_best": spread(&best), "chosen_best": spread(&chosen), "final_mean": spread(&mean),
+                    "best_ever": spread(&ever),
+                    "criterion": criterion.map(|c| serde_json::json!({
+                        "fitness": c, "generation": spread(&reach), "unreached": unreached,
+                    })),
+                }));
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {} | {} | {} |",
+                    stage.name,
+                    evo.generations,
+                    fmt_spread(spread(&best), 3),
+                    fmt_spread(spread(&chosen), 3),
+                    fmt_spread(spread(&mean), 3),
+                    fmt_spread(spread(&ever), 3),
+                    reach_text
+                );
+            }
+            StageRun::Train { actions } => {
+                let mut perf = Vec::new();
+                for &seed in seeds {
+                    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
+                    let t =
+                        rundir::read_trained(&dir)?.ok_or_else(|| missing(&rundir::trained_path(&dir)))?;
+                    let learners =
+                        stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
+                    perf.extend(learners.map(|(_, p)| *p as f64));
+                }
+                json.push(serde_json::json!({
+                    "stage": stage.name, "kind": "train", "actions": actions, "performance": spread(&perf),
+                }));
+                let _ = writeln!(
+                    md,
+                    "| {} | training, {actions} actions | performance at the end {} | - | - | - | - |",
+                    stage.name,
+                    fmt_spread(spread(&perf), 2),
+                );
+            }
+            StageRun::Test { actions, lives, learning } => {
+                let mut fit = Vec::new();
+                let mut grips = Vec::new();
+                let mut rel = Vec::new();
+                for &seed in seeds {
+                    let v: serde_json::Value = read_json(
+                        &rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name).join("summary.json"),
+                    )?;
+                    fit.push(v["fitness"].as_f64().unwrap_or(f64::NAN));
+                    grips.push(v["grips"].as_f64().unwrap_or(f64::NAN));
+                    rel.push(v["releases_outside"].as_f64().unwrap_or(f64::NAN));
+                }
+                json.push(serde_json::json!({
+                    "stage": stage.name, "kind": "test", "actions": actions, "lives": lives, "learning": learning,
+                    "fitness": spread(&fit), "grips": spread(&grips), "releases_outside": spread(&rel),
+                }));
+                let length = match lives {
+                    1 => format!("{actions} actions"),
+                    _ => {
+                        format!("{lives} lives of {actions} actions (fitness: mean per life; events: totals)")
+                    }
+                };
+                let _ = writeln!(
+                    md,
+                    "| {} | test, {length}, learning {} | fitness {} | - | grips {} | released outside {} | - |",
+                    stage.name,
+                    if *learning { "on" } else { "off" },
+                    fmt_spread(spread(&fit), 3),
+                    fmt_spread(spread(&grips), 1),
+                    fmt_spread(spread(&rel), 1),
+                );
+            }
+        }
+    }
+    let runs: Vec<Vec<plot::GenPoint>> = histories.iter().map(|h| report::fitness_points(h).0).collect();
+    if let Some(first) = histories.iter().filter(|h| !h.is_empty()).max_by_key(|h| h.len()) {
+        let starts = report::fitness_points(first).1;
+        plot::multi_seed_fitness(
+            &out.join("fitness-seeds"),
+            &format!("{title}: fitness over {} seeds (median, min-max)", seeds.len()),
+            &runs,
+            &starts,
+        )
+        .map_err(|e| Error::io(format!("error: {e}")))?;
+    }
+    let _ = writeln!(
+        md,
+        "\nPicture: `fitness-seeds.svg` / `fitness-seeds.png` (median best and mean, min-max band)."
+    );
+    Ok((md, json))
+}

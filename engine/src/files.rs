@@ -1,0 +1,243 @@
+//! The file system under a run directory: whole-file writes that a crash
+//! or a second writer cannot tear, the lock that keeps one writer per
+//! directory, and the checksum of saved results.
+//!
+//! - [`write_atomic`]: a new temporary file with a unique name beside the
+//!   target, opened create-new (so a symbolic link planted there is never
+//!   followed), written, synced, then renamed over the target, and the
+//!   directory synced; a failed write removes its temporary file. A reader
+//!   sees the old file or the new one, never a part.
+//! - [`DirLock`]: an OS file lock (`flock`) on `DIR/.lock`, held while a
+//!   run or an experiment writes into `DIR`; a second one is refused at once,
+//!   naming the process that holds it. The lock goes away with its holder,
+//!   also after `kill -9`; the file stays (empty of meaning), readers never
+//!   take it.
+//! - [`seal`] and [`unseal`]: a saved result (`checkpoint.json`,
+//!   `trained.json`) ends with a `"checksum"` field, the FNV-1a of the rest
+//!   of the text; reading verifies it. A file written before checksums
+//!   existed reads as before and gets one when it is next written.
+
+use std::fs::{File, OpenOptions};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use shaping_runtime::evolve::fingerprint::fnv1a;
+
+use crate::error::{Error, ErrorKind, Result};
+
+/// Reads a file, mapping I/O errors to a message that names the path.
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", path.display())))
+}
+
+/// Creates a directory and its parents.
+pub fn create_dir(path: &Path) -> Result<()> {
+    std::fs::create_dir_all(path)
+        .map_err(|e| Error::io(format!("error: cannot create directory `{}`: {e}", path.display())))
+}
+
+/// Writes a file atomically (see the module's documentation).
+pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let fail = |e: std::io::Error| Error::io(format!("error: cannot write `{}`: {e}", path.display()));
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    // Unique per process and write; create-new refuses anything already
+    // there (a file, a link), so try the next name rather than follow it.
+    let (tmp, mut file) = loop {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(f) => break (tmp, f),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && n < u64::MAX => continue,
+            Err(e) => return Err(fail(e)),
+        }
+    };
+    let written = file.write_all(contents).and_then(|()| file.sync_all()).and_then(|()| {
+        drop(file);
+        std::fs::rename(&tmp, path)
+    });
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(fail(e));
+    }
+    // The rename itself is durable once the directory is synced (where a
+    // directory can be opened; elsewhere the rename is atomic anyway).
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// The lock of a directory written by one run or experiment at a time.
+/// Dropping it (or the process ending in any way) releases it.
+#[derive(Debug)]
+pub struct DirLock {
+    _file: File,
+    path: PathBuf,
+}
+
+impl DirLock {
+    /// The name of the lock file in a locked directory.
+    pub const FILE: &'static str = ".lock";
+
+    /// Locks `dir` (created if missing) for this process, or refuses at once
+    /// if another process (or another lock of this one) holds it.
+    pub fn acquire(dir: &Path) -> Result<DirLock> {
+        create_dir(dir)?;
+        let path = dir.join(Self::FILE);
+        // The lock file itself is opened without following a link there.
+        let mut file = open_lock_file(&path)
+            .map_err(|e| Error::io(format!("error: cannot open the lock `{}`: {e}", path.display())))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&path).unwrap_or_default();
+                let holder = holder.trim();
+                let who = if holder.is_empty() {
+                    "another process".to_string()
+                } else {
+                    format!("another process ({holder})")
+                };
+                return Err(Error::new(
+                    ErrorKind::Locked,
+                    format!(
+                        "error: `{}` is in use by {who}; wait for it to finish (or stop it), or choose another `--out`",
+                        dir.display()
+                    ),
+                ));
+            }
+            Err(std::fs::TryLockError::Error(e)) => {
+                return Err(Error::io(format!("error: cannot lock `{}`: {e}", path.display())));
+            }
+        }
+        // Who holds it, for the refusal of the next one.
+        let mut text = format!("process {}", std::process::id());
+        if let Some(cmd) = std::env::args().next() {
+            let name = Path::new(&cmd).file_name().map_or(cmd.clone(), |n| n.to_string_lossy().into_owned());
+            text = format!("{name}, {text}");
+        }
+        let _ = file.set_len(0).and_then(|()| file.write_all(text.as_bytes())).and_then(|()| file.flush());
+        Ok(DirLock { _file: file, path })
+    }
+
+    /// The lock file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+#[cfg(unix)]
+fn open_lock_file(path: &Path) -> std::io::Result<File> {
+    use std::os::unix::fs::OpenOptionsExt as _;
+    // O_NOFOLLOW: a symbolic link planted at `.lock` is refused, not followed.
+    const O_NOFOLLOW: i32 = if cfg!(target_os = "linux") { 0o400000 } else { 0x0100 };
+    OpenOptions::new().read(true).write(true).create(true).truncate(false).custom_flags(O_NOFOLLOW).open(path)
+}
+
+#[cfg(not(unix))]
+fn open_lock_file(path: &Path) -> std::io::Result<File> {
+    OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path)
+}
+
+const CHECKSUM_FIELD: &str = ",\n  \"checksum\": \"";
+
+/// `json` (a pretty-printed JSON object) with a last field `"checksum"`:
+/// the FNV-1a of `json` itself, 16 hex digits.
+pub fn seal(json: &str) -> String {
+    let body = json.trim_end();
+    let Some(open) = body.strip_suffix("\n}") else { return json.to_string() };
+    format!("{open}{CHECKSUM_FIELD}{:016x}\"\n}}", fnv1a(body.as_bytes()))
+}
+
+/// What [`unseal`] found.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Sealed<'a> {
+    /// The checksum matches: the text without it.
+    Verified(String),
+    /// No checksum (written before checksums existed): the text as it is.
+    Unsealed(&'a str),
+    /// A checksum that does not match the text.
+    Damaged,
+}
+
+/// Checks the checksum [`seal`] added to `text`.
+pub fn unseal(text: &str) -> Sealed<'_> {
+    let body = text.trim_end();
+    let Some(at) = body.rfind(CHECKSUM_FIELD) else { return Sealed::Unsealed(text) };
+    let rest = &body[at + CHECKSUM_FIELD.len()..];
+    let Some(hex) = rest.strip_suffix("\"\n}") else { return Sealed::Unsealed(text) };
+    let Ok(sum) = u64::from_str_radix(hex, 16) else { return Sealed::Damaged };
+    if hex.len() != 16 {
+        return Sealed::Damaged;
+    }
+    let original = format!("{}\n}}", &body[..at]);
+    if fnv1a(original.as_bytes()) == sum {
+        Sealed::Verified(original)
+    } else {
+        Sealed::Damaged
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_sealed_text_unseals_to_itself_and_any_changed_digit_is_damage() {
+        let json = "{\n  \"a\": 1,\n  \"b\": [\n    0.5\n  ]\n}";
+        let sealed = seal(json);
+        assert!(sealed.contains("\"checksum\""), "{sealed}");
+        assert_eq!(unseal(&sealed), Sealed::Verified(json.to_string()));
+        assert_eq!(unseal(json), Sealed::Unsealed(json));
+        let damaged = sealed.replace("0.5", "0.6");
+        assert_eq!(unseal(&damaged), Sealed::Damaged);
+        // The value still parses as JSON with the field.
+        let v: serde_json::Value = serde_json::from_str(&sealed).unwrap();
+        assert_eq!(v["a"], 1);
+    }
+
+    #[test]
+    fn an_atomic_write_never_follows_a_link_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "keep").unwrap();
+        let target = dir.path().join("best.genome");
+        // Links planted where the old fixed temporary name was, and at the
+        // first unique names this process would try.
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&victim, dir.path().join("best.genome.tmp")).unwrap();
+            for n in 0..100 {
+                let name = format!(".best.genome.{}.{n}.tmp", std::process::id());
+                std::os::unix::fs::symlink(&victim, dir.path().join(name)).unwrap();
+            }
+        }
+        write_atomic(&target, b"0101\n").unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep");
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "0101\n");
+        assert!(!std::fs::symlink_metadata(&target).unwrap().file_type().is_symlink());
+        let left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        // Only the planted links are left.
+        assert_eq!(left.len(), if cfg!(unix) { 101 } else { 0 }, "{left:?}");
+    }
+
+    #[test]
+    fn a_second_lock_of_a_directory_is_refused_naming_the_holder_and_released_on_drop() {
+        let dir = tempfile::tempdir().unwrap();
+        let first = DirLock::acquire(dir.path()).unwrap();
+        let err = DirLock::acquire(dir.path()).unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Locked);
+        assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
+        drop(first);
+        DirLock::acquire(dir.path()).unwrap();
+    }
+}

@@ -1,0 +1,189 @@
+//! Replays: one individual of a stage run with a trace, its files and
+//! pictures; and the choice of that individual (`replay`, `drive`).
+
+use std::path::{Path, PathBuf};
+
+use shaping_runtime::controller::EpisodeOptions;
+use shaping_runtime::evolve;
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Program, StageRun};
+use shaping_runtime::sim::Sim;
+
+use shaping_runtime::controller::EpisodeResult;
+
+use crate::error::{Error, ErrorKind};
+use crate::files::{create_dir, write_atomic};
+use crate::run::{Event, Observer};
+use crate::{episode, html, load, report, run, rundir};
+
+/// What to replay.
+#[derive(Clone, Debug, Default)]
+pub struct ReplayOptions {
+    /// The architecture file, for the default run directory (`runs/<stem>`).
+    pub file: PathBuf,
+    pub stage: Option<String>,
+    pub genome: Option<String>,
+    pub run: Option<PathBuf>,
+    pub actions: Option<u32>,
+    pub out: Option<PathBuf>,
+    pub seed: Option<u64>,
+    pub no_learning: bool,
+    /// Also write `report.html` for the episode.
+    pub report: bool,
+}
+
+/// Reads `--genome`: an argument made only of `0`, `1`, `_` and blanks is
+/// the genome itself; anything else is the path of a file holding one. A
+/// string of digits that is not a genome (`2101`) is refused as such, not
+/// looked for as a file.
+pub fn parse_genome(arg: &str) -> Result<Genome, Error> {
+    let (position, c) = match Genome::parse_bitstring(arg) {
+        Ok(g) => return Ok(g),
+        Err(bad) => bad,
+    };
+    let blank = |c: char| c == '_' || c.is_whitespace();
+    if arg.chars().all(|c| c.is_ascii_digit() || blank(c)) {
+        return Err(Error::io(format!(
+            "error: `--genome {arg}` is not a genome: character {position} is `{c}`; a genome is a string of 0 and 1 (or the path of a file holding one)"
+        )));
+    }
+    let path = Path::new(arg);
+    if !path.is_file() {
+        return Err(Error::io(format!(
+            "error: `--genome {arg}` is neither a string of 0 and 1 (character {position} is `{c}`) nor a file"
+        )));
+    }
+    read_genome(path)
+}
+
+pub use crate::rundir::read_genome;
+
+/// What `replay` and `drive` run: the program with the weights of every
+/// training stage bound (the one way every command binds them), the stage,
+/// the individual, and for a training stage, its run seed.
+pub struct Chosen {
+    pub program: Program,
+    pub index: usize,
+    pub genome: Genome,
+    /// The run seed of the training stage's life, when `index` is one.
+    pub training_seed: Option<u64>,
+}
+
+/// Loads `file`, binds the training stages from run directory `run` (default
+/// `runs/<file stem>`) and picks the individual: `--genome`, else the best
+/// of the stage (or of the evolved stage it tests) in the run directory.
+/// A training stage has no individual: its life is what there is to see.
+pub fn choose(
+    mut program: Program,
+    file: &Path,
+    stage: Option<&str>,
+    genome: Option<&str>,
+    run: Option<&Path>,
+    observer: &dyn Observer,
+) -> Result<Chosen, Error> {
+    let index = load::stage_index(&program, stage)?;
+    let run_dir = run.map_or_else(|| run::default_out(file), Path::to_path_buf);
+    let seed = run::run_seed(&program, None);
+    let trained = run::bind_training(&mut program, Some(&run_dir), seed, observer)?;
+    let stage = &program.stages[index];
+    let training_seed = trained.iter().find(|(i, _)| *i == index).map(|(_, t)| t.run_seed);
+    let genome = match genome {
+        Some(g) => parse_genome(g)?,
+        None if training_seed.is_some() => Genome::zeros(0),
+        // Nothing is evolved: the empty genome is the only individual.
+        None if stage.layout.bits == 0 && run.is_none() => Genome::zeros(0),
+        None => {
+            let source = run::evolved_ancestor(&program, index).unwrap_or(index);
+            let dir = rundir::stage_dir(&run_dir, &program.stages[source].name);
+            let path = rundir::best_genome_path(&dir);
+            if !path.exists() {
+                return Err(Error::io(format!(
+                    "error: no evolved individual at `{}`; run `shaping run {}{}` first, or pass `--genome`",
+                    path.display(),
+                    file.display(),
+                    run.map_or_else(String::new, |d| format!(" --out {}", d.display()))
+                )));
+            }
+            check_run(&program, source, &dir)?;
+            rundir::read_best(&dir)?
+        }
+    };
+    if genome.bits.len() != stage.layout.bits as usize {
+        return Err(Error::io(format!(
+            "error: the genome has {} bits but stage `{}` needs {}",
+            genome.bits.len(),
+            stage.name,
+            stage.layout.bits
+        )));
+    }
+    Ok(Chosen { program, index, genome, training_seed })
+}
+
+/// A best individual taken from a run directory must come from the program
+/// as it is: its stage's checkpoint must still fit.
+fn check_run(program: &Program, index: usize, dir: &Path) -> Result<(), Error> {
+    let Some(cp) = rundir::read_checkpoint(dir)? else { return Ok(()) };
+    shaping_runtime::evolve::check_resume_of(program, index, &cp).map_err(|e| {
+        Error::new(ErrorKind::Stale, format!(
+            "error: the best individual in `{}` is not of this program: {e}; run the file again (`shaping run` with `--fresh`)",
+            dir.display()
+        ))
+    })
+}
+
+/// What a replay did: the episode's result, where its files are, its
+/// report (if asked for).
+#[derive(Clone, Debug)]
+pub struct Replayed {
+    pub stage: String,
+    pub result: EpisodeResult,
+    pub out: PathBuf,
+    pub report: Option<PathBuf>,
+}
+
+/// Replays an individual of `program` (the file's; see [`choose`]) and
+/// writes its files: `trace.csv`, the pictures, `episode.json`,
+/// `program.json`, `genome`, and `report.html` if asked for.
+pub fn replay(program: Program, args: &ReplayOptions, observer: &dyn Observer) -> Result<Replayed, Error> {
+    let chosen = choose(
+        program,
+        &args.file,
+        args.stage.as_deref(),
+        args.genome.as_deref(),
+        args.run.as_deref(),
+        observer,
+    )?;
+    let Chosen { program, index, genome, training_seed } = chosen;
+    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let stage = &program.stages[index];
+    let (actions, learning) = match &stage.run {
+        StageRun::Evolve(e) => (e.actions, true),
+        // One life of the test, in the stage's own world.
+        StageRun::Test { actions, learning, .. } => (*actions, *learning),
+        StageRun::Train { actions } => (*actions, true),
+    };
+    let actions = args.actions.unwrap_or(actions);
+    let learning = learning && !args.no_learning;
+    // A training stage's own life by default: the one its weights were learned in.
+    let seed = args.seed.unwrap_or_else(|| match training_seed {
+        Some(run_seed) => evolve::train::training_seed(run_seed, index),
+        None => run::run_seed(&program, None),
+    });
+    load::check_recording(stage, actions)?;
+    let (r, trace, ep) = episode::run_recorded(stage, &genome, &EpisodeOptions { actions, learning, seed })
+        .map_err(|e| Error::io(format!("error: {e}")))?;
+    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
+    let mut crowding = run::Crowding::default();
+    crowding.add(r.placement_failures);
+    if let Some(w) = crowding.warning(&stage.name, &out, ("episode", "episodes")) {
+        observer.event(Event::Warning(w));
+    }
+    create_dir(&out)?;
+    let scene = Sim::new(&stage.world, seed).scene();
+    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
+    write_atomic(&out.join("episode.json"), rundir::compact_json(&ep)?.as_bytes())?;
+    rundir::write_program(&out, &program)?;
+    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    let report = if args.report { Some(html::write(&out, None)?) } else { None };
+    Ok(Replayed { stage: stage.name.clone(), result: r, out, report })
+}

@@ -1,0 +1,1137 @@
+//! Running a program's stages in order into a run directory: training
+//! stages, evolution with resume and fingerprint checks, test stages; the
+//! files of each stage, and what the caller is told as it goes.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use serde_json::Value;
+use shaping_runtime::controller::{
+    episode_rngs, run_episode, run_episode_on, Controller, EpisodeOptions, EpisodeResult, Trace,
+};
+use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Param, Program, Stage, StageRun};
+use shaping_runtime::sim::{Scene, Sim};
+
+use crate::episode::{self, Part, Recorder, Stoppable};
+use crate::error::{Error, ErrorKind, Result};
+use crate::files::{create_dir, write_atomic, DirLock};
+use crate::rundir::{self, compact_json, to_json};
+use crate::sweep::Assignment;
+use crate::{html, report, RECORDED_TRAINING_ACTIONS};
+
+/// What a run does: which stages, with which seed, into which directory.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Run only this stage and the stages it needs (all stages: `None`).
+    pub stage: Option<String>,
+    /// The run seed (default: the first evolved stage's declared seed).
+    pub seed: Option<u64>,
+    /// The run directory.
+    pub out: PathBuf,
+    /// Worker threads for local evaluation (default: one per core).
+    pub jobs: Option<usize>,
+    /// Start every stage again, ignoring saved results.
+    pub fresh: bool,
+    /// Write no `report.html` at the end.
+    pub no_report: bool,
+    /// Settings changed from the program's (`--set`, one value each).
+    pub sets: Vec<Assignment>,
+}
+
+/// What a run tells its caller as it goes. The engine prints nothing: a
+/// command line draws progress bars from these, a notebook may log them.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum Event<'a> {
+    /// An evolved stage starts, or resumes with `done` of its `generations` done.
+    EvolveStart { stage: &'a str, generations: u32, done: u32 },
+    /// A stage resumes from its checkpoint (`finished`: nothing is left to do).
+    Resumed { stage: &'a str, generation: u32, generations: u32, finished: bool, checkpoint: &'a Path },
+    /// A generation was evaluated and saved.
+    Generation { stage: &'a str, stats: &'a GenStats },
+    /// The generations of an evolved stage are done (its best is chosen
+    /// next), or stopped (`completed` false: the run was interrupted).
+    EvolveEnd { stage: &'a str, completed: bool },
+    /// An evolved stage is done: its last generation and chosen best.
+    Evolved { stage: &'a str, generations: u32, last: Option<&'a GenStats>, chosen: f32, dir: &'a Path },
+    /// A training stage is done (`reused`: from its saved `trained.json`);
+    /// `recorded` of its actions are in its trace.
+    Trained { stage: &'a Stage, trained: &'a Trained, recorded: u32, reused: bool, dir: &'a Path },
+    /// A test stage is done: its `summary.json`, and the totals of each world.
+    Tested {
+        stage: &'a str,
+        summary: &'a Value,
+        lives: u32,
+        before: &'a EpisodeResult,
+        after: &'a EpisodeResult,
+        dir: &'a Path,
+    },
+    /// Something the user should know: the results are not what they seem
+    /// (a crowded world), or a saved file was not used.
+    Warning(String),
+}
+
+/// Receives a run's [`Event`]s.
+pub trait Observer {
+    fn event(&self, event: Event<'_>);
+}
+
+/// An observer that ignores everything.
+pub struct Silent;
+
+impl Observer for Silent {
+    fn event(&self, _: Event<'_>) {}
+}
+
+/// Where the episodes of an evolved stage are evaluated: on this process's
+/// threads ([`Local`]), over MPI ranks, on a robot. Evaluations come back in
+/// the order of `jobs`, and an episode's result depends only on its genome
+/// and seed, so every evaluator gives the same files.
+pub trait Evaluate {
+    /// Called before the first evaluation of evolved stage `index`, whose
+    /// files are in `dir`; `digest` names the stage as it is (its
+    /// fingerprint's), `fresh` that saved results are not to be used.
+    fn begin_stage(
+        &self,
+        _program: &Program,
+        _index: usize,
+        _dir: &Path,
+        _digest: u64,
+        _fresh: bool,
+    ) -> Result<()> {
+        Ok(())
+    }
+    /// Evaluates `jobs` (genome, episode seed) of evolved stage `index`,
+    /// episodes of `actions` actions with learning on; a failed evaluation
+    /// has a NaN fitness, and [`Evaluate::failure`] says why.
+    fn evaluate(
+        &self,
+        program: &Program,
+        index: usize,
+        actions: u32,
+        jobs: &[(&Genome, u64)],
+    ) -> Vec<Evaluation>;
+    /// What the next evaluations are for, and the checkpoint a new run would
+    /// resume from (for the messages of a failure).
+    fn context(&self, _what: String, _checkpoint: &Path) {}
+    /// Why evaluations failed, if they did.
+    fn failure(&self) -> Option<Error> {
+        None
+    }
+}
+
+/// Evaluation on this process's threads (a rayon pool of `jobs` threads).
+pub struct Local {
+    pool: rayon::ThreadPool,
+}
+
+impl Local {
+    /// A pool of `jobs` threads (one per core: `None`).
+    pub fn new(jobs: Option<usize>) -> Result<Local> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs.unwrap_or(0))
+            .build()
+            .map_err(|e| Error::io(format!("error: cannot start worker threads: {e}")))?;
+        Ok(Local { pool })
+    }
+}
+
+impl Evaluate for Local {
+    fn evaluate(
+        &self,
+        program: &Program,
+        index: usize,
+        actions: u32,
+        jobs: &[(&Genome, u64)],
+    ) -> Vec<Evaluation> {
+        let stage = &program.stages[index];
+        self.pool.install(|| evolve::evaluate_many(&evaluator(stage, actions), jobs))
+    }
+}
+
+/// What a run ended with, stage by stage.
+#[derive(Clone, Debug)]
+pub struct RunOutcome {
+    pub out: PathBuf,
+    pub seed: u64,
+    pub stages: Vec<StageOutcome>,
+    /// `report.html`, unless `no_report`.
+    pub report: Option<PathBuf>,
+}
+
+/// What one stage of a run ended with.
+#[derive(Clone, Debug)]
+pub enum StageOutcome {
+    Train { stage: String, actions: u32, performance: Vec<f32> },
+    Evolve { stage: String, generations: u32, best: f32, genome: Genome },
+    Test { stage: String, summary: Value },
+}
+
+impl StageOutcome {
+    /// The stage's name.
+    pub fn stage(&self) -> &str {
+        match self {
+            StageOutcome::Train { stage, .. }
+            | StageOutcome::Evolve { stage, .. }
+            | StageOutcome::Test { stage, .. } => stage,
+        }
+    }
+
+    /// As the last line of `shaping run --json` shows it.
+    pub fn to_json(&self) -> Value {
+        match self {
+            StageOutcome::Train { stage, actions, performance } => serde_json::json!({
+                "stage": stage, "kind": "train", "actions": actions, "performance": performance,
+            }),
+            StageOutcome::Evolve { stage, generations, best, genome } => serde_json::json!({
+                "stage": stage, "kind": "evolve", "generations": generations,
+                "best": best, "genome": genome.to_bitstring(),
+            }),
+            StageOutcome::Test { stage, summary } => {
+                serde_json::json!({"kind": "test", "summary": summary, "stage": stage})
+            }
+        }
+    }
+}
+
+/// The directory a run of `file` writes to by default: `runs/<file stem>`.
+pub fn default_out(file: &Path) -> PathBuf {
+    let stem = file.file_stem().map_or_else(|| "program".into(), |s| s.to_string_lossy().into_owned());
+    PathBuf::from("runs").join(stem)
+}
+
+/// The run seed: `--seed`, else the first evolved stage's declared seed.
+pub fn run_seed(program: &Program, seed: Option<u64>) -> u64 {
+    seed.unwrap_or_else(|| {
+        program
+            .stages
+            .iter()
+            .find_map(|s| match &s.run {
+                StageRun::Evolve(e) => Some(e.seed),
+                StageRun::Test { .. } | StageRun::Train { .. } => None,
+            })
+            .unwrap_or(1)
+    })
+}
+
+/// The stages to run for a target stage: it, its ancestors and the training
+/// stages whose weights they use, in program order.
+pub fn chain(program: &Program, target: usize) -> Vec<usize> {
+    let mut need = vec![false; program.stages.len()];
+    let mut cur = Some(target);
+    while let Some(i) = cur {
+        need[i] = true;
+        for (_, p) in program.stages[i].modules.iter().flat_map(|m| m.network_params()) {
+            if let Param::Trained { stage, .. } = *p {
+                if let Some(n) = need.get_mut(stage as usize) {
+                    *n = true;
+                }
+            }
+        }
+        cur = program.stages[i].parent;
+    }
+    (0..program.stages.len()).filter(|&i| need[i]).collect()
+}
+
+/// The nearest evolved stage at or above `index` (itself if evolved), if any.
+pub fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
+    let mut cur = Some(index);
+    while let Some(i) = cur {
+        if let StageRun::Evolve(_) = program.stages[i].run {
+            return Some(i);
+        }
+        cur = program.stages[i].parent;
+    }
+    None
+}
+
+/// Evaluation of one genome in an evolved stage: one episode with local learning on.
+pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evaluation + Sync + '_ {
+    move |genome: &Genome, seed: u64| {
+        Evaluation::of_episode(run_episode(
+            stage,
+            genome,
+            &EpisodeOptions { actions, learning: true, seed },
+            None,
+        ))
+    }
+}
+
+/// Episodes whose world could not be placed apart: some placement (an
+/// object, the robot's start, a virtual object coming back) ran out of
+/// tries and kept an overlapping one, so the episode is not the declared
+/// world and its fitness is not that world's. Worlds that can never be
+/// placed are refused before a run (`sim::crowded`); one that is only
+/// crowded runs, and this says how often it did not fit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Crowding {
+    /// Episodes (or lives) counted.
+    pub episodes: u64,
+    /// Those with a placement that overlaps.
+    pub crowded: u64,
+    /// Placements that overlap, over all of them.
+    pub placements: u64,
+}
+
+impl Crowding {
+    /// Counts one episode with `placement_failures` overlapping placements.
+    pub fn add(&mut self, placement_failures: u32) {
+        self.episodes += 1;
+        self.crowded += u64::from(placement_failures > 0);
+        self.placements += u64::from(placement_failures);
+    }
+
+    /// The warning for stage `stage`, whose files are in `dir`, if any of
+    /// its episodes was crowded; `what` names them, one and several
+    /// (`("episode", "episodes")`).
+    pub fn warning(&self, stage: &str, dir: &Path, what: (&str, &str)) -> Option<String> {
+        (self.crowded > 0).then(|| {
+            let (n, m, p) = (self.crowded, self.episodes, self.placements);
+            let (which, those) = if m == 1 {
+                (format!("in its {}", what.0), format!("its {}", what.0))
+            } else {
+                (format!("in {n} of {m} {}", what.1), format!("those {}", what.1))
+            };
+            let places = if p == 1 { "1 placement".to_string() } else { format!("{p} placements") };
+            format!(
+                "warning: the world of stage `{stage}` is too crowded: {which} objects (or the robot) could not be \
+                 placed apart and overlap ({places} kept an overlapping last try), so the results of {those} are not \
+                 of the world as declared; fewer or smaller objects, or a larger arena, give them room (results in `{}`)",
+                dir.display()
+            )
+        })
+    }
+}
+
+/// The error for a saved result (checkpoint or trained weights) that does
+/// not belong to the program as it is now.
+fn stale(path: &Path, e: &evolve::EvolveError) -> Error {
+    let hint = match e {
+        evolve::EvolveError::TooManyGenerations { done, .. } => {
+            format!("declare at least {done} generations, pass `--fresh` to start again, or choose another `--out`")
+        }
+        _ => "pass `--fresh` to start again, or choose another `--out`".to_string(),
+    };
+    Error::new(ErrorKind::Stale, format!("error: cannot resume from `{}`: {e}; {hint}", path.display()))
+}
+
+/// A saved result of another seed than the run's.
+fn other_seed(path: &Path, saved: u64, seed: u64) -> Error {
+    Error::new(
+        ErrorKind::Stale,
+        format!(
+            "error: `{}` belongs to a run with seed {saved} (this run has seed {seed}); pass `--seed {saved}` to resume it, `--fresh` to start again, or another `--out`",
+            path.display()
+        ),
+    )
+}
+
+/// The error of a run stopped by its interruption flag.
+fn interrupted(message: String) -> Error {
+    Error::new(ErrorKind::Interrupted, message)
+}
+
+/// Checks, before anything is written, what a run of `stages` would
+/// resume from `out`: the saved stages belong to one seed (stages of two
+/// seeds, one of them started again with `--fresh --stage S --seed N`,
+/// cannot be resumed by one run with either seed), and each saved
+/// checkpoint and `trained.json` fits the program (training stages bound
+/// in order as the run binds them; the check stops at a training stage
+/// that has to be trained again, whose weights are not known yet).
+fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Result<()> {
+    let mut saved: Vec<(&str, u64)> = Vec::new();
+    let mut bound = program.clone();
+    let mut binding = true;
+    for &i in stages {
+        let st = &program.stages[i];
+        let dir = rundir::stage_dir(out, &st.name);
+        match st.run {
+            StageRun::Evolve(_) => {
+                if let Some(mut cp) = rundir::read_checkpoint(&dir)? {
+                    saved.push((&st.name, cp.seed));
+                    if binding && cp.seed == seed {
+                        let path = rundir::checkpoint_path(&dir);
+                        evolve::resume(&bound, i, &mut cp).map_err(|e| stale(&path, &e))?;
+                    }
+                }
+            }
+            StageRun::Train { .. } => match rundir::read_trained(&dir)? {
+                Some(t) => {
+                    saved.push((&st.name, t.run_seed));
+                    if binding && t.run_seed == seed {
+                        let path = rundir::trained_path(&dir);
+                        evolve::train::check(&bound, i, &t).map_err(|e| stale(&path, &e))?;
+                        evolve::train::bind(&mut bound, i, &t)
+                            .map_err(|e| Error::io(format!("error: {e}")))?;
+                    } else {
+                        binding = false;
+                    }
+                }
+                None => binding = false,
+            },
+            StageRun::Test { .. } => {}
+        }
+    }
+    let mut seeds: Vec<u64> = saved.iter().map(|&(_, s)| s).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    if seeds.len() < 2 {
+        return Ok(());
+    }
+    let which: Vec<String> = saved.iter().map(|(name, s)| format!("`{name}` seed {s}")).collect();
+    Err(Error::new(
+        ErrorKind::Stale,
+        format!(
+            "error: `{}` holds stages of different seeds ({}); one run resumes stages of one seed: \
+             pass `--fresh` to run every stage again with seed {seed}, or choose another `--out`",
+            out.display(),
+            which.join(", ")
+        ),
+    ))
+}
+
+/// Who runs a program's stages: the caller's observer, evaluator and
+/// interruption flag.
+pub struct Runner<'a> {
+    /// Told of progress and warnings.
+    pub observer: &'a dyn Observer,
+    /// Evaluates evolved stages' episodes (this process's threads: `None`).
+    pub evaluator: Option<&'a dyn Evaluate>,
+    /// Once set, the run stops at the next safe point (after the generation
+    /// under way, at the next action of a test's life) and says where.
+    pub interrupt: Option<&'a AtomicBool>,
+}
+
+impl Default for Runner<'_> {
+    fn default() -> Self {
+        Runner { observer: &Silent, evaluator: None, interrupt: None }
+    }
+}
+
+impl Runner<'_> {
+    fn stopped(&self) -> bool {
+        self.interrupt.is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// Runs the stages of `program` (with `opts.sets` applied) into
+    /// `opts.out`, resuming what is saved there, and locks the directory
+    /// while it does.
+    pub fn run(&self, mut program: Program, opts: &RunOptions) -> Result<RunOutcome> {
+        crate::sweep::apply(&mut program, &opts.sets)?;
+        if program.stages.is_empty() {
+            return Err(Error::new(ErrorKind::Invalid, "error: the program has no stages"));
+        }
+        let target = match opts.stage.as_deref() {
+            Some(_) => crate::load::stage_index(&program, opts.stage.as_deref())?,
+            None => program.stages.len() - 1,
+        };
+        let stages =
+            if opts.stage.is_some() { chain(&program, target) } else { (0..program.stages.len()).collect() };
+        crate::load::check_memory(&program, &stages, 1)?;
+        let out = opts.out.clone();
+        let seed = run_seed(&program, opts.seed);
+        let local = Local::new(opts.jobs)?;
+        let _lock = DirLock::acquire(&out)?;
+        if !opts.fresh {
+            precheck(&program, &stages, &out, seed)?;
+        }
+        // The compiled program, for `shaping report` (and `shaping run program.json`).
+        rundir::write_program(&out, &program)?;
+        let evaluator = self.evaluator.unwrap_or(&local);
+        let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
+        let mut results = Vec::new();
+        for &index in &stages {
+            // Stopped during a training life, a test or the choice of a best:
+            // the step under way finished and is saved; stop before the next.
+            if self.stopped() {
+                return Err(interrupted(format!(
+                    "interrupted: stopped before stage `{}`; what ran is saved in `{}`, and the same command resumes",
+                    program.stages[index].name,
+                    out.display()
+                )));
+            }
+            let dir = rundir::stage_dir(&out, &program.stages[index].name);
+            create_dir(&dir)?;
+            if let StageRun::Train { .. } = program.stages[index].run {
+                let trained = self.train_step(&program, index, seed, &dir, opts.fresh)?;
+                evolve::train::bind(&mut program, index, &trained)
+                    .map_err(|e| Error::io(format!("error: {e}")))?;
+                results.push(StageOutcome::Train {
+                    stage: program.stages[index].name.clone(),
+                    actions: trained.result.actions,
+                    performance: trained.performance,
+                });
+                continue;
+            }
+            let stage = &program.stages[index];
+            match &stage.run {
+                StageRun::Evolve(_) => {
+                    let parent = evolved_parent(&program, index, &finals)?;
+                    let cp = self.evolve_stage(&program, index, seed, parent, &dir, opts.fresh, evaluator)?;
+                    best_episode(stage, &cp, seed, &dir)?;
+                    if let Some((genome, best)) = evolve::best_of(&cp) {
+                        results.push(StageOutcome::Evolve {
+                            stage: stage.name.clone(),
+                            generations: cp.generation,
+                            best,
+                            genome,
+                        });
+                    }
+                    finals[index] = Some(cp);
+                }
+                StageRun::Test { actions, lives, learning } => {
+                    let parent = evolved_parent(&program, index, &finals)?.ok_or_else(|| {
+                        Error::new(
+                            ErrorKind::Invalid,
+                            format!("error: test stage `{}` extends no evolved stage", stage.name),
+                        )
+                    })?;
+                    let test = TestRun {
+                        program: &program,
+                        index,
+                        seed,
+                        parent,
+                        actions: *actions,
+                        lives: *lives,
+                        learning: *learning,
+                    };
+                    let summary = self.test_stage(&test, &dir)?;
+                    results.push(StageOutcome::Test { stage: stage.name.clone(), summary });
+                }
+                StageRun::Train { .. } => unreachable!("training stages run above"),
+            }
+        }
+        if self.stopped() {
+            return Err(interrupted(format!(
+                "interrupted: every stage is done and saved in `{0}`, but not `report.html` (`shaping report {0}` writes it)",
+                out.display()
+            )));
+        }
+        let report = if opts.no_report { None } else { Some(html::write(&out, None)?) };
+        Ok(RunOutcome { out, seed, stages: results, report })
+    }
+}
+
+/// `episode.json` of an evolved stage: one recorded episode of its best
+/// individual, the one `shaping replay FILE --stage S` shows by default
+/// (the run seed, the stage's life, learning on).
+fn best_episode(stage: &Stage, cp: &Checkpoint, seed: u64, dir: &Path) -> Result<()> {
+    let StageRun::Evolve(evo) = &stage.run else { return Ok(()) };
+    let Some((genome, _)) = evolve::best_of(cp) else { return Ok(()) };
+    let opts = EpisodeOptions { actions: evo.actions, learning: true, seed };
+    let (_, _, ep) =
+        episode::run_recorded(stage, &genome, &opts).map_err(|e| Error::io(format!("error: {e}")))?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
+}
+
+/// The final checkpoint of the nearest evolved ancestor of `index`.
+fn evolved_parent<'a>(
+    program: &Program,
+    index: usize,
+    finals: &'a [Option<Checkpoint>],
+) -> Result<Option<&'a Checkpoint>> {
+    let Some(p) = program.stages[index].parent.and_then(|p| evolved_ancestor(program, p)) else {
+        return Ok(None);
+    };
+    finals[p].as_ref().map(Some).ok_or_else(|| {
+        Error::new(ErrorKind::Invalid, format!("error: stage `{}` has not been run", program.stages[p].name))
+    })
+}
+
+impl Runner<'_> {
+    /// Runs (or resumes) evolved stage `index` to its end and its chosen best,
+    /// writing its files into `dir`.
+    #[allow(clippy::too_many_arguments)]
+    fn evolve_stage(
+        &self,
+        program: &Program,
+        index: usize,
+        seed: u64,
+        parent: Option<&Checkpoint>,
+        dir: &Path,
+        fresh: bool,
+        evaluator: &dyn Evaluate,
+    ) -> Result<Checkpoint> {
+        let stage = &program.stages[index];
+        let StageRun::Evolve(evo) = &stage.run else {
+            unreachable!("evolve_stage is called for evolved stages")
+        };
+        let path = rundir::checkpoint_path(dir);
+        let existing = if fresh { None } else { rundir::read_checkpoint(dir)? };
+        let mut cp = match existing {
+            Some(mut cp) => {
+                if cp.seed != seed {
+                    return Err(other_seed(&path, cp.seed, seed));
+                }
+                evolve::resume(program, index, &mut cp).map_err(|e| stale(&path, &e))?;
+                self.observer.event(Event::Resumed {
+                    stage: &stage.name,
+                    generation: cp.generation,
+                    generations: evo.generations,
+                    finished: evolve::is_finished(program, &cp) && cp.validated,
+                    checkpoint: &path,
+                });
+                cp
+            }
+            None => evolve::start_stage(program, index, seed, parent)
+                .map_err(|e| Error::io(format!("error: {e}")))?,
+        };
+        // Every individual would silently score 0 on a stage the controller
+        // cannot run (e.g. weights of a training stage that was not bound).
+        let probe = Genome::zeros(stage.layout.bits as usize);
+        shaping_runtime::controller::validate(stage, &probe).map_err(|e| {
+            Error::new(ErrorKind::Invalid, format!("error: stage `{}` cannot run: {e}", stage.name))
+        })?;
+        self.observer.event(Event::EvolveStart {
+            stage: &stage.name,
+            generations: evo.generations,
+            done: cp.generation,
+        });
+        // An evaluator's saved episodes (a robot's log) are tied to the stage
+        // as the checkpoint is.
+        evaluator.begin_stage(program, index, dir, evolve::fingerprint::digest(&cp.fingerprint), fresh)?;
+        let fail = |e| {
+            evaluator.failure().unwrap_or_else(|| Error::new(ErrorKind::Evaluation, format!("error: {e}")))
+        };
+        // The episodes this process runs for the stage, for the warning about
+        // a crowded world (the generations' are in their statistics too).
+        let run_now = std::cell::Cell::new(Crowding::default());
+        let many = |jobs: &[(&Genome, u64)]| {
+            let evaluations = evaluator.evaluate(program, index, evo.actions, jobs);
+            let mut tally = run_now.get();
+            for ev in &evaluations {
+                tally.add(ev.placement_failures);
+            }
+            run_now.set(tally);
+            evaluations
+        };
+        let mut warned = false;
+        while !evolve::is_finished(program, &cp) {
+            evaluator.context(format!("generation {} of stage `{}`", cp.generation, stage.name), &path);
+            let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
+            rundir::write_checkpoint(dir, &cp)?;
+            write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+            self.observer.event(Event::Generation { stage: &stage.name, stats: &stats });
+            if stats.crowded_episodes > 0 && !warned {
+                // Said at once (a long run may be stopped), and again with the
+                // totals at the end of the stage.
+                warned = true;
+                self.observer.event(Event::Warning(format!(
+                    "warning: the world of stage `{}` is too crowded: in generation {}, {} of {} episodes placed \
+                     objects (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
+                    stage.name,
+                    stats.stage_generation,
+                    stats.crowded_episodes,
+                    u64::from(evo.population) * u64::from(evo.evaluations.max(1))
+                )));
+            }
+            if self.stopped() && !evolve::is_finished(program, &cp) {
+                self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: false });
+                return Err(interrupted(format!(
+                    "interrupted: stage `{}` stopped after generation {} of {}, saved in `{}`; the same command resumes it",
+                    stage.name,
+                    cp.generation,
+                    evo.generations,
+                    path.display()
+                )));
+            }
+        }
+        self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: true });
+        let generations_now = run_now.get();
+        if !cp.validated {
+            // Pick the stage's best by its mean over fresh episodes, not by its
+            // luckiest single evaluation.
+            evaluator.context(format!("the choice of the best of stage `{}`", stage.name), &path);
+            evolve::validate_best_with(
+                program,
+                &mut cp,
+                &many,
+                evolve::VALIDATE_CANDIDATES,
+                evolve::VALIDATE_EPISODES,
+            )
+            .map_err(fail)?;
+            rundir::write_checkpoint(dir, &cp)?;
+        }
+        let now = run_now.get();
+        let choice = Crowding {
+            episodes: now.episodes - generations_now.episodes,
+            crowded: now.crowded - generations_now.crowded,
+            placements: now.placements - generations_now.placements,
+        };
+        if let Some(w) =
+            stage_crowding(&cp, &stage.name, evo, choice).warning(&stage.name, dir, ("episode", "episodes"))
+        {
+            self.observer.event(Event::Warning(w));
+        }
+        let (genome, fitness) = evolve::best_of(&cp)
+            .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
+        rundir::write_best_genome(dir, &genome)?;
+        write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+        report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
+        self.observer.event(Event::Evolved {
+            stage: &stage.name,
+            generations: cp.generation,
+            last: cp.history.last(),
+            chosen: fitness,
+            dir,
+        });
+        Ok(cp)
+    }
+}
+
+/// The crowded episodes of evolved stage `name`: its generations in the
+/// checkpoint's history (those of an earlier, resumed run too) and the
+/// choice of its best (`choice`, when this process made it).
+fn stage_crowding(
+    cp: &Checkpoint,
+    name: &str,
+    evo: &shaping_runtime::program::Evolution,
+    choice: Crowding,
+) -> Crowding {
+    let per_generation = u64::from(evo.population) * u64::from(evo.evaluations.max(1));
+    let mut c = choice;
+    for h in cp.history.iter().filter(|h| h.stage == name) {
+        c.episodes += per_generation;
+        c.crowded += u64::from(h.crowded_episodes);
+        c.placements += u64::from(h.placement_failures);
+    }
+    c
+}
+
+/// The lives of a test stage's individual: `lives` lives of at most
+/// `actions` actions in the world of the stage it extends ("before"), then as
+/// many in the stage's own world ("after"), with one controller, so what local
+/// learning acquired (and the performance indicators) carries over from life
+/// to life and across the change (the paper's section 4.9). Every life is a
+/// fresh world (full battery, objects placed anew) with its own simulator
+/// seed, [`evolve::seed::test_life_seed`]; a life ends early when the battery
+/// is empty.
+pub struct BeforeAfter {
+    /// Every life, in order, the action index running on.
+    pub trace: Trace,
+    /// Index of the first action in the changed world.
+    pub switch: u32,
+    /// What each life before the change produced.
+    pub before: Vec<EpisodeResult>,
+    /// What each life after the change produced.
+    pub after: Vec<EpisodeResult>,
+    /// The changed world at the start of its first life, for the trajectory picture.
+    pub scene: Scene,
+    /// The recorded episode, every life a part (`episode.json`).
+    pub episode: episode::Episode,
+}
+
+impl BeforeAfter {
+    /// The first action of every life but the first: the boundaries in the trace.
+    pub fn life_starts(&self) -> Vec<u32> {
+        let mut at = 0;
+        let mut out = Vec::new();
+        for r in self.before.iter().chain(&self.after) {
+            if at > 0 {
+                out.push(at);
+            }
+            at += r.actions;
+        }
+        out
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn before_after(
+    parent: &Stage,
+    stage: &Stage,
+    genome: &Genome,
+    actions: u32,
+    lives: u32,
+    learning: bool,
+    seed: u64,
+    stop: Option<&AtomicBool>,
+) -> Result<BeforeAfter, Error> {
+    if lives == 0 {
+        return Err(Error::io(format!("error: test stage `{}` has no life to run", stage.name)));
+    }
+    let (_, rng) = episode_rngs(seed);
+    let mut ctl = Controller::new(stage, genome, rng)
+        .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
+    let opts = EpisodeOptions { actions, learning, seed };
+    let mut trace = Trace::default();
+    let mut life = Trace::default();
+    let mut parts = Vec::new();
+    let mut results = [Vec::new(), Vec::new()];
+    for (half, world) in [parent, stage].into_iter().enumerate() {
+        for k in 0..lives {
+            let sim = Sim::new(&world.world, evolve::seed::test_life_seed(seed, half == 1, k));
+            let scene = sim.scene();
+            let mut robot = Stoppable::new(sim, stop);
+            let mut rec = Recorder::new(&mut robot);
+            results[half].push(ctl.run(&mut rec, &opts, Some(&mut life)));
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                // The life was cut short: nothing of this test is a result.
+                return Err(interrupted_test(stage, half == 1, k, lives));
+            }
+            let frames = rec.frames;
+            let from = trace.rows.len() as u32;
+            trace.modules.clone_from(&life.modules);
+            trace.rows.extend(life.rows.drain(..).map(|mut r| {
+                r.action += from;
+                r
+            }));
+            parts.push(Part { stage: &world.name, scene, frames });
+        }
+    }
+    let switch = results[0].iter().map(|r| r.actions).sum();
+    let scene = parts[lives as usize].scene.clone();
+    let episode = episode::episode(stage, seed, learning, &trace, &parts);
+    let [before, after] = results;
+    Ok(BeforeAfter { trace, switch, before, after, scene, episode })
+}
+
+/// Ctrl-C during a test stage: the life under way stopped at its next
+/// action, and nothing of the test is written (its files, if any, are
+/// those of an earlier run).
+fn interrupted_test(stage: &Stage, after: bool, life: u32, lives: u32) -> Error {
+    let world = if after { "its own world" } else { "the world before the change" };
+    interrupted(format!(
+        "interrupted: test stage `{}` stopped in life {} of {lives} in {world}; nothing of it was written \
+         (the stages before it are saved), and the same command runs it again",
+        stage.name,
+        life + 1
+    ))
+}
+
+/// The crowded lives of a test, in both worlds.
+fn lives_crowding(ba: &BeforeAfter) -> Crowding {
+    let mut c = Crowding::default();
+    for r in ba.before.iter().chain(&ba.after) {
+        c.add(r.placement_failures);
+    }
+    c
+}
+
+/// The lives of one world together: actions and events summed, the fitness
+/// the mean per life (comparable with a life's fitness in evolution).
+fn lives_total(lives: &[EpisodeResult]) -> EpisodeResult {
+    let mut t = EpisodeResult::default();
+    let mut fitness = 0.0f64;
+    for r in lives {
+        t.actions += r.actions;
+        t.grips += r.grips;
+        t.releases_outside += r.releases_outside;
+        t.recharges += r.recharges;
+        t.collisions += r.collisions;
+        t.placement_failures = t.placement_failures.saturating_add(r.placement_failures);
+        fitness += f64::from(r.fitness);
+    }
+    t.fitness = (fitness / lives.len().max(1) as f64) as f32;
+    t
+}
+
+/// A test stage to run: the program, the stage, the run seed, the final
+/// checkpoint of the evolved stage it tests, and its lives.
+struct TestRun<'a> {
+    program: &'a Program,
+    index: usize,
+    seed: u64,
+    parent: &'a Checkpoint,
+    actions: u32,
+    lives: u32,
+    learning: bool,
+}
+
+impl Runner<'_> {
+    /// Runs test stage `t` and writes its files into `dir` (all of them or,
+    /// when stopped or failing on the way, none); returns its summary.
+    fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<Value> {
+        let stage = &t.program.stages[t.index];
+        let stop = self.interrupt;
+        let (actions, lives, learning) = (t.actions, t.lives, t.learning);
+        // Stopping at the next action once interrupted.
+        let eval = |genome: &Genome, episode: u64| {
+            let opts = EpisodeOptions { actions, learning, seed: episode };
+            Evaluation::of_episode(run_episode_on(stage, genome, &opts, None, |sim| {
+                Stoppable::new(sim, stop)
+            }))
+        };
+        // Checks that the parent fits and picks its best individual and the episode seed.
+        let outcome = evolve::test_best(t.program, t.index, t.seed, t.parent, &eval)
+            .map_err(|e| Error::new(ErrorKind::Stale, format!("error: {e}")))?;
+        if self.stopped() {
+            return Err(interrupted_test(stage, false, 0, lives));
+        }
+        let parent_stage = &t.program.stages[stage.parent.unwrap_or(t.parent.stage)];
+        let ba =
+            before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed, stop)?;
+        // Every file is written into `.writing/` first and moved into `dir`
+        // once all are: an interruption (or a failure) on the way leaves the
+        // files of an earlier run of the stage, if any, as they were.
+        let staging = dir.join(".writing");
+        let _ = std::fs::remove_dir_all(&staging);
+        create_dir(&staging)?;
+        let written = test_files(&staging, stage, parent_stage, &outcome, &ba, lives, learning, stop);
+        let summary = match written {
+            Ok(summary) => summary,
+            Err(e) => {
+                let _ = std::fs::remove_dir_all(&staging);
+                if self.stopped() {
+                    return Err(interrupted(format!(
+                        "interrupted: test stage `{}` stopped while its files were written; nothing of it was written \
+                         (the stages before it are saved), and the same command runs it again",
+                        stage.name
+                    )));
+                }
+                return Err(e);
+            }
+        };
+        let moved = std::fs::read_dir(&staging).and_then(|entries| {
+            for entry in entries {
+                let entry = entry?;
+                std::fs::rename(entry.path(), dir.join(entry.file_name()))?;
+            }
+            std::fs::remove_dir(&staging)
+        });
+        moved.map_err(|e| {
+            Error::io(format!(
+                "error: cannot move the files of `{}` into `{}`: {e}",
+                staging.display(),
+                dir.display()
+            ))
+        })?;
+        let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
+        if let Some(w) = lives_crowding(&ba).warning(&stage.name, dir, ("life", "lives")) {
+            self.observer.event(Event::Warning(w));
+        }
+        self.observer.event(Event::Tested {
+            stage: &stage.name,
+            summary: &summary,
+            lives,
+            before: &b,
+            after: &a,
+            dir,
+        });
+        Ok(summary)
+    }
+}
+
+/// Writes a test stage's files into `dir` (`trace.csv`, the pictures,
+/// `episode.json`, `best.genome`, then `summary.json`), stopping between
+/// them once `stop` is set; returns the summary.
+#[allow(clippy::too_many_arguments)]
+fn test_files(
+    dir: &Path,
+    stage: &Stage,
+    parent_stage: &Stage,
+    outcome: &evolve::TestOutcome,
+    ba: &BeforeAfter,
+    lives: u32,
+    learning: bool,
+    stop: Option<&AtomicBool>,
+) -> Result<serde_json::Value, Error> {
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let check = || if stopped() { Err(Error::io(report::STOPPED)) } else { Ok(()) };
+    // The change, and the other lives' starts lightly (unlabelled marks).
+    let mut marks: Vec<(u32, String)> =
+        ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
+    marks.push((ba.switch, format!("world of `{}`", stage.name)));
+    // The trajectory: the first life in the changed world, over its scene
+    // (the lives before it ran in other worlds).
+    let first = ba.switch as usize..(ba.switch + ba.after[0].actions) as usize;
+    let what = if lives == 1 {
+        "the life after the change".to_string()
+    } else {
+        format!("the first of the {lives} lives after the change")
+    };
+    report::episode_files_until(
+        dir,
+        &stage.name,
+        stage,
+        &ba.trace,
+        &ba.episode,
+        &ba.scene,
+        &marks,
+        Some((first, &what)),
+        &stopped,
+    )?;
+    check()?;
+    write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
+    check()?;
+    write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
+    let perf = |r: &EpisodeResult| {
+        serde_json::json!({
+            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
+            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
+        })
+    };
+    let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
+    let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
+    let mut summary = serde_json::json!({
+        "stage": stage.name, "learning": learning, "seed": outcome.seed,
+        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
+        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
+        "before": perf(&b), "after": perf(&a),
+        "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
+        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
+    });
+    // Only when a world was too crowded to place apart: the lives that
+    // overlap and their overlapping placements (absent: none).
+    let crowding = lives_crowding(ba);
+    if crowding.crowded > 0 {
+        summary["crowded_lives"] = serde_json::json!(crowding.crowded);
+        summary["placement_failures"] = serde_json::json!(crowding.placements);
+    }
+    check()?;
+    write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
+    Ok(summary)
+}
+
+/// Mean reinforcement of each learning module over the lives before the
+/// world changed, the first 100 actions after it, and the rest after it.
+fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json::Value {
+    let mean = |v: &[f32]| {
+        let xs: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+        if xs.is_empty() {
+            serde_json::Value::Null
+        } else {
+            serde_json::json!(xs.iter().sum::<f32>() / xs.len() as f32)
+        }
+    };
+    let mut out = serde_json::Map::new();
+    for (i, name) in report::learning_modules(stage) {
+        let sig = report::reinforcement_signals(trace, i);
+        let s = (switch as usize).min(sig.len());
+        let early = (s + 100).min(sig.len());
+        out.insert(
+            name,
+            serde_json::json!({
+                "before": mean(&sig[..s]), "after_first_100": mean(&sig[s..early]), "after_rest": mean(&sig[early..]),
+            }),
+        );
+    }
+    serde_json::Value::Object(out)
+}
+
+impl Runner<'_> {
+    /// Runs training stage `index` (or reuses the `trained.json` a previous
+    /// run of the same stage and seed left in `dir`) and writes its files:
+    /// the learned weights, the trace of the training life (its first
+    /// [`RECORDED_TRAINING_ACTIONS`] actions) and its pictures.
+    fn train_step(
+        &self,
+        program: &Program,
+        index: usize,
+        seed: u64,
+        dir: &Path,
+        fresh: bool,
+    ) -> Result<Trained> {
+        let stage = &program.stages[index];
+        let StageRun::Train { actions } = stage.run else { unreachable!("train_step runs training stages") };
+        let recorded = actions.min(RECORDED_TRAINING_ACTIONS);
+        if !fresh {
+            if let Some(t) = rundir::read_trained(dir)? {
+                let path = rundir::trained_path(dir);
+                if t.run_seed != seed {
+                    return Err(other_seed(&path, t.run_seed, seed));
+                }
+                evolve::train::check(program, index, &t).map_err(|e| stale(&path, &e))?;
+                self.warn_training(stage, &t, dir);
+                self.observer.event(Event::Trained { stage, trained: &t, recorded, reused: true, dir });
+                return Ok(t);
+            }
+        }
+        let trained =
+            evolve::train_stage(program, index, seed, None).map_err(|e| Error::io(format!("error: {e}")))?;
+        self.warn_training(stage, &trained, dir);
+        // The same life recorded again (the same episode seed and genome), for
+        // `trace.csv`, the pictures and `episode.json`: its first
+        // `RECORDED_TRAINING_ACTIONS` actions (`trace.csv` and `episode.json`
+        // grow by about 500 bytes per action, and a training life may last
+        // millions).
+        let episode_seed = evolve::train::training_seed(seed, index);
+        let opts = EpisodeOptions { actions: recorded, learning: true, seed: episode_seed };
+        let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
+            .map_err(|e| Error::io(format!("error: {e}")))?;
+        let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
+        report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
+        write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
+        rundir::write_trained(dir, &trained)?;
+        self.observer.event(Event::Trained { stage, trained: &trained, recorded, reused: false, dir });
+        Ok(trained)
+    }
+
+    /// Warns when the training life of `stage` had a world too crowded to
+    /// place apart (its weights were learned there).
+    fn warn_training(&self, stage: &Stage, trained: &Trained, dir: &Path) {
+        let mut life = Crowding::default();
+        life.add(trained.result.placement_failures);
+        if let Some(w) = life.warning(&stage.name, dir, ("training life", "training lives")) {
+            self.observer.event(Event::Warning(w));
+        }
+    }
+}
+
+/// Binds the weights of every training stage into `program`: from the
+/// `trained.json` files of run directory `run_dir` where they exist and fit
+/// (a stale one is said, as a warning, and not used), else by training
+/// again from `seed` (training is deterministic by seed). Returns what each
+/// training stage learned. Every command that runs a stage of a file binds
+/// through here (`run` binds each training stage as it runs it).
+pub fn bind_training(
+    program: &mut Program,
+    run_dir: Option<&Path>,
+    seed: u64,
+    observer: &dyn Observer,
+) -> Result<Vec<(usize, Trained)>> {
+    let mut all = Vec::new();
+    for i in 0..program.stages.len() {
+        if !matches!(program.stages[i].run, StageRun::Train { .. }) {
+            continue;
+        }
+        let saved = match run_dir {
+            Some(d) => {
+                let dir = rundir::stage_dir(d, &program.stages[i].name);
+                match rundir::read_trained(&dir)? {
+                    Some(t) => match evolve::train::check(program, i, &t) {
+                        Ok(()) => Some(t),
+                        Err(e) => {
+                            observer.event(Event::Warning(format!(
+                                "note: not using `{}`: {e}; training the stage again",
+                                rundir::trained_path(&dir).display()
+                            )));
+                            None
+                        }
+                    },
+                    None => None,
+                }
+            }
+            None => None,
+        };
+        let trained = match saved {
+            Some(t) => t,
+            None => {
+                evolve::train_stage(program, i, seed, None).map_err(|e| Error::io(format!("error: {e}")))?
+            }
+        };
+        evolve::train::bind(program, i, &trained).map_err(|e| Error::io(format!("error: {e}")))?;
+        all.push((i, trained));
+    }
+    Ok(all)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Running a stage runs its ancestors and the training stages whose
+    /// weights it uses, whatever their place in the file.
+    #[test]
+    fn the_chain_of_a_stage_includes_the_training_stages_it_uses() {
+        let src =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/khepera.bat")).unwrap();
+        let program = shaping_compiler::compile(&src, "khepera.bat").unwrap();
+        let names = |c: Vec<usize>| c.into_iter().map(|i| program.stages[i].name.clone()).collect::<Vec<_>>();
+        assert_eq!(names(chain(&program, 1)), ["avoidance", "navigation"]);
+        assert_eq!(names(chain(&program, 3)), ["avoidance", "navigation", "collect", "bigger"]);
+        assert_eq!(names(chain(&program, 0)), ["avoidance"]);
+    }
+}

@@ -1,0 +1,204 @@
+//! The files of a run directory, each read and written in one place with
+//! one format:
+//!
+//! ```text
+//! DIR/program.json            the compiled program (with any --set applied)
+//! DIR/report.html
+//! DIR/.lock                   held while a run writes (files::DirLock)
+//! DIR/STAGE/checkpoint.json   evolved stages: resumable, with a checksum
+//! DIR/STAGE/best.genome       evolved and test stages: the chosen best
+//! DIR/STAGE/generations.csv   evolved stages
+//! DIR/STAGE/trained.json      training stages: the learned weights, with a checksum
+//! DIR/STAGE/summary.json      test stages
+//! DIR/STAGE/episode.json, trace.csv, *.svg, *.png
+//! ```
+//!
+//! An experiment's directory holds `seed-N/` run directories (under a
+//! sweep, `POINT/seed-N/`), and `summary.md`, `summary.json`.
+
+use std::path::{Path, PathBuf};
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+use shaping_runtime::evolve::{self, Checkpoint, Trained};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::Program;
+
+use crate::error::{Error, ErrorKind, Result};
+use crate::files::{read_bytes, seal, unseal, write_atomic, Sealed};
+
+/// A stage's directory in run directory `out`.
+pub fn stage_dir(out: &Path, stage: &str) -> PathBuf {
+    out.join(stage)
+}
+
+/// `STAGE/checkpoint.json`.
+pub fn checkpoint_path(dir: &Path) -> PathBuf {
+    dir.join("checkpoint.json")
+}
+
+/// `STAGE/trained.json`.
+pub fn trained_path(dir: &Path) -> PathBuf {
+    dir.join("trained.json")
+}
+
+/// `STAGE/best.genome`.
+pub fn best_genome_path(dir: &Path) -> PathBuf {
+    dir.join("best.genome")
+}
+
+/// The run directory of seed `seed` in an experiment's (or a sweep point's)
+/// directory.
+pub fn seed_dir(dir: &Path, seed: u64) -> PathBuf {
+    dir.join(format!("seed-{seed}"))
+}
+
+/// Serialises to pretty JSON.
+pub fn to_json<T: Serialize>(value: &T) -> Result<String> {
+    serde_json::to_string_pretty(value).map_err(|e| Error::io(format!("error: cannot serialise: {e}")))
+}
+
+/// Serialises to compact JSON.
+pub fn compact_json<T: Serialize>(value: &T) -> Result<String> {
+    serde_json::to_string(value).map_err(|e| Error::io(format!("error: cannot serialise: {e}")))
+}
+
+/// Reads a saved result that carries a checksum ([`seal`]): `Ok(None)` if
+/// there is no file; `what` names the file in errors, `advice` says what
+/// to do with a damaged one.
+fn read_sealed<T: DeserializeOwned>(path: &Path, what: &str, advice: &str) -> Result<Option<T>> {
+    if !path.exists() {
+        return Ok(None);
+    }
+    let bytes = read_bytes(path)?;
+    let corrupt = |why: String| {
+        Error::new(
+            ErrorKind::Corrupt,
+            format!("error: {what} `{}` is corrupt ({why}); {advice}", path.display()),
+        )
+    };
+    let text = String::from_utf8(bytes).map_err(|e| corrupt(format!("not UTF-8: {e}")))?;
+    let body = match unseal(&text) {
+        Sealed::Verified(body) => std::borrow::Cow::Owned(body),
+        Sealed::Unsealed(body) => std::borrow::Cow::Borrowed(body),
+        Sealed::Damaged => {
+            return Err(corrupt(
+                "its checksum does not match its contents: it was changed after it was written".into(),
+            ))
+        }
+    };
+    serde_json::from_str(&body).map(Some).map_err(|e| corrupt(e.to_string()))
+}
+
+/// A stage's checkpoint, if there is one (a damaged one is an error).
+pub fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
+    read_sealed(
+        &checkpoint_path(dir),
+        "the checkpoint",
+        "move it away or pass `--fresh` to start the stage again",
+    )
+}
+
+/// Writes a stage's checkpoint, sealed.
+pub fn write_checkpoint(dir: &Path, cp: &Checkpoint) -> Result<()> {
+    write_atomic(&checkpoint_path(dir), seal(&to_json(cp)?).as_bytes())
+}
+
+/// A training stage's learned weights, if saved (a damaged file is an error).
+pub fn read_trained(dir: &Path) -> Result<Option<Trained>> {
+    read_sealed(&trained_path(dir), "the trained weights", "delete it or pass `--fresh`")
+}
+
+/// Writes a training stage's learned weights, sealed.
+pub fn write_trained(dir: &Path, trained: &Trained) -> Result<()> {
+    write_atomic(&trained_path(dir), seal(&to_json(trained)?).as_bytes())
+}
+
+/// Writes `best.genome`.
+pub fn write_best_genome(dir: &Path, genome: &Genome) -> Result<()> {
+    write_atomic(&best_genome_path(dir), format!("{}\n", genome.to_bitstring()).as_bytes())
+}
+
+/// Reads a genome file (`best.genome`): a string of 0 and 1; any other
+/// character is refused naming its line and column.
+pub fn read_genome(path: &Path) -> Result<Genome> {
+    let bytes = read_bytes(path)?;
+    let text = String::from_utf8_lossy(&bytes);
+    Genome::parse_bitstring(&text).map_err(|(position, c)| {
+        let before: String = text.chars().take(position - 1).collect();
+        let line = before.matches('\n').count() + 1;
+        let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+        Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: `{}` does not hold a genome: line {line}, column {column} is `{}`; a genome is a string of 0 and 1",
+                path.display(),
+                c.escape_debug()
+            ),
+        )
+    })
+}
+
+/// The best individual of an evolved stage's directory: `best.genome`,
+/// which must be the checkpoint's best where a checkpoint is beside it (a
+/// hand-edited or damaged `best.genome` is refused, naming it).
+pub fn read_best(dir: &Path) -> Result<Genome> {
+    let path = best_genome_path(dir);
+    let genome = read_genome(&path)?;
+    if let Some(cp) = read_checkpoint(dir)? {
+        if let Some((best, _)) = evolve::best_of(&cp) {
+            if best != genome {
+                return Err(Error::new(
+                    ErrorKind::Corrupt,
+                    format!(
+                        "error: `{}` is not the best individual of the checkpoint beside it (`{}`): it was changed \
+                         after the run wrote it; delete it and run the same command again to write it anew",
+                        path.display(),
+                        checkpoint_path(dir).display()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(genome)
+}
+
+/// `program.json` of a run directory (the program as it ran).
+pub fn program_path(out: &Path) -> PathBuf {
+    out.join("program.json")
+}
+
+/// Writes `program.json`.
+pub fn write_program(out: &Path, program: &Program) -> Result<()> {
+    write_atomic(&program_path(out), compact_json(program)?.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_checkpoint_changed_by_one_digit_is_refused_as_corrupt() {
+        let dir = tempfile::tempdir().unwrap();
+        let trained = Trained {
+            stage: "practice".into(),
+            fingerprint: Vec::new(),
+            run_seed: 3,
+            weights: Vec::new(),
+            activation: Vec::new(),
+            performance: vec![0.25],
+            result: Default::default(),
+        };
+        write_trained(dir.path(), &trained).unwrap();
+        assert_eq!(read_trained(dir.path()).unwrap().unwrap(), trained);
+        let path = trained_path(dir.path());
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, text.replace("0.25", "0.35")).unwrap();
+        let err = read_trained(dir.path()).unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Corrupt);
+        assert!(err.message().contains("checksum does not match"), "{err}");
+        // A file written before checksums existed reads as before.
+        std::fs::write(&path, to_json(&trained).unwrap()).unwrap();
+        assert_eq!(read_trained(dir.path()).unwrap().unwrap(), trained);
+    }
+}
