@@ -101,25 +101,29 @@ pub fn read_source(path: &Path, format: ErrorFormat) -> Result<String, Error> {
 
 /// Loads a `Program` written by `shaping build`.
 pub fn load_built(path: &Path) -> Result<Program, Error> {
-    let bytes = read_bytes(path)?;
-    let program: Program = serde_json::from_slice(&bytes).map_err(|e| {
+    parse_built(&read_bytes(path)?, &path.display().to_string())
+}
+
+/// A `Program` written by `shaping build` from its bytes (`name` names it in
+/// errors): parsed, its format version checked, validated.
+pub fn parse_built(bytes: &[u8], name: &str) -> Result<Program, Error> {
+    let program: Program = serde_json::from_slice(bytes).map_err(|e| {
         Error::new(
             ErrorKind::Invalid,
-            format!("error: `{}` is not a program built by `shaping build`: {e}", path.display()),
+            format!("error: `{name}` is not a program built by `shaping build`: {e}"),
         )
     })?;
     if program.format != FORMAT_VERSION {
-        return Err(Error::new(ErrorKind::Invalid, format!(
-            "error: `{}` was built for program format {}, this shaping reads format {FORMAT_VERSION}; rebuild it",
-            path.display(),
-            program.format
-        )));
-    }
-    if let Err(e) = program.validate() {
         return Err(Error::new(
             ErrorKind::Invalid,
-            format!("error: `{}` is not a valid program: {e}", path.display()),
+            format!(
+                "error: `{name}` was built for program format {}, this shaping reads format {FORMAT_VERSION}; rebuild it",
+                program.format
+            ),
         ));
+    }
+    if let Err(e) = program.validate() {
+        return Err(Error::new(ErrorKind::Invalid, format!("error: `{name}` is not a valid program: {e}")));
     }
     Ok(program)
 }

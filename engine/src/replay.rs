@@ -104,7 +104,11 @@ pub fn choose(
                     run.map_or_else(String::new, |d| format!(" --out {}", d.display()))
                 )));
             }
-            check_run(&program, source, &dir)?;
+            // From the program as it is: the checkpoint, where there is one,
+            // must still fit, and `best.genome` be its best.
+            if rundir::checkpoint_path(&dir).exists() {
+                rundir::checked_best(&program, source, &dir)?;
+            }
             rundir::read_best(&dir)?
         }
     };
@@ -117,18 +121,6 @@ pub fn choose(
         )));
     }
     Ok(Chosen { program, index, genome, training_seed })
-}
-
-/// A best individual taken from a run directory must come from the program
-/// as it is: its stage's checkpoint must still fit.
-fn check_run(program: &Program, index: usize, dir: &Path) -> Result<(), Error> {
-    let Some(cp) = rundir::read_checkpoint(dir)? else { return Ok(()) };
-    shaping_runtime::evolve::check_resume_of(program, index, &cp).map_err(|e| {
-        Error::new(ErrorKind::Stale, format!(
-            "error: the best individual in `{}` is not of this program: {e}; run the file again (`shaping run` with `--fresh`)",
-            dir.display()
-        ))
-    })
 }
 
 /// What a replay did: the episode's result, where its files are, its

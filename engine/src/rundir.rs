@@ -64,21 +64,23 @@ pub fn compact_json<T: Serialize>(value: &T) -> Result<String> {
 }
 
 /// Reads a saved result that carries a checksum ([`seal`]): `Ok(None)` if
-/// there is no file; `what` names the file in errors, `advice` says what
-/// to do with a damaged one.
+/// there is no file.
 fn read_sealed<T: DeserializeOwned>(path: &Path, what: &str, advice: &str) -> Result<Option<T>> {
     if !path.exists() {
         return Ok(None);
     }
-    let bytes = read_bytes(path)?;
+    parse_sealed(&read_bytes(path)?, &path.display().to_string(), what, advice).map(Some)
+}
+
+/// A saved result from its bytes: its checksum verified (a file without
+/// one is read as it is), then parsed; `name` and `what` name the file in
+/// errors, `advice` says what to do with a damaged one.
+fn parse_sealed<T: DeserializeOwned>(bytes: &[u8], name: &str, what: &str, advice: &str) -> Result<T> {
     let corrupt = |why: String| {
-        Error::new(
-            ErrorKind::Corrupt,
-            format!("error: {what} `{}` is corrupt ({why}); {advice}", path.display()),
-        )
+        Error::new(ErrorKind::Corrupt, format!("error: {what} `{name}` is corrupt ({why}); {advice}"))
     };
-    let text = String::from_utf8(bytes).map_err(|e| corrupt(format!("not UTF-8: {e}")))?;
-    let body = match unseal(&text) {
+    let text = std::str::from_utf8(bytes).map_err(|e| corrupt(format!("not UTF-8: {e}")))?;
+    let body = match unseal(text) {
         Sealed::Verified(body) => std::borrow::Cow::Owned(body),
         Sealed::Unsealed(body) => std::borrow::Cow::Borrowed(body),
         Sealed::Damaged => {
@@ -87,16 +89,28 @@ fn read_sealed<T: DeserializeOwned>(path: &Path, what: &str, advice: &str) -> Re
             ))
         }
     };
-    serde_json::from_str(&body).map(Some).map_err(|e| corrupt(e.to_string()))
+    serde_json::from_str(&body).map_err(|e| corrupt(e.to_string()))
 }
+
+const CHECKPOINT: (&str, &str) =
+    ("the checkpoint", "move it away or pass `--fresh` to start the stage again");
+const TRAINED: (&str, &str) = ("the trained weights", "delete it or pass `--fresh`");
 
 /// A stage's checkpoint, if there is one (a damaged one is an error).
 pub fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
-    read_sealed(
-        &checkpoint_path(dir),
-        "the checkpoint",
-        "move it away or pass `--fresh` to start the stage again",
-    )
+    read_sealed(&checkpoint_path(dir), CHECKPOINT.0, CHECKPOINT.1)
+}
+
+/// A checkpoint from the bytes of a `checkpoint.json` (`name` names it in
+/// errors); whether it fits a program is [`evolve::resume`]'s to say.
+pub fn parse_checkpoint(bytes: &[u8], name: &str) -> Result<Checkpoint> {
+    parse_sealed(bytes, name, CHECKPOINT.0, CHECKPOINT.1)
+}
+
+/// Trained weights from the bytes of a `trained.json` (`name` names it in
+/// errors); whether they fit a program is [`evolve::train::check`]'s to say.
+pub fn parse_trained(bytes: &[u8], name: &str) -> Result<Trained> {
+    parse_sealed(bytes, name, TRAINED.0, TRAINED.1)
 }
 
 /// Writes a stage's checkpoint, sealed.
@@ -106,7 +120,7 @@ pub fn write_checkpoint(dir: &Path, cp: &Checkpoint) -> Result<()> {
 
 /// A training stage's learned weights, if saved (a damaged file is an error).
 pub fn read_trained(dir: &Path) -> Result<Option<Trained>> {
-    read_sealed(&trained_path(dir), "the trained weights", "delete it or pass `--fresh`")
+    read_sealed(&trained_path(dir), TRAINED.0, TRAINED.1)
 }
 
 /// Writes a training stage's learned weights, sealed.
@@ -161,6 +175,37 @@ pub fn read_best(dir: &Path) -> Result<Genome> {
         }
     }
     Ok(genome)
+}
+
+/// The chosen best of evolved stage `index` of `program` from its directory
+/// `dir` in a run: its checkpoint must be there and fit the program as it
+/// is (the fingerprint of the stage and all it extends), and `best.genome`,
+/// where present, must be the checkpoint's best. Returns the checkpoint and
+/// the best with its fitness.
+pub fn checked_best(program: &Program, index: usize, dir: &Path) -> Result<(Checkpoint, Genome, f32)> {
+    let path = checkpoint_path(dir);
+    let cp = read_checkpoint(dir)?.ok_or_else(|| {
+        Error::new(
+            ErrorKind::Io,
+            format!("error: there is no checkpoint `{}`: run the stage first", path.display()),
+        )
+    })?;
+    evolve::check_resume_of(program, index, &cp).map_err(|e| {
+        Error::new(
+            ErrorKind::Stale,
+            format!(
+                "error: the best individual in `{}` is not of this program: {e}; run the file again (`shaping run` with `--fresh`)",
+                dir.display()
+            ),
+        )
+    })?;
+    let (genome, fitness) = evolve::best_of(&cp).ok_or_else(|| {
+        Error::new(ErrorKind::Corrupt, format!("error: `{}` holds no evaluated individual", path.display()))
+    })?;
+    if best_genome_path(dir).exists() {
+        read_best(dir)?;
+    }
+    Ok((cp, genome, fitness))
 }
 
 /// `program.json` of a run directory (the program as it ran).
