@@ -11,7 +11,7 @@ use shaping_runtime::sim::Sim;
 
 use shaping_runtime::controller::EpisodeResult;
 
-use crate::error::{Error, ErrorKind};
+use crate::error::Error;
 use crate::files::{create_dir, write_atomic};
 use crate::run::{Event, Observer};
 use crate::{episode, html, load, report, run, rundir};
