@@ -53,5 +53,10 @@ pub fn run_task(
         evaluator: cluster.map(|c| c as &dyn shaping_engine::run::Evaluate),
         interrupt: interrupted.as_deref(),
     };
-    plan.run_task(task, jobs, &runner).map(|_| ())
+    let started = std::time::Instant::now();
+    let outcome = plan.run_task(task, jobs, &runner)?;
+    if !quiet {
+        eprintln!("done in {:.2} s; results in {}", started.elapsed().as_secs_f64(), outcome.out.display());
+    }
+    Ok(())
 }

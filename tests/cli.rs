@@ -1667,3 +1667,33 @@ fn regex_lite_count(text: &str, prefix: &str, between: &str) -> Option<(u64, u64
     let m: String = rest.chars().take_while(char::is_ascii_digit).collect();
     Some((n.parse().ok()?, m.parse().ok()?))
 }
+
+/// Two runs into one `--out`: the second is refused at once, naming the
+/// process that holds the directory; the first goes on unharmed (stopped
+/// here by Ctrl-C, which it reports as usual). The lock goes with its
+/// holder, also after `kill -9`.
+#[cfg(unix)]
+#[test]
+fn a_second_run_into_a_directory_in_use_is_refused_naming_its_holder() {
+    let dir = scratch("locked");
+    let file = dir.join("s.bat");
+    std::fs::write(&file, EDITED.replace("generations 5", "generations 1000")).unwrap();
+    let out = dir.join("out");
+    let child = start_run_until(&file, &out, &["--no-report", "--jobs", "1"], &out.join("s/checkpoint.json"));
+    let second = run_file(&file, &out, &[]);
+    let err = text(&second.stderr);
+    assert_eq!(second.status.code(), Some(2), "{err}");
+    assert!(err.contains("is in use by") && err.contains(&format!("process {}", child.id())), "{err}");
+    assert!(err.contains("choose another `--out`"), "{err}");
+    ctrl_c(&child);
+    let first = child.wait_with_output().unwrap();
+    assert!(text(&first.stderr).contains("interrupted: stage `s` stopped"), "{}", text(&first.stderr));
+    let killed =
+        start_run_until(&file, &out, &["--no-report", "--jobs", "1"], &out.join("s/checkpoint.json"));
+    assert!(run(Command::new("kill").args(["-KILL", &killed.id().to_string()])).status.success());
+    let _ = killed.wait_with_output().unwrap();
+    // Resumed (or refused for its generations): not for a lock.
+    std::fs::write(&file, EDITED).unwrap();
+    let again = run_file(&file, &out, &[]);
+    assert!(!text(&again.stderr).contains("is in use"), "{}", text(&again.stderr));
+}

@@ -15,7 +15,7 @@ use shaping_runtime::program::{
 use crate::episode::{Episode, EPISODE_FORMAT};
 use crate::error::Error;
 use crate::experiment::spread;
-use crate::load;
+use crate::{load, rundir};
 
 /// Version of the data embedded in a report.
 pub const REPORT_FORMAT: u32 = 1;
@@ -654,18 +654,6 @@ fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, Error> {
     Ok(Some(v))
 }
 
-/// The checkpoint in `path` (`None` when there is none); one that does not
-/// read is an error naming it.
-fn read_checkpoint(path: &Path) -> Result<Option<Checkpoint>, Error> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let bytes = crate::files::read_bytes(path)?;
-    serde_json::from_slice(&bytes)
-        .map(Some)
-        .map_err(|e| Error::io(format!("error: `{}` is not a checkpoint: {e}", path.display())))
-}
-
 /// The stages of one run directory, with genomes, results and episodes.
 fn run_stages(
     program: &Program,
@@ -680,11 +668,16 @@ fn run_stages(
             continue;
         }
         let genome = read_genome(&dir.join("best.genome"), st)?;
+        if genome.is_some() && matches!(st.run, StageRun::Evolve(_)) {
+            // The best the checkpoint beside it holds (a `best.genome`
+            // changed after the run wrote it is an error naming it).
+            rundir::read_best(&dir)?;
+        }
         let src = format!("{}/best.genome", st.name);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
         // The seed the stage ran with is its checkpoint's (`--seed`, an
         // experiment's seed), not necessarily the one the file declares.
-        if let Some(cp) = read_checkpoint(&dir.join("checkpoint.json"))? {
+        if let Some(cp) = rundir::read_checkpoint(&dir)? {
             view.run = run_text(st, Some(cp.seed));
             view.crowded = crowded_generations(st, &cp);
         }
@@ -696,12 +689,12 @@ fn run_stages(
             }
         }
         if matches!(st.run, StageRun::Train { .. }) {
-            view.crowded = crowded_training(&dir.join("trained.json"));
+            view.crowded = crowded_training(&dir);
         }
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
             let pdir = run.join(&pst.name);
-            if let Some(cp) = read_checkpoint(&pdir.join("checkpoint.json"))? {
+            if let Some(cp) = rundir::read_checkpoint(&pdir)? {
                 let parent_best = read_genome(&pdir.join("best.genome"), pst)?;
                 provenance(program, i, a, g, &cp, parent_best.as_ref(), &mut view);
             }
@@ -739,10 +732,11 @@ fn crowded_generations(st: &shaping_runtime::program::Stage, cp: &Checkpoint) ->
     (n > 0).then(|| crowded_text(n, m, p, "episodes of its generations"))
 }
 
-/// The training life's overlapping placements, if any (`trained.json`
-/// that does not read is left to the commands that use it).
-fn crowded_training(path: &Path) -> Option<String> {
-    let t: shaping_runtime::evolve::Trained = serde_json::from_slice(&std::fs::read(path).ok()?).ok()?;
+/// The training life's overlapping placements, if any (`trained.json` in
+/// stage directory `dir`; one that does not read is left to the commands
+/// that use it).
+fn crowded_training(dir: &Path) -> Option<String> {
+    let t = rundir::read_trained(dir).ok()??;
     let p = u64::from(t.result.placement_failures);
     (p > 0).then(|| crowded_words("in its training life", p))
 }
@@ -857,7 +851,14 @@ fn series_of(program: &Program, fitness: &[Vec<GenRow>], only: Option<usize>) ->
         .collect()
 }
 
+/// The run directories of an experiment's (or a sweep point's) seeds: those
+/// its `summary.json` covers, when there is one (a directory may hold other
+/// seeds' runs, from earlier experiments), else every `seed-N` on disk.
 fn seed_dirs(dir: &Path) -> Vec<(u64, PathBuf)> {
+    let covered: Option<Vec<u64>> = std::fs::read(dir.join("summary.json"))
+        .ok()
+        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+        .and_then(|v| v["seeds"].as_array().map(|a| a.iter().filter_map(|s| s.as_u64()).collect()));
     let mut seeds: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
         .into_iter()
         .flatten()
@@ -865,7 +866,8 @@ fn seed_dirs(dir: &Path) -> Vec<(u64, PathBuf)> {
         .filter_map(|e| {
             let name = e.file_name().to_string_lossy().into_owned();
             let seed = name.strip_prefix("seed-")?.parse::<u64>().ok()?;
-            e.path().join("program.json").exists().then(|| (seed, e.path()))
+            let covered = covered.as_ref().is_none_or(|c| c.contains(&seed));
+            (covered && e.path().join("program.json").exists()).then(|| (seed, e.path()))
         })
         .collect();
     seeds.sort();

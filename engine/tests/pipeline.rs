@@ -1,0 +1,259 @@
+//! The stage pipeline and run directories, called as a library: what a run
+//! writes, and the run directories a user can trust (a lock, temporary
+//! files that follow no link, nothing written before the checks pass,
+//! damage refused, not used).
+
+use std::cell::Cell;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Barrier};
+
+use shaping_engine::files::{unseal, DirLock, Sealed};
+use shaping_engine::run::{Event, Observer, RunOptions, Runner, StageOutcome};
+use shaping_engine::{html, replay, ErrorKind};
+use shaping_runtime::evolve::fingerprint::fnv1a;
+use shaping_runtime::program::Program;
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn tiny() -> Program {
+    let path = root().join("tests/cli/tiny.bat");
+    let (program, _) =
+        shaping_engine::load::load_program(&path, shaping_engine::diag::ErrorFormat::Plain).unwrap();
+    program
+}
+
+fn options(out: &Path) -> RunOptions {
+    RunOptions { out: out.to_path_buf(), no_report: true, jobs: Some(2), ..RunOptions::default() }
+}
+
+/// The files of a run directory, by relative path (not the lock).
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.file_name().is_some_and(|n| n != DirLock::FILE) {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
+                out.push((rel, std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A run's files as hashes (a sealed file as the text it seals: the files
+/// as they were before checksums, byte for byte).
+fn hashes(dir: &Path) -> Vec<(String, u64)> {
+    files(dir)
+        .into_iter()
+        .filter(|(name, _)| !name.ends_with(".png") && !name.ends_with(".svg"))
+        .map(|(name, bytes)| {
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            let unsealed = match unseal(&text) {
+                Sealed::Verified(body) => body.into_bytes(),
+                Sealed::Unsealed(_) => bytes.clone(),
+                Sealed::Damaged => panic!("{name}: damaged"),
+            };
+            (name, fnv1a(&unsealed))
+        })
+        .collect()
+}
+
+/// The files of a small run are those this program wrote before it was a
+/// library (measured with the binary of commit b8f1daf, `shaping run
+/// tests/cli/tiny.bat --no-report`), apart from the checksums the saved
+/// results gain.
+#[test]
+fn a_small_run_writes_the_same_files_as_before() {
+    let dir = tempfile::tempdir().unwrap();
+    let outcome = Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    let names: Vec<&str> = outcome.stages.iter().map(StageOutcome::stage).collect();
+    assert_eq!(names, ["first", "second"]);
+    let got = hashes(dir.path());
+    let want: Vec<(&str, u64)> = PINNED.to_vec();
+    let got_ref: Vec<(&str, u64)> = got.iter().map(|(n, h)| (n.as_str(), *h)).collect();
+    assert_eq!(got_ref, want, "{got:#x?}");
+    // The saved results are sealed.
+    for name in ["first/checkpoint.json", "second/checkpoint.json"] {
+        let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        assert!(matches!(unseal(&text), Sealed::Verified(_)), "{name}");
+    }
+}
+
+/// fnv1a of each file of `shaping run tests/cli/tiny.bat --no-report` (the
+/// pictures aside: their encoder is another crate's).
+const PINNED: &[(&str, u64)] = &[
+    ("first/best.genome", 0xdf807edb9ebdeb90),
+    ("first/checkpoint.json", 0x922206f9d1abe104),
+    ("first/episode.json", 0x3165823400ec2cec),
+    ("first/generations.csv", 0xa2aeb981a850ed3b),
+    ("program.json", 0xbc88388b57178823),
+    ("second/best.genome", 0x0c28dfcf1df4a754),
+    ("second/checkpoint.json", 0xc87b61015dd7d222),
+    ("second/episode.json", 0x62ac0ba4bec0ace9),
+    ("second/generations.csv", 0x66887ed62b1540ac),
+];
+
+/// Stops at its first generation until the test has tried a second run.
+struct Holding {
+    barrier: Arc<Barrier>,
+    held: Cell<bool>,
+}
+
+impl Observer for Holding {
+    fn event(&self, event: Event<'_>) {
+        if let Event::Generation { .. } = event {
+            if !self.held.replace(true) {
+                self.barrier.wait();
+                self.barrier.wait();
+            }
+        }
+    }
+}
+
+#[test]
+fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharmed() {
+    let dir = tempfile::tempdir().unwrap();
+    let straight = tempfile::tempdir().unwrap();
+    Runner::default().run(tiny(), &options(straight.path())).unwrap();
+    let barrier = Arc::new(Barrier::new(2));
+    let out = dir.path().to_path_buf();
+    let first = {
+        let barrier = Arc::clone(&barrier);
+        std::thread::spawn(move || {
+            let observer = Holding { barrier, held: Cell::new(false) };
+            let runner = Runner { observer: &observer, ..Runner::default() };
+            runner.run(tiny(), &options(&out)).map(|_| ())
+        })
+    };
+    barrier.wait();
+    let err = Runner::default().run(tiny(), &options(dir.path())).unwrap_err();
+    assert_eq!(err.kind(), ErrorKind::Locked, "{err}");
+    assert!(err.message().contains("is in use by"), "{err}");
+    assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
+    barrier.wait();
+    first.join().unwrap().unwrap();
+    assert_eq!(files(dir.path()), files(straight.path()), "the first run's files are a straight run's");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_link_planted_at_a_temporary_name_is_not_followed() {
+    let dir = tempfile::tempdir().unwrap();
+    let victim = dir.path().join("victim");
+    std::fs::write(&victim, "precious").unwrap();
+    let out = dir.path().join("run");
+    std::fs::create_dir_all(out.join("first")).unwrap();
+    for name in ["best.genome.tmp", "checkpoint.json.tmp", "generations.csv.tmp"] {
+        std::os::unix::fs::symlink(&victim, out.join("first").join(name)).unwrap();
+    }
+    std::os::unix::fs::symlink(&victim, out.join("program.json.tmp")).unwrap();
+    Runner::default().run(tiny(), &options(&out)).unwrap();
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    let best = out.join("first/best.genome");
+    assert!(!std::fs::symlink_metadata(&best).unwrap().file_type().is_symlink());
+    assert!(std::fs::read_to_string(best).unwrap().trim().chars().all(|c| c == '0' || c == '1'));
+}
+
+#[test]
+fn a_refused_run_has_written_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    let before = files(dir.path());
+    // The world of the first stage changed since: its checkpoint no longer fits.
+    let mut changed = tiny();
+    changed.stages[0].world.arena[0] *= 2.0;
+    changed.stages[1].world.arena[0] *= 2.0;
+    let err = Runner::default().run(changed, &options(dir.path())).unwrap_err();
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    assert!(err.message().contains("world"), "{err}");
+    assert_eq!(files(dir.path()), before, "program.json and every other file as they were");
+}
+
+#[test]
+fn a_checkpoint_changed_by_one_digit_is_refused_not_resumed() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut opts = options(dir.path());
+    opts.stage = Some("first".into());
+    Runner::default().run(tiny(), &opts).unwrap();
+    let path = dir.path().join("first/checkpoint.json");
+    let text = std::fs::read_to_string(&path).unwrap();
+    // One bit of the population's first genome.
+    let at = text.find("\"bits\": [").unwrap() + "\"bits\": [".len();
+    let digit = text[at..].find(['0', '1']).unwrap() + at;
+    let flipped = if &text[digit..=digit] == "0" { "1" } else { "0" };
+    let damaged = format!("{}{flipped}{}", &text[..digit], &text[digit + 1..]);
+    std::fs::write(&path, &damaged).unwrap();
+    let err = Runner::default().run(tiny(), &options(dir.path())).unwrap_err();
+    assert_eq!(err.kind(), ErrorKind::Corrupt, "{err}");
+    assert!(err.message().contains("checkpoint.json"), "{err}");
+    assert!(err.message().contains("checksum does not match"), "{err}");
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), damaged, "the damaged file is kept");
+}
+
+#[test]
+fn an_edited_best_genome_is_refused_by_replay_and_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    let path = dir.path().join("second/best.genome");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let edited: String = text
+        .trim()
+        .chars()
+        .enumerate()
+        .map(|(i, c)| {
+            if i == 0 {
+                if c == '0' {
+                    '1'
+                } else {
+                    '0'
+                }
+            } else {
+                c
+            }
+        })
+        .collect();
+    std::fs::write(&path, format!("{edited}\n")).unwrap();
+    let file = root().join("tests/cli/tiny.bat");
+    let err =
+        replay::choose(tiny(), &file, Some("second"), None, Some(dir.path()), &shaping_engine::run::Silent)
+            .err()
+            .expect("refused");
+    assert_eq!(err.kind(), ErrorKind::Corrupt, "{err}");
+    assert!(err.message().contains("best.genome") && err.message().contains("checkpoint"), "{err}");
+    let err = html::write(dir.path(), None).unwrap_err();
+    assert!(err.message().contains("best.genome"), "{err}");
+    // Derived anew from the checkpoint, it is accepted again.
+    std::fs::remove_file(&path).unwrap();
+    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
+}
+
+#[test]
+fn a_run_resumed_is_the_run_straight_and_tells_its_observer() {
+    struct Count(Cell<u32>, Cell<u32>);
+    impl Observer for Count {
+        fn event(&self, event: Event<'_>) {
+            match event {
+                Event::Generation { .. } => self.0.set(self.0.get() + 1),
+                Event::Resumed { finished: true, .. } => self.1.set(self.1.get() + 1),
+                _ => {}
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let count = Count(Cell::new(0), Cell::new(0));
+    let runner = Runner { observer: &count, ..Runner::default() };
+    runner.run(tiny(), &options(dir.path())).unwrap();
+    assert_eq!(count.0.get(), 10, "6 + 4 generations");
+    let before = files(dir.path());
+    runner.run(tiny(), &options(dir.path())).unwrap();
+    assert_eq!(count.1.get(), 2, "both stages done before");
+    assert_eq!(files(dir.path()), before);
+}
