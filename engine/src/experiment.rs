@@ -156,7 +156,7 @@ impl Plan {
         if self.args.sets.is_empty() {
             self.out.clone()
         } else {
-            self.out.join(sweep::point_name(&self.points[point]))
+            self.out.join(sweep::point_dir_name(&self.points[point], &self.args.sets))
         }
     }
 
@@ -234,7 +234,11 @@ impl Plan {
             }
             let settings: serde_json::Map<String, serde_json::Value> =
                 point.iter().map(|(t, v)| (t.clone(), serde_json::Value::String(v.clone()))).collect();
-            let dir_name = if point.is_empty() { ".".to_string() } else { name.clone() };
+            let dir_name = if point.is_empty() {
+                ".".to_string()
+            } else {
+                sweep::point_dir_name(point, &self.args.sets)
+            };
             points.push(
                 serde_json::json!({ "name": name, "dir": dir_name, "settings": settings, "stages": stages }),
             );
@@ -533,7 +537,7 @@ fn summarise(
         let starts = report::fitness_points(first).1;
         plot::multi_seed_fitness(
             &out.join("fitness-seeds"),
-            &format!("{title}: fitness over {} seeds (median, min-max)", seeds.len()),
+            &format!("{}: fitness over {} seeds (median, min-max)", title.trim_end_matches(','), seeds.len()),
             &runs,
             &starts,
         )

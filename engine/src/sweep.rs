@@ -70,6 +70,27 @@ pub fn point_name(point: &[Assignment]) -> String {
     point.iter().map(|(t, v)| format!("{t}={v}")).collect::<Vec<_>>().join(",")
 }
 
+/// The directory of a point in a sweep of `sets`: its name without the
+/// settings every point shares (a `--set` of one value), unless every
+/// setting has one value, and with `*` (every stage) written `all`:
+/// `navigation.evolve.mutation=0.02,collect.evolve.mutation=0.01`.
+pub fn point_dir_name(point: &[Assignment], sets: &[Set]) -> String {
+    let varies = |t: &str| sets.iter().any(|s| s.target == t && s.values.len() > 1);
+    let shown: Vec<Assignment> = if point.iter().any(|(t, _)| varies(t)) {
+        point.iter().filter(|(t, _)| varies(t)).cloned().collect()
+    } else {
+        point.to_vec()
+    };
+    point_name(&shown)
+        .split(',')
+        .map(|a| match a.strip_prefix("*.") {
+            Some(rest) => format!("all.{rest}"),
+            None => a.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
 /// Checks the sets of an experiment: a target set twice is an error.
 pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
     for (i, s) in sets.iter().enumerate() {
@@ -346,7 +367,7 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
             .into(),
         )),
         "evolve.inheritance" => Ok(Value::Word(
-            match s.inheritance {
+            match evolution(s).map(|_| s.inheritance)? {
                 Inheritance::Darwinian => "darwinian",
                 Inheritance::Lamarckian => "lamarckian",
             }

@@ -257,3 +257,80 @@ fn a_run_resumed_is_the_run_straight_and_tells_its_observer() {
     assert_eq!(count.1.get(), 2, "both stages done before");
     assert_eq!(files(dir.path()), before);
 }
+
+fn khepera() -> Program {
+    let path = root().join("examples/khepera.bat");
+    shaping_engine::load::load_program(&path, shaping_engine::diag::ErrorFormat::Plain).unwrap().0
+}
+
+/// Inheritance is set on the evolved stages named (and those that
+/// inherit it), whatever other stages the file has; `*` sets every
+/// evolved stage.
+#[test]
+fn inheritance_is_set_in_a_file_with_stages_that_do_not_evolve() {
+    use shaping_runtime::program::Inheritance;
+    let lamarck = |t: &str| vec![(t.to_string(), "lamarckian".to_string())];
+    let mut p = khepera();
+    shaping_engine::sweep::apply(&mut p, &lamarck("collect.evolve.inheritance")).unwrap();
+    assert_eq!(p.stage("collect").unwrap().1.inheritance, Inheritance::Lamarckian);
+    let mut p = khepera();
+    shaping_engine::sweep::apply(&mut p, &lamarck("*.evolve.inheritance")).unwrap();
+    for name in ["navigation", "collect"] {
+        assert_eq!(p.stage(name).unwrap().1.inheritance, Inheritance::Lamarckian, "{name}");
+    }
+    let err =
+        shaping_engine::sweep::apply(&mut khepera(), &lamarck("bigger.evolve.inheritance")).unwrap_err();
+    assert!(err.message().contains("stage `bigger` does not evolve"), "{err}");
+}
+
+/// A point's directory names what varies, never `*`.
+#[test]
+fn a_point_directory_names_what_varies_and_holds_no_star() {
+    use shaping_engine::sweep::{parse_set, point_dir_name};
+    let sets =
+        [parse_set("*.evolve.mutation=0.01,0.02").unwrap(), parse_set("first.evolve.generations=3").unwrap()];
+    let point = vec![
+        ("*.evolve.mutation".to_string(), "0.02".to_string()),
+        ("first.evolve.generations".to_string(), "3".to_string()),
+    ];
+    assert_eq!(point_dir_name(&point, &sets), "all.evolve.mutation=0.02");
+    assert_eq!(point_dir_name(&point[1..], &sets[1..]), "first.evolve.generations=3");
+}
+
+/// An experiment's summaries show the values that ran (`--set`), not the
+/// file's, and its report the seeds they cover.
+#[test]
+fn an_experiment_summarises_the_settings_that_ran() {
+    use shaping_engine::experiment::{ExperimentOptions, Plan};
+    use shaping_engine::sweep::parse_set;
+    let dir = tempfile::tempdir().unwrap();
+    let opts = ExperimentOptions {
+        file: root().join("tests/cli/tiny.bat"),
+        seeds: 2,
+        first_seed: 1,
+        out: Some(dir.path().to_path_buf()),
+        sets: vec![parse_set("first.evolve.generations=2").unwrap()],
+        stage: Some("first".into()),
+        no_report: true,
+        ..ExperimentOptions::default()
+    };
+    let plan = Plan::new(tiny(), opts).unwrap();
+    let _lock = plan.lock().unwrap();
+    for task in plan.tasks() {
+        plan.run_task(task, Some(1), &Runner::default()).unwrap();
+    }
+    plan.finish().unwrap();
+    let md = std::fs::read_to_string(dir.path().join("first.evolve.generations=2/summary.md")).unwrap();
+    assert!(md.contains("| first | 2 |"), "{md}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["points"][0]["stages"][0]["generations"], 2, "{summary}");
+    assert_eq!(summary["points"][0]["dir"], "first.evolve.generations=2");
+    // A second experiment into the directory while this one holds it is refused.
+    let again = Plan::new(
+        tiny(),
+        ExperimentOptions { out: Some(dir.path().to_path_buf()), seeds: 1, ..ExperimentOptions::default() },
+    )
+    .unwrap();
+    assert_eq!(again.lock().unwrap_err().kind(), ErrorKind::Locked);
+}
