@@ -1,6 +1,5 @@
 //! `shaping fmt`: formats files in place, or stdin to stdout.
 
-use std::io::Read;
 use std::path::PathBuf;
 
 use shaping_compiler::fmt::{format, FormatError};
@@ -50,10 +49,9 @@ pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<
 }
 
 fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
-    let mut src = String::new();
-    std::io::stdin()
-        .read_to_string(&mut src)
-        .map_err(|e| CliError::io(format!("error: cannot read standard input: {e}")))?;
+    let bytes = shaping_engine::files::read_input(std::io::stdin(), "standard input")?;
+    let src = String::from_utf8(bytes)
+        .map_err(|e| CliError::io(format!("error: standard input is not UTF-8 text: {e}")))?;
     let out = format_one(&src, "<stdin>", error_format)?;
     if check {
         if out != src {

@@ -233,6 +233,9 @@ enum Command {
         /// Also write `report.html`: the episode animated in a web page.
         #[arg(long)]
         report: bool,
+        /// Change a setting as the run did (`--set` of `run`, one value each).
+        #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
+        sets: Vec<sweep::Set>,
         #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
@@ -404,7 +407,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 no_report,
                 error_format,
                 robot,
-                sets: single_values(sets)?,
+                sets: single_values(sets, "run")?,
             };
             #[cfg(feature = "mpi")]
             if cluster::launcher().is_some() {
@@ -471,6 +474,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             seed,
             no_learning,
             report,
+            sets,
             error_format,
         } => replay::replay(
             shaping_engine::replay::ReplayOptions {
@@ -483,6 +487,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 seed,
                 no_learning,
                 report,
+                sets: single_values(sets, "replay")?,
             },
             error_format,
         ),
@@ -574,13 +579,13 @@ fn refuse_without_mpi(command: &Command) -> Result<(), CliError> {
 }
 
 /// `run --set`: one value each, no setting twice.
-fn single_values(sets: Vec<sweep::Set>) -> Result<Vec<sweep::Assignment>, CliError> {
+fn single_values(sets: Vec<sweep::Set>, command: &str) -> Result<Vec<sweep::Assignment>, CliError> {
     sweep::check_sets(&sets)?;
     sets.into_iter()
         .map(|s| match <[String; 1]>::try_from(s.values) {
             Ok([v]) => Ok((s.target, v)),
             Err(values) => Err(CliError::io(format!(
-                "error: `--set {}={}`: `run` takes one value (`experiment` sweeps several)",
+                "error: `--set {}={}`: `{command}` takes one value (`experiment` sweeps several)",
                 s.target,
                 values.join(",")
             ))),

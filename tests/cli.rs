@@ -1697,3 +1697,20 @@ fn a_second_run_into_a_directory_in_use_is_refused_naming_its_holder() {
     let again = run_file(&file, &out, &[]);
     assert!(!text(&again.stderr).contains("is in use"), "{}", text(&again.stderr));
 }
+
+/// `replay` takes `--set` as `run` does: a run made with a setting changed
+/// on a parent stage replays with the same setting.
+#[test]
+fn replay_takes_the_settings_the_run_was_made_with() {
+    let dir = scratch("replay-set");
+    let out = dir.join("run");
+    let set = ["--set", "first.evolve.generations=2"];
+    let made = run_tiny(&out, &set);
+    assert!(made.status.success(), "{}", text(&made.stderr));
+    let plain = replay_run(&tiny(), &out, &dir.join("plain"), &["--stage", "second"]);
+    assert_eq!(plain.status.code(), Some(2), "{}", text(&plain.stderr));
+    assert!(text(&plain.stderr).contains("is not of this program"), "{}", text(&plain.stderr));
+    let with = replay_run(&tiny(), &out, &dir.join("with"), &["--stage", "second", set[0], set[1]]);
+    assert!(with.status.success(), "{}", text(&with.stderr));
+    assert!(dir.join("with/trace.csv").exists());
+}

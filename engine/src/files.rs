@@ -18,7 +18,7 @@
 //!   existed reads as before and gets one when it is next written.
 
 use std::fs::{File, OpenOptions};
-use std::io::Write as _;
+use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -29,6 +29,37 @@ use crate::error::{Error, ErrorKind, Result};
 /// Reads a file, mapping I/O errors to a message that names the path.
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", path.display())))
+}
+
+/// The largest input read whole: a source file, a built program, standard
+/// input of `fmt` (64 MiB; real architecture files are a few kB).
+pub const MAX_INPUT_BYTES: u64 = 64 << 20;
+
+/// Reads at most [`MAX_INPUT_BYTES`] from `reader` (named `name` in the
+/// error): more is refused before it is all read (`/dev/zero` ends).
+pub fn read_input(mut reader: impl std::io::Read, name: &str) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    (&mut reader)
+        .take(MAX_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(format!("error: cannot read `{name}`: {e}")))?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(Error::new(
+            ErrorKind::Invalid,
+            format!(
+                "error: `{name}` is larger than {} MiB, the most an input may hold",
+                MAX_INPUT_BYTES >> 20
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// Reads a source file or built program: [`read_input`] of a file.
+pub fn read_input_file(path: &Path) -> Result<Vec<u8>> {
+    let file =
+        File::open(path).map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", path.display())))?;
+    read_input(file, &path.display().to_string())
 }
 
 /// Creates a directory and its parents.
@@ -228,6 +259,14 @@ mod tests {
             .collect();
         // Only the planted links are left.
         assert_eq!(left.len(), if cfg!(unix) { 101 } else { 0 }, "{left:?}");
+    }
+
+    #[test]
+    fn an_endless_input_is_refused_at_the_limit() {
+        let err = read_input(std::io::repeat(0), "/dev/zero").unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Invalid);
+        assert!(err.message().contains("larger than 64 MiB"), "{err}");
+        assert_eq!(read_input(&b"stage"[..], "f").unwrap(), b"stage");
     }
 
     #[test]

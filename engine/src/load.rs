@@ -10,7 +10,7 @@ use shaping_runtime::program::{Program, StageRun, FORMAT_VERSION};
 
 use crate::diag::{self, ErrorFormat};
 use crate::error::{Error, ErrorKind, Result};
-use crate::files::read_bytes;
+
 use crate::RECORDED_TRAINING_ACTIONS;
 
 /// The source file is not UTF-8: reported like any other diagnostic, pointing
@@ -77,7 +77,7 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<(Program, Option
 /// Reads a `.bat` source; a file that is not UTF-8 is a diagnostic that
 /// points at the first invalid byte.
 pub fn read_source(path: &Path, format: ErrorFormat) -> Result<String, Error> {
-    let bytes = read_bytes(path)?;
+    let bytes = crate::files::read_input_file(path)?;
     let name = path.display().to_string();
     match String::from_utf8(bytes) {
         Ok(s) => Ok(s),
@@ -101,7 +101,7 @@ pub fn read_source(path: &Path, format: ErrorFormat) -> Result<String, Error> {
 
 /// Loads a `Program` written by `shaping build`.
 pub fn load_built(path: &Path) -> Result<Program, Error> {
-    parse_built(&read_bytes(path)?, &path.display().to_string())
+    parse_built(&crate::files::read_input_file(path)?, &path.display().to_string())
 }
 
 /// A `Program` written by `shaping build` from its bytes (`name` names it in

@@ -30,6 +30,8 @@ pub struct ReplayOptions {
     pub no_learning: bool,
     /// Also write `report.html` for the episode.
     pub report: bool,
+    /// Settings changed from the file's, as the run was made (`--set`).
+    pub sets: Vec<crate::sweep::Assignment>,
 }
 
 /// Reads `--genome`: an argument made only of `0`, `1`, `_` and blanks is
@@ -136,7 +138,12 @@ pub struct Replayed {
 /// Replays an individual of `program` (the file's; see [`choose`]) and
 /// writes its files: `trace.csv`, the pictures, `episode.json`,
 /// `program.json`, `genome`, and `report.html` if asked for.
-pub fn replay(program: Program, args: &ReplayOptions, observer: &dyn Observer) -> Result<Replayed, Error> {
+pub fn replay(
+    mut program: Program,
+    args: &ReplayOptions,
+    observer: &dyn Observer,
+) -> Result<Replayed, Error> {
+    crate::sweep::apply(&mut program, &args.sets)?;
     let chosen = choose(
         program,
         &args.file,

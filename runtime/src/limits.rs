@@ -32,6 +32,11 @@ pub const MAX_HIDDEN: u16 = 256;
 /// Most modules in a stage (module indices are `u16`, and `links all` makes
 /// n * (n - 1) links).
 pub const MAX_MODULES: usize = 256;
+/// Longest performance window of a learning module, in reinforcement
+/// signals: each controller keeps the last `window` of them per module (4
+/// bytes each), so a million is 4 MB a module, and a window longer than a
+/// life of the longest lives could hardly fill.
+pub const MAX_WINDOW: u32 = 1_000_000;
 /// Most stages in a program (stage indices are `u16`; real files have a few).
 pub const MAX_STAGES: usize = 64;
 /// Longest length in a world (arena side, body, charger, lamp height,

@@ -573,7 +573,7 @@ fn modules(at: &At, s: &Stage) -> R {
             if let LearnWhen::Below { threshold } = l.when {
                 at.field("when.threshold").within(threshold, -1.0, 1.0)?;
             }
-            at.field("window").count(l.window, 1, u32::MAX)?;
+            at.field("window").count(l.window, 1, MAX_WINDOW)?;
             at.field("target").ensure(
                 l.target == LearnTarget::Activation || matches!(m.behavior, Behavior::Neural(_)),
                 || "only a neural behavior can learn".into(),

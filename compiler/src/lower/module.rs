@@ -1,7 +1,7 @@
 //! Modules: inputs, activation networks, behaviors, learning, reinforcement.
 
 use shaping_runtime::catalog::{self, ActuatorKind};
-use shaping_runtime::limits::MAX_HIDDEN;
+use shaping_runtime::limits::{MAX_HIDDEN, MAX_WINDOW};
 use shaping_runtime::program::*;
 
 use super::{expr::Scope, Hw, Lower, ModuleSt, Shape, Source, TrainedShape, DEFAULT_RATES, DEFAULT_WINDOW};
@@ -825,7 +825,7 @@ impl Lower<'_> {
             },
         };
         let window = match &l.window {
-            Some(q) => self.count(q, "the performance window", 1)? as u32,
+            Some(q) => self.count_in(q, "the performance window", 1, MAX_WINDOW.into())? as u32,
             None => DEFAULT_WINDOW,
         };
         Some(Learning { target, rate_reward, rate_punish, when, window, error })
