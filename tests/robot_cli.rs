@@ -275,9 +275,10 @@ fn a_closed_link_ends_with_a_message() {
     assert!(err.contains("closed the link") && err.contains("may still be driving"), "{err}");
 }
 
-#[test]
-fn ctrl_c_stops_the_motors() {
-    let dir = scratch("ctrlc");
+/// `drive` sent `signal` (`INT`, `TERM`, `HUP`) once it drives: what it
+/// printed after, and the speed the robot was left with.
+fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
+    let dir = scratch(&format!("signal-{signal}"));
     let emu = Emulator::start(&dir, &[]);
     let genome = "1".repeat(80);
     let mut child = shaping()
@@ -292,20 +293,32 @@ fn ctrl_c_stops_the_motors() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    // Interrupted once it drives (its Ctrl-C handler is set by then).
+    // Interrupted once it drives (its signal handlers are set by then).
     let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut first = String::new();
     std::io::BufRead::read_line(&mut err, &mut first).unwrap();
     assert!(first.contains("driving"), "{first}");
     std::thread::sleep(Duration::from_millis(200));
-    let kill = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let kill = Command::new("kill").args([&format!("-{signal}"), &child.id().to_string()]).status().unwrap();
     assert!(kill.success());
     let mut rest = String::new();
     err.read_to_string(&mut rest).unwrap();
     let status = child.wait().unwrap();
     assert_eq!(status.code(), Some(2), "{rest}");
-    assert!(rest.contains("interrupted") && rest.contains("the motors were stopped"), "{rest}");
-    assert_eq!(emu.last_speed(), Some((0, 0)));
+    assert!(dir.join("d/trace.csv").exists(), "the trace is kept: {rest}");
+    (rest, emu.last_speed())
+}
+
+/// Ctrl-C, SIGTERM and SIGHUP (a closed terminal or ssh session) stop the
+/// motors and keep the trace, each named.
+#[test]
+fn ctrl_c_sigterm_and_sighup_stop_the_motors() {
+    for (signal, words) in [("INT", "Ctrl-C"), ("TERM", "SIGTERM"), ("HUP", "SIGHUP")] {
+        let (rest, speed) = interrupted_drive(signal);
+        assert!(rest.contains("interrupted") && rest.contains("the motors were stopped"), "{rest}");
+        assert!(rest.contains(words), "{signal}: {rest}");
+        assert_eq!(speed, Some((0, 0)), "{signal}");
+    }
 }
 
 #[test]
