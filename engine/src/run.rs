@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::Value;
 use shaping_runtime::controller::{
-    episode_rngs, run_episode, run_episode_on, Controller, EpisodeOptions, EpisodeResult, Trace,
+    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace,
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
 use shaping_runtime::genome::Genome;
@@ -847,19 +847,9 @@ impl Runner<'_> {
         let stage = &t.program.stages[t.index];
         let stop = self.interrupt;
         let (actions, lives, learning) = (t.actions, t.lives, t.learning);
-        // Stopping at the next action once interrupted.
-        let eval = |genome: &Genome, episode: u64| {
-            let opts = EpisodeOptions { actions, learning, seed: episode };
-            Evaluation::of_episode(run_episode_on(stage, genome, &opts, None, |sim| {
-                Stoppable::new(sim, stop)
-            }))
-        };
         // Checks that the parent fits and picks its best individual and the episode seed.
-        let outcome = evolve::test_best(t.program, t.index, t.seed, t.parent, &eval)
+        let outcome = evolve::test_subject(t.program, t.index, t.seed, t.parent)
             .map_err(|e| Error::new(ErrorKind::Stale, format!("error: {e}")))?;
-        if self.stopped() {
-            return Err(interrupted_test(stage, false, 0, lives));
-        }
         let parent_stage = &t.program.stages[stage.parent.unwrap_or(t.parent.stage)];
         let ba =
             before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed, stop)?;
@@ -922,7 +912,7 @@ fn test_files(
     dir: &Path,
     stage: &Stage,
     parent_stage: &Stage,
-    outcome: &evolve::TestOutcome,
+    outcome: &evolve::TestSubject,
     ba: &BeforeAfter,
     lives: u32,
     learning: bool,

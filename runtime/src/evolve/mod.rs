@@ -583,6 +583,18 @@ pub fn validate_best_with(
     Ok(chosen)
 }
 
+/// The individual a test stage runs, and its episode seed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TestSubject {
+    /// The parent stage's best individual.
+    pub genome: Genome,
+    /// Its fitness in the parent stage.
+    pub parent_fitness: f32,
+    /// The episode seed of the test; the lives of the test in both worlds
+    /// take their simulator seeds from it ([`seed::test_life_seed`]).
+    pub seed: u64,
+}
+
 /// The result of a test stage.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TestOutcome {
@@ -607,6 +619,21 @@ pub fn test_best(
     parent: &Checkpoint,
     evaluate: Evaluate,
 ) -> Result<TestOutcome, EvolveError> {
+    let TestSubject { genome, parent_fitness, seed } = test_subject(program, stage, seed, parent)?;
+    let evaluation = evaluate(&genome, seed);
+    Ok(TestOutcome { genome, parent_fitness, seed, evaluation })
+}
+
+/// What test stage `stage` runs, without running it: the best individual of
+/// `parent` (which must be the final checkpoint of the nearest evolved
+/// ancestor, and fit the program) and the episode seed
+/// [`seed::test_seed`]`(seed, stage, 0)`.
+pub fn test_subject(
+    program: &Program,
+    stage: usize,
+    seed: u64,
+    parent: &Checkpoint,
+) -> Result<TestSubject, EvolveError> {
     let st = get_stage(program, stage)?;
     if let StageRun::Evolve(_) = st.run {
         return Err(EvolveError::NotTest { stage: st.name.clone() });
@@ -635,9 +662,7 @@ pub fn test_best(
             ),
         });
     }
-    let episode = seed::test_seed(seed, stage, 0);
-    let evaluation = evaluate(&genome, episode);
-    Ok(TestOutcome { genome, parent_fitness, seed: episode, evaluation })
+    Ok(TestSubject { genome, parent_fitness, seed: seed::test_seed(seed, stage, 0) })
 }
 
 /// The best individual of a checkpoint's stage: `best`, or else the best of
