@@ -263,7 +263,7 @@ pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evalua
 /// object, the robot's start, a virtual object coming back) ran out of
 /// tries and kept an overlapping one, so the episode is not the declared
 /// world and its fitness is not that world's. Worlds that can never be
-/// placed are refused before a run (`sim::crowded`); one that is only
+/// placed are refused before a run (`world::crowded`); one that is only
 /// crowded runs, and this says how often it did not fit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Crowding {

@@ -25,3 +25,4 @@ pub mod robot;
 pub mod sim;
 pub mod testkit;
 pub mod validate;
+pub mod world;

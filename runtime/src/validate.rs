@@ -16,7 +16,7 @@ use crate::catalog::{self, ACT_SLOTS, CHANNELS};
 use crate::expr::{Expr, Op};
 use crate::limits::*;
 use crate::program::*;
-use crate::sim::{crowded, Blocker, Crowded};
+use crate::world::{crowded, Blocker, Crowded};
 
 /// Why a program was refused: the stage (when the problem is in one), the
 /// field (a path like `modules[1] (avoid).activation.params[3]`) and what is

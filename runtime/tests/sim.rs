@@ -647,13 +647,13 @@ fn failed_placements(w: &World, n: u64) -> (Vec<u64>, u32) {
 }
 
 /// A world crowded for the random placement but not certainly impossible
-/// (`sim::crowded` does not refuse it) says, episode by episode, when its
+/// (`world::crowded` does not refuse it) says, episode by episode, when its
 /// objects could not be placed apart: 25 objects of 60 mm in the paper's
 /// arena fail now and then (seed 13), 40 always. The counts are what the
 /// seed draws, like everything else.
 #[test]
 fn a_crowded_world_counts_the_placements_that_overlap() {
-    use shaping_runtime::sim::crowded;
+    use shaping_runtime::world::crowded;
     for virtual_ in [false, true] {
         let some = with_objects(25, 60.0, virtual_);
         assert_eq!(crowded(&some), None);
@@ -716,7 +716,7 @@ fn the_papers_worlds_place_everything_apart() {
 #[test]
 fn a_virtual_object_coming_back_onto_the_robot_counts() {
     let w = World { arena: [110.0, 110.0], charger: None, battery: None, ..with_objects(1, 10.0, true) };
-    assert_eq!(shaping_runtime::sim::crowded(&w), None);
+    assert_eq!(shaping_runtime::world::crowded(&w), None);
     let mut sim = Sim::new(&w, 3);
     assert_eq!(sim.placement_failures(), 1, "the start overlaps the object");
     assert!(sim.set_pose(Pose { x: 47.5, y: 55.0, theta: std::f32::consts::PI }));

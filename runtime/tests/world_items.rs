@@ -3,7 +3,8 @@
 
 use shaping_runtime::catalog::{CHANNELS, CH_FLOOR, CH_IR, CH_LIGHT};
 use shaping_runtime::program::{Battery, Body, Cylinder, InnerWall, Items, Lamp, Start, World, Zone};
-use shaping_runtime::sim::{blocker, Blocker, Command, Pose, Sim};
+use shaping_runtime::sim::{Command, Pose, Sim};
+use shaping_runtime::world::{blocker, Blocker};
 
 fn world(items: Items) -> World {
     World {
@@ -181,8 +182,8 @@ fn the_lamp_distance_channel_reads_metres_to_the_nearest_lamp() {
 #[test]
 fn worlds_that_can_never_be_placed_are_refused() {
     use shaping_runtime::program::Objects;
-    use shaping_runtime::sim::{crowded, Crowded};
     use shaping_runtime::testkit;
+    use shaping_runtime::world::{crowded, Crowded};
     let objects = |count, diameter| Some(Objects { count, diameter, virtual_: false });
     let cylinder =
         |at, diameter| Items { cylinders: vec![Cylinder { name: None, at, diameter }], ..Items::default() };

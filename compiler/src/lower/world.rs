@@ -4,7 +4,7 @@
 
 use shaping_runtime::limits::{MAX_ITEMS, MAX_OBJECTS};
 use shaping_runtime::program::*;
-use shaping_runtime::sim::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
+use shaping_runtime::world::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
 
 use super::*;
 use crate::diag::{did_you_mean, Error};
