@@ -4,8 +4,11 @@
 //! The oracle's `decisions` arbiter knows where the objects and walls are.
 //! This one knows only what the grip and release modules sense: the eight
 //! proximity readings and whether an object is held (the optical barrier).
-//! It runs each seed's evolved collect best on episodes 101 to 103 and
-//! records, at every action where a front sensor reads 0.2 or more:
+//! It runs each seed's evolved collect best (`RUN/seed-N/collect/` of
+//! `shaping experiment`: its checkpoint's best, checked against the file as
+//! `shaping replay` checks it, with the training stages bound from the
+//! run's `trained.json`) on episodes 101 to 103 and records, at every
+//! action where a front sensor reads 0.2 or more:
 //!
 //! - not holding: *grip* (an object's centre within 25 mm of the body, in
 //!   front) or *not* (no object within 40 mm);
@@ -32,6 +35,7 @@
 //! cargo run --release --example discriminate -- FILE --run DIR [--seeds 10] [--first-seed 1] [--ir-data DIR]
 //! ```
 
+use std::path::Path;
 use std::process::ExitCode;
 
 mod common;
@@ -39,9 +43,9 @@ mod common;
 use rand::seq::SliceRandom;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use shaping_engine::rundir;
 use shaping_runtime::catalog::{CHANNELS, CH_IR};
 use shaping_runtime::controller::{EpisodeOptions, Trace};
-use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::oracle::{self, run_arbitrated};
 use shaping_runtime::program::Stage;
@@ -318,15 +322,11 @@ fn run() -> Result<(), String> {
     let mut genomes: Vec<Genome> = Vec::new();
     let mut lives: Vec<Vec<Life>> = Vec::new();
     for &seed in &seeds {
+        let run = rundir::seed_dir(Path::new(&args.run), seed);
         let mut program = base.clone();
-        train_all(&mut program, seed).map_err(|e| e.to_string())?;
+        common::bind(&mut program, Some(&run), seed)?;
+        let g = common::best(&program, index, &run, seed)?;
         let stage = program.stages[index].clone();
-        let path = format!("{}/seed-{seed}/collect/best.genome", args.run);
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
-        let g = Genome::from_bitstring(text.trim()).ok_or_else(|| format!("`{path}` is not a genome"))?;
-        if g.bits.len() != stage.layout.bits as usize {
-            return Err(format!("`{path}` has {} bits, stage needs {}", g.bits.len(), stage.layout.bits));
-        }
         let grip = oracle::module(&stage, "grip")?;
         let release = oracle::module(&stage, "release")?;
         let mut per_seed = Vec::new();

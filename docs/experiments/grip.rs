@@ -21,7 +21,6 @@ use std::process::ExitCode;
 
 mod common;
 
-use shaping_runtime::evolve::train_all;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::oracle::{grip_trial, module};
 
@@ -61,7 +60,7 @@ fn run() -> Result<(), String> {
     let (mut program, index) = common::load(&args.file, &args.stage)?;
     // The trained weights of other modules bind as in a run of seed 1; they
     // do not drive once the grip script has started.
-    train_all(&mut program, 1).map_err(|e| e.to_string())?;
+    common::bind(&mut program, None, 1)?;
     let mut stage = program.stages[index].clone();
     let Some(objects) = stage.world.objects.as_mut() else {
         return Err(format!("stage `{}` has no objects", args.stage));

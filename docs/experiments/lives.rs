@@ -9,26 +9,34 @@
 //!
 //! For each seed `s` of `1..=--seeds`, it binds the training stages of `FILE`
 //! by training them with seed `s` (as `shaping run --seed s` does when it
-//! finds no `trained.json`), takes the best individual of
-//! `DIR/seed-s/PARENT/checkpoint.json` (`PARENT` the evolved stage the test
-//! stage extends in `FILE`; the genome layout must fit), and runs the test stage as `shaping
-//! run` does: the same episode seed, one controller throughout, the lives in
-//! the parent's world, then in the test stage's. So with the file the run was
-//! made from, the lives are those of the run's own test. It prints one line
-//! per life:
+//! finds no `trained.json`; `FILE` may train them otherwise than the run
+//! did), takes the best individual of `DIR/seed-s/PARENT/` (`PARENT` the
+//! evolved stage the test stage extends in `FILE`), and runs the test stage
+//! through the engine's `run::before_after`, as `shaping run` does: the same
+//! episode seed, one controller throughout, the lives in the parent's world,
+//! then in the test stage's. So with the file the run was made from, the
+//! lives are those of the run's own test. The best is checked as the run
+//! made it, not against `FILE` (whose training stages or learning rates may
+//! differ on purpose): its checkpoint must fit the run's own
+//! `DIR/seed-s/program.json` with the run's trained weights bound
+//! (`rundir::checked_best`), its seed must be `s`, and its genome layout
+//! must fit `FILE`'s stage. It prints one line per life:
 //!
 //! `seed S life L world before|after actions A grips G out O signals N sum X`
 //!
 //! where `N` and `X` count and sum the grip module's reinforcement signals.
 
+use std::path::Path;
 use std::process::ExitCode;
 
 mod common;
 
-use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Trace};
-use shaping_runtime::evolve::{best_of, seed, train_all, Checkpoint};
+use shaping_engine::load::load_built;
+use shaping_engine::run::before_after;
+use shaping_engine::rundir;
+use shaping_runtime::evolve::seed;
+use shaping_runtime::genome::Genome;
 use shaping_runtime::program::StageRun;
-use shaping_runtime::sim::Sim;
 
 struct Args {
     file: String,
@@ -72,7 +80,6 @@ fn run() -> Result<(), String> {
             args.stage, program.stages[parent].name
         ));
     }
-    let before_stage = &program.stages[parent];
     let grip = stage
         .modules
         .iter()
@@ -80,15 +87,14 @@ fn run() -> Result<(), String> {
         .ok_or_else(|| format!("stage `{}` has no module `grip`", args.stage))?;
     for s in 1..=args.seeds {
         let mut program = program.clone();
-        train_all(&mut program, s).map_err(|e| format!("seed {s}: {e}"))?;
+        common::bind(&mut program, None, s).map_err(|e| format!("seed {s}: {e}"))?;
         let stage = &program.stages[index];
-        let path = format!("{}/seed-{s}/{}/checkpoint.json", args.run, program.stages[parent].name);
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
-        let cp: Checkpoint = serde_json::from_str(&text).map_err(|e| format!("`{path}`: {e}"))?;
-        let (genome, _) = best_of(&cp).ok_or_else(|| format!("`{path}` holds no evaluated individual"))?;
+        let genome = run_best(&args, &program.stages[parent].name, s)?;
         if genome.bits.len() != stage.layout.bits as usize {
             return Err(format!(
-                "`{path}`: its best has {} bits, stage `{}` of `{}` {}",
+                "the best of `{}` has {} bits, stage `{}` of `{}` {}",
+                rundir::stage_dir(&rundir::seed_dir(Path::new(&args.run), s), &program.stages[parent].name)
+                    .display(),
                 genome.bits.len(),
                 args.stage,
                 args.file,
@@ -96,18 +102,21 @@ fn run() -> Result<(), String> {
             ));
         }
         let episode = seed::test_seed(s, index, 0);
-        let mut ctl = Controller::new(stage, &genome, episode_rngs(episode).1).map_err(|e| e.to_string())?;
-        let opts = EpisodeOptions { actions, learning, seed: episode };
-        let mut trace = Trace::default();
-        for (half, world) in [&before_stage.world, &stage.world].into_iter().enumerate() {
-            for k in 0..lives {
-                let mut sim = Sim::new(world, seed::test_life_seed(episode, half == 1, k));
-                let r = ctl.run(&mut sim, &opts, Some(&mut trace));
-                let signals: Vec<f32> =
-                    trace.rows.iter().map(|row| row.reinforcement[grip]).filter(|&x| x != 0.0).collect();
+        let ba =
+            before_after(&program.stages[parent], stage, &genome, actions, lives, learning, episode, None)
+                .map_err(common::message)?;
+        let mut rows = ba.trace.rows.iter();
+        for (half, results) in [&ba.before, &ba.after].into_iter().enumerate() {
+            for (k, r) in results.iter().enumerate() {
+                let signals: Vec<f32> = rows
+                    .by_ref()
+                    .take(r.actions as usize)
+                    .map(|row| row.reinforcement[grip])
+                    .filter(|&x| x != 0.0)
+                    .collect();
                 println!(
                     "seed {s} life {} world {} actions {} grips {} out {} signals {} sum {}",
-                    half as u32 * lives + k,
+                    half as u32 * lives + k as u32,
                     if half == 0 { "before" } else { "after" },
                     r.actions,
                     r.grips,
@@ -119,6 +128,20 @@ fn run() -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The chosen best of evolved stage `name` in the run directory of seed
+/// `s`, checked against the program that run ran (its `program.json`, with
+/// its training stages bound as the run bound them).
+fn run_best(args: &Args, name: &str, s: u64) -> Result<Genome, String> {
+    let dir = rundir::seed_dir(Path::new(&args.run), s);
+    let mut ran = load_built(&rundir::program_path(&dir)).map_err(common::message)?;
+    common::bind(&mut ran, Some(&dir), s)?;
+    let index = ran
+        .stage(name)
+        .map(|(i, _)| i)
+        .ok_or_else(|| format!("the run in `{}` has no stage `{name}`", dir.display()))?;
+    common::best(&ran, index, &dir, s)
 }
 
 fn main() -> ExitCode {

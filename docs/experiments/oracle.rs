@@ -3,11 +3,13 @@
 //!
 //! - `search`: a blind search with perfect gripping, releasing and
 //!   recharging, no architecture: what the world allows;
-//! - `decisions`: each seed's evolved collect best (`RUN/seed-N/STAGE/best.genome`
-//!   of `shaping experiment`) with grip and release made to win exactly when
-//!   they can succeed; `evolved`: the same individual alone, on the same
-//!   episodes; `physical`: the same with physical objects (they block the
-//!   robot and stay outside once thrown out), as in the paper's test.
+//! - `decisions`: each seed's evolved collect best (`RUN/seed-N/STAGE/` of
+//!   `shaping experiment`: its checkpoint's best, checked against the file
+//!   as `shaping replay` checks it) with grip and release made to win
+//!   exactly when they can succeed; `evolved`: the same individual alone, on
+//!   the same episodes; `physical`: the same with physical objects (they
+//!   block the robot and stay outside once thrown out), as in the paper's
+//!   test.
 //!
 //! ```sh
 //! cargo run --release --example oracle -- [FILE] [--stage collect] [--seeds 10] [--first-seed 1] [--actions 300] [--run DIR]
@@ -20,15 +22,16 @@
 //! so that its lives differ), it prints one line per episode, objects at
 //! random as the stage declares and evenly spread (the paper's figure 11: 8
 //! objects evenly distributed), then the medians. Without `--run`, only
-//! `search`.
+//! `search`. The training stages bind as in a run of each seed: from the
+//! run's `trained.json` where it fits, else trained again with the seed.
 
+use std::path::Path;
 use std::process::ExitCode;
 
 mod common;
 
+use shaping_engine::rundir;
 use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult, Trace};
-use shaping_runtime::evolve::train_all;
-use shaping_runtime::genome::Genome;
 use shaping_runtime::oracle::{self, evenly_spread, run_placed, Decisions, Search};
 
 struct Args {
@@ -94,30 +97,17 @@ fn run() -> Result<(), String> {
     // (rewarded, punished) and the actions won by wander, avoid, follow.
     let (mut grip_signals, mut release_signals, mut drove) = ((0, 0), (0, 0), [0usize; 3]);
     for seed in args.first_seed..args.first_seed + args.seeds {
+        let run = args.run.as_ref().map(|dir| rundir::seed_dir(Path::new(dir), seed));
         let mut program = base.clone();
-        train_all(&mut program, seed).map_err(|e| e.to_string())?;
+        common::bind(&mut program, run.as_deref(), seed)?;
         let stage = &program.stages[index];
         let mut physical = stage.clone();
         if let Some(o) = physical.world.objects.as_mut() {
             o.virtual_ = false;
         }
         let spread = stage.world.objects.as_ref().map(|o| evenly_spread(o.count as usize, stage.world.arena));
-        let best = match &args.run {
-            Some(dir) => {
-                let path = format!("{dir}/seed-{seed}/{}/best.genome", args.stage);
-                let text =
-                    std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
-                let g = Genome::from_bitstring(text.trim())
-                    .ok_or_else(|| format!("`{path}` is not a genome of 0s and 1s"))?;
-                if g.bits.len() != stage.layout.bits as usize {
-                    return Err(format!(
-                        "`{path}` has {} bits, stage needs {}",
-                        g.bits.len(),
-                        stage.layout.bits
-                    ));
-                }
-                Some(g)
-            }
+        let best = match &run {
+            Some(dir) => Some(common::best(&program, index, dir, seed)?),
             None => None,
         };
         let decisions = Decisions::by_name(stage)?;
