@@ -1,24 +1,40 @@
 //! `shaping-fuzz`: a mutation fuzzer on the stable toolchain (no libFuzzer).
 //!
-//! Two targets, each fed inputs mutated from a corpus seeded with every
+//! Four targets, each fed inputs mutated from a corpus seeded with every
 //! `.bat` file of `examples/` and `tests/` (and, for `json`, the programs
-//! those files compile to):
+//! those files compile to). The loaders fuzzed are the engine's own
+//! (`shaping_engine`), the ones `shaping` runs:
 //!
 //! - `text`: source text through the compiler. The compiler must not panic,
 //!   and every program it produces must pass the validation and run one short
 //!   episode per stage without a panic.
-//! - `json`: bytes through `program.json` loading (serde, then the one
+//! - `json`: bytes through `program.json` loading
+//!   (`shaping_engine::load::parse_built`: serde, the format version, the one
 //!   validation). A program that is accepted must run a short episode of
 //!   every stage without a panic. Mutations are byte-level and structural
 //!   (a number or a list of the JSON tree replaced by an extreme value).
 //! - `checkpoint`: bytes and JSON trees through `checkpoint.json` loading
-//!   against `tests/cli/tiny.bat` (serde, then `evolve::resume` for each of
-//!   its stages, as `run` does), seeded with checkpoints of a short run of
-//!   it. A checkpoint that is accepted must continue (a few generations,
-//!   the choice of the best, the next stage's start) without a panic.
+//!   against `tests/cli/tiny.bat`, for each of its stages: the engine's
+//!   reader (`rundir::parse_checkpoint`: the checksum, then serde), then the
+//!   checks the engine makes before it uses a checkpoint: those of
+//!   `rundir::checked_best` (`shaping replay --run`: `evolve::check_resume_of`,
+//!   the best) and those of a run that resumes it (`run::Runner::run`: a
+//!   checkpoint of another seed than the run's is refused, see `precheck` and
+//!   `evolve_stage` in `engine/src/run.rs`, then `evolve::resume`). Seeded
+//!   with checkpoints of a short run of it. A checkpoint that is accepted
+//!   must continue (a few generations, the choice of the best, the next
+//!   stage's start) without a panic.
 //! - `trained`: the same for `trained.json` against
-//!   `examples/pretrained.bat` (serde, then `evolve::train::check`); accepted
-//!   weights are bound and the stage using them runs a short episode.
+//!   `examples/pretrained.bat` (`rundir::parse_trained`, then the run's seed
+//!   and `evolve::train::check`, as the engine binds them); accepted weights
+//!   are bound and the stage using them runs a short episode.
+//!
+//! The saved results (`checkpoint.json`, `trained.json`) are in the corpus
+//! both compact and as the engine writes them: pretty-printed and sealed
+//! with a checksum (`shaping_engine::files::seal`). Half of their JSON-tree
+//! mutants are sealed anew, so that a changed body passes the checksum and
+//! reaches serde and the checks; byte mutants of a sealed file exercise
+//! the checksum's refusal.
 //!
 //! A panic is caught, its input written to `--crashes` (default
 //! `target/fuzz-crashes/`), and the run exits with status 1. Every crash
@@ -36,8 +52,10 @@ use std::time::{Duration, Instant};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde_json::Value;
+use shaping_engine::diag::ErrorFormat;
+use shaping_engine::{files, load, run, rundir, Error};
 use shaping_runtime::controller::{run_episode, EpisodeOptions};
-use shaping_runtime::evolve::{self, Checkpoint, Evaluation, Trained};
+use shaping_runtime::evolve::{self, Evaluation};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
@@ -279,12 +297,15 @@ fn text_target(input: &[u8]) {
     }
 }
 
+/// A refusal must say why.
+fn refused(e: &Error) {
+    assert!(!e.message().is_empty(), "an empty refusal");
+}
+
 fn json_target(input: &[u8]) {
-    if let Ok(p) = serde_json::from_slice::<Program>(input) {
-        match p.validate() {
-            Ok(()) => run_all(&p),
-            Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
-        }
+    match load::parse_built(input, "program.json") {
+        Ok(p) => run_all(&p),
+        Err(e) => refused(&e),
     }
 }
 
@@ -306,15 +327,23 @@ fn ones(g: &Genome, _seed: u64) -> Evaluation {
     Evaluation { fitness: ones as f32 / g.bits.len().max(1) as f32, ..Evaluation::default() }
 }
 
+/// A saved result as the engine writes it: pretty-printed, sealed with a
+/// checksum.
+fn sealed(v: &Value) -> Vec<u8> {
+    files::seal(&serde_json::to_string_pretty(v).expect("a value serialises")).into_bytes()
+}
+
+/// `file` (under the repository's root) loaded by the engine, as `shaping
+/// run` loads it.
 fn compile(root: &Path, file: &str) -> Program {
-    let src = std::fs::read_to_string(root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
-    shaping_compiler::compile(&src, file).unwrap_or_else(|_| panic!("{file} does not compile"))
+    load::load_program(&root.join(file), ErrorFormat::Plain).unwrap_or_else(|e| panic!("{file}: {e}")).0
 }
 
 fn saved(root: &Path) -> Saved {
     let tiny = compile(root, "tests/cli/tiny.bat");
     let mut checkpoints = Vec::new();
-    let mut cp = evolve::start_stage(&tiny, 0, 3, None).expect("tiny.bat starts");
+    // The checkpoints and weights of a run with the file's seed.
+    let mut cp = evolve::start_stage(&tiny, 0, run::run_seed(&tiny, None), None).expect("tiny.bat starts");
     checkpoints.push(cp.clone());
     while !evolve::is_finished(&tiny, &cp) {
         evolve::step_generation(&tiny, &mut cp, &ones).expect("a generation");
@@ -322,11 +351,12 @@ fn saved(root: &Path) -> Saved {
     }
     evolve::validate_best(&tiny, &mut cp, &ones, 3, 2).expect("the best");
     checkpoints.push(cp.clone());
-    let mut second = evolve::start_stage(&tiny, 1, 3, Some(&cp)).expect("the second stage starts");
+    let mut second = evolve::start_stage(&tiny, 1, cp.seed, Some(&cp)).expect("the second stage starts");
     evolve::step_generation(&tiny, &mut second, &ones).expect("a generation");
     checkpoints.push(second);
     let pretrained = compile(root, "examples/pretrained.bat");
-    let trained = evolve::train_stage(&pretrained, 0, 1, None).expect("the training stage trains");
+    let seed = run::run_seed(&pretrained, None);
+    let trained = evolve::train_stage(&pretrained, 0, seed, None).expect("the training stage trains");
     let value = |v: Result<Value, serde_json::Error>| v.expect("a saved result serialises");
     Saved {
         tiny,
@@ -336,11 +366,85 @@ fn saved(root: &Path) -> Saved {
     }
 }
 
+/// Evaluation by [`ones`], for the runs the engine makes here: their
+/// generations cost nothing.
+struct Ones;
+
+impl run::Evaluate for Ones {
+    fn evaluate(&self, _: &Program, _: usize, _: u32, jobs: &[(&Genome, u64)]) -> Vec<Evaluation> {
+        jobs.iter().map(|&(g, seed)| ones(g, seed)).collect()
+    }
+}
+
+/// Inputs given to a run of the engine ([`engine_run`]), and of those the
+/// runs that finished.
+static RUNS: AtomicU64 = AtomicU64::new(0);
+static RUNS_DONE: AtomicU64 = AtomicU64::new(0);
+
+/// Every how many parsed inputs one also goes through a whole run of the
+/// engine (a run writes its files, synced: slower than the checks alone).
+const RUN_EVERY: u64 = 16;
+
+/// Whether this parsed input also goes through a run of the engine.
+fn run_this_one() -> bool {
+    static PARSED: AtomicU64 = AtomicU64::new(0);
+    PARSED.fetch_add(1, Ordering::Relaxed).is_multiple_of(RUN_EVERY)
+}
+
+/// The scratch run directory of [`engine_run`], one per process.
+fn scratch() -> PathBuf {
+    std::env::temp_dir().join(format!("shaping-fuzz-{}", std::process::id()))
+}
+
+/// `shaping run FILE --stage STAGE [--seed S] --no-report` on a run
+/// directory whose stage `stage` holds `input` as `file`
+/// (`checkpoint.json`, `trained.json`): the engine's own checks decide
+/// (`precheck`, then the resume of `evolve_stage` with its seed check, or
+/// the reuse of a saved `trained.json` by `train_step`). A refusal must say
+/// why; an accepted file must run to the end of the stage.
+fn engine_run(program: &Program, stage: &str, file: &str, input: &[u8], seed: Option<u64>) {
+    let out = scratch();
+    let _ = std::fs::remove_dir_all(&out);
+    let dir = rundir::stage_dir(&out, stage);
+    std::fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("cannot create `{}`: {e}", dir.display()));
+    std::fs::write(dir.join(file), input)
+        .unwrap_or_else(|e| panic!("cannot write into `{}`: {e}", dir.display()));
+    let opts = run::RunOptions {
+        stage: Some(stage.into()),
+        seed,
+        out,
+        jobs: Some(1),
+        no_report: true,
+        ..run::RunOptions::default()
+    };
+    let runner = run::Runner { observer: &run::Silent, evaluator: Some(&Ones), interrupt: None };
+    RUNS.fetch_add(1, Ordering::Relaxed);
+    match runner.run(program.clone(), &opts) {
+        Ok(_) => {
+            RUNS_DONE.fetch_add(1, Ordering::Relaxed);
+        }
+        Err(e) => refused(&e),
+    }
+}
+
 fn checkpoint_target(input: &[u8]) {
     let Some(saved) = SAVED.get() else { return };
-    let Ok(cp) = serde_json::from_slice::<Checkpoint>(input) else { return };
+    let cp = match rundir::parse_checkpoint(input, "checkpoint.json") {
+        Ok(cp) => cp,
+        Err(e) => return refused(&e),
+    };
     let program = &saved.tiny;
     for index in 0..program.stages.len() {
+        // `shaping replay --run` (`rundir::checked_best`): the checkpoint
+        // must fit the program; its best is replayed.
+        match evolve::check_resume_of(program, index, &cp) {
+            Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
+            Ok(()) => {
+                std::hint::black_box(evolve::best_of(&cp));
+            }
+        }
+        // A run of the checkpoint's seed resumes it (one of another seed
+        // refuses it first: the runs of the engine below).
         let mut cp = cp.clone();
         match evolve::resume(program, index, &mut cp) {
             Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
@@ -364,13 +468,25 @@ fn checkpoint_target(input: &[u8]) {
             }
         }
     }
+    if run_this_one() {
+        // As the checkpoint of its stage, resumed by a run with the file's
+        // seed (one of another seed is refused) and by one with its own.
+        let stage = &program.stages.get(cp.stage).unwrap_or(&program.stages[0]).name;
+        engine_run(program, stage, "checkpoint.json", input, None);
+        engine_run(program, stage, "checkpoint.json", input, Some(cp.seed));
+    }
 }
 
 fn trained_target(input: &[u8]) {
     let Some(saved) = SAVED.get() else { return };
-    let Ok(t) = serde_json::from_slice::<Trained>(input) else { return };
+    let t = match rundir::parse_trained(input, "trained.json") {
+        Ok(t) => t,
+        Err(e) => return refused(&e),
+    };
+    // As `run::bind_training` binds saved weights (`shaping replay`, the
+    // experiment programs): any that fit the program.
     let mut program = saved.pretrained.clone();
-    match evolve::train::bind(&mut program, 0, &t) {
+    match evolve::train::check(&program, 0, &t).and_then(|()| evolve::train::bind(&mut program, 0, &t)) {
         Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
         Ok(_) => {
             if let Err(e) = program.validate() {
@@ -378,6 +494,12 @@ fn trained_target(input: &[u8]) {
             }
             run_all(&program);
         }
+    }
+    if run_this_one() {
+        // As a run reuses them (`train_step`): of its own seed only.
+        let stage = &saved.pretrained.stages[0].name;
+        engine_run(&saved.pretrained, stage, "trained.json", input, None);
+        engine_run(&saved.pretrained, stage, "trained.json", input, Some(t.run_seed));
     }
 }
 
@@ -449,31 +571,45 @@ fn main() {
     let bytes = |values: &[Value]| -> Vec<Vec<u8>> {
         values.iter().map(|v| serde_json::to_vec(v).expect("a value serialises")).collect()
     };
+    // Saved results also as the engine writes them: pretty, sealed.
+    let and_sealed = |values: &[Value]| -> Vec<Vec<u8>> {
+        let mut all = bytes(values);
+        all.extend(values.iter().map(sealed));
+        all
+    };
     let json_corpus = bytes(&programs);
-    let checkpoint_corpus = bytes(&saved.checkpoints);
-    let trained_corpus = bytes(&saved.trained);
+    let checkpoint_corpus = and_sealed(&saved.checkpoints);
+    let trained_corpus = and_sealed(&saved.trained);
     // Quiet panics: they are reported with their input below.
     std::panic::set_hook(Box::new(|_| {}));
     let budget = Duration::from_secs_f64(args.secs / args.targets.len() as f64);
     let mut crashes = 0;
     for target in &args.targets {
         let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
-        let (corpus, trees, run): (&[Vec<u8>], &[Value], Target) = match *target {
-            "text" => (&sources, &[], text_target),
-            "json" => (&json_corpus, &programs, json_target),
-            "checkpoint" => (&checkpoint_corpus, &saved.checkpoints, checkpoint_target),
-            _ => (&trained_corpus, &saved.trained, trained_target),
+        // `seal`: the target reads saved results, which carry a checksum.
+        let (corpus, trees, seal, run): (&[Vec<u8>], &[Value], bool, Target) = match *target {
+            "text" => (&sources, &[], false, text_target),
+            "json" => (&json_corpus, &programs, false, json_target),
+            "checkpoint" => (&checkpoint_corpus, &saved.checkpoints, true, checkpoint_target),
+            _ => (&trained_corpus, &saved.trained, true, trained_target),
         };
         let start = Instant::now();
         let mut execs = 0u64;
         ACCEPTED.store(0, Ordering::Relaxed);
+        RUNS.store(0, Ordering::Relaxed);
+        RUNS_DONE.store(0, Ordering::Relaxed);
         while start.elapsed() < budget {
             let input = if !trees.is_empty() && rng.random_range(0..3) > 0 {
                 let mut v = trees[rng.random_range(0..trees.len())].clone();
                 for _ in 0..1 + rng.random_range(0..3) {
                     mutate_tree(&mut rng, &mut v);
                 }
-                serde_json::to_vec(&v).expect("a value serialises")
+                // Sealed anew: the checksum holds, the body is the mutant.
+                if seal && rng.random() {
+                    sealed(&v)
+                } else {
+                    serde_json::to_vec(&v).expect("a value serialises")
+                }
             } else {
                 let mut input = corpus[rng.random_range(0..corpus.len())].clone();
                 mutate_bytes(&mut rng, &mut input, corpus);
@@ -495,13 +631,18 @@ fn main() {
                 eprintln!("crash in `{target}`: {msg}\n  input: {}", path.display());
             }
         }
+        let runs = match RUNS.load(Ordering::Relaxed) {
+            0 => String::new(),
+            n => format!(", {n} runs of the engine ({} finished)", RUNS_DONE.load(Ordering::Relaxed)),
+        };
         println!(
-            "{target}: {execs} inputs in {:.1} s, {} accepted and run, corpus {} files",
+            "{target}: {execs} inputs in {:.1} s, {} accepted and run{runs}, corpus {} files",
             start.elapsed().as_secs_f64(),
             ACCEPTED.load(Ordering::Relaxed),
             corpus.len()
         );
     }
+    let _ = std::fs::remove_dir_all(scratch());
     if crashes > 0 {
         eprintln!("{crashes} crashes");
         std::process::exit(1);
