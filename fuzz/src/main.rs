@@ -14,20 +14,27 @@
 //!   every stage without a panic. Mutations are byte-level and structural
 //!   (a number or a list of the JSON tree replaced by an extreme value).
 //! - `checkpoint`: bytes and JSON trees through `checkpoint.json` loading
-//!   against `tests/cli/tiny.bat`, for each of its stages: the engine's
-//!   reader (`rundir::parse_checkpoint`: the checksum, then serde), then the
-//!   checks the engine makes before it uses a checkpoint: those of
-//!   `rundir::checked_best` (`shaping replay --run`: `evolve::check_resume_of`,
-//!   the best) and those of a run that resumes it (`run::Runner::run`: a
-//!   checkpoint of another seed than the run's is refused, see `precheck` and
-//!   `evolve_stage` in `engine/src/run.rs`, then `evolve::resume`). Seeded
-//!   with checkpoints of a short run of it. A checkpoint that is accepted
-//!   must continue (a few generations, the choice of the best, the next
-//!   stage's start) without a panic.
+//!   against `tests/cli/tiny.bat`: the engine's reader
+//!   (`rundir::parse_checkpoint`: the checksum, then serde), then, for each
+//!   stage, the checks the engine makes before it uses a checkpoint:
+//!   `evolve::check_resume_of` and the best (as `rundir::checked_best` does
+//!   for `shaping replay --run`), and `evolve::resume` (as a run of the
+//!   checkpoint's seed resumes it). Every 16th input that parses also goes
+//!   through a whole run of the engine (`run::Runner::run` in a scratch
+//!   directory, with a cheap evaluator) as the checkpoint of its stage, with
+//!   the file's seed and, where it differs, the checkpoint's own: there the
+//!   engine's own checks decide (`precheck`, and `evolve_stage`'s, which
+//!   refuses a checkpoint of another seed than the run's). Seeded with the
+//!   checkpoints of a short run of it (and one of another seed). A
+//!   checkpoint that is accepted must continue (a few generations, the
+//!   choice of the best, the next stage's start) without a panic.
 //! - `trained`: the same for `trained.json` against
-//!   `examples/pretrained.bat` (`rundir::parse_trained`, then the run's seed
-//!   and `evolve::train::check`, as the engine binds them); accepted weights
-//!   are bound and the stage using them runs a short episode.
+//!   `examples/pretrained.bat` (`rundir::parse_trained`, then
+//!   `evolve::train::check` and the binding, as `run::bind_training` binds
+//!   them; every 16th through a run of the training stage, which reuses
+//!   weights of its own seed only), seeded with the weights of two seeds;
+//!   accepted weights are bound and the stage using them runs a short
+//!   episode.
 //!
 //! The saved results (`checkpoint.json`, `trained.json`) are in the corpus
 //! both compact and as the engine writes them: pretty-printed and sealed
@@ -354,15 +361,19 @@ fn saved(root: &Path) -> Saved {
     let mut second = evolve::start_stage(&tiny, 1, cp.seed, Some(&cp)).expect("the second stage starts");
     evolve::step_generation(&tiny, &mut second, &ones).expect("a generation");
     checkpoints.push(second);
+    // And of another seed, which a run without `--seed` refuses.
+    let other = evolve::start_stage(&tiny, 0, cp.seed + 1, None).expect("tiny.bat starts");
+    checkpoints.push(other);
     let pretrained = compile(root, "examples/pretrained.bat");
     let seed = run::run_seed(&pretrained, None);
     let trained = evolve::train_stage(&pretrained, 0, seed, None).expect("the training stage trains");
+    let other = evolve::train_stage(&pretrained, 0, seed + 1, None).expect("the training stage trains");
     let value = |v: Result<Value, serde_json::Error>| v.expect("a saved result serialises");
     Saved {
         tiny,
         pretrained,
         checkpoints: checkpoints.iter().map(|c| value(serde_json::to_value(c))).collect(),
-        trained: vec![value(serde_json::to_value(&trained))],
+        trained: vec![value(serde_json::to_value(&trained)), value(serde_json::to_value(&other))],
     }
 }
 
@@ -443,8 +454,8 @@ fn checkpoint_target(input: &[u8]) {
                 std::hint::black_box(evolve::best_of(&cp));
             }
         }
-        // A run of the checkpoint's seed resumes it (one of another seed
-        // refuses it first: the runs of the engine below).
+        // As a run of the checkpoint's seed resumes it (a run of another
+        // seed refuses it first: the runs of the engine below).
         let mut cp = cp.clone();
         match evolve::resume(program, index, &mut cp) {
             Err(e) => assert!(!e.to_string().is_empty(), "an empty refusal"),
@@ -473,7 +484,9 @@ fn checkpoint_target(input: &[u8]) {
         // seed (one of another seed is refused) and by one with its own.
         let stage = &program.stages.get(cp.stage).unwrap_or(&program.stages[0]).name;
         engine_run(program, stage, "checkpoint.json", input, None);
-        engine_run(program, stage, "checkpoint.json", input, Some(cp.seed));
+        if cp.seed != run::run_seed(program, None) {
+            engine_run(program, stage, "checkpoint.json", input, Some(cp.seed));
+        }
     }
 }
 
@@ -499,7 +512,9 @@ fn trained_target(input: &[u8]) {
         // As a run reuses them (`train_step`): of its own seed only.
         let stage = &saved.pretrained.stages[0].name;
         engine_run(&saved.pretrained, stage, "trained.json", input, None);
-        engine_run(&saved.pretrained, stage, "trained.json", input, Some(t.run_seed));
+        if t.run_seed != run::run_seed(&saved.pretrained, None) {
+            engine_run(&saved.pretrained, stage, "trained.json", input, Some(t.run_seed));
+        }
     }
 }
 
