@@ -89,7 +89,7 @@ pub fn crowded(world: &World) -> Option<Crowded> {
     let span = |lo: f32, hi: f32| if hi > lo { (lo, hi) } else { ((lo + hi) / 2.0, (lo + hi) / 2.0) };
     if let Some(o) = world.objects.as_ref().filter(|o| o.count > 0) {
         let r = o.diameter / 2.0;
-        let discs = o.count.min(MAX_OBJECTS as u32) as f32 * PI * r * r;
+        let discs = o.count.min(MAX_OBJECTS) as f32 * PI * r * r;
         let (need, room) = (discs + PI * body * body, w * d);
         if need > room {
             return Some(Crowded::Objects { need, room });
