@@ -641,6 +641,41 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     }
 }
 
+/// Adds `line` and `column` (1-based, in characters) beside each label's
+/// byte span of a JSON diagnostic and its related ones, and to each
+/// diagnostic the position of its first label.
+fn add_positions(diagnostic: &mut serde_json::Map<String, serde_json::Value>, source: &str) {
+    let position = |offset: usize| {
+        let at = offset.min(source.len());
+        let at = (0..=at).rev().find(|&i| source.is_char_boundary(i)).unwrap_or(0);
+        let before = &source[..at];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        (line, column)
+    };
+    let mut first = None;
+    if let Some(labels) = diagnostic.get_mut("labels").and_then(|l| l.as_array_mut()) {
+        for label in labels {
+            let Some(offset) = label["span"]["offset"].as_u64() else { continue };
+            let (line, column) = position(offset as usize);
+            first.get_or_insert((line, column));
+            label["line"] = line.into();
+            label["column"] = column.into();
+        }
+    }
+    if let Some((line, column)) = first {
+        diagnostic.insert("line".into(), line.into());
+        diagnostic.insert("column".into(), column.into());
+    }
+    if let Some(related) = diagnostic.get_mut("related").and_then(|r| r.as_array_mut()) {
+        for r in related {
+            if let Some(map) = r.as_object_mut() {
+                add_positions(map, source);
+            }
+        }
+    }
+}
+
 /// The JSON object `check --error-format json` prints for one file: `file`
 /// and `ok` always; for a good file its stages and their genome bits; for a
 /// bad one the diagnostic (`message`, `severity`, `labels`, `related`, ...).
@@ -669,6 +704,9 @@ fn check_json(
         >(e.message())
         {
             Ok(serde_json::Value::Object(mut diagnostic)) => {
+                if let Ok(source) = std::fs::read_to_string(file) {
+                    add_positions(&mut diagnostic, &source);
+                }
                 diagnostic.insert("file".into(), name.into());
                 diagnostic.insert("ok".into(), false.into());
                 serde_json::Value::Object(diagnostic)

@@ -1714,3 +1714,18 @@ fn replay_takes_the_settings_the_run_was_made_with() {
     assert!(with.status.success(), "{}", text(&with.stderr));
     assert!(dir.join("with/trace.csv").exists());
 }
+
+/// `check --error-format json` gives each diagnostic's line and column
+/// (1-based, in characters), where the human format points.
+#[test]
+fn json_diagnostics_have_lines_and_columns() {
+    let file = root().join("tests/ui/window_too_large.bat");
+    let out = run(shaping().arg("check").arg(&file).args(["--error-format", "json"]));
+    assert_eq!(out.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = &v["related"][0];
+    assert_eq!((d["line"].as_u64(), d["column"].as_u64()), (Some(12), Some(50)), "{v}");
+    assert_eq!(d["labels"][0]["line"], 12);
+    let human = run(shaping().arg("check").arg(&file).args(["--error-format", "plain"]));
+    assert!(text(&human.stderr).contains("window_too_large.bat:12:50"), "{}", text(&human.stderr));
+}
