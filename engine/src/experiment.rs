@@ -309,8 +309,25 @@ fn sweep_plot(
     if series.is_empty() {
         return Ok(());
     }
-    plot::sweep_points(stem, &format!("{title}: chosen best per point over the seeds"), &series)
-        .map_err(|e| Error::io(format!("error: {e}")))
+    // The values that vary from point to point name them.
+    let value = |point: &[Assignment], t: &str| point.iter().find(|(u, _)| u == t).map(|(_, v)| v.clone());
+    let varies = |t: &str| table.iter().any(|(p, _)| value(p, t) != value(&table[0].0, t));
+    let labels: Vec<String> = table
+        .iter()
+        .map(|(point, _)| {
+            let shown: Vec<&str> = point.iter().filter(|(t, _)| varies(t)).map(|(_, v)| v.as_str()).collect();
+            shown.join(", ")
+        })
+        .collect();
+    let targets: Vec<&str> = table[0].0.iter().map(|(t, _)| t.as_str()).filter(|t| varies(t)).collect();
+    let axis = format!("{} (the rows of summary.md)", targets.join(", "));
+    plot::sweep_points(
+        stem,
+        &format!("{title}: chosen best per point over the seeds"),
+        &series,
+        (&axis, &labels),
+    )
+    .map_err(|e| Error::io(format!("error: {e}")))
 }
 
 /// The sweep's `summary.md`: one row per point, the median (min .. max)
@@ -348,6 +365,17 @@ fn sweep_table(
             head.push(format!("{stage} generation reaching criterion"));
         }
     }
+    // Test stages: the fitness after the change (mean per life).
+    let tests: Vec<String> = table.first().map_or_else(Vec::new, |(_, stages)| {
+        stages
+            .iter()
+            .filter(|s| s["kind"] == "test")
+            .map(|s| s["stage"].as_str().unwrap_or("").to_string())
+            .collect()
+    });
+    for stage in &tests {
+        head.push(format!("{stage} test fitness"));
+    }
     let _ = writeln!(md, "| {} |", head.join(" | "));
     let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
     let cell = |v: &serde_json::Value, digits: usize| match (
@@ -373,6 +401,9 @@ fn sweep_table(
                     if never > 0 { format!("; {never} seeds never") } else { String::new() }
                 ));
             }
+        }
+        for s in stages.iter().filter(|s| s["kind"] == "test") {
+            row.push(cell(&s["fitness"], 3));
         }
         let _ = writeln!(md, "| {} |", row.join(" | "));
     }

@@ -189,14 +189,20 @@ pub struct SweepSeries {
     pub values: Vec<Option<(f64, f64, f64)>>,
 }
 
-/// The points of a sweep along x (1, 2, ...), one marker per stage at the
-/// median with a bar from minimum to maximum.
-pub fn sweep_points(stem: &Path, title: &str, series: &[SweepSeries]) -> Result<(), PlotError> {
+/// The points of a sweep along x (1, 2, ..., each tick named by its
+/// `labels`), one marker per stage at the median with a bar from minimum
+/// to maximum.
+pub fn sweep_points(
+    stem: &Path,
+    title: &str,
+    series: &[SweepSeries],
+    (axis, labels): (&str, &[String]),
+) -> Result<(), PlotError> {
     let points = series.iter().map(|s| s.values.len()).max().unwrap_or(0);
     if points == 0 || series.iter().all(|s| s.values.iter().all(Option::is_none)) {
         return Err(PlotError::input(stem, "no points to plot"));
     }
-    render::render(stem, &points::Points { title, points, series })
+    render::render(stem, &points::Points { title, points, series, axis, labels })
 }
 
 /// Trailing rolling mean (over `window` actions) of reinforcement values in

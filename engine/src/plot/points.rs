@@ -5,7 +5,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::render::{self, palette, span, DrawResult, Figure};
-use super::series::line_chart;
+use super::series::line_chart_labelled;
 use super::SweepSeries;
 
 const SIZE: (u32, u32) = (1000, 600);
@@ -14,6 +14,10 @@ pub(super) struct Points<'a> {
     pub title: &'a str,
     pub points: usize,
     pub series: &'a [SweepSeries],
+    /// What the points set (the x axis's name), and what each point sets,
+    /// in order (its tick).
+    pub axis: &'a str,
+    pub labels: &'a [String],
 }
 
 impl Figure for Points<'_> {
@@ -26,7 +30,16 @@ impl Figure for Points<'_> {
         let values = self.series.iter().flat_map(|s| s.values.iter().flatten().flat_map(|v| [v.1, v.2]));
         let y = span(values.chain([0.0]), 0.06, (0.0, 1.0));
         let x = (0.5, self.points as f64 + 0.5);
-        let mut chart = line_chart(&area, x, y, text, "point (the rows of summary.md)", "chosen best")?;
+        // Each point named by its values, at whole x only.
+        let name = |x: &f64| {
+            let i = x.round();
+            if (x - i).abs() > 1e-6 || i < 1.0 {
+                return String::new();
+            }
+            self.labels.get(i as usize - 1).cloned().unwrap_or_default()
+        };
+        let axis = (self.axis, self.points.min(12), &name as &dyn Fn(&f64) -> String);
+        let mut chart = line_chart_labelled(&area, x, y, text, axis, "chosen best")?;
         let n = self.series.len().max(1) as f64;
         for (k, s) in self.series.iter().enumerate() {
             let c = palette(k);

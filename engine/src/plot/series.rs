@@ -61,6 +61,20 @@ pub(super) fn line_chart<'a, DB: DrawingBackend>(
     x_desc: &str,
     y_desc: &str,
 ) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    line_chart_labelled(area, x, y, text, (x_desc, 10, &render::tick), y_desc)
+}
+
+/// [`line_chart`] with the x axis's ticks (about `x_axis.1` of them) named
+/// by `x_axis.2`.
+pub(super) fn line_chart_labelled<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    x: (f64, f64),
+    y: (f64, f64),
+    text: bool,
+    x_axis: (&str, usize, &dyn Fn(&f64) -> String),
+    y_desc: &str,
+) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
+    let (x_desc, x_ticks, x_label) = x_axis;
     let mut chart = ChartBuilder::on(area)
         .margin_left(16)
         .margin_right(34)
@@ -73,9 +87,9 @@ pub(super) fn line_chart<'a, DB: DrawingBackend>(
     mesh.bold_line_style(render::GRID_BOLD)
         .light_line_style(render::GRID_LIGHT)
         .axis_style(render::INK)
-        .x_labels(10)
+        .x_labels(x_ticks)
         .y_labels(8)
-        .x_label_formatter(&render::tick)
+        .x_label_formatter(x_label)
         .y_label_formatter(&render::tick);
     if text {
         mesh.label_style(render::label_style(15.0))
