@@ -64,6 +64,9 @@ pub(super) fn line_chart<'a, DB: DrawingBackend>(
     line_chart_labelled(area, x, y, text, (x_desc, 10, &render::tick), y_desc)
 }
 
+/// The x axis of a chart: its name, about how many ticks, and their labels.
+pub(super) type XAxis<'f> = (&'f str, usize, &'f dyn Fn(&f64) -> String);
+
 /// [`line_chart`] with the x axis's ticks (about `x_axis.1` of them) named
 /// by `x_axis.2`.
 pub(super) fn line_chart_labelled<'a, DB: DrawingBackend>(
@@ -71,7 +74,7 @@ pub(super) fn line_chart_labelled<'a, DB: DrawingBackend>(
     x: (f64, f64),
     y: (f64, f64),
     text: bool,
-    x_axis: (&str, usize, &dyn Fn(&f64) -> String),
+    x_axis: XAxis<'_>,
     y_desc: &str,
 ) -> Result<Chart<'a, DB>, DrawingAreaErrorKind<DB::ErrorType>> {
     let (x_desc, x_ticks, x_label) = x_axis;
