@@ -1,0 +1,348 @@
+//! What an individual's evaluation did besides its fitness: the events of
+//! its episodes and behaviour descriptors (the final pose, the length of
+//! the path, the 50 mm squares of the arena visited), for optimizers that
+//! look at more than a fitness (MAP-Elites, novelty search) and for Python's
+//! `Program.evaluator`. One place computes them, so every caller (the
+//! Python package, later the worlds) describes an episode the same way.
+//!
+//! The episodes are the ones a run evaluates: [`evaluate`] runs a genome's
+//! episodes as [`crate::run::evaluator`] runs each one (the stage's
+//! `actions`, learning on), with the simulator wrapped in a [`Tracker`]
+//! that only watches (it draws no random number and changes no command),
+//! and combines them as `evolve` combines an individual's `evaluations`
+//! episodes: the fitness is their mean (summed in f64), the events are
+//! summed, and the learned genome is the last episode's.
+
+use std::collections::HashSet;
+
+use shaping_runtime::catalog::CHANNELS;
+use shaping_runtime::controller::{run_episode_on, EpisodeOptions, EpisodeResult, Robot};
+use shaping_runtime::evolve::{seed, Evaluation, Events};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Stage, StageRun};
+use shaping_runtime::sim::{Command, Outcome, Pose, Sim};
+
+/// The side of the squares of [`Descriptors::squares_visited`], mm.
+pub const SQUARE_MM: f32 = 50.0;
+
+/// How an episode (or an individual's episodes) moved the robot.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Descriptors {
+    /// The body centre at the end of the (last) episode, mm from the
+    /// arena's south-west corner.
+    pub x: f32,
+    pub y: f32,
+    /// The heading at the end of the (last) episode, radians
+    /// counter-clockwise from +x, in `-pi..=pi`.
+    pub heading: f32,
+    /// The distance the body centre travelled, mm (the mean over the
+    /// individual's episodes).
+    pub path_length: f32,
+    /// The squares of [`SQUARE_MM`] (a grid from the arena's south-west
+    /// corner) the body centre was in at the start or after an action,
+    /// counted once each (the mean over the individual's episodes).
+    pub squares_visited: f32,
+}
+
+/// A [`Robot`] that forwards every call to `robot` and follows its pose
+/// after every action: the path length and the squares visited. It draws
+/// no random number and changes nothing, so an episode on a tracker is the
+/// same episode as without it.
+pub struct Tracker<R: Robot> {
+    pub robot: R,
+    pose: Pose,
+    path: f64,
+    square: (i64, i64),
+    squares: HashSet<(i64, i64)>,
+}
+
+fn square_of(p: Pose) -> (i64, i64) {
+    // Finite poses of any arena; a non-finite one counts as one square.
+    let cell =
+        |v: f32| if v.is_finite() { (f64::from(v) / f64::from(SQUARE_MM)).floor() as i64 } else { i64::MIN };
+    (cell(p.x), cell(p.y))
+}
+
+impl<R: Robot> Tracker<R> {
+    /// Starts following `robot` from its pose now (the episode's start).
+    pub fn new(robot: R) -> Tracker<R> {
+        let pose = robot.pose();
+        let square = square_of(pose);
+        Tracker { robot, pose, path: 0.0, square, squares: HashSet::from([square]) }
+    }
+
+    /// The descriptors of the episode so far.
+    pub fn descriptors(&self) -> Descriptors {
+        Descriptors {
+            x: self.pose.x,
+            y: self.pose.y,
+            heading: self.pose.theta,
+            path_length: self.path as f32,
+            squares_visited: self.squares.len() as f32,
+        }
+    }
+}
+
+impl<R: Robot> Robot for Tracker<R> {
+    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
+        self.robot.sense(out)
+    }
+    fn step(&mut self, cmd: &Command) -> Outcome {
+        let outcome = self.robot.step(cmd);
+        let p = self.robot.pose();
+        let d = f64::from(p.x - self.pose.x).hypot(f64::from(p.y - self.pose.y));
+        if d.is_finite() {
+            self.path += d;
+        }
+        self.pose = p;
+        let square = square_of(p);
+        if square != self.square {
+            self.square = square;
+            self.squares.insert(square);
+        }
+        outcome
+    }
+    fn alive(&self) -> bool {
+        self.robot.alive()
+    }
+    fn battery(&self) -> f32 {
+        self.robot.battery()
+    }
+    fn pose(&self) -> Pose {
+        self.robot.pose()
+    }
+    fn holding(&self) -> Option<bool> {
+        self.robot.holding()
+    }
+    fn placement_failures(&self) -> u32 {
+        self.robot.placement_failures()
+    }
+}
+
+/// A [`Tracker`] of the episode's simulator that writes its descriptors
+/// into `sink` when the episode drops it (`run_episode_on` owns the robot).
+struct Sink<'a> {
+    tracker: Tracker<Sim>,
+    sink: &'a mut Descriptors,
+}
+
+impl Drop for Sink<'_> {
+    fn drop(&mut self) {
+        *self.sink = self.tracker.descriptors();
+    }
+}
+
+impl Robot for Sink<'_> {
+    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
+        self.tracker.sense(out)
+    }
+    fn step(&mut self, cmd: &Command) -> Outcome {
+        self.tracker.step(cmd)
+    }
+    fn alive(&self) -> bool {
+        self.tracker.alive()
+    }
+    fn battery(&self) -> f32 {
+        self.tracker.battery()
+    }
+    fn pose(&self) -> Pose {
+        self.tracker.pose()
+    }
+    fn holding(&self) -> Option<bool> {
+        self.tracker.holding()
+    }
+    fn placement_failures(&self) -> u32 {
+        self.tracker.placement_failures()
+    }
+}
+
+/// One episode of `genome` on `stage`, as
+/// [`shaping_runtime::controller::run_episode`] runs it, and its descriptors.
+pub fn episode(stage: &Stage, genome: &Genome, opts: &EpisodeOptions) -> (EpisodeResult, Descriptors) {
+    let mut descriptors = Descriptors::default();
+    let sink = &mut descriptors;
+    let result = run_episode_on(stage, genome, opts, None, |sim| Sink { tracker: Tracker::new(sim), sink });
+    (result, descriptors)
+}
+
+/// What one individual's evaluation produced: its [`Evaluation`] as a run
+/// computes it, the collisions (summed over its episodes, like the events)
+/// and its [`Descriptors`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Described {
+    pub evaluation: Evaluation,
+    pub collisions: u32,
+    pub descriptors: Descriptors,
+}
+
+/// The episode seeds of individual `individual` of evolved stage `stage`
+/// evaluated with seed `seed`: those a run with run seed `seed` gives the
+/// individual of that index in the stage's first generation
+/// ([`seed::episode_seed`]`(seed, stage, 0, individual, e)`, `e` from 0 to
+/// the stage's `evaluations` - 1; one episode if it declares none).
+pub fn seeds(stage: &Stage, index: usize, seed: u64, individual: usize) -> Vec<u64> {
+    let episodes = match &stage.run {
+        StageRun::Evolve(evo) => evo.evaluations.max(1),
+        StageRun::Test { .. } | StageRun::Train { .. } => 1,
+    };
+    (0..episodes).map(|e| seed::episode_seed(seed, index, 0, individual, e)).collect()
+}
+
+/// The length of the episodes of `stage`: its evolution's `actions`, a
+/// test's or a training stage's life.
+pub fn actions(stage: &Stage) -> u32 {
+    match &stage.run {
+        StageRun::Evolve(evo) => evo.actions,
+        StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions,
+    }
+}
+
+/// Evaluates `genome` on `stage` over one episode per seed of `seeds` (the
+/// stage's actions, learning on), combined as `evolve` combines an
+/// individual's episodes: the fitness is the mean (summed in f64), the
+/// events and collisions and placement failures are summed, the learned
+/// genome is the last episode's; the final pose is the last episode's, the
+/// path length and the squares visited the means over the episodes.
+pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
+    let actions = actions(stage);
+    let mut sum = 0.0f64;
+    let mut events = Events::default();
+    let (mut collisions, mut placement_failures) = (0u32, 0u32);
+    let mut learned = None;
+    let (mut path, mut squares) = (0.0f64, 0.0f64);
+    let mut last = Descriptors::default();
+    for &s in seeds {
+        let (r, d) = episode(stage, genome, &EpisodeOptions { actions, learning: true, seed: s });
+        sum += f64::from(r.fitness);
+        collisions = collisions.saturating_add(r.collisions);
+        placement_failures = placement_failures.saturating_add(r.placement_failures);
+        let ev = Evaluation::of_episode(r);
+        events.grips = events.grips.saturating_add(ev.events.grips);
+        events.releases_outside = events.releases_outside.saturating_add(ev.events.releases_outside);
+        events.recharges = events.recharges.saturating_add(ev.events.recharges);
+        learned = ev.learned;
+        path += f64::from(d.path_length);
+        squares += f64::from(d.squares_visited);
+        last = d;
+    }
+    let n = seeds.len().max(1) as f64;
+    Described {
+        evaluation: Evaluation { fitness: (sum / n) as f32, learned, events, placement_failures },
+        collisions,
+        descriptors: Descriptors {
+            path_length: (path / n) as f32,
+            squares_visited: (squares / n) as f32,
+            ..last
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::{bind_training, evaluator, Silent};
+    use rand::{Rng, SeedableRng};
+    use shaping_runtime::evolve;
+    use shaping_runtime::program::Program;
+
+    fn khepera() -> Program {
+        let src =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/khepera.bat")).unwrap();
+        let mut program = shaping_compiler::compile(&src, "khepera.bat").unwrap();
+        bind_training(&mut program, None, 1, &Silent).unwrap();
+        program
+    }
+
+    fn random_genome(bits: u32, seed: u64) -> Genome {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        Genome { bits: (0..bits).map(|_| u8::from(rng.random::<bool>())).collect() }
+    }
+
+    /// One episode: the same evaluation as the run's evaluator, with
+    /// descriptors that fit the arena.
+    #[test]
+    fn an_episode_is_the_run_s_episode() {
+        let program = khepera();
+        let stage = &program.stages[1];
+        let StageRun::Evolve(evo) = &stage.run else { panic!("navigation is evolved") };
+        let run = evaluator(stage, evo.actions);
+        for k in 0..4 {
+            let genome = random_genome(stage.layout.bits, k);
+            let s = 1000 + k;
+            let d = evaluate(stage, &genome, &[s]);
+            assert_eq!(d.evaluation, run(&genome, s));
+            let r = shaping_runtime::controller::run_episode(
+                stage,
+                &genome,
+                &EpisodeOptions { actions: evo.actions, learning: true, seed: s },
+                None,
+            );
+            assert_eq!(d.collisions, r.collisions);
+            let [w, h] = stage.world.arena;
+            let p = d.descriptors;
+            assert!((0.0..=w).contains(&p.x) && (0.0..=h).contains(&p.y), "{p:?}");
+            assert!(p.heading.abs() <= std::f32::consts::PI + 1e-6);
+            assert!(p.path_length >= 0.0 && p.squares_visited >= 1.0);
+            // Deterministic.
+            assert_eq!(evaluate(stage, &genome, &[s]), d);
+        }
+    }
+
+    /// Several evaluations: the fitness is the one a run's first generation
+    /// gives the individual of the same index with the same seed.
+    #[test]
+    fn several_episodes_average_as_evolve_does() {
+        let mut program = khepera();
+        let StageRun::Evolve(evo) = &mut program.stages[1].run else { panic!("navigation is evolved") };
+        evo.evaluations = 3;
+        evo.population = 6;
+        let actions = evo.actions;
+        let seed = 7;
+        let mut cp = evolve::start_stage(&program, 1, seed, None).unwrap();
+        let stage = &program.stages[1];
+        evolve::step_generation(&program, &mut cp, &evaluator(stage, actions)).unwrap();
+        for (i, genome) in cp.population.iter().enumerate() {
+            let s = seeds(stage, 1, seed, i);
+            assert_eq!(s.len(), 3);
+            let d = evaluate(stage, genome, &s);
+            assert_eq!(d.evaluation.fitness, cp.fitness[i], "individual {i}");
+            let single: Vec<Described> = s.iter().map(|&x| evaluate(stage, genome, &[x])).collect();
+            assert_eq!(d.descriptors.x, single[2].descriptors.x);
+            assert_eq!(
+                d.evaluation.events.recharges,
+                single.iter().map(|x| x.evaluation.events.recharges).sum::<u32>()
+            );
+            assert_eq!(d.collisions, single.iter().map(|x| x.collisions).sum::<u32>());
+            let mean = single.iter().map(|x| f64::from(x.descriptors.path_length)).sum::<f64>() / 3.0;
+            assert!((f64::from(d.descriptors.path_length) - mean).abs() < 1e-3);
+        }
+        let best = cp.history[0].best_index as usize;
+        let d = evaluate(stage, &cp.population[best], &seeds(stage, 1, seed, best));
+        assert_eq!(d.evaluation.events.recharges, cp.history[0].best_recharges);
+    }
+
+    /// The tracker counts squares and the path as the robot moves.
+    #[test]
+    fn the_tracker_follows_the_pose() {
+        struct Walker(Pose);
+        impl Robot for Walker {
+            fn sense(&mut self, _: &mut [f32; CHANNELS]) {}
+            fn step(&mut self, _: &Command) -> Outcome {
+                self.0.x += 30.0;
+                Outcome::default()
+            }
+            fn pose(&self) -> Pose {
+                self.0
+            }
+        }
+        let mut t = Tracker::new(Walker(Pose { x: 10.0, y: 60.0, theta: 0.5 }));
+        for _ in 0..5 {
+            t.step(&Command::default());
+        }
+        // x: 10, 40, 70, 100, 130, 160: squares 0, 0, 1, 2, 2, 3 of row 1.
+        let d = t.descriptors();
+        assert_eq!(d.squares_visited, 4.0);
+        assert!((d.path_length - 150.0).abs() < 1e-3);
+        assert_eq!((d.x, d.y, d.heading), (160.0, 60.0, 0.5));
+    }
+}
