@@ -1,0 +1,44 @@
+"""shaping from Python.
+
+Compile ``.bat`` architecture files, evaluate genomes of an evolved stage
+with numpy (for any optimizer: CMA-ES, MAP-Elites, ...), and run programs
+like ``shaping run``, at the speed of the Rust core.
+
+>>> import shaping
+>>> program = shaping.compile("examples/khepera.bat")
+>>> program.stages
+['avoidance', 'navigation', 'collect', 'bigger']
+>>> ev = program.evaluator("navigation", seed=0)     # doctest: +SKIP
+>>> result = ev.evaluate(genomes)                    # doctest: +SKIP
+>>> result["fitness"].shape                          # doctest: +SKIP
+(n,)
+
+Errors of shaping raise :class:`ShapingError` (its text is the command
+line's message, its ``kind`` says which kind of error it is); wrong
+arguments (a stage that does not exist, a genome array of the wrong shape,
+dtype or values) raise :class:`ValueError`.
+"""
+
+from ._shaping import (
+    SQUARE_MM,
+    Diagnostic,
+    Evaluator,
+    Program,
+    Run,
+    ShapingError,
+    check,
+    compile,
+    run,
+)
+
+__all__ = [
+    "SQUARE_MM",
+    "Diagnostic",
+    "Evaluator",
+    "Program",
+    "Run",
+    "ShapingError",
+    "check",
+    "compile",
+    "run",
+]

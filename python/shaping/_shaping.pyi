@@ -1,0 +1,152 @@
+"""Type stubs of the Rust extension ``shaping._shaping`` (re-exported by ``shaping``)."""
+
+import os
+from typing import Any, Callable, Mapping, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+PathLike = Union[str, os.PathLike[str]]
+
+SQUARE_MM: float
+"""The side (mm) of the squares counted by ``squares_visited``."""
+
+class ShapingError(Exception):
+    """An error of shaping: the text is the command line's message.
+
+    ``kind`` is one of "diagnostics", "io", "corrupt", "stale",
+    "interrupted", "memory", "invalid", "locked", "evaluation"; a file with
+    errors also has ``diagnostics`` (a list of :class:`Diagnostic`).
+    """
+
+    kind: str
+    diagnostics: list[Diagnostic]
+
+class Diagnostic:
+    """One diagnostic of a file, as ``shaping check`` reports it."""
+
+    message: str
+    severity: str
+    """"error", "warning" or "advice"."""
+    code: Optional[str]
+    line: Optional[int]
+    """1-based line of its first label (None if it points nowhere in the file)."""
+    column: Optional[int]
+    """1-based column, in characters."""
+    help: Optional[str]
+    file: str
+
+def check(path: PathLike) -> list[Diagnostic]:
+    """Every diagnostic (errors and warnings) of a ``.bat`` file; [] for a good file.
+
+    A file that cannot be read raises :class:`ShapingError`.
+    """
+
+def compile(path: PathLike) -> Program:
+    """Compiles a ``.bat`` file (or loads a ``shaping build`` JSON).
+
+    A file with errors raises :class:`ShapingError` whose text holds the
+    diagnostics; warnings of a file that compiles are Python warnings.
+    """
+
+class Program:
+    """A compiled architecture file."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def path(self) -> str: ...
+    @property
+    def stages(self) -> list[str]:
+        """The names of the stages, in order."""
+    def genome_bits(self, stage: str) -> int:
+        """The number of bits of ``stage``'s genome (the frozen genes of earlier stages included)."""
+    def kind(self, stage: str) -> str:
+        """"evolve", "train" or "test"."""
+    def layout(self, stage: str) -> list[dict[str, Any]]:
+        """The genes of ``stage``: the rows of ``shaping layout --format json``."""
+    def layout_text(self, stage: str) -> str:
+        """The table ``shaping layout`` prints."""
+    def evaluator(
+        self,
+        stage: str,
+        run: Optional[Union[Run, PathLike]] = None,
+        seed: int = 0,
+        jobs: Optional[int] = None,
+    ) -> Evaluator:
+        """An evaluator of the genomes of evolved stage ``stage``.
+
+        The weights of training stages come from ``run`` (a :class:`Run` or
+        a run directory); without it they are trained afresh, with the
+        program's run seed (a warning says so). ``jobs``: worker threads
+        (None: one per core).
+        """
+
+class Evaluator:
+    """Evaluates genomes of one evolved stage as a run evaluates them."""
+
+    @property
+    def stage(self) -> str: ...
+    @property
+    def bits(self) -> int: ...
+    @property
+    def episodes(self) -> int:
+        """The episodes per individual (the stage's ``evaluations``)."""
+    @property
+    def seed(self) -> int: ...
+    def evaluate(self, genomes: npt.ArrayLike) -> dict[str, np.ndarray]:
+        """Evaluates each row of ``genomes`` (shape ``(n, bits)``, 0 and 1, integer or bool dtype).
+
+        Returns arrays of shape ``(n,)``: ``fitness`` (float32, the mean
+        over the individual's episodes), ``recharges``, ``grips``,
+        ``releases_outside``, ``collisions``, ``placement_failures``
+        (uint32, summed over its episodes), ``x``, ``y``, ``heading``
+        (float32, the final pose of its last episode, mm and radians),
+        ``path_length`` (mm) and ``squares_visited`` (float32, means over
+        its episodes). Row ``i`` is evaluated on the episodes a run with
+        run seed ``seed`` gives individual ``i`` of the stage's first
+        generation, so the same array and seed give the same results. The
+        GIL is released while it runs. A wrong shape, dtype or value raises
+        ValueError.
+        """
+
+class Run:
+    """A run directory: the stages it holds and their files."""
+
+    def __init__(self, out: PathLike) -> None:
+        """Opens a run directory written by ``shaping run`` or :func:`run`."""
+    @property
+    def out(self) -> str: ...
+    @property
+    def seed(self) -> Optional[int]: ...
+    @property
+    def stages(self) -> list[str]: ...
+    @property
+    def report(self) -> Optional[str]:
+        """The path of ``report.html`` (None if not written)."""
+    def stage_dir(self, stage: str) -> str: ...
+    def generations(self, stage: str) -> dict[str, np.ndarray]:
+        """The columns of the stage's ``generations.csv``."""
+    def best_genome(self, stage: str) -> npt.NDArray[np.uint8]:
+        """The stage's chosen best genome (``best.genome``), 0 and 1."""
+
+def run(
+    path: PathLike,
+    out: Optional[PathLike] = None,
+    seed: Optional[int] = None,
+    stage: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    jobs: Optional[int] = None,
+    callback: Optional[Callable[[dict[str, Any]], Any]] = None,
+    fresh: bool = False,
+    report: bool = True,
+) -> Run:
+    """Runs ``path`` like ``shaping run`` into ``out`` (default ``runs/<file stem>``).
+
+    ``set`` maps ``STAGE.SECTION.FIELD`` to one value each (``--set``).
+    ``callback`` is called with one dict per event (``event``: "evolve_start",
+    "generation", "evolved", "trained", "tested", "warning", ...); an
+    exception in it stops the run (resumable) and is raised. Ctrl-C stops
+    the run after the generation under way, leaves it resumable and raises
+    KeyboardInterrupt.
+    """

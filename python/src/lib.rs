@@ -1,0 +1,802 @@
+//! The `shaping._shaping` extension module: shaping's compiler, engine and
+//! simulator for Python. The `shaping` package (`python/shaping/`) re-exports
+//! it; its docstrings and type stubs are there.
+//!
+//! Everything goes through the engine (`shaping_engine`): `load` to read a
+//! file, `run::Runner` to run it, `descriptors` to evaluate genomes, so the
+//! results and the messages are the command line's.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use miette::Diagnostic as _;
+use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use shaping_engine::descriptors::{self, Described};
+use shaping_engine::diag::ErrorFormat;
+use shaping_engine::run::{self as engine_run, Event, Observer, RunOptions, Runner};
+use shaping_engine::{load, rundir, sweep, ErrorKind};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Program as Compiled, StageRun};
+
+create_exception!(
+    _shaping,
+    ShapingError,
+    PyException,
+    "An error of shaping (a file with errors, a run that cannot resume, ...): its text is the command line's message, `kind` says which kind of error it is."
+);
+
+fn kind_name(kind: ErrorKind) -> &'static str {
+    match kind {
+        ErrorKind::Diagnostics => "diagnostics",
+        ErrorKind::Io => "io",
+        ErrorKind::Corrupt => "corrupt",
+        ErrorKind::Stale => "stale",
+        ErrorKind::Interrupted => "interrupted",
+        ErrorKind::Memory => "memory",
+        ErrorKind::Invalid => "invalid",
+        ErrorKind::Locked => "locked",
+        ErrorKind::Evaluation => "evaluation",
+        _ => "other",
+    }
+}
+
+/// A `ShapingError` with the engine error's message and kind.
+fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
+    let err = ShapingError::new_err(e.message().to_string());
+    let _ = err.value(py).setattr("kind", kind_name(e.kind()));
+    err
+}
+
+fn value_error(message: impl Into<String>) -> PyErr {
+    PyValueError::new_err(message.into())
+}
+
+fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    py.import("warnings")?
+        .call_method1("warn", (message, py.get_type::<pyo3::exceptions::PyUserWarning>(), 2))?;
+    Ok(())
+}
+
+fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (value.to_string(),))
+}
+
+// ------------------------------------------------------------------ check
+
+/// One diagnostic of a file: what `shaping check` prints.
+#[pyclass(module = "shaping", frozen, get_all)]
+#[derive(Clone)]
+struct Diagnostic {
+    /// The message.
+    message: String,
+    /// "error", "warning" or "advice".
+    severity: String,
+    /// The diagnostic's code (`shaping::...`), if any.
+    code: Option<String>,
+    /// Line (1-based) of its first label, if it points into the file.
+    line: Option<usize>,
+    /// Column (1-based, in characters) of its first label.
+    column: Option<usize>,
+    /// What to do about it, if the compiler says.
+    help: Option<String>,
+    /// The file.
+    file: String,
+}
+
+#[pymethods]
+impl Diagnostic {
+    fn __repr__(&self) -> String {
+        let at = match (self.line, self.column) {
+            (Some(l), Some(c)) => format!(":{l}:{c}"),
+            _ => String::new(),
+        };
+        format!("<Diagnostic {}{at}: {}: {}>", self.file, self.severity, self.message)
+    }
+
+    fn __str__(&self) -> String {
+        let at = match (self.line, self.column) {
+            (Some(l), Some(c)) => format!(":{l}:{c}"),
+            _ => String::new(),
+        };
+        let help = self.help.as_ref().map(|h| format!(" (help: {h})")).unwrap_or_default();
+        format!("{}{at}: {}: {}{help}", self.file, self.severity, self.message)
+    }
+}
+
+/// Line and column (1-based, the column in characters) of byte `offset`.
+fn position(source: &str, offset: usize) -> (usize, usize) {
+    let at = offset.min(source.len());
+    let at = (0..=at).rev().find(|&i| source.is_char_boundary(i)).unwrap_or(0);
+    let before = &source[..at];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+fn severity(d: &dyn miette::Diagnostic) -> String {
+    match d.severity() {
+        Some(miette::Severity::Warning) => "warning",
+        Some(miette::Severity::Advice) => "advice",
+        _ => "error",
+    }
+    .to_string()
+}
+
+/// The diagnostics of `path`, or the engine's error for a file that cannot
+/// be read.
+fn diagnostics_of(path: &Path) -> Result<Vec<Diagnostic>, shaping_engine::Error> {
+    let file = path.display().to_string();
+    let plain = |message: String, severity: &str| Diagnostic {
+        message,
+        severity: severity.into(),
+        code: None,
+        line: None,
+        column: None,
+        help: None,
+        file: file.clone(),
+    };
+    if path.extension().is_some_and(|e| e == "json") {
+        return match load::load_built(path) {
+            Ok(_) => Ok(Vec::new()),
+            Err(e) if e.kind() == ErrorKind::Io => Err(e),
+            Err(e) => Ok(vec![plain(e.message().to_string(), "error")]),
+        };
+    }
+    let source = match load::read_source(path, ErrorFormat::Plain) {
+        Ok(s) => s,
+        Err(e) if e.kind() == ErrorKind::Diagnostics => {
+            // Not UTF-8: the message of the plain rendering's first line.
+            let first = e.message().lines().find(|l| !l.trim().is_empty()).unwrap_or("").trim();
+            let message = first.trim_start_matches(['×', 'x', ' ']).to_string();
+            return Ok(vec![plain(message, "error")]);
+        }
+        Err(e) => return Err(e),
+    };
+    let (_, diagnostics) = shaping_compiler::check(&source, &file);
+    Ok(diagnostics
+        .errors()
+        .iter()
+        .map(|d| {
+            let first = d.labels().and_then(|mut l| l.next()).map(|l| position(&source, l.offset()));
+            Diagnostic {
+                message: d.to_string(),
+                severity: severity(d),
+                code: d.code().map(|c| c.to_string()),
+                line: first.map(|p| p.0),
+                column: first.map(|p| p.1),
+                help: d.help().map(|h| h.to_string()),
+                file: file.clone(),
+            }
+        })
+        .collect())
+}
+
+/// check(path) -> list[Diagnostic]
+///
+/// Every diagnostic of a `.bat` file (errors and warnings), as `shaping
+/// check` reports them; an empty list for a good file. A file that cannot
+/// be read raises `ShapingError`.
+#[pyfunction]
+fn check(py: Python<'_>, path: PathBuf) -> PyResult<Vec<Diagnostic>> {
+    py.detach(|| diagnostics_of(&path)).map_err(|e| shaping_error(py, &e))
+}
+
+// ------------------------------------------------------------------ compile
+
+/// A compiled architecture file: its stages and their genomes.
+#[pyclass(module = "shaping", frozen)]
+struct Program {
+    program: Arc<Compiled>,
+    path: PathBuf,
+}
+
+fn stage_index(program: &Compiled, stage: &str) -> PyResult<usize> {
+    load::stage_index(program, Some(stage)).map_err(|e| value_error(e.message()))
+}
+
+/// Reads and compiles `path` (a `.bat` file or a `shaping build` JSON).
+fn load(py: Python<'_>, path: &Path) -> PyResult<Compiled> {
+    let loaded = py.detach(|| load::load_program(path, ErrorFormat::Plain));
+    match loaded {
+        Ok((program, warnings)) => {
+            if let Some(w) = warnings {
+                warn(py, w.trim_end())?;
+            }
+            Ok(program)
+        }
+        Err(e) => {
+            let err = shaping_error(py, &e);
+            if e.kind() == ErrorKind::Diagnostics {
+                if let Ok(d) = diagnostics_of(path) {
+                    let _ = err.value(py).setattr("diagnostics", d);
+                }
+            }
+            Err(err)
+        }
+    }
+}
+
+#[pymethods]
+impl Program {
+    /// The program's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.program.name.clone()
+    }
+
+    /// The file it was compiled from.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+
+    /// The names of the stages, in order.
+    #[getter]
+    fn stages(&self) -> Vec<String> {
+        self.program.stages.iter().map(|s| s.name.clone()).collect()
+    }
+
+    /// The number of bits of `stage`'s genome (frozen genes of earlier stages included).
+    fn genome_bits(&self, stage: &str) -> PyResult<u32> {
+        Ok(self.program.stages[stage_index(&self.program, stage)?].layout.bits)
+    }
+
+    /// What kind of stage `stage` is: "evolve", "train" or "test".
+    fn kind(&self, stage: &str) -> PyResult<&'static str> {
+        Ok(match self.program.stages[stage_index(&self.program, stage)?].run {
+            StageRun::Evolve(_) => "evolve",
+            StageRun::Train { .. } => "train",
+            StageRun::Test { .. } => "test",
+        })
+    }
+
+    /// The genes of `stage`'s genome, one dict per gene: the rows of
+    /// `shaping layout --format json` (`offset`, `bits`, `stage`, `module`,
+    /// `role`, `lo`, `hi`, `frozen`, ...).
+    fn layout<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyAny>> {
+        let st = &self.program.stages[stage_index(&self.program, stage)?];
+        let genes = serde_json::to_value(&st.layout.genes)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot serialise the layout: {e}")))?;
+        json_to_py(py, &genes)
+    }
+
+    /// The text `shaping layout` prints for `stage`.
+    fn layout_text(&self, stage: &str) -> PyResult<String> {
+        Ok(shaping_compiler::render_layout(&self.program, stage_index(&self.program, stage)?))
+    }
+
+    /// evaluator(stage, run=None, seed=0, jobs=None) -> Evaluator
+    #[pyo3(signature = (stage, run=None, seed=0, jobs=None))]
+    fn evaluator(
+        &self,
+        py: Python<'_>,
+        stage: &str,
+        run: Option<&Bound<'_, PyAny>>,
+        seed: u64,
+        jobs: Option<usize>,
+    ) -> PyResult<Evaluator> {
+        let index = stage_index(&self.program, stage)?;
+        if !matches!(self.program.stages[index].run, StageRun::Evolve(_)) {
+            return Err(value_error(format!(
+                "error: stage `{stage}` is not evolved (it is a {} stage): an evaluator evaluates the genomes of an evolved stage",
+                if matches!(self.program.stages[index].run, StageRun::Train { .. }) { "training" } else { "test" }
+            )));
+        }
+        if jobs == Some(0) {
+            return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
+        }
+        let run_dir: Option<PathBuf> = match run {
+            None => None,
+            Some(r) => Some(match r.getattr("out") {
+                Ok(out) => out.extract()?,
+                Err(_) => r.extract()?,
+            }),
+        };
+        if let Some(d) = &run_dir {
+            if !d.is_dir() {
+                return Err(value_error(format!(
+                    "error: the run directory `{}` does not exist",
+                    d.display()
+                )));
+            }
+        }
+        let mut program = (*self.program).clone();
+        let uses_training = engine_run::chain(&program, index)
+            .iter()
+            .any(|&i| matches!(program.stages[i].run, StageRun::Train { .. }));
+        let training_seed = engine_run::run_seed(&program, None);
+        let collected = Collect::default();
+        let bound = py.detach(|| {
+            engine_run::bind_training(&mut program, run_dir.as_deref(), training_seed, &collected)
+        });
+        let trained = bound.map_err(|e| shaping_error(py, &e))?;
+        for w in collected.warnings.into_inner().unwrap_or_default() {
+            warn(py, &w)?;
+        }
+        if uses_training && run_dir.is_none() && !trained.is_empty() {
+            warn(
+                py,
+                &format!(
+                    "stage `{stage}` uses weights of a training stage and no run was given: the training stages were trained afresh with seed {training_seed} (pass run= a run directory to use its weights)"
+                ),
+            )?;
+        }
+        let st = &program.stages[index];
+        shaping_runtime::controller::validate(st, &Genome::zeros(st.layout.bits as usize))
+            .map_err(|e| ShapingError::new_err(format!("error: stage `{}` cannot run: {e}", st.name)))?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs.unwrap_or(0))
+            .build()
+            .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
+        Ok(Evaluator { program: Arc::new(program), index, seed, pool })
+    }
+
+    fn __repr__(&self) -> String {
+        let stages: Vec<String> =
+            self.program.stages.iter().map(|s| format!("{} ({} bits)", s.name, s.layout.bits)).collect();
+        format!("<Program {} from {}: {}>", self.program.name, self.path.display(), stages.join(", "))
+    }
+}
+
+/// compile(path) -> Program
+#[pyfunction]
+fn compile(py: Python<'_>, path: PathBuf) -> PyResult<Program> {
+    let program = load(py, &path)?;
+    Ok(Program { program: Arc::new(program), path })
+}
+
+/// An observer that keeps the warnings.
+#[derive(Default)]
+struct Collect {
+    warnings: Mutex<Vec<String>>,
+}
+
+impl Observer for Collect {
+    fn event(&self, event: Event<'_>) {
+        if let Event::Warning(w) = event {
+            if let Ok(mut v) = self.warnings.lock() {
+                v.push(w);
+            }
+        }
+    }
+}
+
+// ------------------------------------------------------------------ evaluate
+
+/// Evaluates genomes of one evolved stage as a run evaluates them.
+#[pyclass(module = "shaping", frozen)]
+struct Evaluator {
+    program: Arc<Compiled>,
+    index: usize,
+    seed: u64,
+    pool: rayon::ThreadPool,
+}
+
+/// The rows of a 2-D array of 0/1 of `bits` columns, or a ValueError.
+fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize) -> PyResult<Vec<Genome>> {
+    let py = genomes.py();
+    let array = if genomes.is_instance_of::<numpy::PyUntypedArray>() {
+        genomes.clone()
+    } else {
+        py.import("numpy")?.call_method1("asarray", (genomes,))?
+    };
+    let untyped =
+        array.cast::<numpy::PyUntypedArray>().map_err(|_| value_error("genomes must be a numpy array"))?;
+    let shape = untyped.shape().to_vec();
+    if shape.len() != 2 || shape[1] != bits {
+        return Err(value_error(format!(
+            "genomes must be an array of shape (n, {bits}) (one row of the stage's {bits} bits per individual), not {}",
+            match shape.len() {
+                1 => format!("({},)", shape[0]),
+                _ => format!("({})", shape.iter().map(|s| s.to_string()).collect::<Vec<_>>().join(", ")),
+            }
+        )));
+    }
+    macro_rules! rows {
+        ($($t:ty),*) => {
+            $(
+                if let Ok(a) = array.extract::<PyReadonlyArray2<'_, $t>>() {
+                    let view = a.as_array();
+                    let mut out = Vec::with_capacity(shape[0]);
+                    for (i, row) in view.rows().into_iter().enumerate() {
+                        let mut g = Vec::with_capacity(bits);
+                        for (j, &v) in row.iter().enumerate() {
+                            #[allow(clippy::unnecessary_cast, irrefutable_let_patterns)]
+                            let b = if v == (0 as $t) { 0 } else if v == (1 as $t) { 1 } else {
+                                return Err(value_error(format!(
+                                    "genomes must hold 0 and 1 only: row {i}, column {j} holds {v}"
+                                )));
+                            };
+                            g.push(b);
+                        }
+                        out.push(Genome { bits: g });
+                    }
+                    return Ok(out);
+                }
+            )*
+        };
+    }
+    if let Ok(a) = array.extract::<PyReadonlyArray2<'_, bool>>() {
+        return Ok(a
+            .as_array()
+            .rows()
+            .into_iter()
+            .map(|r| Genome { bits: r.iter().map(|&b| u8::from(b)).collect() })
+            .collect());
+    }
+    rows!(u8, i8, i16, u16, i32, u32, i64, u64);
+    let dtype = array.getattr("dtype").and_then(|d| d.str()).map(|s| s.to_string()).unwrap_or_default();
+    Err(value_error(format!(
+        "genomes must be an array of integers or booleans (0 and 1), not of dtype {dtype}; e.g. `genomes.astype(numpy.uint8)` after rounding"
+    )))
+}
+
+#[pymethods]
+impl Evaluator {
+    /// The stage's name.
+    #[getter]
+    fn stage(&self) -> String {
+        self.program.stages[self.index].name.clone()
+    }
+
+    /// The number of bits of a genome (the columns of `evaluate`'s array).
+    #[getter]
+    fn bits(&self) -> u32 {
+        self.program.stages[self.index].layout.bits
+    }
+
+    /// The episodes each individual is evaluated on (the stage's `evaluations`).
+    #[getter]
+    fn episodes(&self) -> u32 {
+        match &self.program.stages[self.index].run {
+            StageRun::Evolve(e) => e.evaluations.max(1),
+            _ => 1,
+        }
+    }
+
+    /// The seed the episode seeds derive from.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// evaluate(genomes) -> dict[str, numpy.ndarray]
+    fn evaluate<'py>(&self, py: Python<'py>, genomes: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let stage = &self.program.stages[self.index];
+        let genomes = genomes_of(genomes, stage.layout.bits as usize)?;
+        let (index, seed) = (self.index, self.seed);
+        let results: Vec<Described> = py.detach(|| {
+            self.pool.install(|| {
+                genomes
+                    .par_iter()
+                    .enumerate()
+                    .map(|(i, g)| descriptors::evaluate(stage, g, &descriptors::seeds(stage, index, seed, i)))
+                    .collect()
+            })
+        });
+        let out = PyDict::new(py);
+        let f32s = |f: &dyn Fn(&Described) -> f32| results.iter().map(f).collect::<Vec<f32>>();
+        let u32s = |f: &dyn Fn(&Described) -> u32| results.iter().map(f).collect::<Vec<u32>>();
+        out.set_item("fitness", PyArray1::from_vec(py, f32s(&|d| d.evaluation.fitness)))?;
+        out.set_item("recharges", PyArray1::from_vec(py, u32s(&|d| d.evaluation.events.recharges)))?;
+        out.set_item("grips", PyArray1::from_vec(py, u32s(&|d| d.evaluation.events.grips)))?;
+        out.set_item(
+            "releases_outside",
+            PyArray1::from_vec(py, u32s(&|d| d.evaluation.events.releases_outside)),
+        )?;
+        out.set_item("collisions", PyArray1::from_vec(py, u32s(&|d| d.collisions)))?;
+        out.set_item("x", PyArray1::from_vec(py, f32s(&|d| d.descriptors.x)))?;
+        out.set_item("y", PyArray1::from_vec(py, f32s(&|d| d.descriptors.y)))?;
+        out.set_item("heading", PyArray1::from_vec(py, f32s(&|d| d.descriptors.heading)))?;
+        out.set_item("path_length", PyArray1::from_vec(py, f32s(&|d| d.descriptors.path_length)))?;
+        out.set_item("squares_visited", PyArray1::from_vec(py, f32s(&|d| d.descriptors.squares_visited)))?;
+        out.set_item(
+            "placement_failures",
+            PyArray1::from_vec(py, u32s(&|d| d.evaluation.placement_failures)),
+        )?;
+        Ok(out)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<Evaluator of stage `{}` ({} bits, {} episodes each, seed {})>",
+            self.stage(),
+            self.bits(),
+            self.episodes(),
+            self.seed
+        )
+    }
+}
+
+// ------------------------------------------------------------------ run
+
+/// A run directory: the stages it holds and their files.
+#[pyclass(module = "shaping", frozen)]
+struct Run {
+    out: PathBuf,
+    seed: Option<u64>,
+    stages: Vec<String>,
+    report: Option<PathBuf>,
+}
+
+#[pymethods]
+impl Run {
+    /// Opens the run directory `out` (written by `shaping run` or `shaping.run`).
+    #[new]
+    fn new(py: Python<'_>, out: PathBuf) -> PyResult<Run> {
+        let program = load::load_built(&rundir::program_path(&out)).map_err(|e| shaping_error(py, &e))?;
+        let stages = program
+            .stages
+            .iter()
+            .filter(|s| rundir::stage_dir(&out, &s.name).is_dir())
+            .map(|s| s.name.clone())
+            .collect();
+        let report = out.join("report.html");
+        let report = report.is_file().then_some(report);
+        Ok(Run { out, seed: None, stages, report })
+    }
+
+    /// The run directory.
+    #[getter]
+    fn out(&self) -> PathBuf {
+        self.out.clone()
+    }
+
+    /// The run seed (None for a directory opened with `Run(out)`).
+    #[getter]
+    fn seed(&self) -> Option<u64> {
+        self.seed
+    }
+
+    /// The stages run, in order.
+    #[getter]
+    fn stages(&self) -> Vec<String> {
+        self.stages.clone()
+    }
+
+    /// The path of `report.html` (None if not written).
+    #[getter]
+    fn report(&self) -> Option<PathBuf> {
+        self.report.clone()
+    }
+
+    /// The directory of `stage`.
+    fn stage_dir(&self, stage: &str) -> PyResult<PathBuf> {
+        let dir = rundir::stage_dir(&self.out, stage);
+        if !dir.is_dir() {
+            return Err(value_error(format!(
+                "error: the run `{}` has no stage `{stage}` (it has {})",
+                self.out.display(),
+                self.stages.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", ")
+            )));
+        }
+        Ok(dir)
+    }
+
+    /// The columns of `generations.csv` of evolved stage `stage`, each a numpy array.
+    fn generations<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyDict>> {
+        let path = self.stage_dir(stage)?.join("generations.csv");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+        let rows: Vec<Vec<&str>> = lines.filter(|l| !l.is_empty()).map(|l| l.split(',').collect()).collect();
+        let out = PyDict::new(py);
+        for (c, name) in header.iter().enumerate() {
+            let cells: Vec<&str> = rows.iter().map(|r| r.get(c).copied().unwrap_or("")).collect();
+            let bad =
+                || ShapingError::new_err(format!("error: `{}`: column `{name}` is damaged", path.display()));
+            match *name {
+                "stage" => {
+                    out.set_item(name, py.import("numpy")?.call_method1("array", (cells,))?)?;
+                }
+                "best" | "mean" | "worst" => {
+                    let v: Vec<f64> =
+                        cells.iter().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad())?;
+                    out.set_item(name, PyArray1::from_vec(py, v))?;
+                }
+                _ => {
+                    let v: Vec<i64> =
+                        cells.iter().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad())?;
+                    out.set_item(name, PyArray1::from_vec(py, v))?;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The chosen best genome of evolved stage `stage` (`best.genome`), a numpy array of 0/1.
+    fn best_genome<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyArray1<u8>>> {
+        let dir = self.stage_dir(stage)?;
+        let genome = rundir::read_best(&dir).map_err(|e| shaping_error(py, &e))?;
+        Ok(PyArray1::from_vec(py, genome.bits))
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Run {}: {}>", self.out.display(), self.stages.join(", "))
+    }
+}
+
+/// Tells the callback of `shaping.run` the run's events (with the GIL), and
+/// keeps the warnings and the callback's first exception.
+struct PyObserver {
+    callback: Option<Py<PyAny>>,
+    warnings: Mutex<Vec<String>>,
+    error: Mutex<Option<PyErr>>,
+    stop: Arc<AtomicBool>,
+}
+
+fn event_json(event: &Event<'_>) -> Option<serde_json::Value> {
+    use serde_json::json;
+    Some(match event {
+        Event::EvolveStart { stage, generations, done } => {
+            json!({"event": "evolve_start", "stage": stage, "generations": generations, "done": done})
+        }
+        Event::Resumed { stage, generation, generations, finished, checkpoint } => json!({
+            "event": "resumed", "stage": stage, "generation": generation, "generations": generations,
+            "finished": finished, "checkpoint": checkpoint.display().to_string(),
+        }),
+        Event::Generation { stage, stats } => {
+            json!({"event": "generation", "stage": stage, "stats": serde_json::to_value(stats).ok()})
+        }
+        Event::EvolveEnd { stage, completed } => {
+            json!({"event": "evolve_end", "stage": stage, "completed": completed})
+        }
+        Event::Evolved { stage, generations, chosen, dir, .. } => json!({
+            "event": "evolved", "stage": stage, "generations": generations, "chosen": chosen,
+            "dir": dir.display().to_string(),
+        }),
+        Event::Trained { stage, trained, recorded, reused, dir } => json!({
+            "event": "trained", "stage": stage.name, "actions": trained.result.actions,
+            "performance": trained.performance, "recorded": recorded, "reused": reused,
+            "dir": dir.display().to_string(),
+        }),
+        Event::Tested { stage, summary, lives, dir, .. } => json!({
+            "event": "tested", "stage": stage, "summary": summary, "lives": lives,
+            "dir": dir.display().to_string(),
+        }),
+        Event::Warning(w) => json!({"event": "warning", "message": w}),
+        _ => return None,
+    })
+}
+
+impl Observer for PyObserver {
+    fn event(&self, event: Event<'_>) {
+        if let Event::Warning(w) = &event {
+            if let Ok(mut v) = self.warnings.lock() {
+                v.push(w.clone());
+            }
+        }
+        let Some(callback) = &self.callback else { return };
+        if self.error.lock().map(|e| e.is_some()).unwrap_or(true) {
+            return;
+        }
+        let Some(value) = event_json(&event) else { return };
+        Python::attach(|py| {
+            let result = json_to_py(py, &value).and_then(|v| callback.call1(py, (v,)));
+            if let Err(e) = result {
+                if let Ok(mut slot) = self.error.lock() {
+                    slot.get_or_insert(e);
+                }
+                self.stop.store(true, Ordering::Relaxed);
+            }
+        });
+    }
+}
+
+/// `set`: a dict of `STAGE.SECTION.FIELD` to one value each.
+fn assignments(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<sweep::Assignment>> {
+    let Some(set) = set else { return Ok(Vec::new()) };
+    let mut out = Vec::new();
+    for (k, v) in set.iter() {
+        let key: String =
+            k.extract().map_err(|_| value_error("set: the keys are STAGE.SECTION.FIELD strings"))?;
+        if v.is_instance_of::<PyList>() || v.is_instance_of::<pyo3::types::PyTuple>() {
+            return Err(value_error(format!(
+                "error: `--set {key}`: `run` takes one value (`experiment` sweeps several)"
+            )));
+        }
+        let text = if let Ok(b) = v.extract::<bool>() { b.to_string() } else { v.str()?.to_string() };
+        let parsed =
+            sweep::parse_set(&format!("{key}={text}")).map_err(|e| value_error(format!("error: {e}")))?;
+        let [value] = <[String; 1]>::try_from(parsed.values).map_err(|values| {
+            value_error(format!(
+                "error: `--set {}={}`: `run` takes one value (`experiment` sweeps several)",
+                parsed.target,
+                values.join(",")
+            ))
+        })?;
+        out.push((parsed.target, value));
+    }
+    Ok(out)
+}
+
+/// run(path, out=None, seed=None, stage=None, set=None, jobs=None, callback=None, fresh=False, report=True) -> Run
+#[pyfunction]
+#[pyo3(signature = (path, out=None, seed=None, stage=None, set=None, jobs=None, callback=None, fresh=false, report=true))]
+#[allow(clippy::too_many_arguments)]
+fn run(
+    py: Python<'_>,
+    path: PathBuf,
+    out: Option<PathBuf>,
+    seed: Option<u64>,
+    stage: Option<String>,
+    set: Option<&Bound<'_, PyDict>>,
+    jobs: Option<usize>,
+    callback: Option<Py<PyAny>>,
+    fresh: bool,
+    report: bool,
+) -> PyResult<Run> {
+    if jobs == Some(0) {
+        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
+    }
+    if let Some(c) = &callback {
+        if !c.bind(py).is_callable() {
+            return Err(value_error("callback must be callable (it is called with one dict per event)"));
+        }
+    }
+    let sets = assignments(set)?;
+    let program = load(py, &path)?;
+    if let Some(s) = &stage {
+        stage_index(&program, s)?;
+    }
+    let out = out.unwrap_or_else(|| engine_run::default_out(&path));
+    let options = RunOptions { stage, seed, out, jobs, fresh, no_report: !report, sets };
+    let stop = Arc::new(AtomicBool::new(false));
+    let observer = PyObserver {
+        callback,
+        warnings: Mutex::new(Vec::new()),
+        error: Mutex::new(None),
+        stop: stop.clone(),
+    };
+    // Ctrl-C sets the flag (the run stops after the generation under way,
+    // resumable) for the run's duration; Python's own handler still runs.
+    let hook = signal_hook::flag::register(signal_hook::consts::SIGINT, stop.clone()).ok();
+    let result = py.detach(|| {
+        let runner = Runner { observer: &observer, evaluator: None, interrupt: Some(&stop) };
+        runner.run(program, &options)
+    });
+    if let Some(id) = hook {
+        signal_hook::low_level::unregister(id);
+    }
+    for w in observer.warnings.lock().map(|v| v.clone()).unwrap_or_default() {
+        warn(py, &w)?;
+    }
+    if let Some(e) = observer.error.lock().ok().and_then(|mut e| e.take()) {
+        return Err(e);
+    }
+    match result {
+        Ok(outcome) => Ok(Run {
+            stages: outcome.stages.iter().map(|s| s.stage().to_string()).collect(),
+            out: outcome.out,
+            seed: Some(outcome.seed),
+            report: outcome.report,
+        }),
+        Err(e) if e.kind() == ErrorKind::Interrupted => {
+            // Python's handler saw the signal too: its KeyboardInterrupt, with the run's message.
+            let _ = py.check_signals();
+            Err(PyKeyboardInterrupt::new_err(e.message().to_string()))
+        }
+        Err(e) => Err(shaping_error(py, &e)),
+    }
+}
+
+#[pymodule]
+fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("ShapingError", m.py().get_type::<ShapingError>())?;
+    m.add("SQUARE_MM", descriptors::SQUARE_MM)?;
+    m.add_class::<Diagnostic>()?;
+    m.add_class::<Program>()?;
+    m.add_class::<Evaluator>()?;
+    m.add_class::<Run>()?;
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(compile, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    Ok(())
+}
