@@ -129,6 +129,8 @@ class Run:
         """The columns of the stage's ``generations.csv``."""
     def best_genome(self, stage: str) -> npt.NDArray[np.uint8]:
         """The stage's chosen best genome (``best.genome``), 0 and 1."""
+    def population(self, stage: str) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
+        """The last evaluated generation (the checkpoint): genomes ``(population, bits)`` and their fitness."""
 
 def run(
     path: PathLike,

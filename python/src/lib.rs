@@ -618,6 +618,32 @@ impl Run {
         Ok(PyArray1::from_vec(py, genome.bits))
     }
 
+    /// The last evaluated generation of evolved stage `stage` (its
+    /// checkpoint): the genomes, an array of shape (population, bits) of
+    /// 0/1, and their fitness (float32), as the run evaluated them.
+    #[allow(clippy::type_complexity)]
+    fn population<'py>(
+        &self,
+        py: Python<'py>,
+        stage: &str,
+    ) -> PyResult<(Bound<'py, numpy::PyArray2<u8>>, Bound<'py, PyArray1<f32>>)> {
+        let dir = self.stage_dir(stage)?;
+        let cp = rundir::read_checkpoint(&dir).map_err(|e| shaping_error(py, &e))?.ok_or_else(|| {
+            ShapingError::new_err(format!(
+                "error: there is no checkpoint `{}`: stage `{stage}` is not evolved or not run",
+                rundir::checkpoint_path(&dir).display()
+            ))
+        })?;
+        let rows: Vec<Vec<u8>> = cp.population.iter().map(|g| g.bits.clone()).collect();
+        let genomes = if rows.is_empty() {
+            numpy::PyArray2::zeros(py, [0, 0], false)
+        } else {
+            numpy::PyArray2::from_vec2(py, &rows)
+                .map_err(|e| ShapingError::new_err(format!("error: the checkpoint of `{stage}`: {e}")))?
+        };
+        Ok((genomes, PyArray1::from_vec(py, cp.fitness)))
+    }
+
     fn __repr__(&self) -> String {
         format!("<Run {}: {}>", self.out.display(), self.stages.join(", "))
     }

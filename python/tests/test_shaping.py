@@ -1,0 +1,302 @@
+"""Tests of the `shaping` package against the files of the repository and
+the `shaping` command line (SHAPING_BIN, else target/{debug,release}/shaping,
+else `shaping` on PATH; skipped without it, failing under CI=true)."""
+
+import json
+import os
+import shutil
+import subprocess
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import shaping
+
+ROOT = Path(__file__).resolve().parents[2]
+KHEPERA = ROOT / "examples" / "khepera.bat"
+TINY = ROOT / "tests" / "cli" / "tiny.bat"
+BAD = "robot khepera {\n  sensor ir[8] proximity\n  wheels\n}\n"
+
+
+def cli():
+    """The `shaping` binary, or a skip (a failure under CI=true)."""
+    candidates = [os.environ.get("SHAPING_BIN")]
+    target = os.environ.get("CARGO_TARGET_DIR", str(ROOT / "target"))
+    candidates += [str(Path(target) / p / "shaping") for p in ("debug", "release")]
+    candidates.append(shutil.which("shaping"))
+    for c in candidates:
+        if c and Path(c).is_file() and os.access(c, os.X_OK):
+            return c
+    if os.environ.get("CI") == "true":
+        pytest.fail("the `shaping` binary is missing (set SHAPING_BIN or build it: cargo build --bin shaping)")
+    pytest.skip("the `shaping` binary is missing (cargo build --bin shaping)")
+
+
+def shaping_cli(*args):
+    return subprocess.run([cli(), *map(str, args)], capture_output=True, text=True, cwd=ROOT)
+
+
+def random_genomes(n, bits, seed=1, dtype=np.uint8):
+    return np.random.default_rng(seed).integers(0, 2, size=(n, bits)).astype(dtype)
+
+
+# ------------------------------------------------------------------ compile, check
+
+
+def test_compile_khepera_stages_and_bits_match_the_cli():
+    program = shaping.compile(KHEPERA)
+    assert program.stages == ["avoidance", "navigation", "collect", "bigger"]
+    assert [program.kind(s) for s in program.stages] == ["train", "evolve", "evolve", "test"]
+    checked = shaping_cli("check", "--error-format", "json", KHEPERA)
+    assert checked.returncode == 0, checked.stderr
+    cli_stages = json.loads(checked.stdout)["stages"]
+    assert [(s["name"], s["bits"]) for s in cli_stages] == [
+        (s, program.genome_bits(s)) for s in program.stages
+    ]
+    for stage in program.stages:
+        out = shaping_cli("layout", KHEPERA, "--stage", stage, "--format", "json")
+        assert out.returncode == 0, out.stderr
+        layout = json.loads(out.stdout)
+        assert program.layout(stage) == layout["genes"]
+        assert layout["bits"] == program.genome_bits(stage)
+        text = shaping_cli("layout", KHEPERA, "--stage", stage).stdout
+        assert program.layout_text(stage).strip() == text.strip()
+
+
+def test_layout_bits_add_up():
+    program = shaping.compile(str(KHEPERA))
+    genes = program.layout("collect")
+    assert sum(g["bits"] for g in genes) == program.genome_bits("collect")
+    assert any(g["frozen"] for g in genes) and not all(g["frozen"] for g in genes)
+
+
+def test_check_good_and_bad_files(tmp_path):
+    assert shaping.check(KHEPERA) == []
+    bad = tmp_path / "bad.bat"
+    bad.write_text(BAD)
+    diags = shaping.check(bad)
+    assert len(diags) == 1
+    d = diags[0]
+    assert d.severity == "error"
+    assert (d.line, d.column) == (3, 3)
+    assert "wheels" in d.message
+    # The CLI's JSON says the same (line and column 1-based).
+    out = shaping_cli("check", "--error-format", "json", bad)
+    assert out.returncode == 1
+    cli_diag = json.loads(out.stdout)
+    related = cli_diag.get("related") or [cli_diag]
+    assert (related[0]["line"], related[0]["column"]) == (3, 3)
+    assert related[0]["message"] == d.message
+
+
+def test_compile_errors_raise_with_the_cli_message(tmp_path):
+    bad = tmp_path / "bad.bat"
+    bad.write_text(BAD)
+    with pytest.raises(shaping.ShapingError) as e:
+        shaping.compile(bad)
+    assert e.value.kind == "diagnostics"
+    assert [d.line for d in e.value.diagnostics] == [3]
+    out = shaping_cli("check", "--error-format", "plain", bad)
+    assert out.returncode == 1
+    assert str(e.value).strip() == out.stderr.strip()
+    assert issubclass(shaping.ShapingError, Exception)
+
+
+def test_a_missing_file_raises_with_the_cli_message(tmp_path):
+    missing = tmp_path / "nope.bat"
+    with pytest.raises(shaping.ShapingError) as e:
+        shaping.compile(missing)
+    assert e.value.kind == "io"
+    out = shaping_cli("check", missing)
+    assert str(e.value).strip() == out.stderr.strip()
+    with pytest.raises(shaping.ShapingError):
+        shaping.check(missing)
+
+
+def test_a_stage_that_does_not_exist():
+    program = shaping.compile(KHEPERA)
+    with pytest.raises(ValueError, match="no stage `nope`"):
+        program.genome_bits("nope")
+    with pytest.raises(ValueError, match="no stage `nope`"):
+        program.evaluator("nope")
+    with pytest.raises(ValueError, match="not evolved"):
+        program.evaluator("avoidance")
+
+
+# ------------------------------------------------------------------ evaluate
+
+
+@pytest.fixture(scope="module")
+def navigation():
+    program = shaping.compile(KHEPERA)
+    with pytest.warns(UserWarning, match="trained afresh"):
+        ev = program.evaluator("navigation", seed=3)
+    return program, ev
+
+
+def test_evaluate_is_deterministic_and_complete(navigation):
+    program, ev = navigation
+    assert ev.bits == program.genome_bits("navigation") == 192
+    genomes = random_genomes(8, ev.bits)
+    a = ev.evaluate(genomes)
+    b = ev.evaluate(genomes.copy())
+    keys = {"fitness", "recharges", "grips", "releases_outside", "collisions", "x", "y", "heading",
+            "path_length", "squares_visited", "placement_failures"}
+    assert keys <= set(a)
+    for k in keys:
+        assert a[k].shape == (8,), k
+        np.testing.assert_array_equal(a[k], b[k])
+    assert a["fitness"].dtype == np.float32
+    assert np.all(np.isfinite(a["fitness"]))
+    # Inside the arena (400 x 600 mm), a path and at least the start square.
+    assert np.all((a["x"] >= 0) & (a["x"] <= 400) & (a["y"] >= 0) & (a["y"] <= 600))
+    assert np.all(np.abs(a["heading"]) <= np.pi + 1e-6)
+    assert np.all(a["squares_visited"] >= 1) and np.all(a["path_length"] >= 0)
+    # Each individual is evaluated on its own episodes: a row's result does
+    # not depend on the other rows, only on its index.
+    one = ev.evaluate(genomes[:1])
+    assert one["fitness"][0] == a["fitness"][0]
+    # bool and int arrays give the same results.
+    np.testing.assert_array_equal(ev.evaluate(genomes.astype(bool))["fitness"], a["fitness"])
+    np.testing.assert_array_equal(ev.evaluate(genomes.astype(np.int64))["fitness"], a["fitness"])
+    # Another seed, other episodes.
+    other = navigation[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ev2 = other.evaluator("navigation", seed=4)
+    assert not np.array_equal(ev2.evaluate(genomes)["fitness"], a["fitness"])
+
+
+def test_evaluate_rejects_bad_arrays(navigation):
+    _, ev = navigation
+    g = random_genomes(4, ev.bits)
+    with pytest.raises(ValueError, match=r"shape \(n, 192\)"):
+        ev.evaluate(g[:, :-1])
+    with pytest.raises(ValueError, match=r"shape \(n, 192\)"):
+        ev.evaluate(g[0])
+    with pytest.raises(ValueError, match="dtype float64"):
+        ev.evaluate(g.astype(float))
+    with pytest.raises(ValueError, match="0 and 1 only: row 1, column 5 holds 2"):
+        bad = g.copy()
+        bad[1, 5] = 2
+        ev.evaluate(bad)
+    with pytest.raises(ValueError, match="0 and 1 only"):
+        ev.evaluate(-g.astype(np.int8) - 1)
+    with pytest.raises(ValueError):
+        ev.evaluate("not an array")
+    assert ev.evaluate(np.zeros((0, ev.bits), np.uint8))["fitness"].shape == (0,)
+
+
+def test_evaluate_equals_the_fitness_of_a_cli_run(tmp_path):
+    """The reference: a run of the CLI (`shaping run`), its first generation
+    evaluated in Rust; `evaluate` with the run's seed and weights gives the
+    same fitness to the same individuals."""
+    out = tmp_path / "run"
+    res = shaping_cli(
+        "run", KHEPERA, "--stage", "navigation", "--seed", 5, "--out", out, "--no-report",
+        "--set", "navigation.evolve.generations=1", "--set", "navigation.evolve.population=8",
+    )
+    assert res.returncode == 0, res.stderr
+    run = shaping.Run(out)
+    assert run.stages == ["avoidance", "navigation"]
+    genomes, fitness = run.population("navigation")
+    assert genomes.shape == (8, 192) and fitness.dtype == np.float32
+    program = shaping.compile(KHEPERA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the run's weights: no warning
+        ev = program.evaluator("navigation", run=run, seed=5)
+    np.testing.assert_array_equal(ev.evaluate(genomes)["fitness"], fitness)
+    # A directory works as well as a Run.
+    ev = program.evaluator("navigation", run=str(out), seed=5)
+    np.testing.assert_array_equal(ev.evaluate(genomes)["fitness"], fitness)
+
+
+# ------------------------------------------------------------------ run
+
+
+def test_run_tiny(tmp_path):
+    events = []
+    run = shaping.run(TINY, out=tmp_path / "tiny", callback=events.append, jobs=2)
+    assert run.stages == ["first", "second"]
+    assert run.seed == 3
+    assert run.report is not None and Path(run.report).is_file()
+    program = shaping.compile(TINY)
+    for stage, generations in [("first", 6), ("second", 4)]:
+        g = run.generations(stage)
+        assert set(g) >= {"stage", "generation", "best", "mean", "worst", "best_index"}
+        rows = g["stage"] == stage
+        assert rows.sum() == generations
+        assert np.all(g["best"][rows] >= g["mean"][rows])
+        best = run.best_genome(stage)
+        assert best.shape == (program.genome_bits(stage),)
+        assert set(np.unique(best)) <= {0, 1}
+    kinds = [e["event"] for e in events]
+    assert kinds.count("generation") == 10
+    assert kinds.count("evolved") == 2
+    # Run again: everything is resumed from the directory, same results.
+    again = shaping.run(TINY, out=tmp_path / "tiny", report=False)
+    np.testing.assert_array_equal(again.best_genome("second"), run.best_genome("second"))
+    # The CLI writes the same best genome.
+    cli_out = tmp_path / "cli"
+    res = shaping_cli("run", TINY, "--out", cli_out, "--no-report")
+    assert res.returncode == 0, res.stderr
+    np.testing.assert_array_equal(shaping.Run(cli_out).best_genome("second"), run.best_genome("second"))
+
+
+def test_run_set_and_bad_arguments(tmp_path):
+    run = shaping.run(TINY, out=tmp_path / "a", stage="first", set={"first.evolve.generations": 2}, report=False)
+    assert run.stages == ["first"]
+    assert len(run.generations("first")["best"]) == 2
+    with pytest.raises(ValueError, match="no stage `nope`"):
+        shaping.run(TINY, out=tmp_path / "b", stage="nope")
+    with pytest.raises(shaping.ShapingError) as e:
+        shaping.run(TINY, out=tmp_path / "c", set={"first.evolve.nothing": 2})
+    res = shaping_cli("run", TINY, "--out", tmp_path / "d", "--set", "first.evolve.nothing=2")
+    assert res.returncode != 0
+    assert str(e.value).strip() == res.stderr.strip()
+    with pytest.raises(ValueError, match="one value"):
+        shaping.run(TINY, out=tmp_path / "e", set={"first.evolve.generations": [1, 2]})
+    with pytest.raises(ValueError, match="STAGE.SECTION.FIELD"):
+        shaping.run(TINY, out=tmp_path / "f", set={"generations": 2})
+    with pytest.raises(ValueError, match="jobs"):
+        shaping.run(TINY, out=tmp_path / "g", jobs=0)
+    with pytest.raises(ValueError, match="no stage"):
+        run.best_genome("second")
+
+
+def test_a_callback_exception_stops_the_run_resumably(tmp_path):
+    out = tmp_path / "stop"
+
+    def stop(event):
+        if event["event"] == "generation" and event["stats"]["stage_generation"] == 1:
+            raise RuntimeError("enough")
+
+    with pytest.raises(RuntimeError, match="enough"):
+        shaping.run(TINY, out=out, callback=stop, report=False)
+    # Stopped after generation 1 of `first`, resumable.
+    done = shaping.Run(out).generations("first")
+    assert len(done["best"]) == 2
+    run = shaping.run(TINY, out=out, report=False)
+    assert len(run.generations("first")["best"]) == 6
+
+
+def test_ctrl_c_stops_the_run_resumably(tmp_path):
+    """SIGINT during a run (sent here from the callback): KeyboardInterrupt,
+    and the stage is saved after its generation, resumable."""
+    import signal
+
+    out = tmp_path / "int"
+    seen = []
+
+    def interrupt(event):
+        seen.append(event["event"])
+        if event["event"] == "generation" and seen.count("generation") == 1:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        shaping.run(TINY, out=out, callback=interrupt, report=False)
+    assert 1 <= len(shaping.Run(out).generations("first")["best"]) < 6
+    run = shaping.run(TINY, out=out, report=False)
+    assert run.stages == ["first", "second"]
