@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The Python package's CI (called by .ci/run): builds and installs it with
+# pip in a fresh virtual environment, then runs its pytest tests, which
+# compare it with the `shaping` command line (built here if SHAPING_BIN is
+# not set). Exits non-zero if the build, the install or a test fails.
+#
+#   bash python/ci.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+python="${PYTHON:-python3}"
+work="$(mktemp -d)"
+trap 'rm -rf "$work"' EXIT
+"$python" -m venv "$work/venv"
+venv="$work/venv/bin"
+
+# maturin (from PyPI, in pip's isolated build environment) builds the
+# extension in release; CARGO_TARGET_DIR, if set, is reused.
+"$venv/pip" install --quiet --disable-pip-version-check ./python pytest numpy
+
+if [ -z "${SHAPING_BIN:-}" ]; then
+  cargo build --quiet --bin shaping
+  target="$(cargo metadata --format-version 1 --no-deps \
+    | "$python" -c 'import json, sys; print(json.load(sys.stdin)["target_directory"])')"
+  export SHAPING_BIN="$target/debug/shaping"
+fi
+
+# Run from outside the source tree, so `import shaping` is the installed package.
+cd "$work"
+CI="${CI:-}" "$venv/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider
