@@ -8,6 +8,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# The binding crate is its own workspace: format and lints here (the root's
+# `cargo fmt --all` and `cargo clippy --workspace` do not see it).
+cargo fmt --manifest-path python/Cargo.toml --check
+cargo clippy --quiet --manifest-path python/Cargo.toml --all-targets -- -D warnings
+
 python="${PYTHON:-python3}"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT

@@ -300,3 +300,46 @@ def test_ctrl_c_stops_the_run_resumably(tmp_path):
     assert 1 <= len(shaping.Run(out).generations("first")["best"]) < 6
     run = shaping.run(TINY, out=out, report=False)
     assert run.stages == ["first", "second"]
+
+
+def test_evaluate_does_not_depend_on_threads(navigation):
+    program, ev = navigation
+    genomes = random_genomes(64, ev.bits, seed=9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one = program.evaluator("navigation", seed=3, jobs=1)
+    a, b = ev.evaluate(genomes), one.evaluate(genomes)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k])
+    with pytest.raises(ValueError, match="jobs"):
+        program.evaluator("navigation", jobs=0)
+
+
+def test_evaluate_releases_the_gil(navigation):
+    """While one thread evaluates, another runs Python: no long pause."""
+    import threading
+    import time
+
+    program, _ = navigation
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ev = program.evaluator("navigation", seed=3, jobs=1)
+    genomes = random_genomes(10000, ev.bits, seed=2)
+    span = {}
+
+    def work():
+        span["start"] = time.perf_counter()
+        ev.evaluate(genomes)
+        span["end"] = time.perf_counter()
+
+    t = threading.Thread(target=work)
+    ticks = []
+    t.start()
+    while t.is_alive():
+        ticks.append(time.perf_counter())
+    t.join()
+    duration = span["end"] - span["start"]
+    inside = [x for x in ticks if span["start"] <= x <= span["end"]]
+    gaps = np.diff([span["start"], *inside, span["end"]])
+    assert duration > 0.1, "too quick to tell"
+    assert gaps.max() < duration / 2, (gaps.max(), duration)
