@@ -177,11 +177,9 @@ fn diagnostics_of(path: &Path) -> Result<Vec<Diagnostic>, shaping_engine::Error>
         .collect())
 }
 
-/// check(path) -> list[Diagnostic]
-///
-/// Every diagnostic of a `.bat` file (errors and warnings), as `shaping
-/// check` reports them; an empty list for a good file. A file that cannot
-/// be read raises `ShapingError`.
+/// Every diagnostic of the `.bat` file `path` (errors and warnings), as
+/// `shaping check` reports them, with 1-based lines and columns; an empty
+/// list for a good file. A file that cannot be read raises ShapingError.
 #[pyfunction]
 fn check(py: Python<'_>, path: PathBuf) -> PyResult<Vec<Diagnostic>> {
     py.detach(|| diagnostics_of(&path)).map_err(|e| shaping_error(py, &e))
@@ -271,7 +269,14 @@ impl Program {
         Ok(shaping_compiler::render_layout(&self.program, stage_index(&self.program, stage)?))
     }
 
-    /// evaluator(stage, run=None, seed=0, jobs=None) -> Evaluator
+    /// An evaluator of the genomes of evolved stage `stage`: see `Evaluator.evaluate`.
+    ///
+    /// `run`: a `Run` or a run directory whose training stages' weights
+    /// (`trained.json`) are used; without it, training stages are trained
+    /// afresh with the program's run seed, and a warning says so. `seed`:
+    /// the seed the episodes derive from. `jobs`: worker threads (None: one
+    /// per core). A stage that does not exist or is not evolved raises
+    /// ValueError.
     #[pyo3(signature = (stage, run=None, seed=0, jobs=None))]
     fn evaluator(
         &self,
@@ -344,7 +349,10 @@ impl Program {
     }
 }
 
-/// compile(path) -> Program
+/// Compiles the `.bat` file `path` (or loads a program written by `shaping
+/// build`). A file with errors raises ShapingError whose text holds the
+/// diagnostics (and whose `diagnostics` lists them); the warnings of a file
+/// that compiles are Python warnings.
 #[pyfunction]
 fn compile(py: Python<'_>, path: PathBuf) -> PyResult<Program> {
     let program = load(py, &path)?;
@@ -466,7 +474,23 @@ impl Evaluator {
         self.seed
     }
 
-    /// evaluate(genomes) -> dict[str, numpy.ndarray]
+    /// Evaluates each row of `genomes`, an array of shape (n, bits) of 0
+    /// and 1 (an integer or bool dtype), as the stage's evolution does: its
+    /// `evaluations` episodes of its `actions` actions, in its world,
+    /// learning on, with the GIL released, on the evaluator's threads.
+    ///
+    /// Returns a dict of arrays of shape (n,): `fitness` (float32, the mean
+    /// over the episodes); `recharges`, `grips`, `releases_outside`,
+    /// `collisions`, `placement_failures` (uint32, summed over them); `x`,
+    /// `y`, `heading` (float32, the final pose of the last episode, mm from
+    /// the arena's south-west corner and radians); `path_length` (mm) and
+    /// `squares_visited` (the 50 mm squares the body centre was in), means
+    /// over the episodes.
+    ///
+    /// Row i is evaluated on the episodes a run with run seed `seed` gives
+    /// individual i of the stage's first generation, so the same array and
+    /// seed give the same results whatever the threads. A wrong shape,
+    /// dtype or value raises ValueError.
     fn evaluate<'py>(&self, py: Python<'py>, genomes: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
         let stage = &self.program.stages[self.index];
         let genomes = genomes_of(genomes, stage.layout.bits as usize)?;
@@ -743,7 +767,20 @@ fn assignments(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<sweep::Assignmen
     Ok(out)
 }
 
-/// run(path, out=None, seed=None, stage=None, set=None, jobs=None, callback=None, fresh=False, report=True) -> Run
+/// Runs the file `path` like `shaping run` into `out` (default
+/// `runs/<file stem>`), resuming what is saved there, and returns its `Run`.
+///
+/// `seed`: the run seed (default: the first evolved stage's); `stage`: run
+/// only it and the stages it needs; `set`: a dict of `STAGE.SECTION.FIELD`
+/// to one value each (`--set`); `jobs`: worker threads; `fresh`: start
+/// every stage again; `report`: write `report.html`. `callback` is called
+/// (with the GIL) with one dict per event (`event`: "evolve_start",
+/// "resumed", "generation", "evolve_end", "evolved", "trained", "tested",
+/// "warning"); an exception it raises stops the run after the generation
+/// under way and is raised. Ctrl-C does the same and raises
+/// KeyboardInterrupt; the run is resumable. Errors of the run raise
+/// ShapingError with the command line's message; malformed arguments raise
+/// ValueError.
 #[pyfunction]
 #[pyo3(signature = (path, out=None, seed=None, stage=None, set=None, jobs=None, callback=None, fresh=false, report=true))]
 #[allow(clippy::too_many_arguments)]
