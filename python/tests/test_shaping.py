@@ -343,3 +343,35 @@ def test_evaluate_releases_the_gil(navigation):
     gaps = np.diff([span["start"], *inside, span["end"]])
     assert duration > 0.1, "too quick to tell"
     assert gaps.max() < duration / 2, (gaps.max(), duration)
+
+
+def test_several_evaluations_equal_the_run_s_fitness(tmp_path):
+    """A stage of 3 evaluations per individual: the mean fitness of the
+    run's first generation, without warnings (no training stage)."""
+    source = TINY.read_text().replace("seed 3", "seed 3  evaluations 3", 1)
+    assert "evaluations 3" in source
+    path = tmp_path / "three.bat"
+    path.write_text(source)
+    run = shaping.run(path, out=tmp_path / "run", stage="first", set={"first.evolve.generations": 1}, report=False)
+    genomes, fitness = run.population("first")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ev = shaping.compile(path).evaluator("first", seed=3)
+    assert ev.episodes == 3
+    result = ev.evaluate(genomes)
+    np.testing.assert_array_equal(result["fitness"], fitness)
+    g = run.generations("first")
+    best = int(g["best_index"][0])
+    assert result["recharges"][best] == g["best_recharges"][0]
+
+
+def test_a_later_stage_takes_its_frozen_genes_from_the_genome(navigation):
+    program, _ = navigation
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ev = program.evaluator("collect", seed=1)
+    assert ev.bits == program.genome_bits("collect") == 344
+    genomes = random_genomes(4, ev.bits, seed=4)
+    changed = genomes.copy()
+    changed[:, :192] = 1 - changed[:, :192]  # navigation's (frozen) genes
+    assert not np.array_equal(ev.evaluate(genomes)["fitness"], ev.evaluate(changed)["fitness"])
