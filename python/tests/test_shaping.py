@@ -375,3 +375,33 @@ def test_a_later_stage_takes_its_frozen_genes_from_the_genome(navigation):
     changed = genomes.copy()
     changed[:, :192] = 1 - changed[:, :192]  # navigation's (frozen) genes
     assert not np.array_equal(ev.evaluate(genomes)["fitness"], ev.evaluate(changed)["fitness"])
+
+
+def test_ctrl_c_without_a_callback(tmp_path):
+    """SIGINT from another thread while the run is in Rust (no Python code
+    runs to see it): the engine's flag stops it after the generation under
+    way; KeyboardInterrupt with the CLI's message; resumable."""
+    import signal
+    import threading
+
+    out = tmp_path / "long"
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt, match="interrupted: stage `navigation` stopped after generation"):
+            shaping.run(KHEPERA, out=out, stage="navigation", set={"navigation.evolve.generations": 100000},
+                        report=False, jobs=2)
+    finally:
+        timer.cancel()
+    done = len(shaping.Run(out).generations("navigation")["best"])
+    assert 1 <= done < 100000
+    # The same call resumes where it stopped.
+    events = []
+    with pytest.raises(RuntimeError):
+        def first_generation(event):
+            events.append(event)
+            if event["event"] == "generation":
+                raise RuntimeError("seen")
+        shaping.run(KHEPERA, out=out, stage="navigation", set={"navigation.evolve.generations": 100000},
+                    report=False, callback=first_generation)
+    assert any(e["event"] == "resumed" and e["generation"] == done for e in events)
