@@ -10,12 +10,15 @@ use thiserror::Error;
 /// One problem in an architecture file.
 #[derive(Clone, Debug, Error, Diagnostic)]
 pub enum Error {
-    #[error("expected {expected}, found {found}")]
+    /// "expected X, found Y", or a bracket that is not closed.
+    #[error("{message}")]
     Syntax {
-        #[label("unexpected here")]
+        #[label("{label}")]
         span: SourceSpan,
-        expected: String,
-        found: String,
+        message: String,
+        label: String,
+        #[label(collection)]
+        others: Vec<LabeledSpan>,
         #[help]
         help: Option<String>,
     },

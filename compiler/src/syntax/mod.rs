@@ -1,6 +1,7 @@
 //! Text to AST: the pest grammar, the AST types and spans.
 
 pub mod ast;
+mod brackets;
 mod parser;
 mod recover;
 pub mod span;

@@ -79,10 +79,16 @@ fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) 
     match masked.as_deref().map(|m| BatParser::parse(Rule::file, m)) {
         Some(Ok(pairs)) => build(pairs, errors),
         _ => {
-            errors.dedup_by_key(|e| e.to_string());
+            errors.dedup_by_key(|e| (e.to_string(), first_label(e)));
             (None, errors)
         }
     }
+}
+
+/// Where the first label of an error is.
+fn first_label(e: &Error) -> Option<usize> {
+    use miette::Diagnostic;
+    e.labels().and_then(|mut l| l.next()).map(|l| l.offset())
 }
 
 /// The AST of a parsed file, with the errors found building it after the
@@ -411,6 +417,9 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
             one_of(names)
         }
     };
+    if let Some(e) = super::brackets::unclosed(src, pos, span, &found) {
+        return e;
+    }
     let word = found.trim_matches('`');
     let help = if RESERVED.contains(&word) && expected.contains("a name") {
         Some(format!("`{word}` is a reserved word; choose another name"))
@@ -419,9 +428,25 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
     } else if expected == "`(`" {
         table_entry_help(src, pos, word)
     } else {
-        None
+        misspelt_keyword(word, &expected)
     };
-    Error::Syntax { span: span.into(), expected, found, help }
+    Error::Syntax {
+        span: span.into(),
+        message: format!("expected {expected}, found {found}"),
+        label: "unexpected here".into(),
+        others: Vec::new(),
+        help,
+    }
+}
+
+/// A word one or two edits from a word the parse expected (`wrold` where
+/// `world` may stand): "did you mean `world`?".
+fn misspelt_keyword(word: &str, expected: &str) -> Option<String> {
+    if word.is_empty() || !word.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return None;
+    }
+    let words = expected.split('`').skip(1).step_by(2).filter(|w| w.chars().all(|c| c.is_ascii_alphabetic()));
+    crate::diag::did_you_mean(word, words.filter(|w| *w != word))
 }
 
 /// A decoding table's entry that is no wheel motion (`sign(2) -> forward |

@@ -99,7 +99,7 @@ pub(super) fn recover(src: &str) -> (Option<String>, Vec<Error>) {
 }
 
 /// The text of a word token.
-fn word<'s>(src: &'s str, t: Option<&Token>) -> Option<&'s str> {
+pub(super) fn word<'s>(src: &'s str, t: Option<&Token>) -> Option<&'s str> {
     t.filter(|t| t.kind == TokenKind::Word).map(|t| &src[t.span.start..t.span.end])
 }
 
@@ -148,7 +148,7 @@ fn top_level_parts(src: &str, tokens: &[Token]) -> Vec<(usize, usize)> {
 
 /// Whether token `i` starts a stage item (a reserved word written where a
 /// name is expected, as in `module link {`, does not).
-fn starts_item(src: &str, tokens: &[Token], i: usize) -> bool {
+pub(super) fn starts_item(src: &str, tokens: &[Token], i: usize) -> bool {
     let prev = i.checked_sub(1).and_then(|p| tokens.get(p));
     if matches!(word(src, prev), Some("module" | "link" | "extends" | "trained"))
         || prev.and_then(|t| punct(src, t)) == Some(b'>')
@@ -163,6 +163,28 @@ fn starts_item(src: &str, tokens: &[Token], i: usize) -> bool {
         Some("train") => next == Some("for"),
         _ => false,
     }
+}
+
+/// The words that start a stage item.
+const ITEM_WORDS: [&str; 10] =
+    ["module", "link", "links", "fitness", "evolve", "world", "test", "train", "genome", "robot"];
+
+/// Whether token `i` looks like a misspelt word starting a stage item
+/// (`fitnes per action ...`): a word close to one of [`ITEM_WORDS`], first on
+/// its line, after a token that ends something (no operator or comma, which
+/// the line would continue). Splitting there lets each misspelling be
+/// reported, each with its own did-you-mean.
+fn misspelt_item(src: &str, tokens: &[Token], i: usize) -> bool {
+    let Some(w) = word(src, tokens.get(i)) else { return false };
+    let Some(prev) = i.checked_sub(1).map(|p| tokens[p]) else { return false };
+    let line_break = src[prev.span.end..tokens[i].span.start].contains('\n');
+    let ends = match punct(src, &prev) {
+        Some(c) => matches!(c, b'}' | b')' | b']'),
+        None => {
+            !matches!(word(src, Some(&prev)), Some("and" | "or" | "not" | "prev" | "per" | "if" | "until"))
+        }
+    };
+    line_break && ends && !ITEM_WORDS.contains(&w) && crate::diag::did_you_mean(w, ITEM_WORDS).is_some()
 }
 
 /// Recovers the items of the stage in `a..b`: blanks those that do not
@@ -199,11 +221,12 @@ fn stage_items(
     let mut depth = 0i64;
     let mut close = None;
     for (j, t) in toks.iter().enumerate().skip(i + 1) {
-        if starts_item(src, toks, j) && t.span.start > start {
+        let starts = starts_item(src, toks, j) || (depth == 0 && misspelt_item(src, toks, j));
+        if starts && t.span.start > start {
             items.push((start, t.span.start));
             start = t.span.start;
             depth = 0;
-        } else if starts_item(src, toks, j) {
+        } else if starts {
             depth = 0;
         }
         match punct(src, t) {

@@ -1,0 +1,199 @@
+//! Brackets left open: where a parse fails because a `(`, `[` or `{` was
+//! never closed, the syntax error names that bracket (and the block it
+//! opens) instead of the token where the parse noticed.
+//!
+//! A lexical walk over the whole source, comments skipped: a closing
+//! bracket closes the innermost bracket of its kind still open (the ones
+//! it skips are left open, as `(` in `toward(light }`). A `}` that starts a
+//! line less indented than the line of the `{` it closes most likely
+//! belongs to an outer block: that `{` is a suspect, preferred when the
+//! parse only fails at the end of the file or at the next stage.
+
+use miette::LabeledSpan;
+
+use super::recover::{starts_item, word};
+use super::Span;
+use crate::diag::Error;
+use crate::fmt::{lex, Token, TokenKind};
+
+struct Open {
+    /// Index of the bracket's token.
+    tok: usize,
+    bracket: u8,
+}
+
+fn closing(open: u8) -> u8 {
+    match open {
+        b'(' => b')',
+        b'[' => b']',
+        _ => b'}',
+    }
+}
+
+/// The bracket left open that made the parse fail at `pos`, if the failure
+/// looks like one: the token there closes a bracket outside the innermost,
+/// the end of the file, a word that starts a stage or a stage item inside a
+/// block that cannot hold it, or a reserved word on a later line than an
+/// open `(` or `[`.
+pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<Error> {
+    let tokens = lex(src).tokens;
+    let line_starts: Vec<usize> =
+        std::iter::once(0).chain(src.match_indices('\n').map(|(i, _)| i + 1)).collect();
+    let line_of = |at: usize| line_starts.partition_point(|&s| s <= at);
+    let indent_of = |at: usize| {
+        let line = &src[line_starts[line_of(at) - 1]..];
+        line.len() - line.trim_start_matches([' ', '\t']).len()
+    };
+    let first_on_line =
+        |i: usize| i == 0 || line_of(tokens[i - 1].span.start) < line_of(tokens[i].span.start);
+    let punct = |t: &Token| (t.kind == TokenKind::Punct).then(|| src.as_bytes()[t.span.start]);
+
+    let mut stack: Vec<Open> = Vec::new();
+    // Brackets most likely closed by a bracket of an outer one.
+    let mut suspects: Vec<Suspect> = Vec::new();
+    let end = tokens.partition_point(|t| t.span.start < pos);
+    for (i, t) in tokens[..end].iter().enumerate() {
+        match punct(t) {
+            Some(b @ (b'(' | b'[' | b'{')) => stack.push(Open { tok: i, bracket: b }),
+            Some(c @ (b')' | b']' | b'}')) => {
+                let Some(k) = stack.iter().rposition(|o| closing(o.bracket) == c) else { continue };
+                let opened = stack[k].tok;
+                if c == b'}'
+                    && first_on_line(i)
+                    && indent_of(t.span.start) < indent_of(tokens[opened].span.start)
+                {
+                    let outer = k.checked_sub(1).map(|o| stack[o].tok);
+                    suspects.push(Suspect { open: opened, closed_by: i, outer });
+                }
+                let skipped = stack.drain(k..).skip(1);
+                suspects.extend(skipped.map(|o| Suspect { open: o.tok, closed_by: i, outer: None }));
+            }
+            _ => {}
+        }
+    }
+    let top = stack.last()?;
+    let at_top = Suspect { open: top.tok, closed_by: end, outer: None };
+    // A suspect inside the innermost open bracket, else that bracket.
+    let candidate = suspects.iter().rev().find(|s| s.open > top.tok).copied().unwrap_or(at_top);
+    let next = tokens.get(end);
+    let chosen = match next {
+        None => candidate,
+        Some(n) => match punct(n) {
+            // A closing bracket of an outer one (not a stray one).
+            Some(c @ (b')' | b']' | b'}'))
+                if c != closing(top.bracket) && stack.iter().any(|o| closing(o.bracket) == c) =>
+            {
+                at_top
+            }
+            _ => {
+                let w = word(src, Some(n))?;
+                let round = top.bracket != b'{';
+                let later_line = line_of(n.span.start) > line_of(tokens[top.tok].span.start);
+                if round && super::RESERVED.contains(&w) && later_line {
+                    at_top
+                } else if starts_part(src, &tokens, end)
+                    || (!round && starts_item(src, &tokens, end) && !opens_stage(src, &tokens, top.tok))
+                {
+                    candidate
+                } else {
+                    return None;
+                }
+            }
+        },
+    };
+    let open = tokens[chosen.open].span;
+    let bracket = src.as_bytes()[open.start] as char;
+    let close = closing(bracket as u8) as char;
+    let block = (bracket == '{').then(|| block_name(src, &tokens, chosen.open)).flatten();
+
+    let message = match &block {
+        Some(block) => format!("{block} is not closed"),
+        None => format!("this `{bracket}` is not closed"),
+    };
+    let label = if block.is_some() { format!("its `{bracket}` opens here") } else { "opened here".into() };
+    let before = if found == "end of file" { "the end of the file".to_string() } else { found.to_string() };
+    // Where the parse failed, or the bracket that closed this one instead
+    // of an outer one.
+    let other = match (tokens.get(chosen.closed_by).filter(|_| chosen.closed_by != end), chosen.outer) {
+        (Some(c), Some(outer)) => {
+            let outer = block_name(src, &tokens, outer).unwrap_or_else(|| "the block around it".into());
+            let this = block.as_deref().unwrap_or("it");
+            (c.span, format!("this `}}` closes {this}, so {outer} is not closed"))
+        }
+        (Some(c), None) => {
+            (c.span, format!("expected `{close}` before this `{}`", &src[c.span.start..c.span.end]))
+        }
+        (None, _) if found == "end of file" => (at, "the file ends here".into()),
+        (None, _) => (at, format!("expected `{close}` before {before}")),
+    };
+    // The closing bracket goes after the last token before the one that
+    // closed it instead, or before the token the parse failed at.
+    let last = chosen.closed_by.checked_sub(1).filter(|&b| b > chosen.open).map(|b| tokens[b]);
+    let same_line = last.is_some_and(|l| line_of(l.span.start) == line_of(other.0.start));
+    let help = match (last, &block) {
+        (Some(l), Some(block)) if !same_line => {
+            format!("add `}}` at the end of line {}, where {block} ends", line_of(l.span.start))
+        }
+        (Some(l), None) if !same_line => format!(
+            "add `{close}` at the end of line {}, or where the bracketed part ends",
+            line_of(l.span.start)
+        ),
+        _ if other.0 == at => format!("add `{close}` before {before}"),
+        _ => format!("add `{close}` before the `{}`", &src[other.0.start..other.0.end]),
+    };
+    // The error is where the closing bracket is missing (there an editor
+    // shows it), and labels the bracket too.
+    Some(Error::Syntax {
+        span: other.0.into(),
+        message,
+        label: other.1,
+        others: vec![LabeledSpan::new_with_span(Some(label), miette::SourceSpan::from(open))],
+        help: Some(help),
+    })
+}
+
+/// A bracket that may be the one left open: the token that opens it, the
+/// token that closed it instead of an outer one (or where the parse
+/// failed), and, for a `}` less indented than its `{`, the outer `{` it
+/// most likely belongs to.
+#[derive(Clone, Copy)]
+struct Suspect {
+    open: usize,
+    closed_by: usize,
+    outer: Option<usize>,
+}
+
+/// Whether token `i` starts a top-level part: `stage`, or `robot` (not `robot adds`).
+fn starts_part(src: &str, tokens: &[Token], i: usize) -> bool {
+    match word(src, tokens.get(i)) {
+        Some("stage") => true,
+        Some("robot") => word(src, tokens.get(i + 1)) != Some("adds"),
+        _ => false,
+    }
+}
+
+/// Whether the `{` at token `i` opens a stage: `stage NAME {` or `stage
+/// NAME extends PARENT {`.
+fn opens_stage(src: &str, tokens: &[Token], i: usize) -> bool {
+    let w = |k: usize| i.checked_sub(k).and_then(|k| word(src, tokens.get(k)));
+    w(2) == Some("stage") || (w(4) == Some("stage") && w(2) == Some("extends"))
+}
+
+/// What the `{` at token `i` opens: `stage `s``, `module `m``, `robot
+/// `r``, or `the `world` block` (`world changes`, `script`, `neural`, ...).
+fn block_name(src: &str, tokens: &[Token], i: usize) -> Option<String> {
+    let w = |k: usize| i.checked_sub(k).and_then(|k| word(src, tokens.get(k)));
+    if opens_stage(src, tokens, i) {
+        let name = if w(2) == Some("stage") { w(1) } else { w(3) };
+        return name.map(|n| format!("stage `{n}`"));
+    }
+    match (w(2), w(1)?) {
+        (Some(kw @ ("robot" | "world")), m @ ("adds" | "changes")) => Some(format!("the `{kw} {m}` block")),
+        (Some(kw @ ("module" | "robot")), name) => Some(format!("{kw} `{name}`")),
+        (Some("script"), "commit") => Some("the `script commit` block".into()),
+        (_, kw @ ("world" | "evolve" | "body" | "genome" | "neural" | "script")) => {
+            Some(format!("the `{kw}` block"))
+        }
+        _ => None,
+    }
+}

@@ -1,0 +1,6 @@
+robot r { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }
+stage s {
+  fitness per action (wheels[0] + wheels[1]
+  module m { sense ir behavior forward }
+  module n { sense light behavior toward(light) }
+}
