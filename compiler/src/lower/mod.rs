@@ -166,6 +166,9 @@ pub(crate) struct Lower<'a> {
     /// Training stages lowered so far, by name: their program index and, per
     /// module, its name, its behavior and its activation network's shape.
     trained: HashMap<String, (u16, Vec<TrainedModule>)>,
+    /// The first use of hardware in a file that declares no robot: the
+    /// one error reported for all of them.
+    no_robot: Option<Span>,
 }
 
 /// A module of a training stage: its name, its behavior's shape and its
@@ -204,6 +207,47 @@ fn default_evolution() -> Evolution {
     }
 }
 
+/// A robot, for messages that say how to declare one.
+const EXAMPLE_ROBOT: &str = "robot khepera { sensor ir[8] proximity  actuator wheels[2] speed }";
+
+/// How a piece of hardware of each kind is declared, for messages.
+fn example_declaration(kind: &str) -> Option<&'static str> {
+    Some(match kind {
+        "proximity" => "sensor ir[8] proximity",
+        "ambient" => "sensor light[8] ambient",
+        "level" => "sensor battery level",
+        "optical" => "sensor barrier optical",
+        "ground" => "sensor floor ground",
+        "lamp_distance" => "sensor home lamp_distance",
+        "speed" => "actuator wheels[2] speed",
+        "lift" => "actuator arm lift",
+        "grip" => "actuator claw grip",
+        _ => return None,
+    })
+}
+
+/// A help for a kind of sensor or actuator written where its name is
+/// expected (`speed[0]` for `wheels[0]`): the name of the hardware of that
+/// kind, or how to declare one.
+fn kind_hint(hw: &Hw, name: &str) -> Option<String> {
+    let (what, declared) = if let Some(info) = catalog::sensor_by_keyword(name) {
+        ("sensor", hw.sensors.iter().find(|s| s.kind == info.kind).map(|s| s.name.as_str()))
+    } else if let Some(info) = catalog::actuator_by_keyword(name) {
+        ("actuator", hw.actuators.iter().find(|a| a.kind == info.kind).map(|a| a.name.as_str()))
+    } else {
+        return None;
+    };
+    Some(match declared {
+        Some(n) => {
+            format!("`{name}` is a kind of {what}: write the name of the robot's `{name}` {what}, `{n}`")
+        }
+        None => format!(
+            "`{name}` is a kind of {what}, and the robot has none: declare one, as in `{}`",
+            example_declaration(name)?
+        ),
+    })
+}
+
 /// Whether an error of a stage whose parent is unknown stands without the
 /// parent: a sensor or actuator that no stage declares, an index out of
 /// range, a bad range, unit or gene size, an unknown function or event.
@@ -238,8 +282,17 @@ pub fn lower_partial(file: &ast::File, file_name: &str) -> (Program, Vec<Error>)
         stage_names: Vec::new(),
         poisoned: Default::default(),
         trained: HashMap::new(),
+        no_robot: None,
     };
     let program = lw.program(file_name);
+    if let Some(at) = lw.no_robot {
+        lw.value_error(
+            at,
+            "the file declares no robot".into(),
+            "used here, but no robot declares it",
+            Some(format!("declare the robot before the stages, as in `{EXAMPLE_ROBOT}`")),
+        );
+    }
     let mut errors = lw.errors;
     errors.sort_by_key(|e| {
         use miette::Diagnostic;
@@ -253,9 +306,24 @@ impl<'a> Lower<'a> {
         self.errors.push(Error::Value { span: span.into(), message, label: label.into(), help });
     }
 
+    /// In a file that declares no robot, notes a use of hardware at `at`
+    /// (reported once, at the first use) and says so.
+    pub(crate) fn no_robot(&mut self, at: Span) -> bool {
+        if !self.file.robots.is_empty() {
+            return false;
+        }
+        if self.no_robot.is_none_or(|first| at.start < first.start) {
+            self.no_robot = Some(at);
+        }
+        true
+    }
+
     /// Reports an unknown sensor or actuator name, or one a later stage adds.
     pub(crate) fn unknown_hardware(&mut self, hw: &Hw, what: &'static str, name: &ast::Name) {
         if self.poisoned.contains(&name.text) {
+            return;
+        }
+        if !self.hw_origin.contains_key(&name.text) && self.no_robot(name.span) {
             return;
         }
         if let Some(origin) = self.hw_origin.get(&name.text) {
@@ -273,12 +341,8 @@ impl<'a> Lower<'a> {
         }
         let names =
             hw.sensors.iter().map(|s| s.name.as_str()).chain(hw.actuators.iter().map(|a| a.name.as_str()));
-        self.errors.push(Error::Unknown {
-            span: name.span.into(),
-            what,
-            name: name.text.clone(),
-            help: did_you_mean(&name.text, names),
-        });
+        let help = kind_hint(hw, &name.text).or_else(|| did_you_mean(&name.text, names));
+        self.errors.push(Error::Unknown { span: name.span.into(), what, name: name.text.clone(), help });
     }
 
     /// Reports every setting named again in one scope (a block, or the

@@ -328,6 +328,9 @@ impl Lower<'_> {
         if hw.actuators.iter().any(|a| a.kind == ActuatorKind::Speed) {
             return true;
         }
+        if self.no_robot(span) {
+            return false;
+        }
         self.errors.push(Error::MissingHardware {
             span: span.into(),
             stage: hw.stage.clone(),
@@ -336,6 +339,41 @@ impl Lower<'_> {
             help: Some("declare the wheels: `actuator wheels[2] speed`".into()),
         });
         false
+    }
+
+    /// Reports `arm down` or `claw closed` when the robot has no actuator of
+    /// that name, and the state is one of an actuator kind's (`down`, of a
+    /// `lift`): the actuator to declare. False when it is not such a case.
+    fn missing_gripper(&mut self, hw: &Hw, name: &ast::Name, state: Option<&ast::Name>) -> bool {
+        if self.poisoned.contains(&name.text) || self.hw_origin.contains_key(&name.text) {
+            return false;
+        }
+        let Some(state) = state else { return false };
+        let Some(info) = catalog::ACTUATORS.iter().find(|a| a.states.contains(&state.text.as_str())) else {
+            return false;
+        };
+        if self.no_robot(name.span) {
+            return true;
+        }
+        let declared = hw.actuators.iter().find(|a| a.kind == info.kind);
+        let help = match declared {
+            Some(a) => format!(
+                "the robot's `{}` actuator is `{}`: write `{} {}`",
+                info.keyword, a.name, a.name, state.text
+            ),
+            None => format!(
+                "declare `actuator {} {}` in the robot, or in this stage's `robot adds`",
+                name.text, info.keyword
+            ),
+        };
+        self.errors.push(Error::MissingHardware {
+            span: name.span.into(),
+            stage: hw.stage.clone(),
+            what: "actuator",
+            name: name.text.clone(),
+            help: Some(help),
+        });
+        true
     }
 
     /// Reports a name in the place of an action that is neither an action
@@ -473,7 +511,7 @@ impl Lower<'_> {
                             "not an actuator",
                             None,
                         );
-                    } else {
+                    } else if !self.missing_gripper(hw, actuator, state.as_ref()) {
                         self.unknown_action(hw, actuator);
                     }
                     return None;
