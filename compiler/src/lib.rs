@@ -34,10 +34,28 @@ pub fn compile(source: &str, file_name: &str) -> Result<Program, Diagnostics> {
 /// Compiles like [`compile`], and returns every diagnostic, warnings
 /// included: the program when no diagnostic is an error.
 pub fn check(source: &str, file_name: &str) -> (Option<Program>, Diagnostics) {
-    let file = match syntax::parse(source) {
+    let (file, units) = match syntax::parse_for_check(source) {
         Ok(f) => f,
         Err(errors) => return (None, Diagnostics::new(file_name, source, errors)),
     };
-    let (program, diagnostics) = lower::lower(&file, file_name);
+    let (mut program, mut diagnostics) = lower::lower(&file, file_name);
+    if !units.is_empty() {
+        // Every unknown unit, and every other mistake: what the checks say
+        // of a quantity with an unknown unit (read as a bare number) is a
+        // consequence of the unit, not reported.
+        program = None;
+        diagnostics.retain(|e| {
+            let at = first_label(e);
+            !units.iter().any(|(q, _)| at.is_some_and(|a| q.start <= a && a < q.end.max(q.start + 1)))
+        });
+        diagnostics.extend(units.into_iter().map(|(_, e)| e));
+        diagnostics.sort_by_key(first_label);
+    }
     (program, Diagnostics::new(file_name, source, diagnostics))
+}
+
+/// Where the first label of a diagnostic is.
+fn first_label(e: &Error) -> Option<usize> {
+    use miette::Diagnostic;
+    e.labels().and_then(|mut l| l.next()).map(|l| l.offset())
 }

@@ -125,6 +125,8 @@ struct WorldSt {
     /// Where each list item was declared, by kind, parallel to the lists of
     /// `world.items` (`wall`, `cylinder`, `lamp`, `zone`).
     item_spans: HashMap<&'static str, Vec<Span>>,
+    /// The arena's width and depth were written without a unit (millimetres).
+    arena_bare: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -439,7 +441,9 @@ impl<'a> Lower<'a> {
                     span: q.span.into(),
                     expected: "a length",
                     found: unit_desc(u),
-                    help: Some(format!("{what} is a length in `mm` or `cm`")),
+                    help: Some(format!(
+                        "{what} is a length in `mm` or `cm`, or a number of millimetres without a unit"
+                    )),
                 });
                 return None;
             }
@@ -796,6 +800,7 @@ impl<'a> Lower<'a> {
                 },
                 spans: HashMap::new(),
                 item_spans: HashMap::new(),
+                arena_bare: false,
             },
             genome: GenomeSt { links: spec, weights: spec, biases: spec },
             evolution: default_evolution(),
@@ -1018,7 +1023,7 @@ impl<'a> Lower<'a> {
             }
         }
         self.check_charger(&st.world);
-        self.check_fit(&st.world, decl.name.span);
+        self.check_fit(&st.world, decl.name.span, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
         self.run(&mut st, decl, parent.is_some());

@@ -86,6 +86,7 @@ impl Lower<'_> {
                     if let (Some(w), Some(d)) = (w, d) {
                         ws.world.arena = [w, d];
                         ws.spans.insert("arena", *span);
+                        ws.arena_bare = width.unit.is_none() && depth.unit.is_none();
                     }
                 }
                 W::Charger { length, wall, lamp, span } => {
@@ -498,17 +499,33 @@ impl Lower<'_> {
         }
     }
 
-    /// The body must fit in the arena.
-    pub(super) fn check_fit(&mut self, ws: &WorldSt, stage: Span) {
+    /// The body must fit in the arena: labelled on the arena, or on the
+    /// body when only the body was declared by this stage (`within`).
+    pub(super) fn check_fit(&mut self, ws: &WorldSt, stage: Span, within: Span) {
         let [w, d] = ws.world.arena;
         let diameter = 2.0 * ws.world.body.radius;
         if diameter >= w.min(d) {
-            let sp = ws.spans.get("body").or(ws.spans.get("arena")).copied().unwrap_or(stage);
+            let here =
+                |key: &str| ws.spans.get(key).filter(|s| within.start <= s.start && s.end <= within.end);
+            let arena = ws.spans.get("arena");
+            let (sp, label) = match (here("arena"), here("body"), arena) {
+                (None, Some(body), _) => (*body, "too large for the arena"),
+                (_, _, Some(arena)) => (*arena, "too small for the body"),
+                (_, _, None) => (stage, "does not fit"),
+            };
+            let help = if ws.arena_bare && arena.is_some() {
+                format!(
+                    "a length without a unit is in millimetres: for centimetres, write `arena {}cm x {}cm`",
+                    w, d
+                )
+            } else {
+                format!("the body is {diameter} mm wide (twice its `radius`); make the arena larger")
+            };
             self.value_error(
                 sp,
                 format!("a body {diameter} mm wide does not fit in an arena of {w} x {d} mm"),
-                "does not fit",
-                None,
+                label,
+                Some(help),
             );
         }
     }
@@ -534,7 +551,21 @@ impl Lower<'_> {
             match n {
                 "radius" => body.radius = self.length(q, "the body radius").unwrap_or(body.radius),
                 "wheel_base" => body.wheel_base = self.length(q, "the wheel base").unwrap_or(body.wheel_base),
-                "v_max" => body.v_max = self.plain(q, "`v_max` (mm/s)", 1e-3, 1e4).unwrap_or(body.v_max),
+                "v_max" => {
+                    if q.unit.is_some() {
+                        self.errors.push(Error::Unit {
+                            span: q.span.into(),
+                            expected: "a plain number",
+                            found: unit_desc(q.unit.unwrap_or(Unit::Mm)),
+                            help: Some(format!(
+                                "`v_max` is a speed in mm/s, written without a unit: `v_max {}`",
+                                q.value
+                            )),
+                        });
+                    } else if let Some(v) = self.in_range(q.value, q.span, "`v_max` (mm/s)", 1e-3, 1e4) {
+                        body.v_max = v;
+                    }
+                }
                 "action" => {
                     if q.unit != Some(Unit::Ms) && q.unit.is_some() {
                         self.errors.push(Error::Unit {

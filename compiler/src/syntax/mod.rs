@@ -6,5 +6,5 @@ mod parser;
 mod recover;
 pub mod span;
 
-pub use parser::{parse, parse_recovering, RESERVED};
+pub use parser::{parse, parse_for_check, parse_recovering, RESERVED};
 pub use span::Span;

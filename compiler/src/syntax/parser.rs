@@ -31,8 +31,8 @@ const CALL_LIMIT: usize = 20_000_000;
 /// that does not parse gives its own, see [`parse_recovering`]).
 pub fn parse(src: &str) -> Result<File, Vec<Error>> {
     match parse_with_limit(src, CALL_LIMIT) {
-        (Some(file), errors) if errors.is_empty() => Ok(file),
-        (_, errors) => Err(errors),
+        Parsed { file: Some(file), errors, .. } if errors.is_empty() => Ok(file),
+        Parsed { errors, .. } => Err(errors),
     }
 }
 
@@ -41,10 +41,42 @@ pub fn parse(src: &str) -> Result<File, Vec<Error>> {
 /// syntax error, each at its place. `None` for a file refused before
 /// parsing (the limits on line length, nesting and pest's call budget).
 pub fn parse_recovering(src: &str) -> (Option<File>, Vec<Error>) {
-    parse_with_limit(src, CALL_LIMIT)
+    let p = parse_with_limit(src, CALL_LIMIT);
+    (p.file, p.errors)
 }
 
-fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) {
+/// Parses a file for checking: the AST when the file parses and its only
+/// errors are unknown units (`0.25s`), which leave the AST whole, so that
+/// the checks that follow report every other mistake too. Each unit error
+/// comes with the span of its quantity (read as a number without a unit):
+/// what the checks say about the quantity is a consequence of it.
+pub fn parse_for_check(src: &str) -> Result<(File, UnitErrors), Vec<Error>> {
+    match parse_with_limit(src, CALL_LIMIT) {
+        Parsed { file: Some(file), errors, units } if errors.len() == units.len() => {
+            Ok((file, units.into_iter().zip(errors).collect()))
+        }
+        Parsed { errors, .. } => Err(errors),
+    }
+}
+
+/// The errors of unknown units, each with the span of its quantity.
+pub type UnitErrors = Vec<(Span, Error)>;
+
+/// What a parse gives: the AST, if any, every error, and the spans of the
+/// quantities with an unknown unit (one per error of that kind).
+struct Parsed {
+    file: Option<File>,
+    errors: Vec<Error>,
+    units: Vec<Span>,
+}
+
+impl Parsed {
+    fn refused(errors: Vec<Error>) -> Parsed {
+        Parsed { file: None, errors, units: Vec::new() }
+    }
+}
+
+fn parse_with_limit(src: &str, call_limit: usize) -> Parsed {
     // A byte order mark some editors put at the start of a UTF-8 file is no
     // part of the text: read as three spaces, so every span stays the place
     // of the same bytes of the file.
@@ -57,7 +89,7 @@ fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) 
         None => src,
     };
     if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
-        return (None, vec![err]);
+        return Parsed::refused(vec![err]);
     }
     pest::set_call_limit(std::num::NonZeroUsize::new(call_limit));
     // Literals the parse expected, for messages at the right place (set on
@@ -66,7 +98,7 @@ fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) 
     let (masked, mut errors) = match BatParser::parse(Rule::file, src) {
         Ok(pairs) => return build(pairs, Vec::new()),
         Err(e) if matches!(e.variant, pest::error::ErrorVariant::CustomError { .. }) => {
-            return (None, vec![syntax_error(src, e)])
+            return Parsed::refused(vec![syntax_error(src, e)])
         }
         Err(e) => {
             let (masked, mut errors) = super::recover::recover(src);
@@ -80,7 +112,7 @@ fn parse_with_limit(src: &str, call_limit: usize) -> (Option<File>, Vec<Error>) 
         Some(Ok(pairs)) => build(pairs, errors),
         _ => {
             errors.dedup_by_key(|e| (e.to_string(), first_label(e)));
-            (None, errors)
+            Parsed::refused(errors)
         }
     }
 }
@@ -93,15 +125,21 @@ fn first_label(e: &Error) -> Option<usize> {
 
 /// The AST of a parsed file, with the errors found building it after the
 /// syntax errors already found.
-fn build(mut pairs: pest::iterators::Pairs<Rule>, mut errors: Vec<Error>) -> (Option<File>, Vec<Error>) {
+fn build(mut pairs: pest::iterators::Pairs<Rule>, mut errors: Vec<Error>) -> Parsed {
     if let Some(err) = check_numbers(&pairs) {
         errors.push(err);
     }
+    // Unknown units are errors that leave the AST whole: the only ones when
+    // the file is otherwise right (see `parse_for_check`).
+    let (units, unit_errors): (Vec<Span>, Vec<Error>) = unknown_units(&pairs).into_iter().unzip();
+    let units = if errors.is_empty() { units } else { Vec::new() };
+    errors.extend(unit_errors);
     let mut b = Builder { pratt: pratt(), errors: Vec::new() };
     let file =
         pairs.next().map(|p| b.file(p)).unwrap_or(File { robots: vec![], genomes: vec![], stages: vec![] });
+    let units = if b.errors.is_empty() { units } else { Vec::new() };
     errors.extend(b.errors);
-    (Some(file), errors)
+    Parsed { file: Some(file), errors, units }
 }
 
 fn pratt() -> PrattParser<Rule> {
@@ -122,9 +160,8 @@ fn pratt() -> PrattParser<Rule> {
 }
 
 /// Rejects the first number a 32-bit float cannot hold (the runtime computes
-/// in `f32`, so `1e39` would become infinite), the first index or count too
-/// large to read (it would be reported as another number), and the first
-/// unknown unit glued to a number (`0.25s`).
+/// in `f32`, so `1e39` would become infinite), and the first index or count
+/// too large to read (it would be reported as another number).
 fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
     pairs.clone().flatten().find_map(|p| match p.as_rule() {
         Rule::number | Rule::unsigned => {
@@ -145,18 +182,41 @@ fn check_numbers(pairs: &pest::iterators::Pairs<Rule>) -> Option<Error> {
                 "an index or a count of elements is a small whole number (`ir[3]`, `sensor ir[8]`)".into(),
             ),
         }),
-        Rule::unknown_unit => Some(Error::Value {
-            span: span(&p).into(),
-            message: format!("unknown unit `{}`", p.as_str()),
-            label: "not a unit".into(),
-            help: Some(UNITS.into()),
-        }),
         _ => None,
     })
 }
 
+/// Every word glued to a number that is no unit (`0.25s`), with the span
+/// of its quantity.
+fn unknown_units(pairs: &pest::iterators::Pairs<Rule>) -> Vec<(Span, Error)> {
+    let quantities = pairs.clone().flatten().filter(|p| p.as_rule() == Rule::quantity);
+    quantities
+        .filter_map(|q| {
+            let mut it = q.clone().into_inner();
+            let value = it.next()?;
+            let u = it.next().filter(|u| u.as_rule() == Rule::unknown_unit)?;
+            let help = match (u.as_str(), value.as_str().parse::<f64>()) {
+                ("s" | "sec" | "secs" | "second" | "seconds", Ok(v)) => {
+                    format!("durations are in milliseconds: `{}ms`", v * 1000.0)
+                }
+                ("m" | "metre" | "metres" | "meter" | "meters", Ok(v)) => {
+                    format!("lengths are in millimetres or centimetres: `{}mm`", v * 1000.0)
+                }
+                _ => UNITS.into(),
+            };
+            let e = Error::Value {
+                span: span(&u).into(),
+                message: format!("unknown unit `{}`", u.as_str()),
+                label: "not a unit".into(),
+                help: Some(help),
+            };
+            Some((span(&q), e))
+        })
+        .collect()
+}
+
 /// The units of the grammar's `unit` rule, for messages.
-const UNITS: &str = "the units are `mm` and `cm` (lengths), `ms` (durations) and `actions` (counts)";
+const UNITS: &str = "the units are `mm` and `cm` (lengths), `ms` (durations) and `actions` (counts); a length without a unit is in millimetres";
 
 /// Rejects the first line longer than [`MAX_LINE`], labelled at its start.
 fn check_lines(src: &str) -> Option<Error> {
@@ -512,7 +572,8 @@ fn quantity(p: Pair<Rule>) -> Quantity {
     let sp = span(&p);
     let mut it = p.into_inner();
     let value = it.next().map(|n| num(&n)).unwrap_or(f64::NAN);
-    let unit = it.next().map(|u| unit(&u));
+    // An unknown unit is reported on its own: the number is read bare.
+    let unit = it.next().filter(|u| u.as_rule() == Rule::unit).map(|u| unit(&u));
     Quantity { value, unit, span: sp }
 }
 
@@ -1242,10 +1303,10 @@ mod tests {
     #[test]
     fn exceeding_the_call_limit_is_a_diagnostic() {
         let src = "robot r { sensor ir[8] proximity }\nstage s { module m { sense ir behavior stop } }";
-        let errors = parse_with_limit(src, 50).1;
+        let errors = parse_with_limit(src, 50).errors;
         assert!(matches!(&errors[..], [Error::TooComplex { .. }]), "{errors:?}");
         assert!(errors[0].to_string().starts_with("the file is too complex to parse"));
-        assert!(parse_with_limit(src, CALL_LIMIT).1.is_empty());
+        assert!(parse_with_limit(src, CALL_LIMIT).errors.is_empty());
     }
 
     #[test]
