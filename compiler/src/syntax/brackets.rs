@@ -197,3 +197,20 @@ fn block_name(src: &str, tokens: &[Token], i: usize) -> Option<String> {
         _ => None,
     }
 }
+
+/// What the innermost `{` open at `pos` opens (see [`block_name`]).
+pub(super) fn innermost_block(src: &str, pos: usize) -> Option<String> {
+    let tokens = lex(src).tokens;
+    let end = tokens.partition_point(|t| t.span.start < pos);
+    let mut stack = Vec::new();
+    for (i, t) in tokens[..end].iter().enumerate() {
+        match (t.kind == TokenKind::Punct).then(|| src.as_bytes()[t.span.start]) {
+            Some(b'{') => stack.push(i),
+            Some(b'}') => {
+                stack.pop();
+            }
+            _ => {}
+        }
+    }
+    block_name(src, &tokens, *stack.last()?)
+}

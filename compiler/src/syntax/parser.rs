@@ -487,6 +487,8 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
         Some("the file ends too early: is a `}` or `)` missing?".to_string())
     } else if expected == "`(`" {
         table_entry_help(src, pos, word)
+    } else if expected == "`at`" || expected == "`from`" {
+        world_item_help(src, pos, &expected)
     } else {
         misspelt_keyword(word, &expected)
     };
@@ -497,6 +499,41 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
         others: Vec::new(),
         help,
     }
+}
+
+/// The forms of the world items placed by a point.
+const PLACED_ITEMS: [(&str, &str); 5] = [
+    ("lamp", "lamp [NAME] at (X, Y) [height H] [intensity K]"),
+    ("cylinder", "cylinder [NAME] at (X, Y) diameter D"),
+    ("wall", "wall [NAME] from (X, Y) to (X, Y)"),
+    ("zone", "zone [NAME] from (X, Y) to (X, Y) [grey G] [charger]"),
+    ("start", "start at (X, Y) [heading A]` or `start from (X, Y) to (X, Y) [heading A]"),
+];
+
+/// A world item without its position (`lamp sun intensity 0.5`), where the
+/// parse expected `at` or `from` (`expected`) at `pos`: its form, and in
+/// `world changes`, that a change restates the whole item.
+fn world_item_help(src: &str, pos: usize, expected: &str) -> Option<String> {
+    let words: Vec<&str> = src[..pos].split_whitespace().rev().take(2).collect();
+    let (kw, name) = match words[..] {
+        [n, k, ..] if PLACED_ITEMS.iter().any(|(w, _)| *w == k) => (k, Some(n)),
+        [k, ..] => (k, None),
+        [] => return None,
+    };
+    let form = PLACED_ITEMS.iter().find(|(w, _)| *w == kw)?.1;
+    if super::brackets::innermost_block(src, pos).as_deref() != Some("the `world changes` block") {
+        return Some(format!("a {kw} is written `{form}`"));
+    }
+    // The rest of the item as written, up to the end of the block or line.
+    let rest = &src[pos..];
+    let rest = rest[..rest.find(['}', '\n']).unwrap_or(rest.len())].trim();
+    let point = if kw == "start" { "at" } else { expected.trim_matches('`') };
+    let name = name.map(|n| format!(" {n}")).unwrap_or_default();
+    let example = format!("{kw}{name} {point} (X, Y) {rest}");
+    Some(format!(
+        "`world changes` replaces an item whole, so a change restates it with its position: `{}`",
+        example.trim_end()
+    ))
 }
 
 /// A word one or two edits from a word the parse expected (`wrold` where
