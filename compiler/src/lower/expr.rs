@@ -59,11 +59,20 @@ impl Lower<'_> {
                 true
             }
             Val::Arr(loads, desc) => {
+                // `desc` names the array as written: "the array `light`", "the slice `light[2..5]`".
+                let written = desc.split('`').nth(1).unwrap_or("ir");
+                let first = match written.split_once('[') {
+                    Some((name, range)) => format!("{name}[{}]", range.split("..").next().unwrap_or("0")),
+                    None => format!("{written}[0]"),
+                };
+                let what = if desc.starts_with("the slice") { "slice" } else { "array" };
                 self.errors.push(Error::Type {
                     span: span.into(),
                     expected: "a number".into(),
                     found: format!("{desc} of {} values", loads.len()),
-                    help: Some("pick one element (`ir[0]`) or aggregate the array (`max(ir)`)".into()),
+                    help: Some(format!(
+                        "pick one element (`{first}`) or aggregate the {what} (`max({written})`)"
+                    )),
                 });
                 false
             }
@@ -226,9 +235,9 @@ impl Lower<'_> {
             };
             let channels: Vec<u16> = (first..=last).map(|i| s.channel + i as u16).collect();
             if let Some((module, allowed, sense)) = scope.only {
-                if let Some(c) = channels.iter().find(|c| !allowed.contains(c)) {
-                    let elem =
-                        if s.count == 1 { s.name.clone() } else { format!("{}[{}]", s.name, c - s.channel) };
+                let unsensed: Vec<u16> = channels.iter().copied().filter(|c| !allowed.contains(c)).collect();
+                if !unsensed.is_empty() {
+                    let elem = s.elements_text(&unsensed);
                     self.errors.push(Error::NotSensed {
                         span: span.into(),
                         sense: sense.map(Into::into),

@@ -38,6 +38,25 @@ pub(crate) struct SensorSt {
     pub span: Span,
 }
 
+impl SensorSt {
+    /// Some of this sensor's channels (in order), as a file would write
+    /// them: `light` for all of them, `light[2]`, `light[2..5]`, or the
+    /// first of them when they are not contiguous.
+    pub(crate) fn elements_text(&self, channels: &[u16]) -> String {
+        let (Some(&a), Some(&b)) = (channels.first(), channels.last()) else {
+            return self.name.clone();
+        };
+        let (i, j) = (a - self.channel, b - self.channel);
+        if self.count == 1 || (i == 0 && j + 1 == self.count && channels.len() == self.count as usize) {
+            self.name.clone()
+        } else if i == j || channels.len() != (j - i + 1) as usize {
+            format!("{}[{i}]", self.name)
+        } else {
+            format!("{}[{i}..{j}]", self.name)
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub(crate) struct ActuatorSt {
     pub name: String,

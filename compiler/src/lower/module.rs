@@ -208,19 +208,15 @@ impl Lower<'_> {
                 ok = false;
                 continue;
             };
-            if let Some(&(c, at)) = channels.iter().find_map(|c| first.iter().find(|(f, _)| f == c)) {
-                let name =
-                    hw.sensors
-                        .iter()
-                        .find(|s| s.channel <= c && c < s.channel + s.count)
-                        .map(|s| {
-                            if s.count == 1 {
-                                s.name.clone()
-                            } else {
-                                format!("{}[{}]", s.name, c - s.channel)
-                            }
-                        })
-                        .unwrap_or_default();
+            if let Some(&(_, at)) = channels.iter().find_map(|c| first.iter().find(|(f, _)| f == c)) {
+                let again: Vec<u16> =
+                    channels.iter().copied().filter(|c| first.iter().any(|(f, _)| f == c)).collect();
+                let name = hw
+                    .sensors
+                    .iter()
+                    .find(|s| s.channel <= again[0] && again[0] < s.channel + s.count)
+                    .map(|s| s.elements_text(&again))
+                    .unwrap_or_default();
                 self.errors.push(Error::Conflict {
                     span: r.span.into(),
                     other: at.into(),

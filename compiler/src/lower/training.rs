@@ -228,6 +228,11 @@ impl Lower<'_> {
         if keep_span.is_some() || ev.selection == Selection::Roulette {
             st.keep_default = false;
         }
+        // A population written here but refused: nothing to compare with.
+        let population_refused = population_span.is_none()
+            && settings
+                .iter()
+                .any(|s| s.name.text == "population" && matches!(s.value, ast::SettingValue::Quantity(_)));
         if population_span.is_some() {
             st.population_span = population_span;
         }
@@ -235,7 +240,9 @@ impl Lower<'_> {
         if st.keep_default {
             ev.selection = Selection::Truncation { keep: (ev.population / 5).max(1) };
         }
-        if let (Selection::Truncation { keep }, Some(sp)) = (ev.selection, keep_span) {
+        if let (Selection::Truncation { keep }, Some(sp), false) =
+            (ev.selection, keep_span, population_refused)
+        {
             if keep > ev.population {
                 let pop = ev.population;
                 self.value_error(
@@ -246,7 +253,7 @@ impl Lower<'_> {
                 );
             }
         }
-        if ev.elitism > ev.population {
+        if ev.elitism > ev.population && !population_refused {
             let (e, p) = (ev.elitism, ev.population);
             let sp = settings.iter().find(|s| s.name.text == "elitism").map(|s| s.span).unwrap_or_default();
             self.value_error(
