@@ -543,7 +543,8 @@ fn misspelt_keyword(word: &str, expected: &str) -> Option<String> {
         return None;
     }
     let words = expected.split('`').skip(1).step_by(2).filter(|w| w.chars().all(|c| c.is_ascii_alphabetic()));
-    crate::diag::did_you_mean(word, words.filter(|w| *w != word))
+    let units = if expected.contains("a unit") { &["actions", "action"][..] } else { &[] };
+    crate::diag::did_you_mean(word, words.chain(units.iter().copied()).filter(|w| *w != word))
 }
 
 /// A decoding table's entry that is no wheel motion (`sign(2) -> forward |
