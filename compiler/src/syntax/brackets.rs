@@ -33,8 +33,8 @@ fn closing(open: u8) -> u8 {
 /// The bracket left open that made the parse fail at `pos`, if the failure
 /// looks like one: the token there closes a bracket outside the innermost,
 /// the end of the file, a word that starts a stage or a stage item inside a
-/// block that cannot hold it, or a reserved word on a later line than an
-/// open `(` or `[`.
+/// block that cannot hold it, or a word that starts a clause (see
+/// [`CLAUSE_WORDS`]) while a `(` or `[` is open.
 pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<Error> {
     let tokens = lex(src).tokens;
     let line_starts: Vec<usize> =
@@ -88,8 +88,7 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
             _ => {
                 let w = word(src, Some(n))?;
                 let round = top.bracket != b'{';
-                let later_line = line_of(n.span.start) > line_of(tokens[top.tok].span.start);
-                if round && super::RESERVED.contains(&w) && later_line {
+                if round && CLAUSE_WORDS.contains(&w) {
                     at_top
                 } else if starts_part(src, &tokens, end)
                     || (!round && starts_item(src, &tokens, end) && !opens_stage(src, &tokens, top.tok))
@@ -162,6 +161,30 @@ struct Suspect {
     closed_by: usize,
     outer: Option<usize>,
 }
+
+/// The reserved words that start a declaration, an item or a clause (not
+/// the operators `and`, `or`, `not`, `prev`, nor the words inside a clause):
+/// none may stand inside brackets, so one where a `(` or `[` is open
+/// follows the place where it should have been closed.
+pub(super) const CLAUSE_WORDS: [&str; 17] = [
+    "robot",
+    "sensor",
+    "actuator",
+    "genome",
+    "stage",
+    "module",
+    "sense",
+    "activation",
+    "behavior",
+    "learn",
+    "reinforce",
+    "links",
+    "link",
+    "world",
+    "evolve",
+    "test",
+    "fitness",
+];
 
 /// Whether token `i` starts a top-level part: `stage`, or `robot` (not `robot adds`).
 fn starts_part(src: &str, tokens: &[Token], i: usize) -> bool {

@@ -457,7 +457,18 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
     };
     let literals = expected_literals(&e, pos);
     let place = |p: usize| p.saturating_add_signed(shift);
-    let pos = place(literals.as_ref().map_or(pos, |(p, _)| *p)).min(src.len());
+    let mut pos = place(literals.as_ref().map_or(pos, |(p, _)| *p)).min(src.len());
+    // A literal that matched the start of a word (`l` of `left` in `link`)
+    // leaves the position inside it: the word is what was found.
+    let bytes = src.as_bytes();
+    let word_char = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
+    while pos > 0
+        && pos < src.len()
+        && word_char(bytes[pos])
+        && (bytes[pos - 1].is_ascii_alphabetic() || bytes[pos - 1] == b'_')
+    {
+        pos -= 1;
+    }
     let (mut span, found) = token_at(src, pos);
     if pos == src.len() {
         // Point at the last token, so that the label shows.
@@ -481,7 +492,10 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
         return e;
     }
     let word = found.trim_matches('`');
-    let help = if RESERVED.contains(&word) && expected.contains("a name") {
+    let operand = expected.contains("an expression");
+    let help = if RESERVED.contains(&word) && operand && super::brackets::CLAUSE_WORDS.contains(&word) {
+        Some(format!("the expression before `{word}` is not finished: an operand is missing"))
+    } else if RESERVED.contains(&word) && expected.contains("a name") && !operand {
         Some(format!("`{word}` is a reserved word; choose another name"))
     } else if pos == src.len() {
         Some("the file ends too early: is a `}` or `)` missing?".to_string())
