@@ -127,7 +127,9 @@ pub enum Error {
 
     #[error("the reinforcement program of `{module}` reads `{sensor}`, which the module does not sense")]
     NotSensed {
-        #[label("read here")]
+        /// Primary: two reads in one module are two errors at two places,
+        /// though the module's inputs come first in the file.
+        #[label(primary, "read here")]
         span: SourceSpan,
         #[label("the module's inputs")]
         sense: Option<SourceSpan>,
