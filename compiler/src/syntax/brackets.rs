@@ -35,11 +35,24 @@ fn closing(open: u8) -> u8 {
 /// the end of the file, a word that starts a stage or a stage item inside a
 /// block that cannot hold it, or a word that starts a clause (see
 /// [`CLAUSE_WORDS`]) while a `(` or `[` is open.
+///
+/// Only the top-level part around `pos` is read (from the last line
+/// starting with `stage` or `robot` before it), so that a file with many
+/// syntax errors is not read whole for each.
 pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<Error> {
-    let tokens = lex(src).tokens;
-    let line_starts: Vec<usize> =
-        std::iter::once(0).chain(src.match_indices('\n').map(|(i, _)| i + 1)).collect();
+    // At the end of the file or at the next stage, the whole part matters
+    // (its own `{`, and suspects); elsewhere the item around `pos` does.
+    let rest = src[pos..].trim_start();
+    let whole_part = rest.is_empty() || rest.starts_with("stage") || rest.starts_with("robot");
+    let base = part_start(src, pos, !whole_part);
+    let (tokens, end) = window_tokens(src, base, pos);
+    let window_end = tokens.last().map_or(pos, |t| t.span.end).max(at.end).min(src.len());
+    // Lines counted from the line of `base`; see `absolute` for messages.
+    let line_starts: Vec<usize> = std::iter::once(base)
+        .chain(src[base..window_end].match_indices('\n').map(|(i, _)| base + i + 1))
+        .collect();
     let line_of = |at: usize| line_starts.partition_point(|&s| s <= at);
+    let absolute = |line: usize| src.as_bytes()[..base].iter().filter(|&&b| b == b'\n').count() + line;
     let indent_of = |at: usize| {
         let line = &src[line_starts[line_of(at) - 1]..];
         line.len() - line.trim_start_matches([' ', '\t']).len()
@@ -51,7 +64,6 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
     let mut stack: Vec<Open> = Vec::new();
     // Brackets most likely closed by a bracket of an outer one.
     let mut suspects: Vec<Suspect> = Vec::new();
-    let end = tokens.partition_point(|t| t.span.start < pos);
     for (i, t) in tokens[..end].iter().enumerate() {
         match punct(t) {
             Some(b @ (b'(' | b'[' | b'{')) => stack.push(Open { tok: i, bracket: b }),
@@ -131,11 +143,11 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
     let same_line = last.is_some_and(|l| line_of(l.span.start) == line_of(other.0.start));
     let help = match (last, &block) {
         (Some(l), Some(block)) if !same_line => {
-            format!("add `}}` at the end of line {}, where {block} ends", line_of(l.span.start))
+            format!("add `}}` at the end of line {}, where {block} ends", absolute(line_of(l.span.start)))
         }
         (Some(l), None) if !same_line => format!(
             "add `{close}` at the end of line {}, or where the bracketed part ends",
-            line_of(l.span.start)
+            absolute(line_of(l.span.start))
         ),
         _ if other.0 == at => format!("add `{close}` before {before}"),
         _ => format!("add `{close}` before the `{}`", &src[other.0.start..other.0.end]),
@@ -149,6 +161,60 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
         others: vec![LabeledSpan::new_with_span(Some(label), miette::SourceSpan::from(open))],
         help: Some(help),
     })
+}
+
+/// The start of the line of the last `stage` or `robot` (not `robot adds`)
+/// that starts a line before `pos`: where the top-level part around `pos`
+/// begins, or 0. With `items`, a line starting with a word that starts a
+/// stage item (`module`, `link`, ...) is a start too.
+fn part_start(src: &str, pos: usize, items: bool) -> usize {
+    let word = |t: &str, w: &str| {
+        t.strip_prefix(w).is_some_and(|r| !r.starts_with(|c: char| c.is_ascii_alphanumeric() || c == '_'))
+    };
+    const ITEMS: [&str; 9] =
+        ["module", "link", "links", "fitness", "evolve", "world", "test", "train", "genome"];
+    let starts_part = |t: &str| {
+        word(t, "stage")
+            || (word(t, "robot") && !word(t["robot".len()..].trim_start(), "adds"))
+            || (items && ITEMS.iter().any(|w| word(t, w)))
+    };
+    let mut line_end = pos;
+    loop {
+        let start = src[..line_end].rfind('\n').map_or(0, |i| i + 1);
+        let line = &src[start..];
+        let text = line.trim_start_matches([' ', '\t']);
+        if start + (line.len() - text.len()) < pos && starts_part(text) {
+            return start;
+        }
+        if start == 0 {
+            return 0;
+        }
+        line_end = start - 1;
+    }
+}
+
+/// The tokens of `src[base..pos]` and the two tokens after `pos` (lexed
+/// from a window that grows until it holds them whole), with the index of
+/// the first token after `pos`.
+fn window_tokens(src: &str, base: usize, pos: usize) -> (Vec<Token>, usize) {
+    let shift =
+        |t: Token, by: usize| Token { span: Span::new(t.span.start + by, t.span.end + by), kind: t.kind };
+    let mut tokens: Vec<Token> = lex(&src[base..pos]).tokens.into_iter().map(|t| shift(t, base)).collect();
+    let end = tokens.len();
+    let mut len = 64;
+    loop {
+        let mut stop = (pos + len).min(src.len());
+        while !src.is_char_boundary(stop) {
+            stop += 1;
+        }
+        let next = lex(&src[pos..stop]).tokens;
+        // A third token shows that the second one is whole.
+        if stop == src.len() || next.len() >= 3 {
+            tokens.extend(next.into_iter().take(2).map(|t| shift(t, pos)));
+            return (tokens, end);
+        }
+        len *= 4;
+    }
 }
 
 /// A bracket that may be the one left open: the token that opens it, the

@@ -140,6 +140,24 @@ fn many_broken_stages_are_recovered_in_linear_time() {
 }
 
 #[test]
+fn many_unclosed_brackets_in_one_stage_are_named_in_linear_time() {
+    // 20000 modules in one stage, every other one with a `(` closed only
+    // after the module's `}` (so that the brackets do not nest deeper and
+    // deeper): each is named, and each is found reading its own item, not
+    // the file.
+    let mut src = format!("{ROBOT}stage s {{\n  fitness per action wheels[0]\n");
+    for i in 0..20_000 {
+        let (inside, after) = if i % 2 == 0 { (")", "") } else { ("", ")") };
+        src.push_str(&format!("  module m{i} {{ sense ir  behavior forward(0.5{inside} }}{after}\n"));
+    }
+    src.push_str("}\n");
+    let (file, errors) = parse_recovering(&src);
+    assert_eq!(errors.len(), 10_000, "{:?}", errors[0]);
+    assert!(errors.iter().all(|e| e.to_string() == "this `(` is not closed"), "{:?}", errors[0]);
+    assert_eq!(modules(&file.unwrap().stages[0]).len(), 10_000);
+}
+
+#[test]
 fn recovery_keeps_the_call_budget_on_huge_files() {
     // 200000 modules in one stage, and a syntax error before or after them:
     // the answer comes (an error, not a hang), with every error found.
