@@ -2,7 +2,8 @@
 //! never closed, the syntax error names that bracket (and the block it
 //! opens) instead of the token where the parse noticed.
 //!
-//! A lexical walk over the whole source, comments skipped: a closing
+//! A lexical walk over the source around the error (its stage item, or its
+//! top-level part), comments skipped: a closing
 //! bracket closes the innermost bracket of its kind still open (the ones
 //! it skips are left open, as `(` in `toward(light }`). A `}` that starts a
 //! line less indented than the line of the `{` it closes most likely
@@ -36,9 +37,10 @@ fn closing(open: u8) -> u8 {
 /// block that cannot hold it, or a word that starts a clause (see
 /// [`CLAUSE_WORDS`]) while a `(` or `[` is open.
 ///
-/// Only the top-level part around `pos` is read (from the last line
-/// starting with `stage` or `robot` before it), so that a file with many
-/// syntax errors is not read whole for each.
+/// Only the source around `pos` is read (from the last line starting a
+/// stage item, or at the end of the file and at a `stage` or `robot`, from
+/// the last line starting with `stage` or `robot`), so that a file with
+/// many syntax errors is not read whole for each.
 pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<Error> {
     // At the end of the file or at the next stage, the whole part matters
     // (its own `{`, and suspects); elsewhere the item around `pos` does.
