@@ -33,6 +33,7 @@ fn closing(open: u8) -> u8 {
 
 /// The bracket left open that made the parse fail at `pos`, if the failure
 /// looks like one: the token there closes a bracket outside the innermost,
+/// opens a block or is an arrow `->` while a `(` or `[` is open,
 /// the end of the file, a word that starts a stage or a stage item inside a
 /// block that cannot hold it, or a word that starts a clause (see
 /// [`CLAUSE_WORDS`]) while a `(` or `[` is open.
@@ -99,6 +100,9 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
             {
                 at_top
             }
+            // A block or a decoding table's arrow: never inside brackets.
+            Some(b'{') if top.bracket != b'{' => at_top,
+            Some(b'-') if top.bracket != b'{' && src[n.span.start..].starts_with("->") => at_top,
             _ => {
                 let w = word(src, Some(n))?;
                 let round = top.bracket != b'{';
@@ -124,7 +128,11 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
         None => format!("this `{bracket}` is not closed"),
     };
     let label = if block.is_some() { format!("its `{bracket}` opens here") } else { "opened here".into() };
-    let before = if found == "end of file" { "the end of the file".to_string() } else { found.to_string() };
+    let before = match found {
+        "end of file" => "the end of the file".to_string(),
+        "`-`" if src[at.start..].starts_with("->") => "`->`".to_string(),
+        _ => found.to_string(),
+    };
     // Where the parse failed, or the bracket that closed this one instead
     // of an outer one.
     let other = match (tokens.get(chosen.closed_by).filter(|_| chosen.closed_by != end), chosen.outer) {
