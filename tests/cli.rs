@@ -1567,7 +1567,7 @@ fn report_names_a_damaged_genome_summary_or_checkpoint() {
         ("bigger/summary.json", "{}", "is not a test stage's summary: no `before.fitness`"),
         ("bigger/summary.json", "[1]", "is not a test stage's summary: it is not a JSON object"),
         ("bigger/summary.json", "{", "is not a test stage's summary"),
-        ("navigation/checkpoint.json", "{}", "is not a checkpoint"),
+        ("navigation/checkpoint.json", "{}", "is corrupt"),
     ];
     for (file, content, wanted) in cases {
         let path = dir.join(file);
