@@ -16,8 +16,8 @@ use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::{self as lt, Uri};
 use miette::Diagnostic as _;
 use serde_json::Value;
-use shaping_compiler::fmt::{lex, Token, TokenKind};
 use shaping_compiler::lower::lower_partial;
+use shaping_compiler::syntax::lex::{lex, Token, TokenKind};
 use shaping_compiler::syntax::{self, ast, parse_recovering};
 use shaping_compiler::{render_layout, Program};
 

@@ -30,13 +30,11 @@
 //! [`format`] checks its own result: the output must parse and compile to the
 //! same program (or the same errors) as the input.
 
-mod lex;
-
 use crate::diag::Diagnostics;
 use crate::syntax::ast::*;
 use crate::syntax::{self, Span};
 
-pub use lex::{lex, Comment, Lexed, Token, TokenKind};
+use crate::syntax::lex::{self, Comment, Lexed, TokenKind};
 
 /// The width a block written on one line must fit in to stay there.
 pub const WIDTH: usize = 110;

@@ -15,7 +15,7 @@ use miette::LabeledSpan;
 use super::recover::{starts_item, word};
 use super::Span;
 use crate::diag::Error;
-use crate::fmt::{lex, Token, TokenKind};
+use crate::syntax::lex::{lex, Token, TokenKind};
 
 struct Open {
     /// Index of the bracket's token.

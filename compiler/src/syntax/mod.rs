@@ -2,6 +2,7 @@
 
 pub mod ast;
 mod brackets;
+pub mod lex;
 mod parser;
 mod recover;
 pub mod span;

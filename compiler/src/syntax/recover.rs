@@ -16,7 +16,7 @@ use pest::Parser as _;
 
 use super::parser::{syntax_error, syntax_error_shifted, BatParser, Rule};
 use crate::diag::Error;
-use crate::fmt::{lex, Token, TokenKind};
+use crate::syntax::lex::{lex, Token, TokenKind};
 
 /// What the wrapper of a lone stage item adds before it.
 const ITEM_HEAD: &str = "stage _ {";

@@ -4,7 +4,8 @@
 //! are kept formatted.
 
 use proptest::prelude::*;
-use shaping_compiler::fmt::{format, lex, FormatError};
+use shaping_compiler::fmt::{format, FormatError};
+use shaping_compiler::syntax::lex::lex;
 use shaping_compiler::{compile, syntax};
 
 use crate::root;

@@ -1,6 +1,8 @@
-//! The source as the formatter needs it: comments, and the positions of the
-//! tokens between them (to find where an item really ends, its separators,
-//! and the spelling of its numbers).
+//! The lexical scan of a source: comments, and the positions of the tokens
+//! between them. The formatter finds with it where an item really ends,
+//! its separators and the spelling of its numbers; the recovery of syntax
+//! errors and the bracket finder split a file with it; the language server
+//! reads the tokens before the cursor.
 
 use crate::syntax::Span;
 
