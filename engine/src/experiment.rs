@@ -35,12 +35,15 @@ pub struct ExperimentOptions {
     pub no_report: bool,
 }
 
-/// Median, minimum and maximum.
+/// Median, minimum and maximum; mean and standard deviation (the sample's,
+/// 0 for one value).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Spread {
     pub median: f64,
     pub min: f64,
     pub max: f64,
+    pub mean: f64,
+    pub sd: f64,
 }
 
 pub fn spread(values: &[f64]) -> Option<Spread> {
@@ -51,12 +54,23 @@ pub fn spread(values: &[f64]) -> Option<Spread> {
     v.sort_by(|a, b| a.total_cmp(b));
     let n = v.len();
     let median = if n % 2 == 1 { v[n / 2] } else { (v[n / 2 - 1] + v[n / 2]) / 2.0 };
-    Some(Spread { median, min: v[0], max: v[n - 1] })
+    let mean = v.iter().sum::<f64>() / n as f64;
+    let sd =
+        if n > 1 { (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt() } else { 0.0 };
+    Some(Spread { median, min: v[0], max: v[n - 1], mean, sd })
 }
 
 fn fmt_spread(s: Option<Spread>, digits: usize) -> String {
     match s {
-        Some(s) => format!("{:.d$} ({:.d$} .. {:.d$})", s.median, s.min, s.max, d = digits),
+        Some(s) => format!(
+            "{:.d$} ({:.d$} .. {:.d$}; mean {:.d$} ± {:.d$})",
+            s.median,
+            s.min,
+            s.max,
+            s.mean,
+            s.sd,
+            d = digits
+        ),
         None => "-".into(),
     }
 }
@@ -348,7 +362,7 @@ fn sweep_table(
         seeds
     );
     let _ =
-        writeln!(md, "Median (min .. max) over seeds; each point's own `summary.md` is in its directory.\n");
+        writeln!(md, "Median (min .. max; mean ± standard deviation) over seeds; each point's own `summary.md` is in its directory.\n");
     let mut head: Vec<String> = vec!["point".to_string()];
     head.extend(sets.iter().map(|s| format!("`{}`", s.target)));
     let evolved: Vec<(String, bool)> = table.first().map_or_else(Vec::new, |(_, stages)| {
@@ -378,13 +392,14 @@ fn sweep_table(
     }
     let _ = writeln!(md, "| {} |", head.join(" | "));
     let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-    let cell = |v: &serde_json::Value, digits: usize| match (
-        v["median"].as_f64(),
-        v["min"].as_f64(),
-        v["max"].as_f64(),
-    ) {
-        (Some(m), Some(a), Some(b)) => fmt_spread(Some(Spread { median: m, min: a, max: b }), digits),
-        _ => "-".to_string(),
+    let cell = |v: &serde_json::Value, digits: usize| {
+        let get = |k: &str| v[k].as_f64();
+        match (get("median"), get("min"), get("max"), get("mean"), get("sd")) {
+            (Some(median), Some(min), Some(max), Some(mean), Some(sd)) => {
+                fmt_spread(Some(Spread { median, min, max, mean, sd }), digits)
+            }
+            _ => "-".to_string(),
+        }
     };
     for (i, (point, stages)) in table.iter().enumerate() {
         let mut row: Vec<String> = vec![(i + 1).to_string()];
@@ -439,7 +454,7 @@ fn summarise(
     let mut json = Vec::new();
     let mut md = String::new();
     let _ = writeln!(md, "# {title} over {} seeds ({:?})\n", seeds.len(), seeds);
-    let _ = writeln!(md, "Median (min .. max) over seeds.\n");
+    let _ = writeln!(md, "Median (min .. max; mean ± standard deviation) over seeds.\n");
     let _ = writeln!(
         md,
         "| stage | generations | final best | chosen best | final mean | best ever | generation reaching criterion |"

@@ -326,6 +326,16 @@ fn an_experiment_summarises_the_settings_that_ran() {
         serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["points"][0]["stages"][0]["generations"], 2, "{summary}");
     assert_eq!(summary["points"][0]["dir"], "first.evolve.generations=2");
+    // Mean and standard deviation beside median and range.
+    let chosen = &summary["points"][0]["stages"][0]["chosen_best"];
+    let (lo, hi, mean, sd) = (
+        chosen["min"].as_f64().unwrap(),
+        chosen["max"].as_f64().unwrap(),
+        chosen["mean"].as_f64().unwrap(),
+        chosen["sd"].as_f64().unwrap(),
+    );
+    assert!((mean - (lo + hi) / 2.0).abs() < 1e-9, "two seeds: the mean is the middle: {chosen}");
+    assert!((sd - (hi - lo) / 2f64.sqrt()).abs() < 1e-9, "two seeds: sd = range / sqrt 2: {chosen}");
     // A second experiment into the directory while this one holds it is refused.
     let again = Plan::new(
         tiny(),
