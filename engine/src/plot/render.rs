@@ -151,14 +151,22 @@ pub(super) fn title_strip<DB: DrawingBackend>(
     let (top, rest) = root.split_vertically(TITLE_H);
     if text && !title.is_empty() {
         let w = top.dim_in_pixel().0 as i32;
-        let style = title_style().pos(Pos::new(HPos::Center, VPos::Center));
+        // A title wider than the picture is set smaller (down to half its
+        // size) rather than cut at both edges.
+        let fits = |size: f64| {
+            top.estimate_text_size(title, &title_style(size)).map_or(true, |(tw, _)| tw as i32 <= w - 24)
+        };
+        let size =
+            [22.0, 20.0, 18.0, 16.0, 14.0, 13.0, 12.0, 11.0].into_iter().find(|&s| fits(s)).unwrap_or(11.0);
+        let style = title_style(size).pos(Pos::new(HPos::Center, VPos::Center));
         top.draw_text(title, &style, (w / 2, TITLE_H as i32 / 2 + 4))?;
     }
     Ok(rest)
 }
 
-pub(super) fn title_style() -> TextStyle<'static> {
-    FontDesc::new(FontFamily::Name(FAMILY), 22.0, FontStyle::Bold).into()
+/// The title's font at `size` pixels (22 unless the title is too wide).
+pub(super) fn title_style(size: f64) -> TextStyle<'static> {
+    FontDesc::new(FontFamily::Name(FAMILY), size, FontStyle::Bold).into()
 }
 
 pub(super) fn label_style(size: f64) -> TextStyle<'static> {
