@@ -1729,3 +1729,15 @@ fn json_diagnostics_have_lines_and_columns() {
     let human = run(shaping().arg("check").arg(&file).args(["--error-format", "plain"]));
     assert!(text(&human.stderr).contains("window_too_large.bat:12:50"), "{}", text(&human.stderr));
 }
+
+/// An experiment's report shows the seeds its summaries cover, not every
+/// `seed-N` an earlier experiment left in the directory.
+#[test]
+fn an_experiment_report_shows_the_seeds_its_summary_covers() {
+    let dir = scratch("covered-seeds");
+    assert!(experiment_tiny(&dir, &["--seeds", "3", "--no-report"]).status.success());
+    let fewer = experiment_tiny(&dir, &["--seeds", "2"]);
+    assert!(fewer.status.success(), "{}", text(&fewer.stderr));
+    let data = report_data(&dir.join("report.html"));
+    assert_eq!(data["seeds"], serde_json::json!([1, 2]), "seed-3 is on disk but not summarised");
+}
