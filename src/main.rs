@@ -645,14 +645,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
 /// byte span of a JSON diagnostic and its related ones, and to each
 /// diagnostic the position of its first label.
 fn add_positions(diagnostic: &mut serde_json::Map<String, serde_json::Value>, source: &str) {
-    let position = |offset: usize| {
-        let at = offset.min(source.len());
-        let at = (0..=at).rev().find(|&i| source.is_char_boundary(i)).unwrap_or(0);
-        let before = &source[..at];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        (line, column)
-    };
+    let position = |offset: usize| diag::line_column(source, offset);
     let mut first = None;
     if let Some(labels) = diagnostic.get_mut("labels").and_then(|l| l.as_array_mut()) {
         for label in labels {

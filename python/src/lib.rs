@@ -111,12 +111,7 @@ impl Diagnostic {
 
 /// Line and column (1-based, the column in characters) of byte `offset`.
 fn position(source: &str, offset: usize) -> (usize, usize) {
-    let at = offset.min(source.len());
-    let at = (0..=at).rev().find(|&i| source.is_char_boundary(i)).unwrap_or(0);
-    let before = &source[..at];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
+    shaping_engine::diag::line_column(source, offset)
 }
 
 fn severity(d: &dyn miette::Diagnostic) -> String {
