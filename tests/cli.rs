@@ -391,6 +391,10 @@ fn bench_prints_one_json_line() {
     let v: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
     assert!(v["sim_steps_per_sec"].as_f64().unwrap() > 0.0);
     assert!(v["controller_actions_per_sec"].as_f64().unwrap() > 0.0);
+    assert!(v["controller_episodes_per_sec"].as_f64().unwrap() > 0.0);
+    // The timed robot moves: not pinned against a wall, not out of battery.
+    assert!(v["sim_moving_share"].as_f64().unwrap() >= 0.9, "{v}");
+    assert!(v["sim_collision_share"].as_f64().unwrap() < 0.1, "{v}");
 }
 
 /// A stage with nothing evolved replays without a genome, and its avoid
