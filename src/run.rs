@@ -74,9 +74,8 @@ impl Observer for Terminal {
             Event::EvolveStart { stage, generations, done } => {
                 *self.bar.borrow_mut() = Some(progress_bar(!self.human(), stage, generations, done));
             }
-            Event::Resumed { stage, generation, generations, finished, checkpoint } => {
-                if !self.human() {
-                } else if finished {
+            Event::Resumed { stage, generation, generations, finished, checkpoint } if self.human() => {
+                if finished {
                     eprintln!(
                         "stage {stage:<12} all {generation} generations done before, from {}",
                         checkpoint.display()

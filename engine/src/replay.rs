@@ -109,9 +109,10 @@ pub fn choose(
             // From the program as it is: the checkpoint, where there is one,
             // must still fit, and `best.genome` be its best.
             if rundir::checkpoint_path(&dir).exists() {
-                rundir::checked_best(&program, source, &dir)?;
+                rundir::checked_best(&program, source, &dir)?.1
+            } else {
+                read_genome(&path)?
             }
-            rundir::read_best(&dir)?
         }
     };
     if genome.bits.len() != stage.layout.bits as usize {

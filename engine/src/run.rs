@@ -340,8 +340,9 @@ fn interrupted(message: String) -> Error {
 /// checkpoint and `trained.json` fits the program (training stages bound
 /// in order as the run binds them; the check stops at a training stage
 /// that has to be trained again, whose weights are not known yet).
-fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Result<()> {
-    let mut saved: Vec<(&str, u64)> = Vec::new();
+fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Result<Saved> {
+    let mut saved = Saved::none(program);
+    let mut seeds_of: Vec<(&str, u64)> = Vec::new();
     let mut bound = program.clone();
     let mut binding = true;
     for &i in stages {
@@ -349,17 +350,18 @@ fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Resul
         let dir = rundir::stage_dir(out, &st.name);
         match st.run {
             StageRun::Evolve(_) => {
-                if let Some(mut cp) = rundir::read_checkpoint(&dir)? {
-                    saved.push((&st.name, cp.seed));
+                if let Some(cp) = rundir::read_checkpoint(&dir)? {
+                    seeds_of.push((&st.name, cp.seed));
                     if binding && cp.seed == seed {
                         let path = rundir::checkpoint_path(&dir);
-                        evolve::resume(&bound, i, &mut cp).map_err(|e| stale(&path, &e))?;
+                        evolve::check_resume_of(&bound, i, &cp).map_err(|e| stale(&path, &e))?;
                     }
+                    saved.checkpoints[i] = Some(cp);
                 }
             }
             StageRun::Train { .. } => match rundir::read_trained(&dir)? {
                 Some(t) => {
-                    saved.push((&st.name, t.run_seed));
+                    seeds_of.push((&st.name, t.run_seed));
                     if binding && t.run_seed == seed {
                         let path = rundir::trained_path(&dir);
                         evolve::train::check(&bound, i, &t).map_err(|e| stale(&path, &e))?;
@@ -368,19 +370,20 @@ fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Resul
                     } else {
                         binding = false;
                     }
+                    saved.trained[i] = Some(t);
                 }
                 None => binding = false,
             },
             StageRun::Test { .. } => {}
         }
     }
-    let mut seeds: Vec<u64> = saved.iter().map(|&(_, s)| s).collect();
+    let mut seeds: Vec<u64> = seeds_of.iter().map(|&(_, s)| s).collect();
     seeds.sort_unstable();
     seeds.dedup();
     if seeds.len() < 2 {
-        return Ok(());
+        return Ok(saved);
     }
-    let which: Vec<String> = saved.iter().map(|(name, s)| format!("`{name}` seed {s}")).collect();
+    let which: Vec<String> = seeds_of.iter().map(|(name, s)| format!("`{name}` seed {s}")).collect();
     Err(Error::new(
         ErrorKind::Stale,
         format!(
@@ -390,6 +393,20 @@ fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Resul
             which.join(", ")
         ),
     ))
+}
+
+/// What a run resumes from, read once by [`precheck`]: per stage, its
+/// checkpoint or trained weights (none with `--fresh`).
+struct Saved {
+    checkpoints: Vec<Option<Checkpoint>>,
+    trained: Vec<Option<Trained>>,
+}
+
+impl Saved {
+    fn none(program: &Program) -> Saved {
+        let n = program.stages.len();
+        Saved { checkpoints: vec![None; n], trained: vec![None; n] }
+    }
 }
 
 /// Who runs a program's stages: the caller's observer, evaluator and
@@ -434,9 +451,8 @@ impl Runner<'_> {
         let seed = run_seed(&program, opts.seed);
         let local = Local::new(opts.jobs)?;
         let _lock = DirLock::acquire(&out)?;
-        if !opts.fresh {
-            precheck(&program, &stages, &out, seed)?;
-        }
+        let mut saved =
+            if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed)? };
         // The compiled program, for `shaping report` (and `shaping run program.json`).
         rundir::write_program(&out, &program)?;
         let evaluator = self.evaluator.unwrap_or(&local);
@@ -455,7 +471,7 @@ impl Runner<'_> {
             let dir = rundir::stage_dir(&out, &program.stages[index].name);
             create_dir(&dir)?;
             if let StageRun::Train { .. } = program.stages[index].run {
-                let trained = self.train_step(&program, index, seed, &dir, opts.fresh)?;
+                let trained = self.train_step(&program, index, seed, &dir, saved.trained[index].take())?;
                 evolve::train::bind(&mut program, index, &trained)
                     .map_err(|e| Error::io(format!("error: {e}")))?;
                 results.push(StageOutcome::Train {
@@ -469,7 +485,9 @@ impl Runner<'_> {
             match &stage.run {
                 StageRun::Evolve(_) => {
                     let parent = evolved_parent(&program, index, &finals)?;
-                    let cp = self.evolve_stage(&program, index, seed, parent, &dir, opts.fresh, evaluator)?;
+                    let existing = saved.checkpoints[index].take();
+                    let cp = self
+                        .evolve_stage(&program, index, seed, parent, &dir, existing, opts.fresh, evaluator)?;
                     best_episode(stage, &cp, seed, &dir)?;
                     if let Some((genome, best)) = evolve::best_of(&cp) {
                         results.push(StageOutcome::Evolve {
@@ -551,6 +569,7 @@ impl Runner<'_> {
         seed: u64,
         parent: Option<&Checkpoint>,
         dir: &Path,
+        existing: Option<Checkpoint>,
         fresh: bool,
         evaluator: &dyn Evaluate,
     ) -> Result<Checkpoint> {
@@ -559,7 +578,6 @@ impl Runner<'_> {
             unreachable!("evolve_stage is called for evolved stages")
         };
         let path = rundir::checkpoint_path(dir);
-        let existing = if fresh { None } else { rundir::read_checkpoint(dir)? };
         let mut cp = match existing {
             Some(mut cp) => {
                 if cp.seed != seed {
@@ -1012,22 +1030,20 @@ impl Runner<'_> {
         index: usize,
         seed: u64,
         dir: &Path,
-        fresh: bool,
+        saved: Option<Trained>,
     ) -> Result<Trained> {
         let stage = &program.stages[index];
         let StageRun::Train { actions } = stage.run else { unreachable!("train_step runs training stages") };
         let recorded = actions.min(RECORDED_TRAINING_ACTIONS);
-        if !fresh {
-            if let Some(t) = rundir::read_trained(dir)? {
-                let path = rundir::trained_path(dir);
-                if t.run_seed != seed {
-                    return Err(other_seed(&path, t.run_seed, seed));
-                }
-                evolve::train::check(program, index, &t).map_err(|e| stale(&path, &e))?;
-                self.warn_training(stage, &t, dir);
-                self.observer.event(Event::Trained { stage, trained: &t, recorded, reused: true, dir });
-                return Ok(t);
+        if let Some(t) = saved {
+            let path = rundir::trained_path(dir);
+            if t.run_seed != seed {
+                return Err(other_seed(&path, t.run_seed, seed));
             }
+            evolve::train::check(program, index, &t).map_err(|e| stale(&path, &e))?;
+            self.warn_training(stage, &t, dir);
+            self.observer.event(Event::Trained { stage, trained: &t, recorded, reused: true, dir });
+            return Ok(t);
         }
         let trained =
             evolve::train_stage(program, index, seed, None).map_err(|e| Error::io(format!("error: {e}")))?;

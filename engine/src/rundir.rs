@@ -157,24 +157,28 @@ pub fn read_genome(path: &Path) -> Result<Genome> {
 /// which must be the checkpoint's best where a checkpoint is beside it (a
 /// hand-edited or damaged `best.genome` is refused, naming it).
 pub fn read_best(dir: &Path) -> Result<Genome> {
-    let path = best_genome_path(dir);
-    let genome = read_genome(&path)?;
+    let genome = read_genome(&best_genome_path(dir))?;
     if let Some(cp) = read_checkpoint(dir)? {
-        if let Some((best, _)) = evolve::best_of(&cp) {
-            if best != genome {
-                return Err(Error::new(
-                    ErrorKind::Corrupt,
-                    format!(
-                        "error: `{}` is not the best individual of the checkpoint beside it (`{}`): it was changed \
-                         after the run wrote it; delete it and run the same command again to write it anew",
-                        path.display(),
-                        checkpoint_path(dir).display()
-                    ),
-                ));
-            }
-        }
+        check_best(dir, &genome, &cp)?;
     }
     Ok(genome)
+}
+
+/// `genome`, read from `dir`'s `best.genome`, must be the best of `cp`,
+/// the checkpoint beside it.
+pub fn check_best(dir: &Path, genome: &Genome, cp: &Checkpoint) -> Result<()> {
+    match evolve::best_of(cp) {
+        Some((best, _)) if best != *genome => Err(Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: `{}` is not the best individual of the checkpoint beside it (`{}`): it was changed \
+                 after the run wrote it; delete it and run the same command again to write it anew",
+                best_genome_path(dir).display(),
+                checkpoint_path(dir).display()
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The chosen best of evolved stage `index` of `program` from its directory
@@ -202,8 +206,9 @@ pub fn checked_best(program: &Program, index: usize, dir: &Path) -> Result<(Chec
     let (genome, fitness) = evolve::best_of(&cp).ok_or_else(|| {
         Error::new(ErrorKind::Corrupt, format!("error: `{}` holds no evaluated individual", path.display()))
     })?;
-    if best_genome_path(dir).exists() {
-        read_best(dir)?;
+    let best = best_genome_path(dir);
+    if best.exists() {
+        check_best(dir, &read_genome(&best)?, &cp)?;
     }
     Ok((cp, genome, fitness))
 }

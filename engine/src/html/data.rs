@@ -668,18 +668,19 @@ fn run_stages(
             continue;
         }
         let genome = read_genome(&dir.join("best.genome"), st)?;
-        if genome.is_some() && matches!(st.run, StageRun::Evolve(_)) {
+        let cp = rundir::read_checkpoint(&dir)?;
+        if let (Some(g), Some(cp), StageRun::Evolve(_)) = (&genome, &cp, &st.run) {
             // The best the checkpoint beside it holds (a `best.genome`
             // changed after the run wrote it is an error naming it).
-            rundir::read_best(&dir)?;
+            rundir::check_best(&dir, g, cp)?;
         }
         let src = format!("{}/best.genome", st.name);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
         // The seed the stage ran with is its checkpoint's (`--seed`, an
         // experiment's seed), not necessarily the one the file declares.
-        if let Some(cp) = rundir::read_checkpoint(&dir)? {
+        if let Some(cp) = &cp {
             view.run = run_text(st, Some(cp.seed));
-            view.crowded = crowded_generations(st, &cp);
+            view.crowded = crowded_generations(st, cp);
         }
         view.results = read_summary(&dir.join("summary.json"))?;
         if let Some(r) = &view.results {
