@@ -20,6 +20,7 @@ pub mod replay;
 pub mod report;
 pub mod run;
 pub mod rundir;
+pub mod stepper;
 pub mod sweep;
 
 pub use error::{Error, ErrorKind, Result};

@@ -240,3 +240,24 @@ pub fn trajectory(stem: &Path, title: &str, scene: &TrajectoryScene) -> Result<(
     arena::check(scene).map_err(|m| PlotError::input(stem, m))?;
     render::render(stem, &arena::Arena::new(title, scene))
 }
+
+/// An RGB picture in memory: `height` rows of `width` pixels, 3 bytes each.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rgb {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<u8>,
+}
+
+/// [`trajectory`] drawn into memory, without text (the same size whatever
+/// the fonts): the frames of an animation or of a Gymnasium environment.
+/// Objects outside the arena are left out, so that every frame of a world
+/// has one size.
+pub fn trajectory_rgb(scene: &TrajectoryScene) -> Result<Rgb, PlotError> {
+    let stem = Path::new("frame");
+    let mut inside = scene.clone();
+    let [w, h] = scene.arena;
+    inside.objects.retain(|o| (0.0..=w).contains(&o.x) && (0.0..=h).contains(&o.y));
+    arena::check(&inside).map_err(|m| PlotError::input(stem, m))?;
+    render::to_rgb(stem, &arena::Arena::new("", &inside))
+}

@@ -333,6 +333,17 @@ fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
         releases = r.releases_outside;
     }
     plot::TrajectoryScene {
+        marks,
+        path_modules: Some(trace.rows.iter().map(|r| r.winner).collect()),
+        module_names: trace.modules.clone(),
+        ..picture(scene, trace.rows.iter().map(|r| [r.pose.x, r.pose.y, r.pose.theta]).collect())
+    }
+}
+
+/// The picture of `scene` with the robot's `path` (poses `[x, y, heading]`),
+/// coloured by time, without marks.
+pub fn picture(scene: &Scene, path: Vec<[f32; 3]>) -> plot::TrajectoryScene {
+    plot::TrajectoryScene {
         arena: scene.arena,
         bar: scene.bar.map(|[a, b]| (a, b)),
         lamp: scene.lamp,
@@ -351,10 +362,10 @@ fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
                 collected: o.state != ObjectState::Floor,
             })
             .collect(),
-        path: trace.rows.iter().map(|r| [r.pose.x, r.pose.y, r.pose.theta]).collect(),
+        path,
         body_radius: scene.body_radius,
-        marks,
-        path_modules: Some(trace.rows.iter().map(|r| r.winner).collect()),
-        module_names: trace.modules.clone(),
+        marks: Vec::new(),
+        path_modules: None,
+        module_names: Vec::new(),
     }
 }

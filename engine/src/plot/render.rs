@@ -137,6 +137,17 @@ pub(super) fn render_with(stem: &Path, fig: &impl Figure, text: bool) -> Result<
     Ok(())
 }
 
+/// Draws `fig` without text into memory.
+pub(super) fn to_rgb(stem: &Path, fig: &impl Figure) -> Result<super::Rgb, PlotError> {
+    let (w, h) = fig.size(false);
+    let mut pixels = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        fig.draw(&root, false).and_then(|()| root.present()).map_err(|e| draw_error(stem, e))?;
+    }
+    Ok(super::Rgb { width: w, height: h, pixels })
+}
+
 fn draw_error<E: std::error::Error + Send + Sync>(path: &Path, e: DrawingAreaErrorKind<E>) -> PlotError {
     PlotError::Draw { path: path.to_path_buf(), message: e.to_string() }
 }

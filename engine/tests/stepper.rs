@@ -1,0 +1,216 @@
+//! A stage's robot driven from outside ([`shaping_engine::stepper`]): the
+//! rewards of a life add up to the fitness a run gives the same episode,
+//! bad actions are refused, and many robots stepped together are
+//! deterministic by seed whatever the threads.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use shaping_engine::stepper::{Stepper, VecStep, VecStepper};
+use shaping_engine::ErrorKind;
+use shaping_runtime::catalog::CHANNELS;
+use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Robot};
+use shaping_runtime::program::{Program, Stage};
+use shaping_runtime::sim::{Command, Outcome, Pose, Sim};
+
+fn khepera() -> Program {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/khepera.bat");
+    let (mut program, _) =
+        shaping_engine::load::load_program(&path, shaping_engine::diag::ErrorFormat::Plain).unwrap();
+    let seed = shaping_engine::run::run_seed(&program, None);
+    shaping_engine::run::bind_training(&mut program, None, seed, &shaping_engine::run::Silent).unwrap();
+    program
+}
+
+fn stage(program: &Program, name: &str) -> Arc<Stage> {
+    Arc::new(program.stages.iter().find(|s| s.name == name).unwrap().clone())
+}
+
+/// The simulator, keeping every command the controller gave it.
+struct Recording {
+    sim: Sim,
+    commands: Vec<Command>,
+}
+
+impl Robot for Recording {
+    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
+        self.sim.sense(out)
+    }
+    fn step(&mut self, cmd: &Command) -> Outcome {
+        self.commands.push(*cmd);
+        self.sim.step(cmd)
+    }
+    fn alive(&self) -> bool {
+        self.sim.alive()
+    }
+    fn battery(&self) -> f32 {
+        self.sim.battery()
+    }
+    fn pose(&self) -> Pose {
+        self.sim.pose()
+    }
+    fn holding(&self) -> Option<bool> {
+        Some(self.sim.holding())
+    }
+}
+
+#[test]
+fn a_lifes_rewards_add_up_to_the_fitness_of_its_episode() {
+    let program = khepera();
+    let nav = stage(&program, "navigation");
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    for seed in 0..6u64 {
+        // A random individual's episode, as evolution runs it.
+        let genome = shaping_runtime::genome::Genome {
+            bits: (0..nav.layout.bits).map(|_| rng.random_range(0..2u8)).collect(),
+        };
+        let (sim_seed, ctl_rng) = episode_rngs(seed);
+        let mut ctl = Controller::new(&nav, &genome, ctl_rng).unwrap();
+        let mut robot = Recording { sim: Sim::new(&nav.world, sim_seed), commands: Vec::new() };
+        let opts = EpisodeOptions { actions: 300, learning: true, seed };
+        let result = ctl.run(&mut robot, &opts, None);
+
+        // The same commands through the stepper, in the world of that seed.
+        let mut env = Stepper::new(nav.clone());
+        assert_eq!(env.spaces().action, ["wheels[0]", "wheels[1]", "charge"]);
+        assert_eq!(env.spaces().observation.len(), 17);
+        let mut obs = vec![0.0; 17];
+        env.reset(seed, &mut obs);
+        let (mut total, mut recharges, mut last) = (0.0f64, 0, None);
+        for (i, c) in robot.commands.iter().enumerate() {
+            let action = [c.wheels[0], c.wheels[1], f32::from(u8::from(c.charge))];
+            let step = env.step(&action, &mut obs).unwrap();
+            total += f64::from(step.reward);
+            recharges += u32::from(step.outcome.recharged);
+            assert!(obs.iter().all(|v| (0.0..=1.0).contains(v)));
+            if i + 1 < robot.commands.len() {
+                assert!(!step.terminated && !step.truncated, "seed {seed}: ended at action {i}");
+            }
+            last = Some(step);
+        }
+        let last = last.unwrap();
+        assert_eq!(env.actions(), result.actions);
+        assert_eq!(recharges, result.recharges);
+        assert_eq!(last.truncated, result.actions == 300, "seed {seed}");
+        assert_eq!(last.terminated, result.actions < 300, "seed {seed}");
+        assert!(
+            (total - f64::from(result.fitness)).abs() < 1e-5,
+            "seed {seed}: rewards {total} against the episode's fitness {}",
+            result.fitness
+        );
+        assert_eq!(env.pose(), robot.sim.pose());
+        assert!(total > 0.0);
+        // The life has ended: a further step is refused.
+        let err = env.step(&[0.0, 0.0, 0.0], &mut obs).unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Invalid);
+        assert!(err.message().contains("reset"), "{}", err.message());
+    }
+}
+
+#[test]
+fn bad_actions_are_refused_naming_the_element() {
+    let program = khepera();
+    let mut env = Stepper::new(stage(&program, "collect"));
+    assert_eq!(env.spaces().action, ["wheels[0]", "wheels[1]", "arm", "claw", "charge"]);
+    let mut obs = vec![0.0; env.spaces().observation.len()];
+    let err = env.step(&[0.0; 5], &mut obs).unwrap_err();
+    assert!(err.message().contains("reset"), "{}", err.message());
+    env.reset(1, &mut obs);
+    let first = obs.clone();
+    for (action, says) in [
+        (vec![0.0; 4], "5 elements"),
+        (vec![1.5, 0.0, 0.0, 0.0, 0.0], "action element 0 (`wheels[0]`) is 1.5, outside -1..1"),
+        (vec![0.0, f32::NAN, 0.0, 0.0, 0.0], "(`wheels[1]`) is NaN"),
+        (vec![0.0, 0.0, 0.0, -0.1, 0.0], "(`claw`) is -0.1, outside 0..1"),
+    ] {
+        let err = env.step(&action, &mut obs).unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Invalid);
+        assert!(err.message().contains(says), "{}", err.message());
+        assert_eq!(env.actions(), 0);
+        assert_eq!(obs, first);
+    }
+    env.step(&[1.0, 1.0, 1.0, 0.0, 0.0], &mut obs).unwrap();
+    assert_eq!(env.actions(), 1);
+}
+
+/// `steps` steps of `n` robots with random actions on `threads` threads:
+/// the observations, rewards and ends of every step.
+fn vec_run(stage: &Arc<Stage>, n: usize, steps: usize, threads: usize) -> Vec<VecStep> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| {
+        let mut envs = VecStepper::new(stage.clone(), n);
+        let dims = envs.spaces().action.len();
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut out = VecStep::default();
+        envs.reset(5, &mut out);
+        let mut all = vec![out.clone()];
+        for _ in 0..steps {
+            let actions: Vec<f32> = (0..n * dims)
+                .map(
+                    |i| if i % dims < 2 { rng.random_range(-1.0..=1.0) } else { rng.random_range(0.0..=1.0) },
+                )
+                .collect();
+            envs.step(&actions, &mut out).unwrap();
+            all.push(out.clone());
+        }
+        all
+    })
+}
+
+#[test]
+fn robots_stepped_together_are_deterministic_and_start_again_after_a_life() {
+    let program = khepera();
+    let nav = stage(&program, "navigation");
+    let one = vec_run(&nav, 40, 320, 1);
+    assert_eq!(one, vec_run(&nav, 40, 320, 2));
+    // Lives of 300 actions: every robot's life ended (by the battery or at
+    // 300), and on the step after, it started again: reward 0, not ended,
+    // a fresh observation (a full battery).
+    let battery = 16;
+    for r in 0..40 {
+        let end = (1..one.len())
+            .find(|&s| one[s].terminated[r] || one[s].truncated[r])
+            .unwrap_or_else(|| panic!("robot {r} never ended"));
+        assert!(end <= 300);
+        assert_eq!(one[end].truncated[r], end == 300, "robot {r}");
+        let next = &one[end + 1];
+        assert_eq!(next.rewards[r], 0.0);
+        assert!(!next.terminated[r] && !next.truncated[r]);
+        assert_eq!(next.observations[r * 17 + battery], 1.0);
+    }
+    // The robots do not share one world.
+    assert_ne!(one[1].observations[..17], one[1].observations[17..34]);
+    // A malformed row is refused, naming it, and no robot moves.
+    let mut envs = VecStepper::new(nav, 3);
+    let mut out = VecStep::default();
+    envs.reset(0, &mut out);
+    let before = out.clone();
+    let err = envs.step(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0], &mut out).unwrap_err();
+    assert!(err.message().contains("row 2 of the actions"), "{}", err.message());
+    assert_eq!(out, before);
+    assert_eq!(envs.get(0).unwrap().actions(), 0);
+}
+
+#[test]
+fn a_frame_of_the_world_has_one_size_throughout_a_life() {
+    let program = khepera();
+    let mut env = Stepper::new(stage(&program, "collect"));
+    env.keep_path(true);
+    let mut obs = vec![0.0; env.spaces().observation.len()];
+    env.reset(2, &mut obs);
+    let frame = |env: &Stepper| {
+        let picture = shaping_engine::report::picture(&env.scene().unwrap(), env.path().to_vec());
+        shaping_engine::plot::trajectory_rgb(&picture).unwrap()
+    };
+    let first = frame(&env);
+    assert_eq!(first.pixels.len(), (first.width * first.height * 3) as usize);
+    for _ in 0..50 {
+        env.step(&[1.0, 0.6, 0.0, 0.0, 0.0], &mut obs).unwrap();
+    }
+    assert_eq!(env.path().len(), 51);
+    let later = frame(&env);
+    assert_eq!((later.width, later.height), (first.width, first.height));
+    assert_ne!(later.pixels, first.pixels, "the robot moved");
+}
