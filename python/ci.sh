@@ -21,7 +21,7 @@ venv="$work/venv/bin"
 
 # maturin (from PyPI, in pip's isolated build environment) builds the
 # extension in release; CARGO_TARGET_DIR, if set, is reused.
-"$venv/pip" install --quiet --disable-pip-version-check ./python pytest numpy
+"$venv/pip" install --quiet --disable-pip-version-check "./python[test]"
 
 if [ -z "${SHAPING_BIN:-}" ]; then
   cargo build --quiet --bin shaping

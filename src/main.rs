@@ -25,7 +25,7 @@ use shaping_engine::{html, sweep};
 /// Most worker threads `--jobs` accepts.
 const MAX_JOBS: u64 = 1024;
 /// Most seeds an experiment runs.
-const MAX_SEEDS: u64 = 10_000;
+use shaping_engine::experiment::MAX_SEEDS;
 
 /// Declarative behavior architectures for autonomous robots, evolved and
 /// trained incrementally (Urzelai, Floreano, Dorigo, Colombetti 1998).

@@ -121,6 +121,12 @@ impl Plan {
         if args.seeds == 0 {
             return Err(Error::new(ErrorKind::Invalid, "error: `--seeds` must be at least 1"));
         }
+        if args.seeds > MAX_SEEDS {
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!("error: `--seeds {}` is more than the limit of {MAX_SEEDS}", args.seeds),
+            ));
+        }
         let end = args.first_seed.checked_add(args.seeds).ok_or_else(|| {
             Error::new(
                 ErrorKind::Invalid,
@@ -294,6 +300,9 @@ pub struct Finished {
     pub summary: String,
     pub reports: Vec<PathBuf>,
 }
+
+/// Most seeds an experiment runs.
+pub const MAX_SEEDS: u64 = 10_000;
 
 /// Most points a sweep runs.
 const MAX_POINTS: usize = 10_000;

@@ -2,7 +2,9 @@
 
 Compile ``.bat`` architecture files, evaluate genomes of an evolved stage
 with numpy (for any optimizer: CMA-ES, MAP-Elites, ...), and run programs
-like ``shaping run``, at the speed of the Rust core.
+and experiments like ``shaping run`` and ``shaping experiment``, and drive a
+stage's robot from a reinforcement-learning library (``shaping.gym``, with
+``gymnasium`` installed), at the speed of the Rust core.
 
 >>> import shaping
 >>> program = shaping.compile("examples/khepera.bat")
@@ -23,11 +25,13 @@ from ._shaping import (
     SQUARE_MM,
     Diagnostic,
     Evaluator,
+    Experiment,
     Program,
     Run,
     ShapingError,
     check,
     compile,
+    experiment,
     run,
 )
 
@@ -35,10 +39,12 @@ __all__ = [
     "SQUARE_MM",
     "Diagnostic",
     "Evaluator",
+    "Experiment",
     "Program",
     "Run",
     "ShapingError",
     "check",
     "compile",
+    "experiment",
     "run",
 ]

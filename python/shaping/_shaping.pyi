@@ -152,3 +152,75 @@ def run(
     the run after the generation under way, leaves it resumable and raises
     KeyboardInterrupt.
     """
+
+class Experiment:
+    """An experiment's directory: its runs and its summaries."""
+
+    @property
+    def out(self) -> str: ...
+    @property
+    def seeds(self) -> list[int]: ...
+    @property
+    def runs(self) -> list[Run]:
+        """Every run, point after point, seed after seed."""
+    @property
+    def summary(self) -> dict[str, Any]:
+        """``summary.json``: per point, its settings and per stage the median, range, mean and sd over the seeds."""
+    @property
+    def summary_text(self) -> str:
+        """The summary the command line prints."""
+    @property
+    def reports(self) -> list[str]: ...
+
+def experiment(
+    path: PathLike,
+    seeds: int = 5,
+    first_seed: int = 1,
+    out: Optional[PathLike] = None,
+    stage: Optional[str] = None,
+    set: Optional[Mapping[str, Any]] = None,
+    criterion: Optional[Mapping[str, float]] = None,
+    jobs: Optional[int] = None,
+    callback: Optional[Callable[[dict[str, Any]], Any]] = None,
+    fresh: bool = False,
+    report: bool = True,
+) -> Experiment:
+    """Runs ``path`` over ``seeds`` seeds like ``shaping experiment`` (default
+    ``runs/<file stem>/experiment``) and writes the summaries.
+
+    ``set`` maps ``STAGE.SECTION.FIELD`` to a value or a list of values (a
+    sweep over the cartesian product); ``criterion`` maps a stage to a
+    fitness (the generation at which the best reaches it is reported).
+    The rest as :func:`run`.
+    """
+
+class Stepper:
+    """One robot of a stage driven one action at a time (see ``shaping.gym``)."""
+
+    def __init__(self, program: Program, stage: str, keep_path: bool = False) -> None: ...
+    @property
+    def observation_names(self) -> list[str]: ...
+    @property
+    def action_names(self) -> list[str]: ...
+    @property
+    def action_bounds(self) -> tuple[list[float], list[float]]: ...
+    @property
+    def life(self) -> int: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
+    def step(
+        self, action: npt.NDArray[np.float32]
+    ) -> tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]: ...
+    def render(self) -> npt.NDArray[np.uint8]: ...
+
+class VecStepper:
+    """Many robots of a stage stepped together in Rust (see ``shaping.gym.make_vec``)."""
+
+    def __init__(self, program: Program, stage: str, num_envs: int, jobs: Optional[int] = None) -> None: ...
+    @property
+    def num_envs(self) -> int: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
+    def step(
+        self, actions: npt.NDArray[np.float32]
+    ) -> tuple[
+        npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.bool_], npt.NDArray[np.bool_]
+    ]: ...

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use miette::Diagnostic as _;
-use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -533,6 +533,191 @@ impl Evaluator {
     }
 }
 
+// ------------------------------------------------------------------ step
+
+fn invalid(e: &shaping_engine::Error) -> PyErr {
+    value_error(e.message())
+}
+
+/// The stage `stage` of `program` for a robot driven from outside.
+fn stepped_stage(program: &Program, stage: &str) -> PyResult<Arc<shaping_runtime::program::Stage>> {
+    Ok(Arc::new(program.program.stages[stage_index(&program.program, stage)?].clone()))
+}
+
+/// One robot of a stage driven one action at a time (`shaping.gym.make`
+/// wraps it in a Gymnasium environment).
+#[pyclass(module = "shaping")]
+struct Stepper {
+    inner: shaping_engine::stepper::Stepper,
+    obs: Vec<f32>,
+}
+
+#[pymethods]
+impl Stepper {
+    /// A robot of stage `stage` of `program`; `keep_path` keeps the poses
+    /// of each life for `render`.
+    #[new]
+    #[pyo3(signature = (program, stage, keep_path=false))]
+    fn new(program: &Program, stage: &str, keep_path: bool) -> PyResult<Stepper> {
+        let mut inner = shaping_engine::stepper::Stepper::new(stepped_stage(program, stage)?);
+        inner.keep_path(keep_path);
+        let obs = vec![0.0; inner.spaces().channels.len()];
+        Ok(Stepper { inner, obs })
+    }
+
+    /// The names of the observation's elements (the declared sensors).
+    #[getter]
+    fn observation_names(&self) -> Vec<String> {
+        self.inner.spaces().observation.clone()
+    }
+
+    /// The names of the action's elements.
+    #[getter]
+    fn action_names(&self) -> Vec<String> {
+        self.inner.spaces().action.clone()
+    }
+
+    /// The lowest and highest value of each action element.
+    #[getter]
+    fn action_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        self.inner.spaces().action_bounds()
+    }
+
+    /// The length of a life, in actions.
+    #[getter]
+    fn life(&self) -> u32 {
+        self.inner.life()
+    }
+
+    /// Starts a life in the world of episode seed `seed`; returns the first observation.
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> Bound<'py, PyArray1<f32>> {
+        self.inner.reset(seed, &mut self.obs);
+        PyArray1::from_slice(py, &self.obs)
+    }
+
+    /// Runs one action (a float32 array); returns the observation, the
+    /// reward, terminated, truncated and a dict of what happened.
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        action: numpy::PyReadonlyArray1<'py, f32>,
+    ) -> PyResult<(Bound<'py, PyArray1<f32>>, f32, bool, bool, Bound<'py, PyDict>)> {
+        let action = action.as_slice().map_err(|e| value_error(format!("the action: {e}")))?;
+        let step = self.inner.step(action, &mut self.obs).map_err(|e| invalid(&e))?;
+        let info = PyDict::new(py);
+        let pose = self.inner.pose();
+        info.set_item("grips", step.outcome.grips)?;
+        info.set_item("releases_outside", step.outcome.releases_outside)?;
+        info.set_item("recharged", step.outcome.recharged)?;
+        info.set_item("collided", step.outcome.collided)?;
+        info.set_item("battery", self.inner.battery())?;
+        info.set_item("x", pose.x)?;
+        info.set_item("y", pose.y)?;
+        info.set_item("heading", pose.theta)?;
+        if step.terminated || step.truncated {
+            let d = self.inner.descriptors();
+            info.set_item("path_length", d.path_length)?;
+            info.set_item("squares_visited", d.squares_visited)?;
+        }
+        Ok((PyArray1::from_slice(py, &self.obs), step.reward, step.terminated, step.truncated, info))
+    }
+
+    /// A picture of the world now and the path of the life so far: an
+    /// array of shape (height, width, 3) of uint8.
+    fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        let scene = self.inner.scene().ok_or_else(|| value_error("error: reset before rendering"))?;
+        let picture = shaping_engine::report::picture(&scene, self.inner.path().to_vec());
+        let rgb = py
+            .detach(|| shaping_engine::plot::trajectory_rgb(&picture))
+            .map_err(|e| ShapingError::new_err(format!("error: {e}")))?;
+        let flat = PyArray1::from_vec(py, rgb.pixels);
+        flat.reshape([rgb.height as usize, rgb.width as usize, 3])
+    }
+}
+
+/// Many robots of one stage stepped together in Rust (`shaping.gym.make_vec`).
+#[pyclass(module = "shaping")]
+struct VecStepper {
+    inner: shaping_engine::stepper::VecStepper,
+    out: shaping_engine::stepper::VecStep,
+    pool: rayon::ThreadPool,
+}
+
+#[pymethods]
+impl VecStepper {
+    /// `num_envs` robots of stage `stage` of `program`, stepped on `jobs`
+    /// threads (None: one per core).
+    #[new]
+    #[pyo3(signature = (program, stage, num_envs, jobs=None))]
+    fn new(program: &Program, stage: &str, num_envs: usize, jobs: Option<usize>) -> PyResult<VecStepper> {
+        if num_envs == 0 {
+            return Err(value_error("error: num_envs must be at least 1"));
+        }
+        if jobs == Some(0) {
+            return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
+        }
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(jobs.unwrap_or(0))
+            .build()
+            .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
+        let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs);
+        Ok(VecStepper { inner, out: Default::default(), pool })
+    }
+
+    #[getter]
+    fn num_envs(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Starts a life of every robot (robot i's lives from stream i of
+    /// `seed`); returns the observations, shape (num_envs, observation).
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, numpy::PyArray2<f32>>> {
+        self.inner.reset(seed, &mut self.out);
+        self.observations(py)
+    }
+
+    /// Steps every robot with its row of `actions` (float32, shape
+    /// (num_envs, action)), with the GIL released; returns the
+    /// observations, rewards, terminated and truncated. A robot whose life
+    /// ended at the last step starts again instead (its action ignored).
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: numpy::PyReadonlyArray2<'py, f32>,
+    ) -> PyResult<(
+        Bound<'py, numpy::PyArray2<f32>>,
+        Bound<'py, PyArray1<f32>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<bool>>,
+    )> {
+        let (n, dims) = (self.inner.len(), self.inner.spaces().controls.len());
+        if actions.shape() != [n, dims] {
+            return Err(value_error(format!(
+                "error: the actions must be an array of shape ({n}, {dims}), not {:?}",
+                actions.shape()
+            )));
+        }
+        let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
+        let (inner, out, pool) = (&mut self.inner, &mut self.out, &self.pool);
+        py.detach(|| pool.install(|| inner.step(flat, out))).map_err(|e| invalid(&e))?;
+        Ok((
+            self.observations(py)?,
+            PyArray1::from_slice(py, &self.out.rewards),
+            PyArray1::from_slice(py, &self.out.terminated),
+            PyArray1::from_slice(py, &self.out.truncated),
+        ))
+    }
+}
+
+impl VecStepper {
+    fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray2<f32>>> {
+        let width = self.inner.spaces().channels.len();
+        PyArray1::from_slice(py, &self.out.observations).reshape([self.inner.len(), width])
+    }
+}
+
 // ------------------------------------------------------------------ run
 
 /// A run directory: the stages it holds and their files.
@@ -794,11 +979,7 @@ fn run(
     if jobs == Some(0) {
         return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
     }
-    if let Some(c) = &callback {
-        if !c.bind(py).is_callable() {
-            return Err(value_error("callback must be callable (it is called with one dict per event)"));
-        }
-    }
+    check_callback(py, &callback)?;
     let sets = assignments(set)?;
     let program = load(py, &path)?;
     if let Some(s) = &stage {
@@ -806,6 +987,33 @@ fn run(
     }
     let out = out.unwrap_or_else(|| engine_run::default_out(&path));
     let options = RunOptions { stage, seed, out, jobs, fresh, no_report: !report, sets };
+    let outcome = observed(py, callback, |observer, stop| {
+        Runner { observer, evaluator: None, interrupt: Some(stop) }.run(program, &options)
+    })?;
+    Ok(Run::of(outcome))
+}
+
+impl Run {
+    fn of(outcome: engine_run::RunOutcome) -> Run {
+        Run {
+            stages: outcome.stages.iter().map(|s| s.stage().to_string()).collect(),
+            out: outcome.out,
+            seed: Some(outcome.seed),
+            report: outcome.report,
+        }
+    }
+}
+
+/// Runs `body` with the GIL released, its events told to `callback`, Ctrl-C
+/// setting its stop flag (it stops after the generation under way,
+/// resumable; Python's own handler still runs); then warns of its
+/// warnings, and raises the callback's first exception, KeyboardInterrupt
+/// for an interruption, or the error.
+fn observed<T: Send>(
+    py: Python<'_>,
+    callback: Option<Py<PyAny>>,
+    body: impl FnOnce(&PyObserver, &AtomicBool) -> Result<T, shaping_engine::Error> + Send,
+) -> PyResult<T> {
     let stop = Arc::new(AtomicBool::new(false));
     let observer = PyObserver {
         callback,
@@ -813,13 +1021,8 @@ fn run(
         error: Mutex::new(None),
         stop: stop.clone(),
     };
-    // Ctrl-C sets the flag (the run stops after the generation under way,
-    // resumable) for the run's duration; Python's own handler still runs.
     let hook = signal_hook::flag::register(signal_hook::consts::SIGINT, stop.clone()).ok();
-    let result = py.detach(|| {
-        let runner = Runner { observer: &observer, evaluator: None, interrupt: Some(&stop) };
-        runner.run(program, &options)
-    });
+    let result = py.detach(|| body(&observer, &stop));
     if let Some(id) = hook {
         signal_hook::low_level::unregister(id);
     }
@@ -830,12 +1033,7 @@ fn run(
         return Err(e);
     }
     match result {
-        Ok(outcome) => Ok(Run {
-            stages: outcome.stages.iter().map(|s| s.stage().to_string()).collect(),
-            out: outcome.out,
-            seed: Some(outcome.seed),
-            report: outcome.report,
-        }),
+        Ok(v) => Ok(v),
         Err(e) if e.kind() == ErrorKind::Interrupted => {
             // Python's handler saw the signal too: its KeyboardInterrupt, with the run's message.
             let _ = py.check_signals();
@@ -843,6 +1041,181 @@ fn run(
         }
         Err(e) => Err(shaping_error(py, &e)),
     }
+}
+
+fn check_callback(py: Python<'_>, callback: &Option<Py<PyAny>>) -> PyResult<()> {
+    match callback {
+        Some(c) if !c.bind(py).is_callable() => {
+            Err(value_error("callback must be callable (it is called with one dict per event)"))
+        }
+        _ => Ok(()),
+    }
+}
+
+// ------------------------------------------------------------------ experiment
+
+/// An experiment's directory: its runs and its summaries.
+#[pyclass(module = "shaping", frozen)]
+struct Experiment {
+    out: PathBuf,
+    seeds: Vec<u64>,
+    runs: Vec<Py<Run>>,
+    summary_text: String,
+    reports: Vec<PathBuf>,
+}
+
+#[pymethods]
+impl Experiment {
+    /// The experiment's directory.
+    #[getter]
+    fn out(&self) -> PathBuf {
+        self.out.clone()
+    }
+
+    /// The seeds run.
+    #[getter]
+    fn seeds(&self) -> Vec<u64> {
+        self.seeds.clone()
+    }
+
+    /// Every run, point after point (one point without `set` lists), seed after seed.
+    #[getter]
+    fn runs(&self, py: Python<'_>) -> Vec<Py<Run>> {
+        self.runs.iter().map(|r| r.clone_ref(py)).collect()
+    }
+
+    /// The summary the command line prints (`summary.md` of the point, or the sweep's table).
+    #[getter]
+    fn summary_text(&self) -> String {
+        self.summary_text.clone()
+    }
+
+    /// `summary.json`: per point, its settings and per stage the median,
+    /// range, mean and standard deviation over the seeds.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let path = self.out.join("summary.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
+    /// The reports written (`report.html` of each point, and of the sweep).
+    #[getter]
+    fn reports(&self) -> Vec<PathBuf> {
+        self.reports.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<Experiment {}: {} runs, seeds {:?}>", self.out.display(), self.runs.len(), self.seeds)
+    }
+}
+
+/// `set` of an experiment: a dict of `STAGE.SECTION.FIELD` to a value or a
+/// list of values (a sweep over them).
+fn sweep_sets(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<sweep::Set>> {
+    let Some(set) = set else { return Ok(Vec::new()) };
+    let mut out = Vec::new();
+    for (k, v) in set.iter() {
+        let key: String =
+            k.extract().map_err(|_| value_error("set: the keys are STAGE.SECTION.FIELD strings"))?;
+        let one = |v: &Bound<'_, PyAny>| -> PyResult<String> {
+            Ok(if let Ok(b) = v.extract::<bool>() { b.to_string() } else { v.str()?.to_string() })
+        };
+        let values: Vec<String> =
+            if v.is_instance_of::<PyList>() || v.is_instance_of::<pyo3::types::PyTuple>() {
+                v.try_iter()?.map(|x| one(&x?)).collect::<PyResult<_>>()?
+            } else {
+                vec![one(&v)?]
+            };
+        out.push(
+            sweep::parse_set(&format!("{key}={}", values.join(",")))
+                .map_err(|e| value_error(format!("error: {e}")))?,
+        );
+    }
+    Ok(out)
+}
+
+/// Runs the file `path` over `seeds` consecutive seeds from `first_seed`,
+/// like `shaping experiment`, into `out` (default
+/// `runs/<file stem>/experiment`), and writes the summaries and reports.
+///
+/// `set`: a dict of `STAGE.SECTION.FIELD` to a value or a list of values:
+/// a sweep over the cartesian product of the lists, every point over the
+/// seeds. `criterion`: a dict of stage to fitness, to report the generation
+/// at which the best reaches it. `stage`, `jobs`, `fresh`, `report`,
+/// `callback`, Ctrl-C and the errors: as `run`.
+#[pyfunction]
+#[pyo3(signature = (path, seeds=5, first_seed=1, out=None, stage=None, set=None, criterion=None, jobs=None, callback=None, fresh=false, report=true))]
+#[allow(clippy::too_many_arguments)]
+fn experiment(
+    py: Python<'_>,
+    path: PathBuf,
+    seeds: u64,
+    first_seed: u64,
+    out: Option<PathBuf>,
+    stage: Option<String>,
+    set: Option<&Bound<'_, PyDict>>,
+    criterion: Option<&Bound<'_, PyDict>>,
+    jobs: Option<usize>,
+    callback: Option<Py<PyAny>>,
+    fresh: bool,
+    report: bool,
+) -> PyResult<Experiment> {
+    if jobs == Some(0) {
+        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
+    }
+    check_callback(py, &callback)?;
+    let sets = sweep_sets(set)?;
+    let mut criteria = Vec::new();
+    if let Some(c) = criterion {
+        for (k, v) in c.iter() {
+            let stage: String =
+                k.extract().map_err(|_| value_error("criterion: the keys are stage names"))?;
+            let value: f64 =
+                v.extract().map_err(|_| value_error("criterion: the values are fitness values"))?;
+            criteria.push(format!("{stage}={value}"));
+        }
+    }
+    let program = load(py, &path)?;
+    let options = shaping_engine::experiment::ExperimentOptions {
+        file: path,
+        seeds,
+        first_seed,
+        out,
+        jobs,
+        criterion: criteria,
+        sets,
+        stage,
+        fresh,
+        no_report: !report,
+    };
+    let plan = shaping_engine::experiment::Plan::new(program, options).map_err(|e| shaping_error(py, &e))?;
+    let (outcomes, finished) = observed(py, callback, |observer, stop| {
+        let _lock = plan.lock()?;
+        let runner = Runner { observer, evaluator: None, interrupt: Some(stop) };
+        let outcomes = plan
+            .tasks()
+            .into_iter()
+            .map(|task| plan.run_task(task, jobs, &runner))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((outcomes, plan.finish()?))
+    })?;
+    let mut runs = Vec::new();
+    let mut seen = Vec::new();
+    for o in outcomes {
+        if !seen.contains(&o.seed) {
+            seen.push(o.seed);
+        }
+        runs.push(Py::new(py, Run::of(o))?);
+    }
+    Ok(Experiment {
+        out: plan.out().to_path_buf(),
+        seeds: seen,
+        runs,
+        summary_text: finished.summary,
+        reports: finished.reports,
+    })
 }
 
 #[pymodule]
@@ -853,8 +1226,12 @@ fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Program>()?;
     m.add_class::<Evaluator>()?;
     m.add_class::<Run>()?;
+    m.add_class::<Experiment>()?;
+    m.add_class::<Stepper>()?;
+    m.add_class::<VecStepper>()?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(experiment, m)?)?;
     Ok(())
 }

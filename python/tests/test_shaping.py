@@ -405,3 +405,49 @@ def test_ctrl_c_without_a_callback(tmp_path):
         shaping.run(KHEPERA, out=out, stage="navigation", set={"navigation.evolve.generations": 100000},
                     report=False, callback=first_generation)
     assert any(e["event"] == "resumed" and e["generation"] == done for e in events)
+
+
+# ------------------------------------------------------------------ experiment
+
+
+def test_experiment_writes_what_the_cli_writes(tmp_path):
+    exp = shaping.experiment(TINY, seeds=2, first_seed=4, out=tmp_path / "py", jobs=2, report=False)
+    assert exp.seeds == [4, 5]
+    assert [r.seed for r in exp.runs] == [4, 5]
+    assert all(r.stages == ["first", "second"] for r in exp.runs)
+    assert "seed" in exp.summary_text or "median" in exp.summary_text
+    summary = exp.summary
+    assert summary["seeds"] == [4, 5]
+    res = shaping_cli("experiment", TINY, "--seeds", 2, "--first-seed", 4, "--out", tmp_path / "cli", "--no-report")
+    assert res.returncode == 0, res.stderr
+    for name in ["summary.json", "summary.md"]:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
+    assert res.stdout == exp.summary_text
+    for seed in (4, 5):
+        np.testing.assert_array_equal(
+            exp.runs[seed - 4].best_genome("second"),
+            shaping.Run(tmp_path / "cli" / f"seed-{seed}").best_genome("second"),
+        )
+
+
+def test_experiment_sweeps_a_list_of_values(tmp_path):
+    exp = shaping.experiment(
+        TINY,
+        seeds=1,
+        out=tmp_path / "sweep",
+        stage="first",
+        set={"first.evolve.generations": [1, 2]},
+        report=False,
+    )
+    assert len(exp.runs) == 2
+    assert [len(r.generations("first")["best"]) for r in exp.runs] == [1, 2]
+    points = exp.summary["points"]
+    assert [p["settings"] for p in points] == [
+        {"first.evolve.generations": "1"},
+        {"first.evolve.generations": "2"},
+    ]
+    with pytest.raises(shaping.ShapingError, match="seeds"):
+        shaping.experiment(TINY, seeds=0, out=tmp_path / "none")
+    with pytest.raises(shaping.ShapingError, match="no stage `nope`"):
+        shaping.experiment(TINY, seeds=1, out=tmp_path / "crit", criterion={"nope": 0.5})
+    assert not (tmp_path / "none").exists()

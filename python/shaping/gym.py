@@ -1,0 +1,191 @@
+"""Gymnasium environments of a stage's world and robot.
+
+>>> import shaping.gym
+>>> env = shaping.gym.make("examples/khepera.bat", "navigation")
+>>> obs, info = env.reset(seed=0)
+>>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+- The observation is the robot's declared sensors in declaration order,
+  a float32 ``Box`` of 0..1 (``env.observation_names`` names them).
+- The action is a float32 ``Box``: the two wheel speeds (-1..1 of
+  ``v_max``), then ``arm`` (above 0.5: down) and ``claw`` (above 0.5:
+  closed) where the robot declares a gripper, then ``charge`` (above 0.5:
+  ask the charger to recharge; it charges when the body touches the bar)
+  where the world has a charger (``env.action_names``).
+- The reward is the stage's fitness for the action (its per-action term,
+  and its bonuses for the events of the action): a life's rewards add up
+  to the fitness a run gives that episode.
+- ``terminated`` when the battery is empty; ``truncated`` at the stage's
+  length of life (its ``actions``).
+- ``render_mode="rgb_array"``: ``render()`` returns the arena from above,
+  with the path of the life so far.
+
+The robot is driven by the agent alone: the stage's modules, their
+learning and the genome are not used. ``make_vec`` steps all its robots in
+Rust in one call.
+
+Needs ``gymnasium`` (``pip install ./python[gym]``).
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from . import Program, compile
+from ._shaping import Stepper, VecStepper
+
+__all__ = ["ENV_ID", "ShapingEnv", "ShapingVecEnv", "make", "make_vec"]
+
+ENV_ID = "shaping/Stage-v0"
+"""The id under which Gymnasium knows the environment:
+``gymnasium.make(shaping.gym.ENV_ID, path=..., stage=...)``."""
+
+
+def _program(path: str | os.PathLike[str] | Program) -> Program:
+    return path if isinstance(path, Program) else compile(path)
+
+
+def _spaces(names_obs: list[str], bounds: tuple[list[float], list[float]]):
+    observation = spaces.Box(0.0, 1.0, shape=(len(names_obs),), dtype=np.float32)
+    low, high = (np.asarray(b, dtype=np.float32) for b in bounds)
+    return observation, spaces.Box(low, high, dtype=np.float32)
+
+
+def _action(action: Any, shape: tuple[int, ...]) -> np.ndarray:
+    a = np.ascontiguousarray(action, dtype=np.float32)
+    if a.shape != shape:
+        raise ValueError(f"error: the action must be an array of shape {shape}, not {a.shape}")
+    return a
+
+
+class ShapingEnv(gymnasium.Env):
+    """One robot of a stage (see the module's documentation)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str] | Program,
+        stage: str,
+        render_mode: str | None = None,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"error: render_mode must be None or 'rgb_array', not {render_mode!r}")
+        self.program = _program(path)
+        self.stage = stage
+        self.render_mode = render_mode
+        self._robot = Stepper(self.program, stage, keep_path=render_mode == "rgb_array")
+        self.observation_names: list[str] = self._robot.observation_names
+        self.action_names: list[str] = self._robot.action_names
+        self.observation_space, self.action_space = _spaces(self.observation_names, self._robot.action_bounds)
+
+    @property
+    def life(self) -> int:
+        """The length of a life, in actions."""
+        return self._robot.life
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Starts a life. The world is that of an episode seed drawn from
+        ``self.np_random`` (seeded by ``seed``), or of
+        ``options["episode_seed"]`` (the world `Evaluator.evaluate`'s
+        episode of that seed is placed in)."""
+        super().reset(seed=seed)
+        options = options or {}
+        unknown = set(options) - {"episode_seed"}
+        if unknown:
+            raise ValueError(f"error: unknown reset options {sorted(unknown)} (known: 'episode_seed')")
+        episode_seed = options.get("episode_seed")
+        if episode_seed is None:
+            episode_seed = int(self.np_random.integers(0, 2**63))
+        obs = self._robot.reset(int(episode_seed))
+        return obs, {"episode_seed": int(episode_seed)}
+
+    def step(self, action: Any):
+        a = _action(action, self.action_space.shape)
+        return self._robot.step(a)
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            gymnasium.logger.warn("render() needs render_mode='rgb_array'")
+            return None
+        return self._robot.render()
+
+
+class ShapingVecEnv(VectorEnv):
+    """``num_envs`` robots of a stage, stepped together in Rust on ``jobs``
+    threads (None: one per core). Each robot starts a new life on the step
+    after its life ended (Gymnasium's next-step autoreset): that step's
+    action is ignored, its reward is 0."""
+
+    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str] | Program,
+        stage: str,
+        num_envs: int,
+        jobs: int | None = None,
+    ) -> None:
+        self.program = _program(path)
+        self.stage = stage
+        self._robots = VecStepper(self.program, stage, int(num_envs), jobs)
+        probe = Stepper(self.program, stage)
+        self.num_envs = int(num_envs)
+        self.observation_names: list[str] = probe.observation_names
+        self.action_names: list[str] = probe.action_names
+        self.single_observation_space, self.single_action_space = _spaces(
+            self.observation_names, probe.action_bounds
+        )
+        self.observation_space = gymnasium.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = gymnasium.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self.render_mode = None
+        self._seeded = False
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Starts a life of every robot; robot i's worlds come from stream i
+        of ``seed`` (or of a seed drawn from ``self.np_random``)."""
+        if options:
+            raise ValueError(f"error: make_vec's reset takes no options, not {sorted(options)}")
+        if isinstance(seed, (list, tuple)):
+            raise ValueError("error: make_vec's reset takes one seed (robot i takes stream i of it), not a list")
+        if seed is not None or not self._seeded:
+            self._worlds, _ = gymnasium.utils.seeding.np_random(seed)
+            self._seeded = True
+        world_seed = int(self._worlds.integers(0, 2**63))
+        return self._robots.reset(world_seed), {}
+
+    def step(self, actions: Any):
+        a = _action(actions, self.action_space.shape)
+        obs, rewards, terminated, truncated = self._robots.step(a)
+        return obs, rewards, terminated, truncated, {}
+
+
+def make(
+    path: str | os.PathLike[str] | Program,
+    stage: str,
+    render_mode: str | None = None,
+) -> ShapingEnv:
+    """A Gymnasium environment of stage ``stage`` of the ``.bat`` file
+    ``path`` (or of a compiled :class:`shaping.Program`)."""
+    return ShapingEnv(path, stage, render_mode=render_mode)
+
+
+def make_vec(
+    path: str | os.PathLike[str] | Program,
+    stage: str,
+    num_envs: int,
+    jobs: int | None = None,
+) -> ShapingVecEnv:
+    """A Gymnasium vector environment of ``num_envs`` robots of stage
+    ``stage``, stepped in Rust in one call on ``jobs`` threads."""
+    return ShapingVecEnv(path, stage, num_envs, jobs=jobs)
+
+
+if ENV_ID not in gymnasium.registry:
+    gymnasium.register(id=ENV_ID, entry_point="shaping.gym:ShapingEnv")
