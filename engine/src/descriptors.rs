@@ -175,17 +175,18 @@ pub struct Described {
     pub descriptors: Descriptors,
 }
 
-/// The episode seeds of individual `individual` of evolved stage `stage`
-/// evaluated with seed `seed`: those a run with run seed `seed` gives the
-/// individual of that index in the stage's first generation
-/// ([`seed::episode_seed`]`(seed, stage, 0, individual, e)`, `e` from 0 to
-/// the stage's `evaluations` - 1; one episode if it declares none).
-pub fn seeds(stage: &Stage, index: usize, seed: u64, individual: usize) -> Vec<u64> {
+/// The episode seeds of individual `individual` of generation
+/// `generation` of evolved stage `stage` evaluated with seed `seed`: those
+/// a run with run seed `seed` gives the individual of that index in that
+/// generation of the stage ([`seed::episode_seed`]`(seed, stage,
+/// generation, individual, e)`, `e` from 0 to the stage's `evaluations` -
+/// 1; one episode if it declares none).
+pub fn seeds(stage: &Stage, index: usize, seed: u64, generation: u32, individual: usize) -> Vec<u64> {
     let episodes = match &stage.run {
         StageRun::Evolve(evo) => evo.evaluations.max(1),
         StageRun::Test { .. } | StageRun::Train { .. } => 1,
     };
-    (0..episodes).map(|e| seed::episode_seed(seed, index, 0, individual, e)).collect()
+    (0..episodes).map(|e| seed::episode_seed(seed, index, generation, individual, e)).collect()
 }
 
 /// The length of the episodes of `stage`: its evolution's `actions`, a
@@ -302,7 +303,7 @@ mod tests {
         let stage = &program.stages[1];
         evolve::step_generation(&program, &mut cp, &evaluator(stage, actions)).unwrap();
         for (i, genome) in cp.population.iter().enumerate() {
-            let s = seeds(stage, 1, seed, i);
+            let s = seeds(stage, 1, seed, 0, i);
             assert_eq!(s.len(), 3);
             let d = evaluate(stage, genome, &s);
             assert_eq!(d.evaluation.fitness, cp.fitness[i], "individual {i}");
@@ -317,7 +318,7 @@ mod tests {
             assert!((f64::from(d.descriptors.path_length) - mean).abs() < 1e-3);
         }
         let best = cp.history[0].best_index as usize;
-        let d = evaluate(stage, &cp.population[best], &seeds(stage, 1, seed, best));
+        let d = evaluate(stage, &cp.population[best], &seeds(stage, 1, seed, 0, best));
         assert_eq!(d.evaluation.events.recharges, cp.history[0].best_recharges);
     }
 

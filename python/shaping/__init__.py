@@ -35,7 +35,10 @@ from ._shaping import (
     run,
 )
 
+from . import genes
+
 __all__ = [
+    "genes",
     "SQUARE_MM",
     "Diagnostic",
     "Evaluator",

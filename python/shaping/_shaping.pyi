@@ -94,7 +94,7 @@ class Evaluator:
         """The episodes per individual (the stage's ``evaluations``)."""
     @property
     def seed(self) -> int: ...
-    def evaluate(self, genomes: npt.ArrayLike) -> dict[str, np.ndarray]:
+    def evaluate(self, genomes: npt.ArrayLike, generation: int = 0) -> dict[str, np.ndarray]:
         """Evaluates each row of ``genomes`` (shape ``(n, bits)``, 0 and 1, integer or bool dtype).
 
         Returns arrays of shape ``(n,)``: ``fitness`` (float32, the mean
@@ -104,8 +104,10 @@ class Evaluator:
         (float32, the final pose of its last episode, mm and radians),
         ``path_length`` (mm) and ``squares_visited`` (float32, means over
         its episodes). Row ``i`` is evaluated on the episodes a run with
-        run seed ``seed`` gives individual ``i`` of the stage's first
-        generation, so the same array and seed give the same results. The
+        run seed ``seed`` gives individual ``i`` of generation
+        ``generation`` of the stage (pass an optimizer's generation for
+        fresh episodes each generation, as a run's are), so the same
+        array, seed and generation give the same results. The
         GIL is released while it runs. A wrong shape, dtype or value raises
         ValueError.
         """

@@ -483,10 +483,18 @@ impl Evaluator {
     /// over the episodes.
     ///
     /// Row i is evaluated on the episodes a run with run seed `seed` gives
-    /// individual i of the stage's first generation, so the same array and
-    /// seed give the same results whatever the threads. A wrong shape,
-    /// dtype or value raises ValueError.
-    fn evaluate<'py>(&self, py: Python<'py>, genomes: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+    /// individual i of generation `generation` of the stage (an optimizer
+    /// passes its generation's number for fresh episodes each generation,
+    /// as a run's are), so the same array, seed and generation give the
+    /// same results whatever the threads. A wrong shape, dtype or value
+    /// raises ValueError.
+    #[pyo3(signature = (genomes, generation=0))]
+    fn evaluate<'py>(
+        &self,
+        py: Python<'py>,
+        genomes: &Bound<'py, PyAny>,
+        generation: u32,
+    ) -> PyResult<Bound<'py, PyDict>> {
         let stage = &self.program.stages[self.index];
         let genomes = genomes_of(genomes, stage.layout.bits as usize)?;
         let (index, seed) = (self.index, self.seed);
@@ -495,7 +503,13 @@ impl Evaluator {
                 genomes
                     .par_iter()
                     .enumerate()
-                    .map(|(i, g)| descriptors::evaluate(stage, g, &descriptors::seeds(stage, index, seed, i)))
+                    .map(|(i, g)| {
+                        descriptors::evaluate(
+                            stage,
+                            g,
+                            &descriptors::seeds(stage, index, seed, generation, i),
+                        )
+                    })
                     .collect()
             })
         });

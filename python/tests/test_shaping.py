@@ -211,6 +211,16 @@ def test_evaluate_equals_the_fitness_of_a_cli_run(tmp_path):
     # A directory works as well as a Run.
     ev = program.evaluator("navigation", run=str(out), seed=5)
     np.testing.assert_array_equal(ev.evaluate(genomes)["fitness"], fitness)
+    # A later generation's episodes: those the run gave that generation.
+    later = tmp_path / "later"
+    res = shaping_cli(
+        "run", KHEPERA, "--stage", "navigation", "--seed", 5, "--out", later, "--no-report",
+        "--set", "navigation.evolve.generations=3", "--set", "navigation.evolve.population=8",
+    )
+    assert res.returncode == 0, res.stderr
+    genomes, fitness = shaping.Run(later).population("navigation")
+    np.testing.assert_array_equal(ev.evaluate(genomes, generation=2)["fitness"], fitness)
+    assert not np.array_equal(ev.evaluate(genomes, generation=1)["fitness"], fitness)
 
 
 # ------------------------------------------------------------------ run
@@ -451,3 +461,26 @@ def test_experiment_sweeps_a_list_of_values(tmp_path):
     with pytest.raises(shaping.ShapingError, match="no stage `nope`"):
         shaping.experiment(TINY, seeds=1, out=tmp_path / "crit", criterion={"nope": 0.5})
     assert not (tmp_path / "none").exists()
+
+
+def test_genes_encode_to_the_nearest_level_and_decode_back():
+    from shaping import genes
+
+    program = shaping.compile(KHEPERA)
+    lo, hi = genes.bounds(program, "navigation")
+    assert len(lo) == 48 and np.all(lo == -4) and np.all(hi == 4)
+    levels = lo + (hi - lo) * (np.arange(48) % 16) / 15
+    g = genes.encode(program, "navigation", levels + 0.1)
+    assert g.shape == (1, program.genome_bits("navigation")) and g.dtype == np.uint8
+    np.testing.assert_allclose(genes.decode(program, "navigation", g)[0], levels)
+    # Gene 5 is level 5: bits 0101, most significant first.
+    assert list(g[0, 20:24]) == [0, 1, 0, 1]
+    # The frozen genes of a later stage are the base genome's.
+    base = random_genomes(1, program.genome_bits("collect"))[0]
+    frozen = [x for x in program.layout("collect") if x["frozen"]]
+    values = np.zeros((2, len(genes.evolvable(program, "collect"))))
+    out = genes.encode(program, "collect", values, base=base)
+    for x in frozen:
+        np.testing.assert_array_equal(out[:, x["offset"] : x["offset"] + x["bits"]], [base[x["offset"] : x["offset"] + x["bits"]]] * 2)
+    with pytest.raises(ValueError, match="48 columns"):
+        genes.encode(program, "navigation", np.zeros((1, 3)))
