@@ -89,6 +89,8 @@ pub struct TrajectoryScene {
     pub cylinders: Vec<[f32; 3]>,
     /// Declared lamps' positions, mm.
     pub lamps: Vec<[f32; 2]>,
+    /// The indices in `lamps` of the lamps that are off (drawn dark).
+    pub dark_lamps: Vec<usize>,
     /// Floor zones: south-west and north-east corners, grey level (0 black
     /// .. 1 white) and whether the zone is a charger.
     pub zones: Vec<([f32; 2], [f32; 2], f32, bool)>,

@@ -350,6 +350,7 @@ pub fn picture(scene: &Scene, path: Vec<[f32; 3]>) -> plot::TrajectoryScene {
         walls: scene.walls.iter().map(|&[a, b]| (a, b)).collect(),
         cylinders: scene.cylinders.clone(),
         lamps: scene.lamps.clone(),
+        dark_lamps: scene.dark_lamps.clone(),
         zones: scene.zones.iter().map(|z| (z.from, z.to, z.grey, z.charger)).collect(),
         objects: scene
             .objects

@@ -85,6 +85,42 @@ fn lamps_add_up_and_scale_with_intensity() {
 }
 
 #[test]
+fn walls_and_cylinders_between_a_lamp_and_a_sensor_shade_it() {
+    let lamp = Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity: 1.0 };
+    let north = std::f32::consts::FRAC_PI_2;
+    let read = |items: Items, x: f32| {
+        let mut sim = Sim::new(&world(Items { lamps: vec![lamp.clone()], ..items }), 1);
+        assert!(sim.set_pose(Pose { x, y: 100.0, theta: north }));
+        let p = percept(&mut sim);
+        [p[CH_LIGHT + 2], p[CH_LIGHT + 3]]
+    };
+    let open = read(Items::default(), 200.0);
+    assert!(open[0] > 0.05 && open[1] > 0.05, "{open:?}");
+    // A wall across the arena between the robot and the lamp: dark.
+    assert_eq!(read(wall_across(300.0), 200.0), [0.0, 0.0]);
+    // A wall beside the line does not shade.
+    let aside = Items {
+        walls: vec![InnerWall { name: None, from: [300.0, 250.0], to: [390.0, 250.0] }],
+        ..Items::default()
+    };
+    assert_eq!(read(aside, 200.0), open);
+    // A cylinder on the line shades; beside it, it does not.
+    let cylinder = |x: f32| Items {
+        cylinders: vec![Cylinder { name: None, at: [x, 300.0], diameter: 60.0 }],
+        ..Items::default()
+    };
+    assert_eq!(read(cylinder(200.0), 200.0), [0.0, 0.0]);
+    assert_eq!(read(cylinder(350.0), 200.0), open);
+    // A lamp of intensity 0 is off.
+    let mut sim = Sim::new(
+        &world(Items { lamps: vec![Lamp { intensity: 0.0, ..lamp.clone() }], ..Items::default() }),
+        1,
+    );
+    assert!(sim.set_pose(Pose { x: 200.0, y: 100.0, theta: north }));
+    assert!(percept(&mut sim)[CH_LIGHT..CH_LIGHT + 8].iter().all(|&v| v == 0.0));
+}
+
+#[test]
 fn the_ground_sensor_reads_the_zone_under_the_body_and_a_charging_zone_refills() {
     let items = Items {
         zones: vec![

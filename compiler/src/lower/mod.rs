@@ -146,6 +146,9 @@ struct WorldSt {
     item_spans: HashMap<&'static str, Vec<Span>>,
     /// The arena's width and depth were written without a unit (millimetres).
     arena_bare: bool,
+    /// Named list items refused with an error (kind, name): a later change
+    /// of one is not reported again as an item the world lacks.
+    refused: std::collections::HashSet<(&'static str, String)>,
 }
 
 #[derive(Clone, Debug)]
@@ -820,6 +823,7 @@ impl<'a> Lower<'a> {
                 spans: HashMap::new(),
                 item_spans: HashMap::new(),
                 arena_bare: false,
+                refused: Default::default(),
             },
             genome: GenomeSt { links: spec, weights: spec, biases: spec },
             evolution: default_evolution(),

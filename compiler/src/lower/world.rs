@@ -174,7 +174,10 @@ impl Lower<'_> {
                 }
                 W::Wall { name, from, to, span } => {
                     let (a, b) = (self.point(from, "a wall's end"), self.point(to, "a wall's end"));
-                    let (Some(from), Some(to)) = (a, b) else { continue };
+                    let (Some(from), Some(to)) = (a, b) else {
+                        refuse(ws, "wall", name.as_ref());
+                        continue;
+                    };
                     let wall = InnerWall { name: name.as_ref().map(|n| n.text.clone()), from, to };
                     let place = self.place(ws, block, stage, "wall", name.as_ref(), *span);
                     put(&mut ws.world.items.walls, place, wall);
@@ -182,7 +185,10 @@ impl Lower<'_> {
                 W::Cylinder { name, at, diameter, span } => {
                     let at = self.point(at, "a cylinder's centre");
                     let d = self.length(diameter, "the cylinder diameter");
-                    let (Some(at), Some(diameter)) = (at, d) else { continue };
+                    let (Some(at), Some(diameter)) = (at, d) else {
+                        refuse(ws, "cylinder", name.as_ref());
+                        continue;
+                    };
                     let cyl = Cylinder { name: name.as_ref().map(|n| n.text.clone()), at, diameter };
                     let place = self.place(ws, block, stage, "cylinder", name.as_ref(), *span);
                     put(&mut ws.world.items.cylinders, place, cyl);
@@ -194,10 +200,13 @@ impl Lower<'_> {
                         None => Some(DEFAULT_LAMP_HEIGHT),
                     };
                     let k = match intensity {
-                        Some(q) => self.plain(q, "the lamp intensity", 1e-6, 1e6),
+                        Some(q) => self.plain(q, "the lamp intensity", 0.0, 1e6),
                         None => Some(1.0),
                     };
-                    let (Some(at), Some(height), Some(intensity)) = (at, h, k) else { continue };
+                    let (Some(at), Some(height), Some(intensity)) = (at, h, k) else {
+                        refuse(ws, "lamp", name.as_ref());
+                        continue;
+                    };
                     let lamp = Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity };
                     let place = self.place(ws, block, stage, "lamp", name.as_ref(), *span);
                     put(&mut ws.world.items.lamps, place, lamp);
@@ -208,7 +217,10 @@ impl Lower<'_> {
                         Some(q) => self.plain(q, "the grey level", 0.0, 1.0),
                         None => Some(0.0),
                     };
-                    let (Some(from), Some(to), Some(grey)) = (a, b, g) else { continue };
+                    let (Some(from), Some(to), Some(grey)) = (a, b, g) else {
+                        refuse(ws, "zone", name.as_ref());
+                        continue;
+                    };
                     let zone = Zone {
                         name: name.as_ref().map(|n| n.text.clone()),
                         from,
@@ -268,6 +280,12 @@ impl Lower<'_> {
         let existing = name.and_then(|n| names.iter().position(|m| *m == Some(n.text.as_str())));
         let here = |sp: Span| block.span.start <= sp.start && sp.end <= block.span.end;
         match (block.mode, existing) {
+            (ast::WorldMode::Changes, None)
+                if name.is_some_and(|n| ws.refused.contains(&(kind, n.text.clone()))) =>
+            {
+                // Its declaration was refused, and said so.
+                Err(())
+            }
             (ast::WorldMode::Changes, None) => {
                 let help = match name {
                     Some(n) => did_you_mean(&n.text, names.iter().flatten().copied())
@@ -615,5 +633,12 @@ pub(super) fn key_desc(key: &str) -> &'static str {
         "battery" => "a battery",
         "start" => "a start pose",
         _ => "a set of objects",
+    }
+}
+
+/// Remembers that the named item of `kind` was refused with an error.
+fn refuse(ws: &mut WorldSt, kind: &'static str, name: Option<&ast::Name>) {
+    if let Some(n) = name {
+        ws.refused.insert((kind, n.text.clone()));
     }
 }

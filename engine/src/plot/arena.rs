@@ -203,8 +203,9 @@ impl Figure for Arena<'_> {
             let line = vec![(f64::from(a[0]), f64::from(a[1])), (f64::from(b[0]), f64::from(b[1]))];
             chart.draw_series(std::iter::once(PathElement::new(line, BAR.stroke_width(7))))?;
         }
-        for l in s.lamp.iter().chain(&s.lamps) {
-            draw_lamp(chart.plotting_area(), (f64::from(l[0]), f64::from(l[1])))?;
+        let lamps = s.lamp.iter().map(|l| (l, true));
+        for (l, on) in lamps.chain(s.lamps.iter().enumerate().map(|(i, l)| (l, !s.dark_lamps.contains(&i)))) {
+            draw_lamp(chart.plotting_area(), (f64::from(l[0]), f64::from(l[1])), on)?;
         }
         for o in &s.objects {
             let c = (f64::from(o.x), f64::from(o.y));
@@ -301,10 +302,19 @@ pub(super) fn unmitered(line: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
 fn draw_lamp<DB: DrawingBackend, CT: CoordTranslate>(
     area: &DrawingArea<DB, CT>,
     at: CT::From,
+    on: bool,
 ) -> DrawResult<DB>
 where
     CT::From: Clone,
 {
+    if !on {
+        // Off: a dark disc without rays.
+        area.draw(
+            &(EmptyElement::at(at.clone()) + Circle::new((0, 0), 7, RGBColor(120, 120, 120).filled())),
+        )?;
+        area.draw(&(EmptyElement::at(at) + Circle::new((0, 0), 7, INK.stroke_width(1))))?;
+        return Ok(());
+    }
     for k in 0..8 {
         let a = std::f64::consts::FRAC_PI_4 * f64::from(k);
         let p = |r: f64| ((r * a.cos()).round() as i32, (r * a.sin()).round() as i32);
@@ -338,7 +348,7 @@ impl Arena<'_> {
             entry(area, &mut y, "charger bar")?;
         }
         if s.lamp.is_some() {
-            draw_lamp(area, (gx + 14, y))?;
+            draw_lamp(area, (gx + 14, y), true)?;
             entry(area, &mut y, "lamp")?;
         }
         let has = |f: &dyn Fn(&super::SceneObject) -> bool| s.objects.iter().any(f);

@@ -26,8 +26,10 @@
 //!   substeps and stops before the overlap (`Outcome::collided`);
 //! - IR: [`ir::KHEPERA`], fitted to real readings; walls and floor objects
 //!   add up, clamped at 1, plus `+-sensor_noise`;
-//! - light: a lamp above the bar's middle, irradiance falling as
-//!   `1 / (rho^2 + h^2)` times a `cos(1.5 a)` lobe around each sensor's axis;
+//! - light: a lamp above the bar's middle (and the declared lamps),
+//!   irradiance falling as `1 / (rho^2 + h^2)` times a `cos(1.5 a)` lobe
+//!   around each sensor's axis; an inner wall or a cylinder across the line
+//!   from a sensor to the point below a lamp shades the sensor from it;
 //! - battery: integer charge, `-1/capacity` per action, `+1/recharge` per
 //!   action asked to charge with the body within [`CONTACT`] mm of the bar;
 //! - gripper: arm and claw change at the start of the action; closing the
@@ -217,6 +219,23 @@ struct Lamp {
     height: f32,
     /// The intensity constant `K` of `K / (rho^2 + h^2)`.
     k: f32,
+}
+
+/// The segments `p1 p2` and `q1 q2` cross or touch.
+fn segments_cross(p1: &Point2<f32>, p2: &Point2<f32>, q1: &Point2<f32>, q2: &Point2<f32>) -> bool {
+    let cross = |o: &Point2<f32>, a: &Point2<f32>, b: &Point2<f32>| (a - o).perp(&(b - o));
+    let (d1, d2) = (cross(q1, q2, p1), cross(q1, q2, p2));
+    let (d3, d4) = (cross(p1, p2, q1), cross(p1, p2, q2));
+    let straddles = |a: f32, b: f32| (a <= 0.0 && b >= 0.0) || (a >= 0.0 && b <= 0.0);
+    if !(straddles(d1, d2) && straddles(d3, d4)) {
+        return false;
+    }
+    if d1 == 0.0 && d2 == 0.0 {
+        // Collinear: they cross when their extents overlap.
+        let overlap = |a: f32, b: f32, c: f32, d: f32| a.min(b) <= c.max(d) && c.min(d) <= a.max(b);
+        return overlap(p1.x, p2.x, q1.x, q2.x) && overlap(p1.y, p2.y, q1.y, q2.y);
+    }
+    true
 }
 
 /// A uniform draw in `lo..hi` that never panics (the middle if `hi <= lo`).
@@ -684,16 +703,26 @@ impl Sim {
         }
     }
 
-    /// Adds one lamp's readings to `out` (unclamped).
+    /// Adds one lamp's readings to `out` (unclamped). An inner wall or a
+    /// cylinder on the line from a sensor to the point below the lamp,
+    /// seen from above, shades that sensor from it (the arena's walls do
+    /// not: they are the table's low border, and a lamp may stand outside).
     #[inline(always)]
     fn add_lamp(&self, lamp: &Lamp, out: &mut [f32; ir::SENSORS]) {
+        if lamp.k <= 0.0 {
+            return;
+        }
         // The lamp in the body frame.
         let rel = self.pose.inverse_transform_point(&lamp.at).coords;
         let rho2 = rel.norm_squared();
         let intensity = lamp.k / (rho2 + lamp.height * lamp.height);
         let rho = rho2.sqrt();
         let along = self.geo.rays * rel;
+        let shadows = !self.inner.is_empty() || !self.cylinders.is_empty();
         for i in 0..ir::SENSORS {
+            if shadows && self.shaded(&(self.pose * self.geo.position(i)), &lamp.at) {
+                continue;
+            }
             // cos of the bearing off the axis; straight below the lamp every
             // sensor sees it head-on.
             let cos_a = if rho > 1e-3 { along[i] / rho } else { 1.0 };
@@ -702,6 +731,12 @@ impl Sim {
             let lobe = (4.0 * q * q * q - 3.0 * q).max(0.0);
             out[i] += intensity * lobe;
         }
+    }
+
+    /// An inner wall or a cylinder crosses the segment from `from` to `to`.
+    fn shaded(&self, from: &Point2<f32>, to: &Point2<f32>) -> bool {
+        self.inner.iter().any(|[a, b]| segments_cross(from, to, a, b))
+            || self.cylinders.iter().any(|c| segment_distance2(&c.at, from, to) < c.radius * c.radius)
     }
 
     /// The optical barrier: arm down, claw open and an object centre in the
@@ -1056,6 +1091,7 @@ impl Sim {
             walls: self.inner.iter().map(|&[a, b]| [xy(a), xy(b)]).collect(),
             cylinders: self.cylinders.iter().map(|c| [c.at.x, c.at.y, c.radius]).collect(),
             lamps: self.lamps.iter().map(|l| xy(l.at)).collect(),
+            dark_lamps: self.lamps.iter().enumerate().filter(|(_, l)| l.k <= 0.0).map(|(i, _)| i).collect(),
             zones: self
                 .zones
                 .iter()

@@ -44,6 +44,9 @@ pub struct Scene {
     /// Declared lamps (the charger's is `lamp`).
     #[serde(default)]
     pub lamps: Vec<[f32; 2]>,
+    /// The indices in `lamps` of the lamps that are off (intensity 0).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dark_lamps: Vec<usize>,
     #[serde(default)]
     pub zones: Vec<SceneZone>,
     pub pose: Pose,
