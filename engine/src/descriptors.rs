@@ -2,166 +2,28 @@
 //! its episodes and behaviour descriptors (the final pose, the length of
 //! the path, the 50 mm squares of the arena visited), for optimizers that
 //! look at more than a fitness (MAP-Elites, novelty search) and for Python's
-//! `Program.evaluator`. One place computes them, so every caller (the
-//! Python package, later the worlds) describes an episode the same way.
+//! `Program.evaluator`. The runtime's controller computes each episode's
+//! descriptors ([`shaping_runtime::state::Odometer`], the same numbers the
+//! fitness terms read as `robot.distance`, `robot.squares`, ...).
 //!
 //! The episodes are the ones a run evaluates: [`evaluate`] runs a genome's
 //! episodes as [`crate::run::evaluator`] runs each one (the stage's
-//! `actions`, learning on), with the simulator wrapped in a [`Tracker`]
-//! that only watches (it draws no random number and changes no command),
-//! and combines them as `evolve` combines an individual's `evaluations`
-//! episodes: the fitness is their mean (summed in f64), the events are
-//! summed, and the learned genome is the last episode's.
+//! `actions`, learning on) and combines them as `evolve` combines an
+//! individual's `evaluations` episodes: the fitness is their mean (summed
+//! in f64), the events are summed, and the learned genome is the last
+//! episode's.
 
-use std::collections::HashSet;
-
-use shaping_runtime::catalog::CHANNELS;
-use shaping_runtime::controller::{run_episode_on, EpisodeOptions, EpisodeResult, Robot};
+use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult};
 use shaping_runtime::evolve::{seed, Evaluation, Events};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Stage, StageRun};
-use shaping_runtime::sim::{Command, Outcome, Pose, Sim};
-
-/// The side of the squares of [`Descriptors::squares_visited`], mm.
-pub const SQUARE_MM: f32 = 50.0;
-
-/// How an episode (or an individual's episodes) moved the robot.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Descriptors {
-    /// The body centre at the end of the (last) episode, mm from the
-    /// arena's south-west corner.
-    pub x: f32,
-    pub y: f32,
-    /// The heading at the end of the (last) episode, radians
-    /// counter-clockwise from +x, in `-pi..=pi`.
-    pub heading: f32,
-    /// The distance the body centre travelled, mm (the mean over the
-    /// individual's episodes).
-    pub path_length: f32,
-    /// The squares of [`SQUARE_MM`] (a grid from the arena's south-west
-    /// corner) the body centre was in at the start or after an action,
-    /// counted once each (the mean over the individual's episodes).
-    pub squares_visited: f32,
-}
-
-/// A [`Robot`] that forwards every call to `robot` and follows its pose
-/// after every action: the path length and the squares visited. It draws
-/// no random number and changes nothing, so an episode on a tracker is the
-/// same episode as without it.
-pub struct Tracker<R: Robot> {
-    pub robot: R,
-    pose: Pose,
-    path: f64,
-    square: (i64, i64),
-    squares: HashSet<(i64, i64)>,
-}
-
-fn square_of(p: Pose) -> (i64, i64) {
-    // Finite poses of any arena; a non-finite one counts as one square.
-    let cell =
-        |v: f32| if v.is_finite() { (f64::from(v) / f64::from(SQUARE_MM)).floor() as i64 } else { i64::MIN };
-    (cell(p.x), cell(p.y))
-}
-
-impl<R: Robot> Tracker<R> {
-    /// Starts following `robot` from its pose now (the episode's start).
-    pub fn new(robot: R) -> Tracker<R> {
-        let pose = robot.pose();
-        let square = square_of(pose);
-        Tracker { robot, pose, path: 0.0, square, squares: HashSet::from([square]) }
-    }
-
-    /// The descriptors of the episode so far.
-    pub fn descriptors(&self) -> Descriptors {
-        Descriptors {
-            x: self.pose.x,
-            y: self.pose.y,
-            heading: self.pose.theta,
-            path_length: self.path as f32,
-            squares_visited: self.squares.len() as f32,
-        }
-    }
-}
-
-impl<R: Robot> Robot for Tracker<R> {
-    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
-        self.robot.sense(out)
-    }
-    fn step(&mut self, cmd: &Command) -> Outcome {
-        let outcome = self.robot.step(cmd);
-        let p = self.robot.pose();
-        let d = f64::from(p.x - self.pose.x).hypot(f64::from(p.y - self.pose.y));
-        if d.is_finite() {
-            self.path += d;
-        }
-        self.pose = p;
-        let square = square_of(p);
-        if square != self.square {
-            self.square = square;
-            self.squares.insert(square);
-        }
-        outcome
-    }
-    fn alive(&self) -> bool {
-        self.robot.alive()
-    }
-    fn battery(&self) -> f32 {
-        self.robot.battery()
-    }
-    fn pose(&self) -> Pose {
-        self.robot.pose()
-    }
-    fn holding(&self) -> Option<bool> {
-        self.robot.holding()
-    }
-    fn placement_failures(&self) -> u32 {
-        self.robot.placement_failures()
-    }
-}
-
-/// A [`Tracker`] of the episode's simulator that writes its descriptors
-/// into `sink` when the episode drops it (`run_episode_on` owns the robot).
-struct Sink<'a> {
-    tracker: Tracker<Sim>,
-    sink: &'a mut Descriptors,
-}
-
-impl Drop for Sink<'_> {
-    fn drop(&mut self) {
-        *self.sink = self.tracker.descriptors();
-    }
-}
-
-impl Robot for Sink<'_> {
-    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
-        self.tracker.sense(out)
-    }
-    fn step(&mut self, cmd: &Command) -> Outcome {
-        self.tracker.step(cmd)
-    }
-    fn alive(&self) -> bool {
-        self.tracker.alive()
-    }
-    fn battery(&self) -> f32 {
-        self.tracker.battery()
-    }
-    fn pose(&self) -> Pose {
-        self.tracker.pose()
-    }
-    fn holding(&self) -> Option<bool> {
-        self.tracker.holding()
-    }
-    fn placement_failures(&self) -> u32 {
-        self.tracker.placement_failures()
-    }
-}
+pub use shaping_runtime::state::{Descriptors, SQUARE_MM};
 
 /// One episode of `genome` on `stage`, as
 /// [`shaping_runtime::controller::run_episode`] runs it, and its descriptors.
 pub fn episode(stage: &Stage, genome: &Genome, opts: &EpisodeOptions) -> (EpisodeResult, Descriptors) {
-    let mut descriptors = Descriptors::default();
-    let sink = &mut descriptors;
-    let result = run_episode_on(stage, genome, opts, None, |sim| Sink { tracker: Tracker::new(sim), sink });
+    let result = run_episode(stage, genome, opts, None);
+    let descriptors = result.descriptors;
     (result, descriptors)
 }
 
@@ -320,30 +182,5 @@ mod tests {
         let best = cp.history[0].best_index as usize;
         let d = evaluate(stage, &cp.population[best], &seeds(stage, 1, seed, 0, best));
         assert_eq!(d.evaluation.events.recharges, cp.history[0].best_recharges);
-    }
-
-    /// The tracker counts squares and the path as the robot moves.
-    #[test]
-    fn the_tracker_follows_the_pose() {
-        struct Walker(Pose);
-        impl Robot for Walker {
-            fn sense(&mut self, _: &mut [f32; CHANNELS]) {}
-            fn step(&mut self, _: &Command) -> Outcome {
-                self.0.x += 30.0;
-                Outcome::default()
-            }
-            fn pose(&self) -> Pose {
-                self.0
-            }
-        }
-        let mut t = Tracker::new(Walker(Pose { x: 10.0, y: 60.0, theta: 0.5 }));
-        for _ in 0..5 {
-            t.step(&Command::default());
-        }
-        // x: 10, 40, 70, 100, 130, 160: squares 0, 0, 1, 2, 2, 3 of row 1.
-        let d = t.descriptors();
-        assert_eq!(d.squares_visited, 4.0);
-        assert!((d.path_length - 150.0).abs() < 1e-3);
-        assert_eq!((d.x, d.y, d.heading), (160.0, 60.0, 0.5));
     }
 }

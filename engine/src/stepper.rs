@@ -28,13 +28,14 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use shaping_runtime::catalog::{ActuatorKind, ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
-use shaping_runtime::controller::{FastExpr, Robot};
+use shaping_runtime::controller::FastExpr;
 use shaping_runtime::expr::Env;
 use shaping_runtime::program::{Event, Stage};
 use shaping_runtime::sim::{Command, Outcome, Pose, Scene, Sim};
 
-use crate::descriptors::{self, Descriptors, Tracker};
+use crate::descriptors::{self, Descriptors};
 use crate::error::{Error, ErrorKind};
+use shaping_runtime::state::Odometer;
 
 /// What an action of the robot commands: one element each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -154,9 +155,12 @@ pub struct Stepper {
     stage: Arc<Stage>,
     spaces: Arc<Spaces>,
     fitness: Option<FastExpr>,
+    at_end: Option<FastExpr>,
+    reads_state: bool,
     life: u32,
     /// `None` before the first reset.
-    sim: Option<Tracker<Sim>>,
+    sim: Option<Sim>,
+    odo: Odometer,
     now: [f32; CHANNELS],
     next: [f32; CHANNELS],
     slots: [f32; ACT_SLOTS],
@@ -176,10 +180,13 @@ impl Stepper {
     fn with_spaces(stage: Arc<Stage>, spaces: Arc<Spaces>) -> Stepper {
         Stepper {
             fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
+            at_end: stage.fitness.at_end.as_ref().map(FastExpr::new),
+            reads_state: shaping_runtime::state::reads_state(&stage),
             life: descriptors::actions(&stage),
             stage,
             spaces,
             sim: None,
+            odo: Odometer::default(),
             now: [0.0; CHANNELS],
             next: [0.0; CHANNELS],
             slots: [0.0; ACT_SLOTS],
@@ -211,8 +218,9 @@ impl Stepper {
     /// evolved individual's episode of that seed is placed in) and writes
     /// the first observation into `obs`.
     pub fn reset(&mut self, seed: u64, obs: &mut [f32]) {
-        let mut sim = Tracker::new(Sim::new(&self.stage.world, seed));
+        let mut sim = Sim::new(&self.stage.world, seed);
         sim.sense(&mut self.now);
+        self.odo.start(sim.position(), self.life);
         self.sim = Some(sim);
         self.slots = [0.0; ACT_SLOTS];
         self.actions = 0;
@@ -250,6 +258,7 @@ impl Stepper {
     fn run(&mut self, cmd: &Command, obs: &mut [f32]) -> Step {
         let Some(sim) = &mut self.sim else { return Step::default() };
         let outcome = sim.step(cmd);
+        self.odo.moved(sim.position());
         self.slots[ACT_LEFT] = cmd.wheels[0];
         self.slots[ACT_RIGHT] = cmd.wheels[1];
         if let Some(d) = cmd.arm {
@@ -259,7 +268,8 @@ impl Stepper {
             self.slots[ACT_CLAW] = f32::from(u8::from(c));
         }
         sim.sense(&mut self.next);
-        let env = Env { now: &self.next, prev: &self.now, act: &self.slots };
+        let state = if self.reads_state { self.odo.state(sim.pose().theta) } else { Default::default() };
+        let env = Env { now: &self.next, prev: &self.now, act: &self.slots, state: &state };
         let mut reward = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
         for b in &self.stage.fitness.bonuses {
             let n = match b.event {
@@ -270,10 +280,15 @@ impl Stepper {
             };
             reward += b.points * n as f32;
         }
+        let terminated = !sim.alive();
+        let truncated = !terminated && self.actions + 1 >= self.life;
+        if terminated || truncated {
+            if let Some(e) = &self.at_end {
+                reward += e.eval(&env);
+            }
+        }
         self.now = self.next;
         self.actions += 1;
-        let terminated = !sim.alive();
-        let truncated = !terminated && self.actions >= self.life;
         self.ended = terminated || truncated;
         if let Some(p) = &mut self.path {
             let pose = sim.pose();
@@ -300,12 +315,12 @@ impl Stepper {
 
     /// How the life so far moved the robot.
     pub fn descriptors(&self) -> Descriptors {
-        self.sim.as_ref().map(|s| s.descriptors()).unwrap_or_default()
+        self.odo.descriptors(self.pose().theta)
     }
 
     /// The world now (before the first reset: `None`).
     pub fn scene(&self) -> Option<Scene> {
-        self.sim.as_ref().map(|s| s.robot.scene())
+        self.sim.as_ref().map(|s| s.scene())
     }
 
     /// The poses of the life so far, if kept.

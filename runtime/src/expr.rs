@@ -7,6 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::catalog::{ACT_SLOTS, CHANNELS};
+use crate::state::STATE_SLOTS;
 
 /// Deepest stack an expression may need; the compiler rejects deeper ones.
 pub const MAX_STACK: usize = 32;
@@ -20,6 +21,8 @@ pub enum Op {
     Prev(u16),
     /// Actuator slot (see `catalog::ACT_*`), as commanded this action.
     Act(u16),
+    /// The robot's state (see `state::ST_*`): its pose, distance, time, squares.
+    State(u16),
     Neg,
     Not,
     Abs,
@@ -60,6 +63,13 @@ pub struct Env<'a> {
     pub now: &'a [f32; CHANNELS],
     pub prev: &'a [f32; CHANNELS],
     pub act: &'a [f32; ACT_SLOTS],
+    /// The robot's state (`state::ST_*`).
+    pub state: &'a [f32; STATE_SLOTS],
+}
+
+impl Env<'_> {
+    /// A state of zeros, for expressions evaluated outside a life.
+    pub const NO_STATE: [f32; STATE_SLOTS] = [0.0; STATE_SLOTS];
 }
 
 fn truth(b: bool) -> f32 {
@@ -82,7 +92,7 @@ impl Expr {
         let mut max = 0i64;
         for op in ops {
             let (pop, push) = match *op {
-                Op::Const(_) | Op::Chan(_) | Op::Prev(_) | Op::Act(_) => (0, 1),
+                Op::Const(_) | Op::Chan(_) | Op::Prev(_) | Op::Act(_) | Op::State(_) => (0, 1),
                 Op::Neg | Op::Not | Op::Abs | Op::Sign | Op::Sqrt => (1, 1),
                 Op::Select => (3, 1),
                 Op::Max(n) | Op::Min(n) | Op::Sum(n) | Op::Mean(n) => {
@@ -112,6 +122,7 @@ impl Expr {
         let indices_ok = self.ops.iter().all(|op| match *op {
             Op::Chan(c) | Op::Prev(c) => (c as usize) < CHANNELS,
             Op::Act(a) => (a as usize) < ACT_SLOTS,
+            Op::State(v) => (v as usize) < STATE_SLOTS,
             _ => true,
         });
         indices_ok
@@ -174,6 +185,10 @@ pub fn apply(op: Op, stack: &mut [f32; MAX_STACK], mut sp: usize, env: &Env) -> 
             stack[sp] = env.act[a as usize];
             sp += 1;
         }
+        Op::State(v) => {
+            stack[sp] = env.state[v as usize];
+            sp += 1;
+        }
         Op::Neg => stack[sp - 1] = -stack[sp - 1],
         Op::Not => stack[sp - 1] = truth(stack[sp - 1] == 0.0),
         Op::Abs => stack[sp - 1] = stack[sp - 1].abs(),
@@ -230,7 +245,7 @@ mod tests {
         assert!(e.is_valid());
         let prev = [0.5; CHANNELS];
         let act = [0.25, -0.75, 0.0, 1.0];
-        e.eval(&Env { now: &now, prev: &prev, act: &act })
+        e.eval(&Env { now: &now, prev: &prev, act: &act, state: &Env::NO_STATE })
     }
 
     #[test]

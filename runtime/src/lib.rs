@@ -23,6 +23,7 @@ pub mod oracle;
 pub mod program;
 pub mod robot;
 pub mod sim;
+pub mod state;
 pub mod testkit;
 pub mod validate;
 pub mod world;

@@ -525,6 +525,10 @@ pub enum GeneRole {
 pub struct Fitness {
     /// Evaluated after every action and summed over the life.
     pub per_action: Option<Expr>,
+    /// Evaluated once after the life's last action and added (left out of
+    /// files when absent, so programs written before it read as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub at_end: Option<Expr>,
     /// Points per event, added to the sum.
     pub bonuses: Vec<Bonus>,
 }

@@ -256,7 +256,7 @@ pub fn bare_stage(name: &str, world: World) -> Stage {
         modules: Vec::new(),
         links: Vec::new(),
         layout: GenomeLayout { genes: Vec::new(), bits: 0 },
-        fitness: Fitness { per_action: None, bonuses: Vec::new() },
+        fitness: Fitness { per_action: None, at_end: None, bonuses: Vec::new() },
         run: evolution(300),
         inheritance: Inheritance::Darwinian,
     }

@@ -661,6 +661,9 @@ fn expr(at: &At, e: &Expr) -> R {
             Op::Act(a) => {
                 at.ensure((a as usize) < ACT_SLOTS, || format!("actuator slot {a} does not exist"))?
             }
+            Op::State(v) => at.ensure((v as usize) < crate::state::STATE_SLOTS, || {
+                format!("state slot {v} does not exist")
+            })?,
             Op::Const(v) => at.finite(v)?,
             _ => {}
         }
@@ -684,6 +687,9 @@ fn links(at: &At, s: &Stage) -> R {
 fn fitness(at: &At, f: &Fitness) -> R {
     if let Some(e) = &f.per_action {
         expr(&at.field("per_action"), e)?;
+    }
+    if let Some(e) = &f.at_end {
+        expr(&at.field("at_end"), e)?;
     }
     for (i, b) in f.bonuses.iter().enumerate() {
         at.field("bonuses").index(i).field("points").finite(b.points)?;

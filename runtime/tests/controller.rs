@@ -842,3 +842,46 @@ fn lamarckian_inheritance_writes_learned_behavior_genes_back() {
     assert!(learned.gene_int(&s.layout.genes[1]) > 8, "{}", learned.to_bitstring());
     assert_eq!(learned.gene_int(&s.layout.genes[2]), 8, "input 1 was 0: its weight is unchanged");
 }
+
+/// Fitness terms read the robot's state: the time, the distance travelled
+/// and the squares visited, the same numbers as the episode's descriptors.
+#[test]
+fn fitness_terms_read_the_robot_s_state_as_the_descriptors_report_it() {
+    use shaping_runtime::state::{ST_DISTANCE, ST_SQUARES, ST_TIME, ST_X};
+    let mut stage = shaping_runtime::testkit::navigation();
+    let one = |ops: Vec<Op>| Expr { depth: Expr::required_depth(&ops).unwrap(), ops };
+    let run = |stage: &Stage| {
+        let genome = Genome::zeros(stage.layout.bits as usize);
+        let opts = EpisodeOptions { actions: 150, learning: true, seed: 4 };
+        run_episode(stage, &genome, &opts, None)
+    };
+    let plain = run(&stage);
+    // Per action: the actions done so far (1, 2, ...): their sum.
+    stage.fitness.per_action = Some(one(vec![Op::State(ST_TIME as u16)]));
+    // At the end: the distance plus 1000 times the squares, minus x.
+    stage.fitness.at_end = Some(one(vec![
+        Op::State(ST_DISTANCE as u16),
+        Op::State(ST_SQUARES as u16),
+        Op::Const(1000.0),
+        Op::Mul,
+        Op::Add,
+        Op::State(ST_X as u16),
+        Op::Sub,
+    ]));
+    let r = run(&stage);
+    // Reading the state changes nothing of the episode.
+    assert_eq!(
+        (r.actions, r.collisions, r.descriptors),
+        (plain.actions, plain.collisions, plain.descriptors)
+    );
+    let n = f64::from(r.actions);
+    let d = r.descriptors;
+    assert!(d.path_length > 100.0 && d.squares_visited >= 3.0, "{d:?}");
+    let expected = n * (n + 1.0) / 2.0 + f64::from(d.path_length) + 1000.0 * f64::from(d.squares_visited)
+        - f64::from(d.x);
+    assert!(
+        (f64::from(r.fitness) - expected).abs() < 1e-2 * expected.abs().max(1.0),
+        "{} vs {expected}",
+        r.fitness
+    );
+}

@@ -62,7 +62,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, run: StageRun)
         modules: vec![],
         links: vec![],
         layout,
-        fitness: Fitness { per_action: None, bonuses: vec![] },
+        fitness: Fitness { per_action: None, at_end: None, bonuses: vec![] },
         run,
         inheritance: Inheritance::Darwinian,
     }

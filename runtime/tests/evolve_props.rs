@@ -78,7 +78,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, evo: Evolution
         modules: vec![],
         links: vec![],
         layout,
-        fitness: Fitness { per_action: None, bonuses: vec![] },
+        fitness: Fitness { per_action: None, at_end: None, bonuses: vec![] },
         run: StageRun::Evolve(evo),
         inheritance: Inheritance::Darwinian,
     }

@@ -831,7 +831,7 @@ impl<'a> Lower<'a> {
             population_span: None,
             inheritance: Inheritance::Darwinian,
             run: StageRun::Evolve(default_evolution()),
-            fitness: Fitness { per_action: None, bonuses: Vec::new() },
+            fitness: Fitness { per_action: None, at_end: None, bonuses: Vec::new() },
             fitness_declared: false,
             fitness_reported: false,
             modules: Vec::new(),

@@ -334,7 +334,7 @@ impl Lower<'_> {
             }
             bonuses.push(Bonus { event, points: b.points as f32 });
         }
-        st.fitness = Fitness { per_action, bonuses };
+        st.fitness = Fitness { per_action, at_end: None, bonuses };
         st.fitness_declared = true;
     }
 }

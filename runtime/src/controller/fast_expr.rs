@@ -186,7 +186,7 @@ mod tests {
                 for v in now.iter_mut().chain(prev.iter_mut()).chain(act.iter_mut()) {
                     *v = if rng.random_range(0..4) == 0 { 0.0 } else { rng.random_range(-1.0..1.0) };
                 }
-                let env = Env { now: &now, prev: &prev, act: &act };
+                let env = Env { now: &now, prev: &prev, act: &act, state: &Env::NO_STATE };
                 let (a, b) = (e.eval(&env), f.eval(&env));
                 assert!(a == b || (a.is_nan() && b.is_nan()), "{:?}: {a} vs {b}", e.ops);
             }

@@ -92,6 +92,7 @@ use crate::expr::Env;
 use crate::genome::Genome;
 use crate::program::{Behavior, Decode, Event, Inheritance, LearnTarget, LearnWhen, Learning, Param, Stage};
 use crate::sim::{Command, Outcome, Pose, Sim};
+use crate::state::{Descriptors, Odometer, STATE_SLOTS};
 
 pub use fast_expr::FastExpr;
 pub use net::{sigmoid, Net};
@@ -130,6 +131,9 @@ pub struct EpisodeResult {
     /// existed read as 0).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub placement_failures: u32,
+    /// How the episode moved the robot (not kept in files).
+    #[serde(skip)]
+    pub descriptors: Descriptors,
 }
 
 /// For `skip_serializing_if`: counts added to saved results are left out
@@ -206,6 +210,12 @@ pub trait Robot {
     fn pose(&self) -> Pose {
         Pose::default()
     }
+    /// The body centre, mm: [`Robot::pose`]'s position, which a robot may
+    /// give without computing the heading.
+    fn position(&self) -> [f32; 2] {
+        let p = self.pose();
+        [p.x, p.y]
+    }
     /// Whether an object is held, if the robot knows (`None`: the controller
     /// tracks it from grips and claw openings).
     fn holding(&self) -> Option<bool> {
@@ -236,6 +246,10 @@ impl Robot for Sim {
     }
     fn pose(&self) -> Pose {
         Sim::pose(self)
+    }
+    #[inline]
+    fn position(&self) -> [f32; 2] {
+        Sim::position(self)
     }
     fn holding(&self) -> Option<bool> {
         Some(Sim::holding(self))
@@ -328,6 +342,13 @@ pub struct Controller<'s> {
     forbidden: Vec<bool>,
     holding: bool,
     fitness: Option<FastExpr>,
+    /// The fitness term of the life's end.
+    at_end: Option<FastExpr>,
+    /// The life so far: pose, distance, squares, actions.
+    odo: Odometer,
+    /// The state the expressions read (`robot.x` ...), filled only when one does.
+    state: [f32; STATE_SLOTS],
+    reads_state: bool,
 }
 
 impl<'s> Controller<'s> {
@@ -417,6 +438,10 @@ impl<'s> Controller<'s> {
             forbidden: vec![false; n],
             holding: false,
             fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
+            at_end: stage.fitness.at_end.as_ref().map(FastExpr::new),
+            odo: Odometer::default(),
+            state: [0.0; STATE_SLOTS],
+            reads_state: crate::state::reads_state(stage),
         })
     }
 
@@ -451,8 +476,23 @@ impl<'s> Controller<'s> {
         self.forced = None;
         self.forbidden.fill(false);
         self.holding = false;
+        self.odo.start(sim.position(), 1024);
+        self.observe_state(sim);
         sim.sense(&mut self.now);
         self.before = self.now;
+    }
+
+    /// Fills the state the expressions read.
+    #[inline]
+    fn observe_state<R: Robot>(&mut self, sim: &R) {
+        if self.reads_state {
+            self.state = self.odo.state(sim.pose().theta);
+        }
+    }
+
+    /// How this life has moved the robot so far.
+    pub fn descriptors<R: Robot>(&self, sim: &R) -> Descriptors {
+        self.odo.descriptors(sim.pose().theta)
     }
 
     /// Activation levels of the last action.
@@ -542,6 +582,7 @@ impl<'s> Controller<'s> {
         self.reinf.fill(0.0);
         if self.mods.is_empty() {
             let outcome = sim.step(&Command::default());
+            self.odo.moved(sim.position());
             sim.sense(&mut self.next);
             self.before = self.now;
             self.now = self.next;
@@ -584,7 +625,7 @@ impl<'s> Controller<'s> {
         let module = &mut self.mods[winner];
         let cmd = match &mut module.gen {
             Gen::Script(s) => {
-                let env = Env { now: &self.now, prev: &self.before, act: &self.slots };
+                let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
                 s.command(&env, &mut r)
             }
             Gen::Neural { net, decode, bits } => {
@@ -599,6 +640,8 @@ impl<'s> Controller<'s> {
 
         // 5: act and sense.
         let outcome = sim.step(&cmd);
+        self.odo.moved(sim.position());
+        self.observe_state(sim);
         self.slots[ACT_LEFT] = cmd.wheels[0];
         self.slots[ACT_RIGHT] = cmd.wheels[1];
         if let Some(d) = cmd.arm {
@@ -619,7 +662,7 @@ impl<'s> Controller<'s> {
         sim.sense(&mut self.next);
 
         // 6-7: after-action expressions, reinforcement and learning.
-        let env = Env { now: &self.next, prev: &self.now, act: &self.slots };
+        let env = Env { now: &self.next, prev: &self.now, act: &self.slots, state: &self.state };
         let module = &mut self.mods[winner];
         if let Gen::Script(s) = &mut module.gen {
             s.after_action(&env);
@@ -753,9 +796,14 @@ impl<'s> Controller<'s> {
                 });
             }
         }
+        if let Some(e) = &self.at_end {
+            let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
+            fitness += f64::from(e.eval(&env));
+        }
         add_bonuses(self.stage, &res, &mut fitness);
         res.fitness = fitness as f32;
         res.placement_failures = sim.placement_failures();
+        res.descriptors = self.descriptors(sim);
         res
     }
 

@@ -252,7 +252,7 @@ mod tests {
         for barrier in [0.0, 1.0] {
             let mut p = [0.0; CHANNELS];
             p[CH_BARRIER] = barrier;
-            let env = Env { now: &p, prev: &p, act: &act };
+            let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
             let mut s = ScriptRun::new(&script);
             assert_eq!(s.command(&env, &mut r).arm, Some(true));
             s.after_action(&env);
@@ -274,7 +274,7 @@ mod tests {
         let script = Script { steps: vec![step(Action::Arm(true), Some(never))], commit: false };
         let mut s = ScriptRun::new(&script);
         let p = [0.0; CHANNELS];
-        let env = Env { now: &p, prev: &p, act: &act };
+        let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
         assert_eq!(s.command(&env, &mut r), Command::default());
         s.after_action(&env);
         assert_eq!((s.position(), s.holds_control()), (0, false));

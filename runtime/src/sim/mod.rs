@@ -944,6 +944,13 @@ impl Sim {
         self.pose.into()
     }
 
+    /// The body centre, mm (the pose without its heading).
+    #[inline]
+    pub fn position(&self) -> [f32; 2] {
+        let t = self.pose.translation.vector;
+        [t.x, t.y]
+    }
+
     /// Distance each wheel (left, right) travelled during the last action,
     /// mm, noise included; less than commanded when a collision stopped the
     /// move.

@@ -1,0 +1,174 @@
+//! The robot's state as expressions and descriptors read it: where it is,
+//! how far it went, how long it has lived and how much of the arena it has
+//! seen. One [`Odometer`] follows a life (the controller's, the stepper's),
+//! so the fitness terms, the per-episode descriptors and Python's
+//! `evaluate` all read the same numbers.
+
+use serde::{Deserialize, Serialize};
+
+use crate::expr::{Expr, Op};
+use crate::program::{Action, Behavior, Stage, StepEnd};
+
+/// Number of state slots an expression can read (`robot.x` ...).
+pub const STATE_SLOTS: usize = 6;
+/// The body centre, mm from the arena's south-west corner.
+pub const ST_X: usize = 0;
+pub const ST_Y: usize = 1;
+/// The heading, radians counter-clockwise from east, in `-pi..=pi`.
+pub const ST_HEADING: usize = 2;
+/// The distance the body centre travelled in this life so far, mm.
+pub const ST_DISTANCE: usize = 3;
+/// The actions done in the life so far (0 before the first; 1 in the
+/// expressions evaluated after it).
+pub const ST_TIME: usize = 4;
+/// The squares of [`SQUARE_MM`] the body centre has been in during this life.
+pub const ST_SQUARES: usize = 5;
+
+/// The side of the squares of [`Descriptors::squares_visited`], mm.
+pub const SQUARE_MM: f32 = 50.0;
+
+/// How a life (or the lives of an evaluation) moved the robot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Descriptors {
+    /// The body centre at the end of the (last) life, mm from the arena's
+    /// south-west corner.
+    pub x: f32,
+    pub y: f32,
+    /// The heading at the end of the (last) life, radians counter-clockwise
+    /// from +x, in `-pi..=pi`.
+    pub heading: f32,
+    /// The distance the body centre travelled, mm.
+    pub path_length: f32,
+    /// The squares of [`SQUARE_MM`] (a grid from the arena's south-west
+    /// corner) the body centre was in at the start or after an action,
+    /// counted once each.
+    pub squares_visited: f32,
+}
+
+/// Follows one life's poses: the path length, the squares visited, the
+/// actions done. It allocates only when [`Odometer::start`] reserves room.
+#[derive(Clone, Debug, Default)]
+pub struct Odometer {
+    /// Where the body centre is, mm.
+    at: [f32; 2],
+    path: f64,
+    actions: u32,
+    square: (i64, i64),
+    /// The squares visited, in the order first visited (a life visits few:
+    /// a linear search when the square changes is cheaper than hashing).
+    squares: Vec<(i64, i64)>,
+}
+
+fn square_of([x, y]: [f32; 2]) -> (i64, i64) {
+    // Finite positions of any arena; a non-finite one counts as one square.
+    let cell =
+        |v: f32| if v.is_finite() { (f64::from(v) / f64::from(SQUARE_MM)).floor() as i64 } else { i64::MIN };
+    (cell(x), cell(y))
+}
+
+impl Odometer {
+    /// Starts a life at `at`, with room for `actions` actions' squares.
+    pub fn start(&mut self, at: [f32; 2], actions: u32) {
+        self.at = at;
+        self.path = 0.0;
+        self.actions = 0;
+        self.square = square_of(at);
+        self.squares.clear();
+        self.squares.reserve(actions.min(1 << 16) as usize + 1);
+        self.squares.push(self.square);
+    }
+
+    /// One action done, the body centre now at `at`.
+    #[inline]
+    pub fn moved(&mut self, at: [f32; 2]) {
+        self.actions += 1;
+        let d = f64::from(at[0] - self.at[0]).hypot(f64::from(at[1] - self.at[1]));
+        if d.is_finite() {
+            self.path += d;
+        }
+        self.at = at;
+        let square = square_of(at);
+        if square != self.square {
+            self.square = square;
+            if !self.squares.contains(&square) {
+                self.squares.push(square);
+            }
+        }
+    }
+
+    /// Actions done in this life.
+    pub fn actions(&self) -> u32 {
+        self.actions
+    }
+
+    /// The state slots, with the robot's `heading`.
+    pub fn state(&self, heading: f32) -> [f32; STATE_SLOTS] {
+        let mut s = [0.0; STATE_SLOTS];
+        s[ST_X] = self.at[0];
+        s[ST_Y] = self.at[1];
+        s[ST_HEADING] = heading;
+        s[ST_DISTANCE] = self.path as f32;
+        s[ST_TIME] = self.actions as f32;
+        s[ST_SQUARES] = self.squares.len() as f32;
+        s
+    }
+
+    /// The descriptors of the life so far, the robot's heading now `heading`.
+    pub fn descriptors(&self, heading: f32) -> Descriptors {
+        Descriptors {
+            x: self.at[0],
+            y: self.at[1],
+            heading,
+            path_length: self.path as f32,
+            squares_visited: self.squares.len() as f32,
+        }
+    }
+}
+
+/// Some expression of `stage` reads the robot's state (`robot.x` ...).
+pub fn reads_state(stage: &Stage) -> bool {
+    let mut exprs: Vec<&Expr> = Vec::new();
+    exprs.extend(&stage.fitness.per_action);
+    exprs.extend(&stage.fitness.at_end);
+    for m in &stage.modules {
+        exprs.extend(&m.reinforce);
+        if let Behavior::Script(s) = &m.behavior {
+            for st in &s.steps {
+                exprs.extend(&st.when);
+                if let Action::Reinforce(e) = &st.action {
+                    exprs.push(e);
+                }
+                if let StepEnd::Until { cond, .. } = &st.end {
+                    exprs.push(cond);
+                }
+            }
+        }
+    }
+    exprs.iter().any(|e| e.ops.iter().any(|op| matches!(op, Op::State(_))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_odometer_counts_the_path_and_each_square_once() {
+        let at = |x, y| [x, y];
+        let mut o = Odometer::default();
+        o.start(at(10.0, 10.0), 10);
+        o.moved(at(40.0, 50.0)); // 50 mm, into square (0, 1)
+        o.moved(at(60.0, 50.0));
+        o.moved(at(40.0, 50.0)); // back to a square seen
+        let d = o.descriptors(0.5);
+        assert!((d.path_length - 90.0).abs() < 1e-4, "{d:?}");
+        assert_eq!(d.squares_visited, 3.0);
+        assert_eq!((d.x, d.y, d.heading), (40.0, 50.0, 0.5));
+        let s = o.state(0.5);
+        assert_eq!(s[ST_TIME], 3.0);
+        assert_eq!(s[ST_SQUARES], 3.0);
+        assert_eq!(o.actions(), 3);
+        o.start(at(0.0, 0.0), 10);
+        assert_eq!(o.descriptors(0.0).squares_visited, 1.0);
+        assert_eq!(o.descriptors(0.0).path_length, 0.0);
+    }
+}
