@@ -726,10 +726,14 @@ fn follow_light_then_recharge_keeps_the_robot_alive() {
         let r = run_episode(&s, &g, &EpisodeOptions { actions: 300, learning: true, seed }, Some(&mut t));
         let last = t.rows.last().unwrap();
         assert!(last.pose.y > 500.0, "seed {seed}: the light leads to the north wall: {:?}", last.pose);
+        // Charged at all (a top-up too, which is not a `recharge` event).
+        let charged = t.rows.windows(2).any(|w| w[1].battery > w[0].battery);
         if r.recharges > 0 {
+            assert!(t.rows.iter().any(|row| row.recharged && row.winner == 3));
+        }
+        if charged {
             recharged += 1;
             assert_eq!(r.actions, 300, "seed {seed}: a recharged robot lives the whole episode");
-            assert!(t.rows.iter().any(|row| row.recharged && row.winner == 3));
         } else {
             assert_eq!(r.actions, 200, "seed {seed}: without recharge the battery lasts 200 actions");
         }

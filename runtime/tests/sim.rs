@@ -279,6 +279,23 @@ fn the_battery_drains_and_recharges_only_at_the_bar_while_charging() {
     }
     assert_eq!(sim.battery(), 1.0);
     assert_eq!(recharged, 1);
+    // Staying, or leaving and topping up, counts no further recharge: a
+    // bout counts only when it starts at most half full.
+    let mut again = 0;
+    for round in 0..30 {
+        let charge = round % 3 != 0;
+        again += u32::from(sim.step(&Command { charge, ..Command::default() }).recharged);
+    }
+    assert_eq!(again, 0, "top-ups are not recharges");
+    for _ in 0..120 {
+        sim.step(&Command::default());
+    }
+    assert!(sim.battery() < 0.45);
+    let mut refilled = 0;
+    for _ in 0..12 {
+        refilled += u32::from(sim.step(&Command { charge: true, ..Command::default() }).recharged);
+    }
+    assert_eq!((refilled, sim.battery()), (1, 1.0), "a bout from below half counts once");
     // Next to the wall but beside the bar: no charging.
     assert!(sim.set_pose(Pose { x: 50.0, y: 600.0 - 27.5 - 1.0, theta: 0.0 }));
     sim.step(&Command { charge: true, ..Command::default() });

@@ -180,6 +180,11 @@ pub struct Sim {
     pose: Isometry2<f32>,
     /// Battery charge in units of `1 / (capacity * recharge)`.
     charge: u64,
+    /// The last action charged: a charging bout is under way.
+    charging: bool,
+    /// The bout under way started at most half full: filling the battery
+    /// counts as a recharge (once).
+    bout_counts: bool,
     arm_down: bool,
     claw_closed: bool,
     held: Option<usize>,
@@ -373,6 +378,8 @@ impl Sim {
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
             pose: Isometry2::identity(),
             charge: battery_spec.map_or(0, |(c, r)| c * r),
+            charging: false,
+            bout_counts: false,
             arm_down: false,
             claw_closed: false,
             held: None,
@@ -805,19 +812,29 @@ impl Sim {
     }
 
     /// The battery part of an action, after the move: recharges when asked
-    /// to in contact with the bar, else drains one action's worth. Returns
-    /// true when this action filled the battery.
+    /// to in contact with the bar (or on a charging zone), else drains one
+    /// action's worth. Returns true when this action filled the battery in
+    /// a charging bout (consecutive charging actions) that started at most
+    /// half full: a top-up, or staying at the charger, counts nothing.
     pub fn tick_battery(&mut self, charge: bool) -> bool {
         let Some((cap, rech)) = self.battery_spec else {
             return false;
         };
         let full = cap * rech;
         if (charge && self.in_contact()) || self.on_charging_zone() {
+            if !self.charging {
+                self.charging = true;
+                self.bout_counts = 2 * self.charge <= full;
+            }
             if self.charge < full {
                 self.charge = (self.charge + cap).min(full);
-                return self.charge == full;
+                if self.charge == full && self.bout_counts {
+                    self.bout_counts = false;
+                    return true;
+                }
             }
         } else {
+            self.charging = false;
             self.charge = self.charge.saturating_sub(rech);
         }
         false
