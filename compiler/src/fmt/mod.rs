@@ -763,6 +763,9 @@ impl F<'_> {
     fn fitness(&self, f: &FitnessDecl) -> String {
         let mut terms: Vec<(usize, String)> =
             f.per_action.iter().map(|e| (e.span.start, format!("per action {}", self.expr(e)))).collect();
+        for e in &f.at_end {
+            terms.push((e.span.start, format!("at end {}", self.expr(e))));
+        }
         for b in &f.bonuses {
             terms.push((b.span.start, format!("{} per {}", self.num(b.points, b.span), b.event.text)));
         }
@@ -982,6 +985,7 @@ impl F<'_> {
                 }
             }
             ExprKind::Ref(n, i) => format!("{}{}", n.text, Self::index(i)),
+            ExprKind::State(n) => format!("robot.{}", n.text),
             ExprKind::Call(n, args) => {
                 let a: Vec<String> = args.iter().map(|a| self.expr(a)).collect();
                 format!("{}({})", n.text, a.join(", "))
@@ -1021,6 +1025,6 @@ fn level(e: &Expr) -> u8 {
         },
         ExprKind::Unary(UnOp::Not, _) => 4,
         ExprKind::Unary(..) => 8,
-        ExprKind::Number(..) | ExprKind::Ref(..) | ExprKind::Call(..) => 9,
+        ExprKind::Number(..) | ExprKind::Ref(..) | ExprKind::State(..) | ExprKind::Call(..) => 9,
     }
 }

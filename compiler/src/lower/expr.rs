@@ -16,7 +16,27 @@ pub struct Scope<'a> {
     /// `Some((module, channels, sense span))`: only these channels (a
     /// reinforcement program reads what its module senses).
     pub only: Option<(&'a str, &'a [u16], Option<Span>)>,
+    /// The robot's state (`robot.x` ...) may be read: a fitness term.
+    pub state: bool,
 }
+
+/// The fields of `robot.FIELD` and their state slots.
+pub const STATE_FIELDS: [(&str, usize, &str); 6] = [
+    ("x", shaping_runtime::state::ST_X, "the body centre's x, mm from the arena's west wall"),
+    ("y", shaping_runtime::state::ST_Y, "the body centre's y, mm from the arena's south wall"),
+    (
+        "heading",
+        shaping_runtime::state::ST_HEADING,
+        "the heading, radians counter-clockwise from east, -pi..pi",
+    ),
+    (
+        "distance",
+        shaping_runtime::state::ST_DISTANCE,
+        "the distance the body centre travelled in this life, mm",
+    ),
+    ("time", shaping_runtime::state::ST_TIME, "the actions done in this life so far"),
+    ("squares", shaping_runtime::state::ST_SQUARES, "the 50 mm squares of the arena visited in this life"),
+];
 
 enum Val {
     /// Emitted onto the code.
@@ -96,6 +116,7 @@ impl Lower<'_> {
                 Val::Num
             }
             ExprKind::Ref(name, index) => self.reference(hw, name, index.as_ref(), e.span, scope, prev, ops),
+            ExprKind::State(field) => self.state(field, e.span, scope, prev, ops),
             ExprKind::Unary(op, inner) => match op {
                 UnOp::Prev => self.go(hw, inner, scope, true, ops),
                 UnOp::Neg | UnOp::Not => {
@@ -216,6 +237,53 @@ impl Lower<'_> {
                 Val::Err
             }
         }
+    }
+
+    /// `robot.FIELD`.
+    fn state(&mut self, field: &ast::Name, span: Span, scope: &Scope, prev: bool, ops: &mut Vec<Op>) -> Val {
+        let Some(&(_, slot, _)) = STATE_FIELDS.iter().find(|f| f.0 == field.text) else {
+            self.errors.push(Error::Value {
+                span: field.span.into(),
+                message: format!("the robot's state has no field `{}`", field.text),
+                label: "unknown field".into(),
+                help: Some(
+                    crate::diag::did_you_mean(&field.text, STATE_FIELDS.iter().map(|f| f.0)).unwrap_or_else(
+                        || {
+                            let all: Vec<String> =
+                                STATE_FIELDS.iter().map(|f| format!("`robot.{}`", f.0)).collect();
+                            format!("the fields are {}", all.join(", "))
+                        },
+                    ),
+                ),
+            });
+            return Val::Err;
+        };
+        if !scope.state {
+            self.errors.push(Error::Value {
+                span: span.into(),
+                message: format!(
+                    "`robot.{}` is the simulator's knowledge of the robot: only a fitness reads it",
+                    field.text
+                ),
+                label: "not a sensor".into(),
+                help: Some("a module's reinforcement and conditions read the robot's sensors".into()),
+            });
+            return Val::Err;
+        }
+        if prev {
+            self.errors.push(Error::Value {
+                span: span.into(),
+                message: format!(
+                    "`prev` reads sensors only, and `robot.{}` is the robot's state",
+                    field.text
+                ),
+                label: "no previous value".into(),
+                help: None,
+            });
+            return Val::Err;
+        }
+        ops.push(Op::State(slot as u16));
+        Val::Num
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -135,7 +135,8 @@ impl Lower<'_> {
                     st.script_reinforces = false;
                     st.behavior = match b {
                         ast::BehaviorDecl::Script(steps, commit, _) => {
-                            let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
+                            let scope =
+                                Scope { only: Some((&m.name.text, &inputs, sense_span)), state: false };
                             let lowered: Vec<Step> =
                                 steps.iter().filter_map(|x| self.step(hw, x, &scope)).collect();
                             st.script_reinforces =
@@ -154,7 +155,7 @@ impl Lower<'_> {
                     st.learn_span = Some(l.span);
                 }
                 ModuleItem::Reinforce(e, _) => {
-                    let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)) };
+                    let scope = Scope { only: Some((&m.name.text, &inputs, sense_span)), state: false };
                     st.reinforce = self.expr(hw, e, &scope);
                     st.reinforce_declared = true;
                 }
@@ -570,12 +571,12 @@ impl Lower<'_> {
             });
         }
         // Lowered first, so its errors are reported even when `end` fails.
-        let when = x.cond.as_ref().map(|c| self.expr(hw, c, &Scope { only: None }));
+        let when = x.cond.as_ref().map(|c| self.expr(hw, c, &Scope { only: None, state: false }));
         let end = match &x.end {
             None => StepEnd::Actions(1),
             Some(EndDecl::For(q)) => StepEnd::Actions(self.count(q, "a step's duration", 1)? as u32),
             Some(EndDecl::Until { cond, within, span }) => {
-                let cond = self.expr(hw, cond, &Scope { only: None });
+                let cond = self.expr(hw, cond, &Scope { only: None, state: false });
                 let Some(w) = within else {
                     self.errors.push(Error::UnboundedUntil { span: (*span).into() });
                     return None;

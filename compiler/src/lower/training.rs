@@ -265,28 +265,35 @@ impl Lower<'_> {
         }
     }
 
+    /// `old + x`, a stack too deep reported at `span`.
+    fn added(&mut self, old: Expr, x: Expr, span: Span) -> Expr {
+        let mut ops = old.ops;
+        ops.extend(x.ops);
+        ops.push(Op::Add);
+        let depth = Expr::required_depth(&ops).unwrap_or(old.depth.max(x.depth) + 1);
+        if depth as usize > shaping_runtime::expr::MAX_STACK {
+            self.errors.push(Error::StackTooDeep {
+                span: span.into(),
+                depth: depth as usize,
+                max: shaping_runtime::expr::MAX_STACK,
+            });
+        }
+        Expr { ops, depth }
+    }
+
     pub(super) fn fitness(&mut self, hw: &Hw, st: &mut StageSt, f: &ast::FitnessDecl) {
         let mut per_action: Option<Expr> = if f.adds { st.fitness.per_action.clone() } else { None };
+        let mut at_end: Option<Expr> = if f.adds { st.fitness.at_end.clone() } else { None };
         let mut bonuses = if f.adds { st.fitness.bonuses.clone() } else { Vec::new() };
-        for e in &f.per_action {
-            if let Some(x) = self.expr(hw, e, &Scope { only: None }) {
-                per_action = Some(match per_action {
-                    None => x,
-                    Some(old) => {
-                        let mut ops = old.ops;
-                        ops.extend(x.ops);
-                        ops.push(Op::Add);
-                        let depth = Expr::required_depth(&ops).unwrap_or(old.depth.max(x.depth) + 1);
-                        if depth as usize > shaping_runtime::expr::MAX_STACK {
-                            self.errors.push(Error::StackTooDeep {
-                                span: e.span.into(),
-                                depth: depth as usize,
-                                max: shaping_runtime::expr::MAX_STACK,
-                            });
-                        }
-                        Expr { ops, depth }
-                    }
-                });
+        let scope = Scope { only: None, state: true };
+        for (terms, sum) in [(&f.per_action, &mut per_action), (&f.at_end, &mut at_end)] {
+            for e in terms {
+                if let Some(x) = self.expr(hw, e, &scope) {
+                    *sum = Some(match sum.take() {
+                        None => x,
+                        Some(old) => self.added(old, x, e.span),
+                    });
+                }
             }
         }
         const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
@@ -334,7 +341,7 @@ impl Lower<'_> {
             }
             bonuses.push(Bonus { event, points: b.points as f32 });
         }
-        st.fitness = Fitness { per_action, at_end: None, bonuses };
+        st.fitness = Fitness { per_action, at_end, bonuses };
         st.fitness_declared = true;
     }
 }

@@ -198,6 +198,8 @@ pub enum SettingValue {
 pub struct FitnessDecl {
     pub adds: bool,
     pub per_action: Vec<Expr>,
+    /// `at end EXPR` terms.
+    pub at_end: Vec<Expr>,
     pub bonuses: Vec<BonusDecl>,
     pub span: Span,
 }
@@ -440,6 +442,7 @@ impl Expr {
             ExprKind::Ref(n, None) => n.text.clone(),
             ExprKind::Ref(n, Some(Index { first, last: None, .. })) => format!("{}[{first}]", n.text),
             ExprKind::Ref(n, Some(Index { first, last: Some(l), .. })) => format!("{}[{first}..{l}]", n.text),
+            ExprKind::State(n) => format!("robot.{}", n.text),
             ExprKind::Call(n, args) => {
                 let args: Vec<String> = args.iter().map(Expr::sexpr).collect();
                 format!("({} {})", n.text, args.join(" "))
@@ -509,6 +512,8 @@ pub enum ExprKind {
     Number(f64, Option<Unit>),
     /// A sensor or actuator, whole or indexed.
     Ref(Name, Option<Index>),
+    /// `robot.FIELD`: the robot's state (the name is the field).
+    State(Name),
     Call(Name, Vec<Expr>),
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),

@@ -331,6 +331,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::fitness => "`fitness`",
         Rule::fitness_mode => "`adds`",
         Rule::per_action => "`per action`",
+        Rule::at_end => "`at end`",
         Rule::bonus => "a bonus `N per EVENT`",
         Rule::k_outside => "`outside`",
         Rule::module => "`module`",
@@ -382,7 +383,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::link => "`link`",
         Rule::k_all => "`all`",
         Rule::link_kind => "`evolvable` or `fixed`",
-        Rule::expr | Rule::reference | Rule::call => "an expression",
+        Rule::expr | Rule::reference | Rule::call | Rule::state_ref => "an expression",
         Rule::neg | Rule::not | Rule::prev => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
         Rule::lt | Rule::le | Rule::gt | Rule::ge | Rule::eq | Rule::ne => "an operator",
@@ -848,7 +849,8 @@ impl Builder {
 
     fn fitness(&mut self, p: Pair<Rule>) -> FitnessDecl {
         let sp = span(&p);
-        let mut f = FitnessDecl { adds: false, per_action: vec![], bonuses: vec![], span: sp };
+        let mut f =
+            FitnessDecl { adds: false, per_action: vec![], at_end: vec![], bonuses: vec![], span: sp };
         for c in p.into_inner() {
             let csp = span(&c);
             match c.as_rule() {
@@ -857,6 +859,12 @@ impl Builder {
                     if let Some(e) = c.into_inner().next() {
                         let e = self.expr(e);
                         f.per_action.push(e);
+                    }
+                }
+                Rule::at_end => {
+                    if let Some(e) = c.into_inner().find(|x| x.as_rule() == Rule::expr) {
+                        let e = self.expr(e);
+                        f.at_end.push(e);
                     }
                 }
                 Rule::bonus => {
@@ -1167,6 +1175,10 @@ fn primary(pratt: &PrattParser<Rule>, p: Pair<Rule>) -> Expr {
             let f = it.next().map(name).unwrap_or(Name { text: String::new(), span: sp });
             let args = it.map(|a| expr_inner(pratt, a)).collect();
             Expr { kind: ExprKind::Call(f, args), span: sp }
+        }
+        Rule::state_ref => {
+            let field = p.into_inner().next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+            Expr { kind: ExprKind::State(field), span: sp }
         }
         Rule::literal => {
             let mut it = p.into_inner();
