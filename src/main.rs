@@ -233,6 +233,12 @@ enum Command {
         /// Also write `report.html`: the episode animated in a web page.
         #[arg(long)]
         report: bool,
+        /// Also write the episode as an animated GIF (at most 300 frames).
+        #[arg(long, value_name = "FILE")]
+        gif: Option<PathBuf>,
+        /// Also write the episode as an MP4 video (needs `ffmpeg` on the PATH).
+        #[arg(long, value_name = "FILE")]
+        mp4: Option<PathBuf>,
         /// Change a setting as the run did (`--set` of `run`, one value each).
         #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
         sets: Vec<sweep::Set>,
@@ -474,6 +480,8 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             seed,
             no_learning,
             report,
+            gif,
+            mp4,
             sets,
             error_format,
         } => replay::replay(
@@ -487,6 +495,8 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 seed,
                 no_learning,
                 report,
+                gif,
+                mp4,
                 sets: single_values(sets, "replay")?,
             },
             error_format,

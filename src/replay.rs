@@ -24,5 +24,8 @@ pub fn replay(args: ReplayOptions, error_format: ErrorFormat) -> Result<(), CliE
     if let Some(path) = r.report {
         outln!("report: {}", path.display())?;
     }
+    for path in &r.animations {
+        outln!("animation: {}", path.display())?;
+    }
     Ok(())
 }

@@ -384,6 +384,54 @@ fn run_rejects_unknown_stage_and_replay_writes_pictures() {
     assert!(text(&short.stderr).contains("bits"));
 }
 
+/// `replay --gif` writes the episode as an animated GIF: the collect stage
+/// of `khepera.bat` as run, more than 10 frames, at most 300; `--mp4`
+/// without `ffmpeg` on the PATH is refused naming it, before anything runs.
+#[test]
+fn replay_writes_an_animated_gif_and_mp4_needs_ffmpeg() {
+    let dir = scratch("replay-gif");
+    let khepera = root().join("examples/khepera.bat");
+    let out = run(shaping().arg("run").arg(&khepera).args(["--quiet", "--no-report", "--out"]).arg(&dir));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let gif_path = dir.join("out.gif");
+    let out = run(shaping()
+        .arg("replay")
+        .arg(&khepera)
+        .args(["--stage", "collect", "--run"])
+        .arg(&dir)
+        .arg("--gif")
+        .arg(&gif_path));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("animation: "), "{}", text(&out.stdout));
+    let bytes = std::fs::read(&gif_path).unwrap();
+    assert_eq!(&bytes[..6], b"GIF89a");
+    let mut decoder = gif::DecodeOptions::new().read_info(bytes.as_slice()).unwrap();
+    let (w, h) = (decoder.width(), decoder.height());
+    let mut frames = 0;
+    while let Some(f) = decoder.read_next_frame().unwrap() {
+        assert!(f.left + f.width <= w && f.top + f.height <= h);
+        frames += 1;
+    }
+    assert!((11..=300).contains(&frames), "{frames} frames");
+
+    let empty = dir.join("no-programs");
+    std::fs::create_dir_all(&empty).unwrap();
+    let mp4 = dir.join("out.mp4");
+    let out = run(shaping()
+        .env("PATH", &empty)
+        .arg("replay")
+        .arg(&khepera)
+        .args(["--stage", "collect", "--run"])
+        .arg(&dir)
+        .arg("--out")
+        .arg(dir.join("never"))
+        .arg("--mp4")
+        .arg(&mp4));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("`ffmpeg`"), "{}", text(&out.stderr));
+    assert!(!mp4.exists() && !dir.join("never").exists());
+}
+
 #[test]
 fn bench_prints_one_json_line() {
     let out = run(shaping().arg("bench").arg(tiny()).args(["--runs", "1"]));

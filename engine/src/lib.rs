@@ -7,6 +7,7 @@
 //! interruption comes in as a flag, and errors are one [`Error`] type whose
 //! [`ErrorKind`] a caller can match.
 
+pub mod animation;
 pub mod descriptors;
 pub mod diag;
 pub mod episode;

@@ -1,5 +1,5 @@
 //! Replays: one individual of a stage run with a trace, its files and
-//! pictures; and the choice of that individual (`replay`, `drive`).
+//! pictures (and animations); and the choice of that individual (`replay`, `drive`).
 
 use std::path::{Path, PathBuf};
 
@@ -14,7 +14,7 @@ use shaping_runtime::controller::EpisodeResult;
 use crate::error::Error;
 use crate::files::{create_dir, write_atomic};
 use crate::run::{Event, Observer};
-use crate::{episode, html, load, report, run, rundir};
+use crate::{animation, episode, html, load, report, run, rundir};
 
 /// What to replay.
 #[derive(Clone, Debug, Default)]
@@ -30,6 +30,10 @@ pub struct ReplayOptions {
     pub no_learning: bool,
     /// Also write `report.html` for the episode.
     pub report: bool,
+    /// Also write the episode as an animated GIF here.
+    pub gif: Option<PathBuf>,
+    /// Also write the episode as an MP4 here (through `ffmpeg`).
+    pub mp4: Option<PathBuf>,
     /// Settings changed from the file's, as the run was made (`--set`).
     pub sets: Vec<crate::sweep::Assignment>,
 }
@@ -134,17 +138,23 @@ pub struct Replayed {
     pub result: EpisodeResult,
     pub out: PathBuf,
     pub report: Option<PathBuf>,
+    /// The animations written (`--gif`, `--mp4`).
+    pub animations: Vec<PathBuf>,
 }
 
 /// Replays an individual of `program` (the file's; see [`choose`]) and
 /// writes its files: `trace.csv`, the pictures, `episode.json`,
-/// `program.json`, `genome`, and `report.html` if asked for.
+/// `program.json`, `genome`, and `report.html` and the animations if
+/// asked for (`--mp4` without `ffmpeg` is refused before anything runs).
 pub fn replay(
     mut program: Program,
     args: &ReplayOptions,
     observer: &dyn Observer,
 ) -> Result<Replayed, Error> {
     crate::sweep::apply(&mut program, &args.sets)?;
+    if args.mp4.is_some() {
+        animation::ffmpeg()?;
+    }
     let chosen = choose(
         program,
         &args.file,
@@ -185,5 +195,17 @@ pub fn replay(
     rundir::write_program(&out, &program)?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     let report = if args.report { Some(html::write(&out, None)?) } else { None };
-    Ok(Replayed { stage: stage.name.clone(), result: r, out, report })
+    let mut animations = Vec::new();
+    if args.gif.is_some() || args.mp4.is_some() {
+        let frames = animation::frames(&scene, &ep)?;
+        if let Some(path) = &args.gif {
+            animation::write_gif(path, &frames)?;
+            animations.push(path.clone());
+        }
+        if let Some(path) = &args.mp4 {
+            animation::write_mp4(path, &frames)?;
+            animations.push(path.clone());
+        }
+    }
+    Ok(Replayed { stage: stage.name.clone(), result: r, out, report, animations })
 }
