@@ -131,32 +131,36 @@ def won_per_life(run, stage):
     return ", ".join(f"{k} {v / lives:.0f}" for k, v in sorted(count.items(), key=lambda kv: -kv[1]))
 
 
-def bigger_trace(run, s):
-    """The rows of a seed's stage `bigger` and the action where the world changed."""
-    with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
+def bigger_trace(run, s, stage="bigger"):
+    """The rows of a seed's test stage and the action where the world changed."""
+    with open(f"{R}/{run}/seed-{s}/{stage}/summary.json") as f:
         switch = json.load(f)["before"]["actions"]
-    return rows(f"{R}/{run}/seed-{s}/bigger/trace.csv"), switch
+    return rows(f"{R}/{run}/seed-{s}/{stage}/trace.csv"), switch
 
 
-def grip_signals_by_life(run, s):
+def summary(run, s, stage):
+    with open(f"{R}/{run}/seed-{s}/{stage}/summary.json") as f:
+        return json.load(f)
+
+
+def grip_signals_by_life(run, s, stage="bigger"):
     """The grip module's reinforcement signals of a seed's many-lives test, as
     (life, signal) in order (lives 0..L-1 before the change, L..2L-1 after),
     and the test's summary.json."""
-    with open(f"{R}/{run}/seed-{s}/bigger/summary.json") as f:
-        sm = json.load(f)
+    sm = summary(run, s, stage)
     life = [i for i, n in enumerate(sm["before_lives"] + sm["after_lives"]) for _ in range(n)]
-    t = rows(f"{R}/{run}/seed-{s}/bigger/trace.csv")
+    t = rows(f"{R}/{run}/seed-{s}/{stage}/trace.csv")
     assert len(t) == len(life), f"{run} seed {s}: {len(t)} rows, lives add up to {len(life)}"
     return [(life[i], float(r["reinf_grip"])) for i, r in enumerate(t) if float(r["reinf_grip"]) != 0.0], sm
 
 
-def figure13(run, title):
-    """The issue's criterion, seed by seed: a drop of 0.2 or more within 100
+def figure13(run, title, stage="bigger"):
+    """The old criterion, seed by seed: a drop of 0.2 or more within 100
     actions of the change, and back within 0.1 of the level before at the end."""
-    print(f"\n== figure 13: {title}")
+    print(f"\n== figure 13, the old criterion: {title}")
     drops = recov = 0
     for s in SEEDS:
-        t, switch = bigger_trace(run, s)
+        t, switch = bigger_trace(run, s, stage)
         perf = [float(r["perf_grip"]) for r in t]
         sig = [float(r["reinf_grip"]) for r in t]
         n_before = sum(1 for x in sig[:switch] if x)
@@ -212,68 +216,68 @@ for run in ("khepera", "khepera-explore", "khepera-practice"):
     print(f"  learning: the grip module's activation where an attempt starts: rewarded {spread(acts[1], 3)}, punished {spread(acts[-1], 3)}; "
           f"the highest other module's {spread(runner_up, 3)}")
 
-    figure13(run, f"{run} bigger (test of the collect best; objects 10 -> 25 mm, learning only)")
+# The issue's target for khepera-practice.bat: each seed's 3 fresh replays.
+v = sel("khepera-practice", "collect")
+print("\n== khepera-practice collect replays, per seed (seeds 101, 102, 103): released outside")
+for s in SEEDS:
+    print(f"  seed {s:2d}: {' '.join(str(r['out']) for r in v if r['seed'] == s)}")
+outs = [r["out"] for r in v]
+print(f"  median {statistics.median(outs)}, best {max(outs)}, mean {statistics.mean(outs):.2f} over {len(outs)} replays "
+      f"(target: median >= 3, one replay >= 5)")
 
-# Figure 13 over many lives: khepera-practice's collect bests, 40 lives of
-# 300 actions in the collect world (the paper's battery: a life ends when it
-# runs out), then 40 lives with 25 mm objects (f13-long), with 10 mm objects
-# (f13-control: no change) and with 25 mm objects without learning
-# (f13-nolearning); one controller throughout. The first two share their
-# first half (the same lives). f13-at25: the same architecture with 25 mm
-# objects from its training stage on, tested the same way (80 lives, all
-# with 25 mm objects); f13-at25-to10: its bests with the objects going from
-# 25 to 10 mm (its first half is f13-at25's).
+
+for run in ("khepera", "khepera-explore"):
+    figure13(run, f"{run} bigger (one life of 300 actions after 300 before; objects 10 -> 25 mm, learning only)")
+figure13("khepera-practice", "khepera-practice bigger (40 + 40 lives; objects 10 -> 25 mm, learning only)")
+
+
+BLOCK = 10
+
+
+# Figure 13 over many lives, block by block: khepera-practice's three tests
+# (the same lives), and f13-at25 (the same architecture with 25 mm objects
+# from its training stage on: its `bigger` keeps 25 mm, its
+# `bigger_unchanged` goes from 25 to 10 mm).
 mean_or_none = lambda v: statistics.mean(v) if v else None
 with_mean = lambda v: f"{spread(v)} (mean over seeds {statistics.mean([x for x in v if x is not None]):+.2f})"
-BLOCK = 10
 first30, last30, per_block = {}, {}, {}
-for run, what in (("f13-long", "objects 10 -> 25 mm, learning"), ("f13-control", "objects stay 10 mm, learning"),
-                  ("f13-nolearning", "objects 10 -> 25 mm, no learning"),
-                  ("f13-at25", "25 mm objects from the training stage on, no change, learning"),
-                  ("f13-at25-to10", "f13-at25's bests, objects 25 -> 10 mm, learning")):
-    figure13(run, f"{run}: 40 + 40 lives of 300 actions, the paper's battery; {what}")
-    by_life = [grip_signals_by_life(run, s) for s in SEEDS]
+TESTS = (("long", "khepera-practice", "bigger", "objects 10 -> 25 mm, learning"),
+         ("control", "khepera-practice", "bigger_unchanged", "objects stay 10 mm, learning"),
+         ("nolearning", "khepera-practice", "bigger_nolearning", "objects 10 -> 25 mm, no learning"),
+         ("at25", "f13-at25", "bigger", "25 mm objects from the training stage on, no change, learning"),
+         ("at25-to10", "f13-at25", "bigger_unchanged", "f13-at25's bests, objects 25 -> 10 mm, learning"))
+for key, run, stage, what in TESTS:
+    print(f"\n== figure 13 over many lives: {run} {stage}, 40 + 40 lives of 300 actions; {what}")
+    by_life = [grip_signals_by_life(run, s, stage) for s in SEEDS]
     lives = len(by_life[0][1]["before_lives"])
     before = [[x for l, x in sig if l < lives] for sig, _ in by_life]
     after = [[x for l, x in sig if l >= lives] for sig, _ in by_life]
     pre = [mean_or_none(v[-30:]) for v in before]
-    first = first30[run] = [mean_or_none(v[:30]) for v in after]
-    last = last30[run] = [mean_or_none(v[-30:]) for v in after]
+    first = first30[key] = [mean_or_none(v[:30]) for v in after]
+    last = last30[key] = [mean_or_none(v[-30:]) for v in after]
     up = sum(1 for a, b in zip(first, last) if a is not None and b is not None and b > a)
     print(f"  grip signals before the change {spread([len(v) for v in before], 0)}, after it {spread([len(v) for v in after], 0)}")
     print(f"  mean of the last 30 signals before the change {with_mean(pre)}; of the first 30 after {with_mean(first)}; "
           f"of the last 30 {with_mean(last)}; the last 30 above the first 30 on {up} of {N} seeds")
-    # Per seed, the mean of the signals of each block of 10 lives; then the median and the mean over seeds.
     per_seed = [[mean_or_none([x for l, x in sig if k * BLOCK <= l < (k + 1) * BLOCK]) for k in range(2 * lives // BLOCK)]
                 for sig, _ in by_life]
-    counts = [[sum(1 for l, _ in sig if k * BLOCK <= l < (k + 1) * BLOCK) for k in range(2 * lives // BLOCK)]
-              for sig, _ in by_life]
     nb, half = 2 * lives // BLOCK, lives // BLOCK
-    per_block[run] = (per_seed, half)
-    fmt = lambda x: "  -  " if x is None else f"{x:+.2f}"
-    print(f"  per seed, the mean of the grip signals in each block of {BLOCK} lives (signals in brackets), "
-          f"{half} blocks before the change | {nb - half} after:")
-    for s, p, c in zip(SEEDS, per_seed, counts):
-        cells = [f"{fmt(p[k])} ({c[k]:3d})" for k in range(nb)]
-        print(f"    seed {s:2d}: {' '.join(cells[:half])} | {' '.join(cells[half:])}")
+    per_block[key] = (per_seed, half)
     for name, f in (("median", statistics.median), ("mean", statistics.mean)):
         col = [f([p[k] for p in per_seed if p[k] is not None]) for k in range(nb)]
-        print(f"    {name} over seeds: {' '.join(f'{x:+.2f}' for x in col[:half])} | {' '.join(f'{x:+.2f}' for x in col[half:])}")
+        print(f"  {name} over seeds of the mean grip signal per block of {BLOCK} lives: "
+              f"{' '.join(f'{x:+.2f}' for x in col[:half])} | {' '.join(f'{x:+.2f}' for x in col[half:])}")
     out_per_life = [(sm["before"]["releases_outside"] / len(sm["before_lives"]),
                      sm["after"]["releases_outside"] / len(sm["after_lives"])) for _, sm in by_life]
     print(f"  released outside per life, before the change {spread([a for a, _ in out_per_life])}, "
           f"after it {spread([b for _, b in out_per_life])}")
-for run in ("f13-long", "f13-nolearning"):
-    (test, half), (control, _) = per_block[run], per_block["f13-control"]
+for key in ("long", "nolearning"):
+    (test, half), (control, _) = per_block[key], per_block["control"]
     cells = []
     for k in range(half, len(test[0])):
         d = [a[k] - b[k] for a, b in zip(test, control) if a[k] is not None and b[k] is not None]
         cells.append(f"{statistics.median(d):+.2f} (lower on {sum(1 for x in d if x < 0)} of {len(d)})")
-    print(f"  paired by seed, each block of {BLOCK} lives after the change, {run} minus f13-control (median): {'; '.join(cells)}")
-for name, table in (("first", first30), ("last", last30)):
-    pairs = [(a, b) for a, b in zip(table["f13-long"], table["f13-control"]) if a is not None and b is not None]
-    print(f"  paired by seed, mean of the {name} 30 signals after the change, 25 mm minus 10 mm: {spread([a - b for a, b in pairs])}; "
-          f"lower with 25 mm on {sum(1 for a, b in pairs if a < b)} of {len(pairs)} seeds")
+    print(f"  paired by seed, each block of {BLOCK} lives after the change, {key} minus control (median): {'; '.join(cells)}")
 
 
 # The same bests with grip and release networks trained with 25 mm objects,
@@ -301,28 +305,28 @@ def block_means(lives):
     return out
 
 
-# The tool runs the f13 tests' own lives: it must agree with them life by life.
-for v in ("long", "control", "nolearning"):
+# The tool runs the tests' own lives: it must agree with them life by life.
+for v in ("bigger", "bigger_unchanged", "bigger_nolearning"):
     for s, ls in zip(SEEDS, lives_of(f"lives-{v}")):
-        sig, sm = grip_signals_by_life(f"f13-{v}", s)
+        sig, sm = grip_signals_by_life("khepera-practice", s, v)
         for i, x in enumerate(ls):
             mine = [y for l, y in sig if l == i]
             assert (int(x["actions"]), int(x["signals"]), float(x["sum"])) == \
                 ((sm["before_lives"] + sm["after_lives"])[i], len(mine), sum(mine)), f"lives-{v} seed {s} life {i}"
-print(f"\n== figure 13: what learning in the test does (lives.rs; the f13 tests' lives, which it reproduces, and variants)")
+print(f"\n== figure 13: what learning in the test does (lives.rs; the tests' own lives, which it reproduces, and variants)")
 print(f"  median over seeds of the mean grip signal per block of {BLOCK} lives, 4 before the change | 4 after; "
       f"signals per seed and block; released outside per life before / after")
 lives_blocks = {}
-for name, what in (("lives-long", "f13-long: 10 -> 25 mm, CRBP 0.5 / 0.1 (collect's)"),
-                   ("lives-control", "f13-control: stays 10 mm, 0.5 / 0.1"),
-                   ("lives-nolearning", "f13-nolearning: 10 -> 25 mm, no learning"),
-                   ("lives-long-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, 0.5 / 0.1"),
-                   ("lives-control-practice25", "networks trained with 25 mm objects, stays 10 mm, 0.5 / 0.1"),
-                   ("lives-nolearning-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, no learning"),
-                   ("lives-long-0.25", "10 -> 25 mm, the test learns at 0.5 / 0.25"),
-                   ("lives-control-0.25", "stays 10 mm, 0.5 / 0.25"),
-                   ("lives-long-0.5", "10 -> 25 mm, the test learns at 0.5 / 0.5"),
-                   ("lives-control-0.5", "stays 10 mm, 0.5 / 0.5")):
+for name, what in (("lives-bigger", "bigger: 10 -> 25 mm, CRBP 0.5 / 0.1 (collect's)"),
+                   ("lives-bigger_unchanged", "bigger_unchanged: stays 10 mm, 0.5 / 0.1"),
+                   ("lives-bigger_nolearning", "bigger_nolearning: 10 -> 25 mm, no learning"),
+                   ("lives-bigger-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, 0.5 / 0.1"),
+                   ("lives-bigger_unchanged-practice25", "networks trained with 25 mm objects, stays 10 mm, 0.5 / 0.1"),
+                   ("lives-bigger_nolearning-practice25", "networks trained with 25 mm objects, 10 -> 25 mm, no learning"),
+                   ("lives-bigger-0.25", "10 -> 25 mm, the test learns at 0.5 / 0.25"),
+                   ("lives-bigger_unchanged-0.25", "stays 10 mm, 0.5 / 0.25"),
+                   ("lives-bigger-0.5", "10 -> 25 mm, the test learns at 0.5 / 0.5"),
+                   ("lives-bigger_unchanged-0.5", "stays 10 mm, 0.5 / 0.5")):
     lives = lives_of(name)
     per_seed = lives_blocks[name] = block_means(lives)
     nb = len(per_seed[0])
@@ -332,19 +336,6 @@ for name, what in (("lives-long", "f13-long: 10 -> 25 mm, CRBP 0.5 / 0.1 (collec
     out = [statistics.mean([sum(int(x["out"]) for x in ls[h * half:(h + 1) * half]) / half for ls in lives]) for h in (0, 1)]
     print(f"  {what}:\n    {' '.join(f'{x:+.2f}' for x in col[:nb // 2])} | {' '.join(f'{x:+.2f}' for x in col[nb // 2:])}"
           f"; signals {' '.join(f'{x:.0f}' for x in n)}; released outside per life {out[0]:.2f} / {out[1]:.2f}")
-print("  per seed, a drop (the last block before minus the first after >= 0.2), and back (the last block after within 0.1 "
-      "below the last before, or above it):")
-for name in ("lives-long", "lives-nolearning", "lives-long-practice25", "lives-long-0.25", "lives-long-0.5",
-             "lives-control", "lives-control-0.25", "lives-control-0.5"):
-    drops = back = 0
-    for p in lives_blocks[name]:
-        h = len(p) // 2
-        if None in (p[h - 1], p[h], p[-1]):
-            continue
-        if p[h - 1] - p[h] >= 0.2:
-            drops += 1
-            back += p[-1] >= p[h - 1] - 0.1
-    print(f"    {name}: drop on {drops} of {N} seeds, back on {back}")
 
 print("\n== shaping vs evolution from scratch, whole task (criterion: best of a generation >= 3.0)")
 sh, sc = [], []

@@ -34,7 +34,7 @@ mod common;
 use shaping_engine::load::load_built;
 use shaping_engine::run::before_after;
 use shaping_engine::rundir;
-use shaping_runtime::evolve::seed;
+use shaping_runtime::evolve::{self, seed};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::StageRun;
 
@@ -101,7 +101,7 @@ fn run() -> Result<(), String> {
                 stage.layout.bits
             ));
         }
-        let episode = seed::test_seed(s, index, 0);
+        let episode = seed::test_seed(s, evolve::test_seed_stage(&program, index), 0);
         let ba =
             before_after(&program.stages[parent], stage, &genome, actions, lives, learning, episode, None)
                 .map_err(common::message)?;

@@ -5,7 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet
-B=target/release/shaping
+T=${CARGO_TARGET_DIR:-target}/release
+B=$T/shaping
+L=$T/examples/lives
 R=runs/experiments
 D=docs/experiments
 SEEDS=10
@@ -37,70 +39,34 @@ grep -q 'generations 80  inheritance lamarckian' $R/khepera-explore.bat
 [ "$(grep -c 'learn crbp(0.5, 0.1) on activation always' $R/khepera-explore.bat)" = 2 ]
 $B experiment $R/khepera-explore.bat --seeds $SEEDS --out $R/khepera-explore --fresh \
   --criterion navigation=0.7 --criterion collect=3 > /dev/null
-# The exploring variant with grip and release trained before evolution
-# (EXPERIMENTS.md, "Training before evolution"): the training stage of
-# docs/experiments/practice-stage.txt (the paper's figure 8) appended, and the
-# collect stage's grip and release start their activation networks (4 hidden
-# units) from what they learned in it.
-sed 's#^    sense ir, barrier$#&\n    activation trained practice hidden 4#' $R/khepera-explore.bat > $R/khepera-practice.bat
-[ "$(grep -c '^    activation trained practice hidden 4$' $R/khepera-practice.bat)" = 2 ]
-cat $D/practice-stage.txt >> $R/khepera-practice.bat
+# examples/khepera-practice.bat: the exploring variant with grip and
+# release trained before evolution (the paper's figure 8), and figure 13's
+# test (bigger) with its two controls (bigger_nolearning, bigger_unchanged),
+# each 40 lives before and 40 after the change, the same lives in all three.
 # Its avoidance and navigation stages are the variant's: resumed from the
-# variant's runs (the checkpoints say they are done), not evolved again.
+# variant's runs (the checkpoints say they are done, and the files are
+# those a fresh run writes), not evolved again.
 rm -rf $R/khepera-practice
 for s in $(seq 1 $SEEDS); do
   mkdir -p $R/khepera-practice/seed-$s
   cp -r $R/khepera-explore/seed-$s/avoidance $R/khepera-explore/seed-$s/navigation $R/khepera-practice/seed-$s/
 done
-$B experiment $R/khepera-practice.bat --seeds $SEEDS --out $R/khepera-practice \
+$B experiment examples/khepera-practice.bat --seeds $SEEDS --out $R/khepera-practice \
   --criterion navigation=0.7 --criterion collect=3 > /dev/null
-# Figure 13 over many lives (EXPERIMENTS.md, "Figure 13 over many lives"):
-# khepera-practice's collect bests (the runs above: only stage bigger runs
-# again) are tested for 40 lives of 300 actions in the collect world, then
-# 40 lives in the changed world, one controller throughout, each life with
-# the paper's battery: with 25 mm objects, with the objects kept at 10 mm
-# (the control: no change), and with 25 mm objects without learning.
-for v in long control nolearning; do
-  case $v in
-    long) w='objects diameter 25mm'; l=with ;;
-    control) w='objects diameter 10mm'; l=with ;;
-    nolearning) w='objects diameter 25mm'; l=without ;;
-  esac
-  sed -e "s#world changes { objects diameter 25mm }#world changes { $w }#" \
-    -e "s#test best for 300 actions with learning#test best for 40 lives of 300 actions $l learning#" \
-    $R/khepera-practice.bat > $R/f13-$v.bat
-  grep -q "world changes { $w }" $R/f13-$v.bat
-  grep -q "test best for 40 lives of 300 actions $l learning" $R/f13-$v.bat
-  rm -rf $R/f13-$v
-  cp -r $R/khepera-practice $R/f13-$v
-  for s in $(seq 1 $SEEDS); do
-    $B run $R/f13-$v.bat --seed $s --out $R/f13-$v/seed-$s --quiet --no-report
-  done
-done
 # The level the same architecture reaches with 25 mm objects from the
 # start: khepera-practice.bat with 25 mm objects in its training stage and
-# in collect (the variant's avoidance and navigation reused), its bests
-# tested as above for 40 + 40 lives, all with 25 mm objects.
+# in collect (the variant's avoidance and navigation reused); its test
+# `bigger` then keeps 25 mm objects, and `bigger_unchanged` takes them from
+# 25 to 10 mm: the same individuals on both sides.
 sed -e 's#objects 8 diameter 10mm virtual#objects 8 diameter 25mm virtual#' \
-  -e 's#test best for 300 actions with learning#test best for 40 lives of 300 actions with learning#' \
-  $R/khepera-practice.bat > $R/f13-at25.bat
+  examples/khepera-practice.bat > $R/f13-at25.bat
 [ "$(grep -c 'objects 8 diameter 25mm virtual' $R/f13-at25.bat)" = 2 ]
-grep -q 'test best for 40 lives of 300 actions with learning' $R/f13-at25.bat
 rm -rf $R/f13-at25
 for s in $(seq 1 $SEEDS); do
   mkdir -p $R/f13-at25/seed-$s
   cp -r $R/khepera-explore/seed-$s/avoidance $R/khepera-explore/seed-$s/navigation $R/f13-at25/seed-$s/
 done
 $B experiment $R/f13-at25.bat --seeds $SEEDS --out $R/f13-at25 --criterion collect=3 > /dev/null
-# Its bests in the test with the objects going from 25 to 10 mm: the same
-# individuals on both sides.
-sed 's#world changes { objects diameter 25mm }#world changes { objects diameter 10mm }#' $R/f13-at25.bat > $R/f13-at25-to10.bat
-grep -q 'world changes { objects diameter 10mm }' $R/f13-at25-to10.bat
-rm -rf $R/f13-at25-to10
-cp -r $R/f13-at25 $R/f13-at25-to10
-for s in $(seq 1 $SEEDS); do
-  $B run $R/f13-at25-to10.bat --seed $s --out $R/f13-at25-to10/seed-$s --quiet --no-report
-done
 # Shaping against evolution from scratch on the whole task.
 $B experiment examples/scratch-full.bat --seeds $SEEDS --out $R/scratch-full --fresh --criterion full=3 > /dev/null
 
@@ -139,16 +105,18 @@ for s in $(seq 1 $SEEDS); do
   $B run examples/avoid.bat --seed $s --out $R/avoid-$s --fresh --quiet
 done
 
-# Figure 11: the collect best of seed 1 over 225 actions.
-$B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 > /dev/null
-$B replay $R/khepera-explore.bat --stage collect --run $R/khepera-explore/seed-1 --actions 225 --seed 101 --out $R/explore-figure11 > /dev/null
+# Figure 11: the collect best of seed 1 over 225 actions, as pictures and
+# as an animation.
+$B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 --gif $D/figure11.gif > /dev/null
+$B replay examples/khepera-practice.bat --stage collect --run $R/khepera-practice/seed-1 --actions 225 --seed 101 --out $R/practice-figure11 --gif $D/practice-figure11.gif > /dev/null
 
 # The F&M 1996 best of seed 1 over its 150 actions, for the picture.
 $B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed-1 --seed 101 --out $R/fm1996-replay > /dev/null
 
 for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
   figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement \
-  khepera-explore/fitness-seeds explore-figure11/activations explore-figure11/trajectory khepera-explore/seed-1/bigger/reinforcement; do
+  khepera-explore/fitness-seeds khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
+  khepera-practice/seed-1/bigger/reinforcement; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
 
@@ -156,8 +124,8 @@ done
 # gripping, releasing and recharging, and each seed's collect best with
 # perfect grip and release decisions (docs/experiments/oracle.rs).
 cargo build --release --quiet --example oracle
-target/release/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
-target/release/examples/oracle $R/khepera-explore.bat --run $R/khepera-explore > $R/oracle-explore.txt
+$T/examples/oracle examples/khepera.bat --run $R/khepera > $R/oracle.txt
+$T/examples/oracle $R/khepera-explore.bat --run $R/khepera-explore > $R/oracle-explore.txt
 
 # What the proximity sensors allow the grip and release decisions
 # (docs/experiments/discriminate.rs): rules fitted on the exploring
@@ -165,42 +133,44 @@ target/release/examples/oracle $R/khepera-explore.bat --run $R/khepera-explore >
 # quadratic) decide in the lives of the other half of the seeds; and how
 # well the real Khepera's readings tell a wall from a 25 mm cylinder.
 cargo build --release --quiet --example discriminate
-target/release/examples/discriminate $R/khepera-explore.bat --run $R/khepera-explore > $R/discriminate.txt
+$T/examples/discriminate $R/khepera-explore.bat --run $R/khepera-explore > $R/discriminate.txt
 
 # The grip script's mechanics alone (docs/experiments/grip.rs): the share of
 # objects it catches when started in front of one, with the four turns that
 # face the object and without them (the script before this report).
 cargo build --release --quiet --example grip
-target/release/examples/grip examples/khepera.bat > $R/grip.txt
+$T/examples/grip examples/khepera.bat > $R/grip.txt
 grep -v -E '^      turn (left|right)\((0.5|0.25)\) if ' examples/khepera.bat > $R/khepera-no-facing.bat
 [ "$(grep -c 'turn left(0.5) if' $R/khepera-no-facing.bat)" = 0 ]
-target/release/examples/grip $R/khepera-no-facing.bat > $R/grip-no-facing.txt
-target/release/examples/grip examples/khepera.bat --diameter 25 > $R/grip-25mm.txt
+$T/examples/grip $R/khepera-no-facing.bat > $R/grip-no-facing.txt
+$T/examples/grip examples/khepera.bat --diameter 25 > $R/grip-25mm.txt
 
 # What learning in the test does, and whether the architecture holds a grip
 # network that copes with 25 mm objects (docs/experiments/lives.rs):
-# khepera-practice's collect bests in the 40 + 40 lives of the f13 tests,
+# khepera-practice's collect bests in the 40 + 40 lives of its tests,
 # (a) with grip and release networks trained by the practice stage with
 # 25 mm objects instead of 10 mm (the same evolved links), and (b) with the
 # test learning at CRBP 0.5 / 0.25 and 0.5 / 0.5 instead of collect's
-# 0.5 / 0.1. The f13 files themselves (the lives of f13-long, f13-control
-# and f13-nolearning, which the tool reproduces) are the reference.
+# 0.5 / 0.1. The tests' own lives (which the tool reproduces) are the
+# reference.
 cargo build --release --quiet --example lives
-for v in long control nolearning; do
-  sed 's#objects 8 diameter 10mm virtual }  // as in collect#objects 8 diameter 25mm virtual }  // as in collect#' \
-    $R/f13-$v.bat > $R/lives-$v-practice25.bat
-  grep -q 'objects 8 diameter 25mm virtual }  // as in collect' $R/lives-$v-practice25.bat
-  [ "$(grep -c 'diameter 10mm virtual' $R/lives-$v-practice25.bat)" = 1 ]
-  target/release/examples/lives $R/f13-$v.bat --run $R/khepera-practice > $R/lives-$v.txt
-  target/release/examples/lives $R/lives-$v-practice25.bat --run $R/khepera-practice > $R/lives-$v-practice25.txt
+sed 's#objects 8 diameter 10mm virtual }  // as in collect#objects 8 diameter 25mm virtual }  // as in collect#' \
+  examples/khepera-practice.bat > $R/lives-practice25.bat
+grep -q 'objects 8 diameter 25mm virtual }  // as in collect' $R/lives-practice25.bat
+[ "$(grep -c 'diameter 10mm virtual' $R/lives-practice25.bat)" = 1 ]
+for r in 0.25 0.5; do
+  sed "s#^    learn crbp(0.5, 0.1) on activation always\$#    learn crbp(0.5, $r) on activation always#" \
+    examples/khepera-practice.bat > $R/lives-$r.bat
+  [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' examples/khepera-practice.bat)" = 2 ]
+  [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' $R/lives-$r.bat)" = 0 ]
 done
-for v in long control; do
+for v in bigger bigger_unchanged bigger_nolearning; do
+  $L examples/khepera-practice.bat --stage $v --run $R/khepera-practice > $R/lives-$v.txt
+  $L $R/lives-practice25.bat --stage $v --run $R/khepera-practice > $R/lives-$v-practice25.txt
+done
+for v in bigger bigger_unchanged; do
   for r in 0.25 0.5; do
-    sed "s#^    learn crbp(0.5, 0.1) on activation always\$#    learn crbp(0.5, $r) on activation always#" \
-      $R/f13-$v.bat > $R/lives-$v-$r.bat
-    [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' $R/f13-$v.bat)" = 2 ]
-    [ "$(grep -c '^    learn crbp(0.5, 0.1) on activation always$' $R/lives-$v-$r.bat)" = 0 ]
-    target/release/examples/lives $R/lives-$v-$r.bat --run $R/khepera-practice > $R/lives-$v-$r.txt
+    $L $R/lives-$r.bat --stage $v --run $R/khepera-practice > $R/lives-$v-$r.txt
   done
 done
 

@@ -980,6 +980,7 @@ fn test_files(
         "before": perf(&b), "after": perf(&a),
         "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
         "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
+        "reinforcement_counts": reinforcement_counts(stage, ba),
     });
     // Only when a world was too crowded to place apart: the lives that
     // overlap and their overlapping placements (absent: none).
@@ -1015,6 +1016,34 @@ fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json:
                 "before": mean(&sig[..s]), "after_first_100": mean(&sig[s..early]), "after_rest": mean(&sig[early..]),
             }),
         );
+    }
+    serde_json::Value::Object(out)
+}
+
+/// Each learning module's reinforcement signals counted life by life:
+/// `{module: {before: {rewards: [..], punishments: [..]}, after: {..}}}`,
+/// one number per life of each world (rewards are positive signals,
+/// punishments negative ones), so that a module's mean signal over any
+/// lives can be computed from `summary.json` alone.
+fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> serde_json::Value {
+    let mut out = serde_json::Map::new();
+    for (i, name) in report::learning_modules(stage) {
+        let sig = report::reinforcement_signals(&ba.trace, i);
+        let mut at = 0usize;
+        let mut world = |lives: &[EpisodeResult]| {
+            let (mut rewards, mut punishments) = (Vec::new(), Vec::new());
+            for r in lives {
+                let end = (at + r.actions as usize).min(sig.len());
+                let life = &sig[at.min(end)..end];
+                rewards.push(life.iter().filter(|&&x| x > 0.0).count());
+                punishments.push(life.iter().filter(|&&x| x < 0.0).count());
+                at = end;
+            }
+            serde_json::json!({ "rewards": rewards, "punishments": punishments })
+        };
+        let before = world(&ba.before);
+        let after = world(&ba.after);
+        out.insert(name, serde_json::json!({ "before": before, "after": after }));
     }
     serde_json::Value::Object(out)
 }

@@ -533,6 +533,16 @@ fn test_stage_runs_the_parents_best() {
     program.stages.push(stage("more", Some(1), layout(12, 10), StageRun::Evolve(evolution(10, 1))));
     let cp2 = start_stage(&program, 2, 8, Some(&cp)).unwrap();
     assert_eq!(cp2.population[0].bits[..40], best.bits[..]);
+    // A second test of the same best runs the first test's lives (paired).
+    program.stages.push(stage(
+        "check again",
+        Some(0),
+        layout(10, 10),
+        StageRun::Test { actions: 50, lives: 1, learning: true },
+    ));
+    let again = test_best(&program, 3, 8, &cp, &ones).unwrap();
+    assert_eq!((again.genome, again.seed), (best.clone(), out.seed));
+    assert_eq!(shaping_runtime::evolve::test_seed_stage(&program, 3), 1);
     // Misuse is reported.
     assert!(matches!(test_best(&program, 0, 8, &cp, &ones), Err(EvolveError::NotTest { .. })));
     assert!(matches!(start_stage(&program, 1, 8, Some(&cp)), Err(EvolveError::NotEvolved { .. })));

@@ -627,7 +627,7 @@ pub fn test_best(
 /// What test stage `stage` runs, without running it: the best individual of
 /// `parent` (which must be the final checkpoint of the nearest evolved
 /// ancestor, and fit the program) and the episode seed
-/// [`seed::test_seed`]`(seed, stage, 0)`.
+/// [`seed::test_seed`]`(seed, test_seed_stage(program, stage), 0)`.
 pub fn test_subject(
     program: &Program,
     stage: usize,
@@ -662,7 +662,26 @@ pub fn test_subject(
             ),
         });
     }
-    Ok(TestSubject { genome, parent_fitness, seed: seed::test_seed(seed, stage, 0) })
+    Ok(TestSubject {
+        genome,
+        parent_fitness,
+        seed: seed::test_seed(seed, test_seed_stage(program, stage), 0),
+    })
+}
+
+/// The stage whose place seeds the lives of test stage `stage`: the first
+/// test stage that tests the same evolved stage. So every test of one best
+/// runs the same lives (the same worlds, the same controller's random
+/// numbers): tests that differ only in their change or in learning are
+/// paired; the first (or only) test of a stage keeps its own seed.
+pub fn test_seed_stage(program: &Program, stage: usize) -> usize {
+    let Ok(Some(p)) = evolved_ancestor(program, stage) else { return stage };
+    (0..stage)
+        .find(|&i| {
+            matches!(program.stages[i].run, StageRun::Test { .. })
+                && evolved_ancestor(program, i).ok().flatten() == Some(p)
+        })
+        .unwrap_or(stage)
 }
 
 /// The best individual of a checkpoint's stage: `best`, or else the best of
