@@ -231,7 +231,62 @@ for run in ("khepera", "khepera-explore"):
 figure13("khepera-practice", "khepera-practice bigger (40 + 40 lives; objects 10 -> 25 mm, learning only)")
 
 
+# ---------------------------------------------------------------- figure 13, restated
+# From the run directories alone: each test's summary.json counts, per life,
+# the grip module's rewards and punishments (reinforcement_counts).
+GRIP = "grip (activation)"
 BLOCK = 10
+
+
+def mean_signal(counts, lives):
+    """(rewards - punishments) / (rewards + punishments) over the given lives, None without signals."""
+    r = sum(counts["rewards"][i] for i in lives)
+    p = sum(counts["punishments"][i] for i in lives)
+    return (r - p) / (r + p) if r + p else None
+
+
+def restated(run, title, learn="bigger", control="bigger_nolearning", unchanged="bigger_unchanged"):
+    print(f"\n== figure 13, the restated criterion: {title}")
+    counted = readapted = 0
+    out_l = out_nl = 0
+    gaps = []
+    for s in SEEDS:
+        sl, snl, su = summary(run, s, learn), summary(run, s, control), summary(run, s, unchanged)
+        L = sl["lives"]
+        cl, cnl, cu = (x["reinforcement_counts"][GRIP] for x in (sl, snl, su))
+        bl, al = mean_signal(cl["before"], range(L)), mean_signal(cl["after"], range(L))
+        bn, an = mean_signal(cnl["before"], range(L)), mean_signal(cnl["after"], range(L))
+        drop_nl = None if None in (bn, an) else bn - an
+        diff_l = None if None in (bl, al) else bl - al
+        count = drop_nl is not None and drop_nl >= 0.1
+        re = count and diff_l is not None and diff_l <= drop_nl / 2
+        counted += count
+        readapted += re
+        ol, onl = sl["after"]["releases_outside"], snl["after"]["releases_outside"]
+        out_l += ol
+        out_nl += onl
+        gap = []
+        for k in range(L // BLOCK):
+            lives = range(k * BLOCK, (k + 1) * BLOCK)
+            a, b = mean_signal(cl["after"], lives), mean_signal(cu["after"], lives)
+            gap.append(None if None in (a, b) else a - b)
+        gaps.append(gap)
+        f = lambda x: "  -  " if x is None else f"{x:+.2f}"
+        need = "" if not count else f" (needs <= {drop_nl / 2:+.2f}: {'met' if re else f'missed by {diff_l - drop_nl / 2:.2f}'})"
+        print(f"  seed {s:2d}: without learning {f(bn)} -> {f(an)}, drop {f(drop_nl)}{' counted' if count else ' not counted'}; "
+              f"with learning {f(bl)} -> {f(al)}, difference {f(diff_l)}{need}; "
+              f"released outside per life after the change {ol / L:.2f} with learning, {onl / L:.2f} without")
+    share = out_l / out_nl if out_nl else float("nan")
+    print(f"  seeds counted (drop without learning >= 0.1): {counted} of {N} (target >= 7); "
+          f"re-adaptation on {readapted} of {counted} counted (target >= 7)")
+    print(f"  task kept: released outside per life after the change, with learning {out_l / (N * L):.2f}, "
+          f"without {out_nl / (N * L):.2f}: {100 * share:.0f}% (target >= 75%)")
+    cols = [[g[k] for g in gaps if g[k] is not None] for k in range(len(gaps[0]))]
+    print(f"  with learning minus unchanged, each block of {BLOCK} lives after the change, median over seeds "
+          f"(lower on n seeds): " + "; ".join(f"{statistics.median(c):+.2f} ({sum(1 for x in c if x < 0)})" for c in cols))
+
+
+restated("khepera-practice", "khepera-practice.bat, 40 + 40 lives, objects 10 -> 25 mm, paired with learning off and with no change")
 
 
 # Figure 13 over many lives, block by block: khepera-practice's three tests
