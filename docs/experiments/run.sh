@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates every number and picture of EXPERIMENTS.md (a few minutes on
+# Regenerates every number and picture of EXPERIMENTS.md (about 15 minutes on
 # two cores). Results go to runs/experiments/; the pictures EXPERIMENTS.md
 # shows are copied next to this script; the numbers are printed.
 set -euo pipefail
@@ -114,8 +114,8 @@ $B replay examples/khepera-practice.bat --stage collect --run $R/khepera-practic
 $B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed-1 --seed 101 --out $R/fm1996-replay > /dev/null
 
 for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
-  figure11/activations figure11/trajectory khepera/seed-1/bigger/reinforcement \
-  khepera-explore/fitness-seeds khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
+  figure11/activations figure11/trajectory \
+  khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
   khepera-practice/seed-1/bigger/reinforcement; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
