@@ -361,7 +361,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
     match command {
         Command::Check { files, error_format } => check(&files, error_format),
         Command::Fmt { files, check, error_format } => fmt::fmt(&files, check, error_format),
-        Command::Lsp => lsp::lsp(),
+        Command::Lsp => lsp::stdio().map_err(|e| CliError::io(format!("error: language server: {e}"))),
         Command::Layout { file, stage, format, error_format } => {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;

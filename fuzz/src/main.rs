@@ -36,6 +36,11 @@
 //!   accepted weights are bound and the stage using them runs a short
 //!   episode.
 //!
+//! - `lsp`: streams of random and malformed JSON-RPC frames through the
+//!   language server's loop (`src/lsp`, in process): no panic, only whole
+//!   messages written, and a valid request at the end of the stream is
+//!   answered (`lsp_target.rs`). Not part of `all`: CI runs it on its own.
+//!
 //! The saved results (`checkpoint.json`, `trained.json`) are in the corpus
 //! both compact and as the engine writes them: pretty-printed and sealed
 //! with a checksum (`shaping_engine::files::seal`). Half of their JSON-tree
@@ -47,7 +52,9 @@
 //! `target/fuzz-crashes/`), and the run exits with status 1. Every crash
 //! found becomes a regression test.
 //!
-//! `shaping-fuzz [text|json|checkpoint|trained|all] [--secs N] [--seed S] [--crashes DIR]`
+//! `shaping-fuzz [text|json|checkpoint|trained|lsp|all] [--secs N] [--seed S] [--crashes DIR]`
+
+mod lsp_target;
 
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
@@ -553,11 +560,12 @@ fn args(root: &Path) -> Result<Args, String> {
             "json" => a.targets = vec!["json"],
             "checkpoint" => a.targets = vec!["checkpoint"],
             "trained" => a.targets = vec!["trained"],
+            "lsp" => a.targets = vec!["lsp"],
             "all" => a.targets = TARGETS.to_vec(),
             "--secs" => a.secs = value("--secs")?.parse().map_err(|e| format!("--secs: {e}"))?,
             "--seed" => a.seed = value("--seed")?.parse().map_err(|e| format!("--seed: {e}"))?,
             "--crashes" => a.crashes = PathBuf::from(value("--crashes")?),
-            _ => return Err(format!("unknown argument `{x}`; usage: shaping-fuzz [text|json|checkpoint|trained|all] [--secs N] [--seed S] [--crashes DIR]")),
+            _ => return Err(format!("unknown argument `{x}`; usage: shaping-fuzz [text|json|checkpoint|trained|lsp|all] [--secs N] [--seed S] [--crashes DIR]")),
         }
     }
     Ok(a)
@@ -595,6 +603,7 @@ fn main() {
     let json_corpus = bytes(&programs);
     let checkpoint_corpus = and_sealed(&saved.checkpoints);
     let trained_corpus = and_sealed(&saved.trained);
+    let messages = lsp_target::messages(&sources);
     // Quiet panics: they are reported with their input below.
     std::panic::set_hook(Box::new(|_| {}));
     let budget = Duration::from_secs_f64(args.secs / args.targets.len() as f64);
@@ -604,6 +613,7 @@ fn main() {
         // `seal`: the target reads saved results, which carry a checksum.
         let (corpus, trees, seal, run): (&[Vec<u8>], &[Value], bool, Target) = match *target {
             "text" => (&sources, &[], false, text_target),
+            "lsp" => (&sources, &[], false, lsp_target::target),
             "json" => (&json_corpus, &programs, false, json_target),
             "checkpoint" => (&checkpoint_corpus, &saved.checkpoints, true, checkpoint_target),
             _ => (&trained_corpus, &saved.trained, true, trained_target),
@@ -614,7 +624,9 @@ fn main() {
         RUNS.store(0, Ordering::Relaxed);
         RUNS_DONE.store(0, Ordering::Relaxed);
         while start.elapsed() < budget {
-            let input = if !trees.is_empty() && rng.random_range(0..3) > 0 {
+            let input = if *target == "lsp" {
+                lsp_target::input(&mut rng, &messages, corpus)
+            } else if !trees.is_empty() && rng.random_range(0..3) > 0 {
                 let mut v = trees[rng.random_range(0..trees.len())].clone();
                 for _ in 0..1 + rng.random_range(0..3) {
                     mutate_tree(&mut rng, &mut v);
@@ -650,6 +662,15 @@ fn main() {
             0 => String::new(),
             n => format!(", {n} runs of the engine ({} finished)", RUNS_DONE.load(Ordering::Relaxed)),
         };
+        if *target == "lsp" {
+            println!(
+                "lsp: {execs} streams in {:.1} s: the last request answered after {}; {} ended before it (exit, or a length past the end)",
+                start.elapsed().as_secs_f64(),
+                lsp_target::ANSWERED.load(Ordering::Relaxed),
+                lsp_target::ENDED.load(Ordering::Relaxed)
+            );
+            continue;
+        }
         println!(
             "{target}: {execs} inputs in {:.1} s, {} accepted and run{runs}, corpus {} files",
             start.elapsed().as_secs_f64(),

@@ -1,18 +1,8 @@
-//! `shaping lsp`: a language server over stdio (`lsp-server` + `lsp-types`).
-//!
-//! Documents are synchronised whole. Every change recompiles the document
-//! and publishes its diagnostics; requests (hover, definition, references,
-//! completion, document symbols, formatting) work from the last text. A file
-//! with syntax errors still has the AST of the parts that parse (the
-//! parser's recovery) and the program lowered from them, so hover,
-//! definitions, references, symbols and completion go on working there. Every
-//! request handler runs under `catch_unwind`: a bug answers an error, it
-//! never stops the server.
+//! The requests of the language server, on the documents it holds: each
+//! takes the text and a position and answers with `lsp-types` values.
 
 use std::collections::HashMap;
-use std::io::{BufRead as _, Read as _};
 
-use lsp_server::{Connection, Message, Notification, Request, Response};
 use lsp_types::{self as lt, Uri};
 use miette::Diagnostic as _;
 use serde_json::Value;
@@ -21,229 +11,96 @@ use shaping_compiler::syntax::lex::{lex, Token, TokenKind};
 use shaping_compiler::syntax::{self, ast, parse_recovering};
 use shaping_compiler::{render_layout, Program};
 
-use crate::CliError;
+use super::rpc::RpcError;
+use super::{params, Document};
 
-/// Runs the server on stdin and stdout until the client says `exit`.
-pub fn lsp() -> Result<(), CliError> {
-    let (conn, io) = stdio();
-    let served = serve(&conn);
-    drop(conn);
-    // An input the server cannot read ends it; what was wrong with it says
-    // more than the closed channel the server then found.
-    io.join().map_err(|e| CliError::io(format!("error: language server: {e}")))?;
-    served.map_err(|e| CliError::io(format!("error: language server: {e}")))
-}
-
-/// The largest message the server reads: a document is at most a few MiB;
-/// a `Content-Length` above this is refused before anything is allocated.
-pub const MAX_MESSAGE_BYTES: usize = 64 << 20;
-
-/// The reader and writer threads of [`stdio`].
-struct Io {
-    reader: std::thread::JoinHandle<std::io::Result<()>>,
-    writer: std::thread::JoinHandle<std::io::Result<()>>,
-}
-
-impl Io {
-    fn join(self) -> std::io::Result<()> {
-        let thread = |_| std::io::Error::other("an I/O thread of the server panicked");
-        self.reader.join().map_err(thread)??;
-        self.writer.join().map_err(thread)?
+/// A request on an open document (`null` for a document that is not open).
+pub(super) fn request(docs: &HashMap<String, Document>, method: &str, p: Value) -> Result<Value, RpcError> {
+    /// The document and the byte offset of a position in it.
+    fn at(docs: &HashMap<String, Document>, p: lt::TextDocumentPositionParams) -> Option<(&Document, usize)> {
+        let doc = docs.get(p.text_document.uri.as_str())?;
+        Some((doc, Lines::new(&doc.text).offset(p.position)))
     }
-}
-
-/// `lsp_server::Connection::stdio`, reading messages with [`read_message`]
-/// (which refuses one larger than [`MAX_MESSAGE_BYTES`]).
-fn stdio() -> (Connection, Io) {
-    let (server, client) = Connection::memory();
-    let Connection { sender: to_server, receiver: from_server } = client;
-    let reader = std::thread::spawn(move || {
-        let mut stdin = std::io::stdin().lock();
-        while let Some(msg) = read_message(&mut stdin)? {
-            let exit = matches!(&msg, Message::Notification(n) if n.method == "exit");
-            if to_server.send(msg).is_err() || exit {
-                break;
+    let doc = |id: &lt::TextDocumentIdentifier| docs.get(id.uri.as_str());
+    let answer = match method {
+        "textDocument/hover" => {
+            let p: lt::HoverParams = params(p)?;
+            at(docs, p.text_document_position_params).and_then(|(d, o)| hover(&d.text, o))
+        }
+        "textDocument/definition" => {
+            let p: lt::GotoDefinitionParams = params(p)?;
+            at(docs, p.text_document_position_params).map(|(d, o)| locations(&d.uri, &d.text, o, false))
+        }
+        "textDocument/references" => {
+            let p: lt::ReferenceParams = params(p)?;
+            at(docs, p.text_document_position).map(|(d, o)| locations(&d.uri, &d.text, o, true))
+        }
+        "textDocument/completion" => {
+            let p: lt::CompletionParams = params(p)?;
+            at(docs, p.text_document_position).map(|(d, o)| completion(&d.text, o))
+        }
+        "textDocument/documentSymbol" => {
+            let p: lt::DocumentSymbolParams = params(p)?;
+            doc(&p.text_document).map(|d| symbols(&d.text))
+        }
+        "textDocument/formatting" => {
+            let p: lt::DocumentFormattingParams = params(p)?;
+            match doc(&p.text_document) {
+                Some(d) => Some(formatting(&d.text)?),
+                None => None,
             }
         }
-        Ok(())
-    });
-    let writer = std::thread::spawn(move || {
-        let mut stdout = std::io::stdout().lock();
-        from_server.into_iter().try_for_each(|msg| msg.write(&mut stdout))
-    });
-    (server, Io { reader, writer })
-}
-
-/// One message of the base protocol (`Content-Length: N` and other headers,
-/// an empty line, N bytes of JSON); `None` at the end of the input.
-fn read_message(input: &mut impl std::io::BufRead) -> std::io::Result<Option<Message>> {
-    let bad = |what: String| std::io::Error::new(std::io::ErrorKind::InvalidData, what);
-    let mut size = None;
-    loop {
-        let mut line = String::new();
-        // A header line is short; a longer one is not a header.
-        if (&mut *input).take(1024).read_line(&mut line)? == 0 {
-            return Ok(None);
+        m => {
+            return Err(RpcError::new(RpcError::METHOD_NOT_FOUND, format!("method not found: `{m}`")));
         }
-        let Some(line) = line.strip_suffix("\r\n") else {
-            return Err(bad(format!("malformed header {line:?} (a header line ends with CR LF)")));
-        };
-        if line.is_empty() {
-            break;
-        }
-        let (name, value) = line.split_once(": ").ok_or_else(|| bad(format!("malformed header {line:?}")))?;
-        if name.eq_ignore_ascii_case("Content-Length") {
-            let n: u64 = value.parse().map_err(|e| bad(format!("bad Content-Length {value:?}: {e}")))?;
-            if n > MAX_MESSAGE_BYTES as u64 {
-                return Err(bad(format!(
-                    "a message of {n} bytes (its Content-Length) is larger than the {} MiB the server reads",
-                    MAX_MESSAGE_BYTES >> 20
-                )));
-            }
-            size = Some(n as usize);
-        }
-    }
-    let size = size.ok_or_else(|| bad("a message without Content-Length".into()))?;
-    let mut body = vec![0; size];
-    input.read_exact(&mut body)?;
-    serde_json::from_slice(&body).map(Some).map_err(|e| bad(format!("malformed message: {e}")))
-}
-
-fn capabilities() -> lt::ServerCapabilities {
-    lt::ServerCapabilities {
-        text_document_sync: Some(lt::TextDocumentSyncCapability::Kind(lt::TextDocumentSyncKind::FULL)),
-        hover_provider: Some(lt::HoverProviderCapability::Simple(true)),
-        definition_provider: Some(lt::OneOf::Left(true)),
-        references_provider: Some(lt::OneOf::Left(true)),
-        document_symbol_provider: Some(lt::OneOf::Left(true)),
-        document_formatting_provider: Some(lt::OneOf::Left(true)),
-        completion_provider: Some(lt::CompletionOptions::default()),
-        ..Default::default()
-    }
-}
-
-fn serve(conn: &Connection) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-    let caps = serde_json::to_value(capabilities())?;
-    conn.initialize(caps)?;
-    let mut docs: HashMap<String, (Uri, String)> = HashMap::new();
-    for msg in &conn.receiver {
-        match msg {
-            Message::Request(req) => {
-                if conn.handle_shutdown(&req)? {
-                    return Ok(());
-                }
-                let id = req.id.clone();
-                let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| request(&docs, &req)));
-                let resp = match result {
-                    Ok(Ok(v)) => Response::new_ok(id, v),
-                    Ok(Err(msg)) => Response::new_err(id, lsp_server::ErrorCode::MethodNotFound as i32, msg),
-                    Err(_) => Response::new_err(
-                        id,
-                        lsp_server::ErrorCode::InternalError as i32,
-                        "internal error of the shaping language server".into(),
-                    ),
-                };
-                conn.sender.send(Message::Response(resp))?;
-            }
-            Message::Notification(n) => {
-                if let Some((uri, text)) = document_change(&n) {
-                    let diags =
-                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| diagnostics(&uri, &text)))
-                            .unwrap_or_default();
-                    let params =
-                        lt::PublishDiagnosticsParams { uri: uri.clone(), diagnostics: diags, version: None };
-                    conn.sender.send(Message::Notification(Notification::new(
-                        "textDocument/publishDiagnostics".into(),
-                        params,
-                    )))?;
-                    docs.insert(uri.as_str().to_string(), (uri, text));
-                } else if n.method == "textDocument/didClose" {
-                    if let Ok(p) = serde_json::from_value::<lt::DidCloseTextDocumentParams>(n.params) {
-                        docs.remove(p.text_document.uri.as_str());
-                    }
-                }
-            }
-            Message::Response(_) => {}
-        }
-    }
-    Ok(())
-}
-
-/// The new text of a document opened or changed.
-fn document_change(n: &Notification) -> Option<(Uri, String)> {
-    match n.method.as_str() {
-        "textDocument/didOpen" => {
-            let p: lt::DidOpenTextDocumentParams = serde_json::from_value(n.params.clone()).ok()?;
-            Some((p.text_document.uri, p.text_document.text))
-        }
-        "textDocument/didChange" => {
-            let p: lt::DidChangeTextDocumentParams = serde_json::from_value(n.params.clone()).ok()?;
-            let text = p.content_changes.into_iter().next_back()?.text;
-            Some((p.text_document.uri, text))
-        }
-        _ => None,
-    }
-}
-
-fn request(docs: &HashMap<String, (Uri, String)>, req: &Request) -> Result<Value, String> {
-    let uri_of =
-        |v: &Value| -> Option<String> { v.get("textDocument")?.get("uri")?.as_str().map(str::to_string) };
-    let Some((uri, text)) = uri_of(&req.params).and_then(|u| docs.get(&u)) else {
-        return Ok(Value::Null);
     };
-    let pos = || -> Option<usize> {
-        let p: lt::Position = serde_json::from_value(req.params.get("position")?.clone()).ok()?;
-        Some(offset(text, p))
-    };
-    let json = |v: Option<Value>| -> Result<Value, String> { Ok(v.unwrap_or(Value::Null)) };
-    match req.method.as_str() {
-        "textDocument/hover" => json(pos().and_then(|o| hover(text, o))),
-        "textDocument/definition" => json(pos().map(|o| locations(uri, text, o, false))),
-        "textDocument/references" => json(pos().map(|o| locations(uri, text, o, true))),
-        "textDocument/completion" => json(pos().map(|o| completion(text, o))),
-        "textDocument/documentSymbol" => json(Some(symbols(text))),
-        "textDocument/formatting" => json(formatting(text)),
-        m => Err(format!("`{m}` is not supported")),
-    }
+    Ok(answer.unwrap_or(Value::Null))
 }
 
 // ------------------------------------------------------------------ positions
 
-/// The byte offset of an LSP position (UTF-16 columns), clamped to the text.
-fn offset(text: &str, p: lt::Position) -> usize {
-    let mut line_start = 0;
-    for _ in 0..p.line {
-        match text[line_start..].find('\n') {
-            Some(i) => line_start += i + 1,
-            None => return text.len(),
-        }
-    }
-    let line = &text[line_start..];
-    let line = &line[..line.find('\n').unwrap_or(line.len())];
-    let mut units = 0;
-    for (i, c) in line.char_indices() {
-        if units >= p.character as usize {
-            return line_start + i;
-        }
-        units += c.len_utf16();
-    }
-    line_start + line.len()
+/// A text with the offsets of its line starts: positions in time
+/// logarithmic in the lines and linear in the line's length.
+pub(super) struct Lines<'t> {
+    text: &'t str,
+    starts: Vec<usize>,
 }
 
-/// The LSP position of a byte offset.
-fn position(text: &str, offset: usize) -> lt::Position {
-    let mut offset = offset.min(text.len());
-    while !text.is_char_boundary(offset) {
-        offset -= 1;
+impl<'t> Lines<'t> {
+    pub(super) fn new(text: &'t str) -> Lines<'t> {
+        let starts = std::iter::once(0).chain(text.match_indices('\n').map(|(i, _)| i + 1)).collect();
+        Lines { text, starts }
     }
-    let before = &text[..offset];
-    let line = before.matches('\n').count();
-    let col = before.rfind('\n').map_or(before, |i| &before[i + 1..]);
-    lt::Position::new(line as u32, col.encode_utf16().count() as u32)
-}
 
-fn range(text: &str, start: usize, end: usize) -> lt::Range {
-    lt::Range::new(position(text, start), position(text, end))
+    /// The byte offset of an LSP position (UTF-16 columns), clamped to the text.
+    fn offset(&self, p: lt::Position) -> usize {
+        let Some(&start) = self.starts.get(p.line as usize) else { return self.text.len() };
+        let line = &self.text[start..];
+        let line = &line[..line.find('\n').unwrap_or(line.len())];
+        let mut units = 0;
+        for (i, c) in line.char_indices() {
+            if units >= p.character as usize {
+                return start + i;
+            }
+            units += c.len_utf16();
+        }
+        start + line.len()
+    }
+
+    /// The LSP position of a byte offset.
+    fn position(&self, offset: usize) -> lt::Position {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line = self.starts.partition_point(|&s| s <= offset) - 1;
+        let col = self.text[self.starts[line]..offset].encode_utf16().count();
+        lt::Position::new(line as u32, col as u32)
+    }
+
+    fn range(&self, start: usize, end: usize) -> lt::Range {
+        lt::Range::new(self.position(start), self.position(end))
+    }
 }
 
 // ------------------------------------------------------------------ diagnostics
@@ -252,12 +109,13 @@ fn range(text: &str, start: usize, end: usize) -> lt::Range {
 /// related information.
 pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
     let (_, d) = shaping_compiler::check(text, "document.bat");
+    let lines = Lines::new(text);
     d.errors()
         .iter()
         .map(|e| {
             let labels: Vec<miette::LabeledSpan> = e.labels().map(|l| l.collect()).unwrap_or_default();
             let primary = labels.iter().find(|l| l.primary()).or(labels.first());
-            let r = primary.map_or(range(text, 0, 0), |l| range(text, l.offset(), l.offset() + l.len()));
+            let r = primary.map_or(lines.range(0, 0), |l| lines.range(l.offset(), l.offset() + l.len()));
             let mut message = e.to_string();
             if let Some(label) = primary.and_then(|l| l.label()) {
                 message += &format!(" ({label})");
@@ -269,7 +127,7 @@ pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
                 .iter()
                 .filter(|l| primary.is_none_or(|p| !std::ptr::eq(*l, p)))
                 .map(|l| lt::DiagnosticRelatedInformation {
-                    location: lt::Location::new(uri.clone(), range(text, l.offset(), l.offset() + l.len())),
+                    location: lt::Location::new(uri.clone(), lines.range(l.offset(), l.offset() + l.len())),
                     message: l.label().unwrap_or("here").to_string(),
                 })
                 .collect();
@@ -356,8 +214,9 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
         // The first declaration: a module redeclared by a later stage is defined where it first appears.
         decls.iter().take(1).map(|d| (d.2.span.start, d.2.span.end)).collect()
     };
+    let lines = Lines::new(text);
     let locs: Vec<lt::Location> =
-        spans.into_iter().map(|(a, b)| lt::Location::new(uri.clone(), range(text, a, b))).collect();
+        spans.into_iter().map(|(a, b)| lt::Location::new(uri.clone(), lines.range(a, b))).collect();
     serde_json::to_value(locs).unwrap_or(Value::Null)
 }
 
@@ -448,9 +307,10 @@ fn hover(text: &str, offset: usize) -> Option<Value> {
     };
     // What the program does not hold (a stage in an `extends` cycle, say) is named only.
     let md = md().unwrap_or_else(|| format!("**{} `{word}`**", format!("{kind:?}").to_lowercase()));
+    let lines = Lines::new(text);
     let h = lt::Hover {
         contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value: md }),
-        range: Some(range(text, a, b)),
+        range: Some(lines.range(a, b)),
     };
     serde_json::to_value(h).ok()
 }
@@ -560,7 +420,7 @@ enum Context {
 /// The words that start a world item, from the grammar's `world_item` rule
 /// (each item's first keyword), so that they follow the grammar.
 fn world_items() -> Vec<String> {
-    const GRAMMAR: &str = include_str!("../grammar/shaping.pest");
+    const GRAMMAR: &str = include_str!("../../grammar/shaping.pest");
     // The first quoted word of a rule's definition, through `k_...` rules.
     fn first_word(rule: &str, depth: usize) -> Option<String> {
         let line = GRAMMAR.lines().find(|l| l.split_whitespace().next() == Some(rule) && l.contains('='))?;
@@ -772,7 +632,7 @@ fn lineage_or_all(file: Option<&ast::File>, offset: usize) -> Vec<&ast::StageDec
 
 #[allow(deprecated)] // `DocumentSymbol::deprecated` must be given
 fn symbol(
-    text: &str,
+    lines: &Lines,
     name: &ast::Name,
     kind: lt::SymbolKind,
     children: Vec<lt::DocumentSymbol>,
@@ -783,30 +643,31 @@ fn symbol(
         kind,
         tags: None,
         deprecated: None,
-        range: range(text, name.span.start, name.span.end),
-        selection_range: range(text, name.span.start, name.span.end),
+        range: lines.range(name.span.start, name.span.end),
+        selection_range: lines.range(name.span.start, name.span.end),
         children: (!children.is_empty()).then_some(children),
     }
 }
 
 fn symbols(text: &str) -> Value {
     let Some(file) = parse_recovering(text).0 else { return Value::Null };
+    let lines = Lines::new(text);
     let mut out = Vec::new();
     for r in &file.robots {
-        let hw = r.hardware.iter().map(|h| symbol(text, &h.name, lt::SymbolKind::FIELD, vec![])).collect();
-        out.push((r.span.start, symbol(text, &r.name, lt::SymbolKind::STRUCT, hw)));
+        let hw = r.hardware.iter().map(|h| symbol(&lines, &h.name, lt::SymbolKind::FIELD, vec![])).collect();
+        out.push((r.span.start, symbol(&lines, &r.name, lt::SymbolKind::STRUCT, hw)));
     }
     for s in &file.stages {
         let modules = s
             .items
             .iter()
             .filter_map(|i| match i {
-                ast::StageItem::Module(m) => Some(symbol(text, &m.name, lt::SymbolKind::MODULE, vec![])),
+                ast::StageItem::Module(m) => Some(symbol(&lines, &m.name, lt::SymbolKind::MODULE, vec![])),
                 _ => None,
             })
             .collect();
-        let mut sym = symbol(text, &s.name, lt::SymbolKind::CLASS, modules);
-        sym.range = range(text, s.span.start, s.span.end);
+        let mut sym = symbol(&lines, &s.name, lt::SymbolKind::CLASS, modules);
+        sym.range = lines.range(s.span.start, s.span.end);
         out.push((s.span.start, sym));
     }
     out.sort_by_key(|s| s.0);
@@ -814,12 +675,28 @@ fn symbols(text: &str) -> Value {
     serde_json::to_value(out).unwrap_or(Value::Null)
 }
 
-fn formatting(text: &str) -> Option<Value> {
-    let out = shaping_compiler::fmt::format(text, "document.bat").ok()?;
+/// The whole text formatted, or why it cannot be.
+fn formatting(text: &str) -> Result<Value, RpcError> {
+    use shaping_compiler::fmt::FormatError;
+    let out = shaping_compiler::fmt::format(text, "document.bat").map_err(|e| {
+        let why = match e {
+            FormatError::Syntax(d) => {
+                let n = d.error_count();
+                let first =
+                    d.errors().iter().find(|e| !e.is_warning()).map(|e| e.to_string()).unwrap_or_default();
+                match n {
+                    1 => format!("it does not parse: {first}"),
+                    _ => format!("it does not parse ({n} errors; the first: {first})"),
+                }
+            }
+            FormatError::Changed(why) => format!("a bug of the formatter: {why}"),
+        };
+        RpcError::new(RpcError::REQUEST_FAILED, format!("the document is left as it is: {why}"))
+    })?;
     let edits = if out == text {
         vec![]
     } else {
-        vec![lt::TextEdit { range: range(text, 0, text.len()), new_text: out }]
+        vec![lt::TextEdit { range: Lines::new(text).range(0, text.len()), new_text: out }]
     };
-    serde_json::to_value(edits).ok()
+    Ok(serde_json::to_value(edits).expect("edits serialise"))
 }
