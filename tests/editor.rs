@@ -268,13 +268,15 @@ fn hover_definition_references_completion_symbols_and_formatting() {
     // references of a sensor
     let r = c.at("textDocument/references", URI, &src, "sensor battery", 8);
     assert!(r["result"].as_array().unwrap().len() >= 5, "{r}");
-    // completion offers the names
+    // completion in a stage's body offers what a stage may hold
     let comp = c.at("textDocument/completion", URI, &src, "links all", 0);
     let labels: Vec<&str> =
         comp["result"].as_array().unwrap().iter().filter_map(|i| i["label"].as_str()).collect();
-    for want in ["wander", "navigation", "light", "claw", "module", "evolvable"] {
+    for want in ["module", "links", "link", "world", "evolve", "fitness", "test", "train", "genome", "robot"]
+    {
         assert!(labels.contains(&want), "{want} missing from {labels:?}");
     }
+    assert!(!labels.contains(&"wander") && !labels.contains(&"sense"), "{labels:?}");
     // document symbols: the robot and the stages with their modules
     let s = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": URI } }));
     let names: Vec<&str> =
@@ -555,10 +557,180 @@ fn completion_after_a_motion_offers_the_motions() {
         }
         assert!(!labels.contains(&"ir".to_string()), "{labels:?}");
     }
-    // elsewhere: keywords and every name
-    let labels = completions(&mut c, TUTOR, "stage first {\n");
-    for want in ["module", "fitness", "go", "practice", "light"] {
-        assert!(labels.contains(&want.to_string()), "{want} missing from {labels:?}");
+    c.stop();
+}
+
+/// Completion offers exactly what the compiler accepts where the cursor is.
+#[test]
+fn completion_by_context_everywhere() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    let has = |labels: &[String], want: &[&str], not: &[&str], at: &str| {
+        for w in want {
+            assert!(labels.contains(&w.to_string()), "at `{at}`: {w} missing from {labels:?}");
+        }
+        for w in not {
+            assert!(!labels.contains(&w.to_string()), "at `{at}`: {w} offered in {labels:?}");
+        }
+    };
+    // after `behavior`: the steps, not the decoding table's bare turns
+    let at = "module go { sense ir[2..3]  behavior ";
+    let labels = completions(&mut c, TUTOR, at);
+    has(
+        &labels,
+        &["script", "neural", "toward", "wait", "recharge", "forward", "turn", "stop", "wheels(0.5, 0.5)"],
+        &["left", "right", "ir", "module"],
+        at,
+    );
+    // in a module's body: what a module may hold
+    let text = TUTOR.replacen(
+        "module go { sense ir[2..3]  behavior forward }",
+        "module go { sense ir[2..3]
+    
+  behavior forward }",
+        1,
+    );
+    let labels = completions(
+        &mut c,
+        &text,
+        "sense ir[2..3]
+    ",
+    );
+    assert_eq!(labels, ["sense", "activation", "behavior", "learn", "reinforce"], "module body");
+    // at the top level
+    let labels = completions(&mut c, TUTOR, "  actuator wheels[2] speed\n}\n");
+    assert_eq!(labels, ["robot", "genome", "stage"], "top level");
+    // in `evolve { }`
+    let text = TUTOR.replacen(
+        "fitness per action wheels[0]",
+        "fitness per action wheels[0]
+  evolve { population 10  }",
+        1,
+    );
+    let labels = completions(&mut c, &text, "evolve { population 10 ");
+    has(
+        &labels,
+        &["population", "generations", "evaluations", "elitism", "selection"],
+        &["module", "arena", "sense"],
+        "evolve",
+    );
+    // in a fitness expression: functions and the hardware
+    let text = TUTOR.replacen("fitness per action wheels[0]", "fitness per action wheels[0] * ", 1);
+    let labels = completions(&mut c, &text, "wheels[0] * ");
+    has(&labels, &["max", "abs", "not", "prev", "ir", "wheels"], &["module", "population"], "fitness");
+    // after a number and `per`: the events
+    let text = TUTOR.replacen("fitness per action wheels[0]", "fitness per action wheels[0], 0.5 per ", 1);
+    let labels = completions(&mut c, &text, "0.5 per ");
+    has(&labels, &["grip", "release", "collision", "recharge"], &["action", "module"], "bonus");
+    // after `sensor NAME`: the kinds of the catalog
+    let text = TUTOR.replacen("sensor light[8]    ambient", "sensor light[8] ", 1);
+    let labels = completions(&mut c, &text, "sensor light[8] ");
+    has(
+        &labels,
+        &["proximity", "ambient", "level", "optical", "ground", "lamp_distance"],
+        &["speed"],
+        "sensor kind",
+    );
+    // after `module` in a later stage: the inherited modules, to change one
+    let text = TUTOR.replacen("module turn {", "module  turn {", 1);
+    assert_eq!(completions(&mut c, &text, "module  "), ["go"]);
+    c.stop();
+}
+
+#[test]
+fn hover_on_keywords_says_what_they_mean_with_a_link() {
+    let mut c = Client::start();
+    let src = example("khepera.bat");
+    c.open(URI, &src);
+    for (needle, word, section) in [
+        ("toward(", "toward", "10-scripts"),
+        ("evolve {", "evolve", "7-evolution"),
+        ("sense ", "sense", "9-modules"),
+        ("proximity", "proximity", "3-the-robot"),
+    ] {
+        let h = c.at("textDocument/hover", URI, &src, needle, 1);
+        let md = h["result"]["contents"]["value"].as_str().unwrap_or_default();
+        assert!(md.starts_with(&format!("**`{word}`**: ")), "{needle}: {h}");
+        assert!(md.contains(&format!("docs/language.md#{section}")), "{needle}: {md}");
+    }
+    c.stop();
+}
+
+#[test]
+fn quick_fixes_for_did_you_mean_and_declare_hints() {
+    let mut c = Client::start();
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+               stage s {\n  fitness per action wheels[0]\n\
+               module m { sense irr  behavior script { claw closed; forward } }\n}\n";
+    let d = c.open(URI, src);
+    assert_eq!(d.len(), 2, "{d:?}");
+    let actions = c.request(
+        "textDocument/codeAction",
+        json!({ "textDocument": { "uri": URI }, "range": { "start": { "line": 0, "character": 0 }, "end": { "line": 5, "character": 0 } },
+                "context": { "diagnostics": [] } }),
+    );
+    let list = actions["result"].as_array().unwrap();
+    let titles: Vec<&str> = list.iter().filter_map(|a| a["title"].as_str()).collect();
+    assert_eq!(titles, ["replace with `ir`", "declare `actuator claw grip` in the robot"], "{actions}");
+    // applied, the file compiles
+    let mut fixed = src.to_string();
+    let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    for a in list {
+        for e in a["edit"]["changes"][URI].as_array().unwrap() {
+            let off = |p: &Value| {
+                let line = p["line"].as_u64().unwrap() as usize;
+                let start: usize = src.split_inclusive('\n').take(line).map(str::len).sum();
+                start + p["character"].as_u64().unwrap() as usize
+            };
+            edits.push((
+                off(&e["range"]["start"]),
+                off(&e["range"]["end"]),
+                e["newText"].as_str().unwrap().into(),
+            ));
+        }
+    }
+    edits.sort_by_key(|e| std::cmp::Reverse(e.0));
+    for (a, b, t) in edits {
+        fixed.replace_range(a..b, &t);
+    }
+    assert_eq!(c.change(URI, 2, &fixed), Vec::<Value>::new(), "{fixed}");
+    c.stop();
+}
+
+#[test]
+fn rename_modules_and_stages() {
+    let mut c = Client::start();
+    c.open(URI, TUTOR);
+    // a module: its declarations and every use
+    let p = c.at("textDocument/prepareRename", URI, TUTOR, "link turn", 6);
+    assert_eq!(p["result"]["placeholder"], json!("turn"), "{p}");
+    let pos = |needle: &str, extra: usize| {
+        let off = TUTOR.find(needle).unwrap() + extra;
+        json!({ "line": TUTOR[..off].matches('\n').count(), "character": off - TUTOR[..off].rfind('\n').map_or(0, |i| i + 1) })
+    };
+    let r = c.request(
+        "textDocument/rename",
+        json!({ "textDocument": { "uri": URI }, "position": pos("module go", 8), "newName": "ahead" }),
+    );
+    let edits = r["result"]["changes"][URI].as_array().unwrap();
+    assert_eq!(edits.len(), 2, "{r}");
+    // a stage: its declaration, `extends` and nothing else
+    let r = c.request(
+        "textDocument/rename",
+        json!({ "textDocument": { "uri": URI }, "position": pos("extends first", 9), "newName": "basic" }),
+    );
+    assert_eq!(r["result"]["changes"][URI].as_array().unwrap().len(), 2, "{r}");
+    // refused: a sensor, a reserved word, a name in use
+    let p = c.at("textDocument/prepareRename", URI, TUTOR, "sense ir", 7);
+    assert_eq!(p["result"], Value::Null, "{p}");
+    for (name, why) in
+        [("module", "reserved"), ("steer", "already the name of a module"), ("2x", "not a name")]
+    {
+        let r = c.request(
+            "textDocument/rename",
+            json!({ "textDocument": { "uri": URI }, "position": pos("module go", 8), "newName": name }),
+        );
+        assert!(r["error"]["message"].as_str().unwrap_or_default().contains(why), "{name}: {r}");
     }
     c.stop();
 }

@@ -314,6 +314,46 @@ impl Diagnostics {
     }
 }
 
+/// What a diagnostic's help proposes, as an edit an editor can make.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Suggestion {
+    /// Write `with` instead of the word at `span` (a "did you mean").
+    Replace { span: crate::syntax::Span, with: String },
+    /// Declare this hardware (`actuator arm lift`) in the robot.
+    Declare { line: String },
+}
+
+impl Error {
+    /// The suggestion of the help: a "did you mean `x`?" of
+    /// [`did_you_mean`] on a diagnostic labelled on one word, or a
+    /// "declare `sensor ...`" or "declare ... `actuator ...`".
+    pub fn suggestion(&self) -> Option<Suggestion> {
+        let help = self.help()?.to_string();
+        let quoted = |from: &str| -> Option<String> {
+            let rest = &help[help.find(from)? + from.len()..];
+            Some(rest[..rest.find('`')?].to_string())
+        };
+        if let Some(with) = quoted(DID_YOU_MEAN) {
+            let mut labels = self.labels()?;
+            let l = labels.find(|l| l.primary()).or_else(|| self.labels()?.next())?;
+            return Some(Suggestion::Replace {
+                span: crate::syntax::Span { start: l.offset(), end: l.offset() + l.len() },
+                with,
+            });
+        }
+        if help.starts_with("declare") {
+            let line = quoted("`")?;
+            if line.starts_with("actuator ") || line.starts_with("sensor ") {
+                return Some(Suggestion::Declare { line });
+            }
+        }
+        None
+    }
+}
+
+/// How [`did_you_mean`] starts its help.
+const DID_YOU_MEAN: &str = "did you mean `";
+
 /// The closest candidate within a small Levenshtein distance (about one edit
 /// per three characters of `name`), as a help message.
 pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<String> {
@@ -323,7 +363,7 @@ pub fn did_you_mean<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str
         .map(|c| (strsim::levenshtein(name, c), c))
         .filter(|(d, _)| *d <= limit)
         .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| format!("did you mean `{c}`?"))
+        .map(|(_, c)| format!("{DID_YOU_MEAN}{c}`?"))
 }
 
 #[cfg(test)]

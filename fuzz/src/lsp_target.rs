@@ -51,6 +51,15 @@ pub fn messages(sources: &[Vec<u8>]) -> Vec<Value> {
         {
             out.push(json!({ "jsonrpc": "2.0", "id": i * 10 + n, "method": method, "params": at(line, (i % 30) as u32) }));
         }
+        let mut rename = at(line, 9);
+        rename["newName"] = json!(["x", "module", "go", "2"][i % 4]);
+        out.push(
+            json!({ "jsonrpc": "2.0", "id": i * 10 + 5, "method": "textDocument/rename", "params": rename }),
+        );
+        out.push(json!({ "jsonrpc": "2.0", "id": i * 10 + 6, "method": "textDocument/prepareRename", "params": at(line, 9) }));
+        out.push(json!({ "jsonrpc": "2.0", "id": i * 10 + 7, "method": "textDocument/codeAction",
+            "params": { "textDocument": doc, "range": { "start": { "line": 0, "character": 0 }, "end": { "line": line, "character": 0 } },
+                        "context": { "diagnostics": [] } } }));
         let mut refs = at(line, 8);
         refs["context"] = json!({ "includeDeclaration": true });
         out.push(json!({ "jsonrpc": "2.0", "id": format!("r{i}"), "method": "textDocument/references", "params": refs }));

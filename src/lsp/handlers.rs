@@ -6,9 +6,9 @@ use std::collections::HashMap;
 use lsp_types::{self as lt, Uri};
 use miette::Diagnostic as _;
 use serde_json::Value;
+use shaping_compiler::ide::{self, Kind};
 use shaping_compiler::lower::lower_partial;
-use shaping_compiler::syntax::lex::{lex, Token, TokenKind};
-use shaping_compiler::syntax::{self, ast, parse_recovering};
+use shaping_compiler::syntax::{ast, parse_recovering};
 use shaping_compiler::{render_layout, Program};
 
 use super::rpc::RpcError;
@@ -49,6 +49,45 @@ pub(super) fn request(docs: &HashMap<String, Document>, method: &str, p: Value) 
                 Some(d) => Some(formatting(&d.text)?),
                 None => None,
             }
+        }
+        "textDocument/prepareRename" => {
+            let p: lt::TextDocumentPositionParams = params(p)?;
+            at(docs, p).and_then(|(d, o)| {
+                let (span, name) = ide::prepare_rename(&d.text, o)?;
+                let range = Lines::new(&d.text).range(span.start, span.end);
+                serde_json::to_value(lt::PrepareRenameResponse::RangeWithPlaceholder {
+                    range,
+                    placeholder: name,
+                })
+                .ok()
+            })
+        }
+        "textDocument/rename" => {
+            let p: lt::RenameParams = params(p)?;
+            match at(docs, p.text_document_position) {
+                Some((d, o)) => {
+                    let spans = ide::rename(&d.text, o, &p.new_name)
+                        .map_err(|why| RpcError::new(RpcError::REQUEST_FAILED, why))?;
+                    let lines = Lines::new(&d.text);
+                    let edits: Vec<lt::TextEdit> = spans
+                        .into_iter()
+                        .map(|s| lt::TextEdit {
+                            range: lines.range(s.start, s.end),
+                            new_text: p.new_name.clone(),
+                        })
+                        .collect();
+                    let edit = lt::WorkspaceEdit {
+                        changes: Some([(d.uri.clone(), edits)].into_iter().collect()),
+                        ..Default::default()
+                    };
+                    Some(serde_json::to_value(edit).expect("edits serialise"))
+                }
+                None => None,
+            }
+        }
+        "textDocument/codeAction" => {
+            let p: lt::CodeActionParams = params(p)?;
+            doc(&p.text_document).map(|d| code_actions(d, p.range))
         }
         m => {
             return Err(RpcError::new(RpcError::METHOD_NOT_FOUND, format!("method not found: `{m}`")));
@@ -147,51 +186,53 @@ pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
         .collect()
 }
 
-// ------------------------------------------------------------------ names
+// ------------------------------------------------------------------ quick fixes
 
-/// What a name is declared as.
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-enum Kind {
-    Stage,
-    Module,
-    Sensor,
-    Actuator,
+/// The quick fixes of the diagnostics that touch `range`: each
+/// suggestion of a help ("did you mean", "declare ...") as an edit.
+fn code_actions(d: &Document, range: lt::Range) -> Value {
+    let lines = Lines::new(&d.text);
+    let (from, to) = (lines.offset(range.start), lines.offset(range.end));
+    let (_, diagnostics) = shaping_compiler::check(&d.text, "document.bat");
+    let published = self::diagnostics(&d.uri, &d.text);
+    let mut actions = Vec::new();
+    for (e, shown) in diagnostics.errors().iter().zip(published) {
+        let (a, b) = (lines.offset(shown.range.start), lines.offset(shown.range.end));
+        if b < from || a > to {
+            continue;
+        }
+        for fix in ide::fixes(&d.text, e) {
+            let edits: Vec<lt::TextEdit> = fix
+                .edits
+                .into_iter()
+                .map(|(s, new_text)| lt::TextEdit { range: lines.range(s.start, s.end), new_text })
+                .collect();
+            actions.push(lt::CodeActionOrCommand::CodeAction(lt::CodeAction {
+                title: fix.title,
+                kind: Some(lt::CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![shown.clone()]),
+                edit: Some(lt::WorkspaceEdit {
+                    changes: Some([(d.uri.clone(), edits)].into_iter().collect()),
+                    ..Default::default()
+                }),
+                is_preferred: Some(true),
+                ..Default::default()
+            }));
+        }
+    }
+    serde_json::to_value(actions).expect("code actions serialise")
 }
+
+// ------------------------------------------------------------------ names
 
 /// Every declaration of the document: (name, kind, span of the name, stage).
 fn declarations(file: &ast::File) -> Vec<(String, Kind, ast::Name, Option<String>)> {
-    let mut out = Vec::new();
-    let hw = |h: &ast::Hardware, stage: Option<String>| {
-        let k = if h.is_sensor { Kind::Sensor } else { Kind::Actuator };
-        (h.name.text.clone(), k, h.name.clone(), stage)
-    };
-    for r in &file.robots {
-        out.extend(r.hardware.iter().map(|h| hw(h, None)));
-    }
-    for s in &file.stages {
-        out.push((s.name.text.clone(), Kind::Stage, s.name.clone(), None));
-        for i in &s.items {
-            match i {
-                ast::StageItem::Module(m) => {
-                    out.push((m.name.text.clone(), Kind::Module, m.name.clone(), Some(s.name.text.clone())))
-                }
-                ast::StageItem::RobotAdds(hws, _) => {
-                    out.extend(hws.iter().map(|h| hw(h, Some(s.name.text.clone()))))
-                }
-                _ => {}
-            }
-        }
-    }
-    out
+    ide::declarations(file).into_iter().map(|d| (d.name.text.clone(), d.kind, d.name, d.stage)).collect()
 }
 
 /// The word at a byte offset and its span.
 fn word_at(text: &str, offset: usize) -> Option<(usize, usize)> {
-    let lx = lex(text);
-    lx.tokens
-        .iter()
-        .find(|t| t.kind == TokenKind::Word && t.span.start <= offset && offset <= t.span.end)
-        .map(|t| (t.span.start, t.span.end))
+    ide::word_at(text, offset).map(|s| (s.start, s.end))
 }
 
 /// Definitions (or, with `refs`, every use) of the name at `offset`.
@@ -204,12 +245,7 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
         return Value::Null;
     }
     let spans: Vec<(usize, usize)> = if refs {
-        lex(text)
-            .tokens
-            .iter()
-            .filter(|t| t.kind == TokenKind::Word && &text[t.span.start..t.span.end] == word)
-            .map(|t| (t.span.start, t.span.end))
-            .collect()
+        ide::uses(text, word).into_iter().map(|s| (s.start, s.end)).collect()
     } else {
         // The first declaration: a module redeclared by a later stage is defined where it first appears.
         decls.iter().take(1).map(|d| (d.2.span.start, d.2.span.end)).collect()
@@ -223,6 +259,20 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
 // ------------------------------------------------------------------ hover
 
 fn hover(text: &str, offset: usize) -> Option<Value> {
+    let markdown = |value: String, (a, b): (usize, usize)| {
+        let h = lt::Hover {
+            contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value }),
+            range: Some(Lines::new(text).range(a, b)),
+        };
+        serde_json::to_value(h).ok()
+    };
+    if let Some((span, w)) = ide::keyword_at(text, offset) {
+        let md = format!(
+            "**`{}`**: {}\n\n[docs/language.md#{2}](docs/language.md#{2})",
+            w.text, w.meaning, w.section
+        );
+        return markdown(md, (span.start, span.end));
+    }
     let (a, b) = word_at(text, offset)?;
     let word = &text[a..b];
     let file = parse_recovering(text).0?;
@@ -306,13 +356,8 @@ fn hover(text: &str, offset: usize) -> Option<Value> {
         })
     };
     // What the program does not hold (a stage in an `extends` cycle, say) is named only.
-    let md = md().unwrap_or_else(|| format!("**{} `{word}`**", format!("{kind:?}").to_lowercase()));
-    let lines = Lines::new(text);
-    let h = lt::Hover {
-        contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value: md }),
-        range: Some(lines.range(a, b)),
-    };
-    serde_json::to_value(h).ok()
+    let md = md().unwrap_or_else(|| format!("**{} `{word}`**", kind.as_str()));
+    markdown(md, (a, b))
 }
 
 /// The name of a percept channel: `ir[3]`, `battery`.
@@ -326,308 +371,25 @@ fn channel(p: &Program, stage: usize, c: u16) -> String {
 
 // ------------------------------------------------------------------ completion, symbols, formatting
 
-/// Words of the language that are not reserved (those are
-/// `syntax::RESERVED`), offered by completion.
-const WORDS: &[&str] = &[
-    "train",
-    "lives",
-    "trained",
-    "error",
-    "difference",
-    "squared",
-    "script",
-    "commit",
-    "neural",
-    "outputs",
-    "weights",
-    "hidden",
-    "range",
-    "bits",
-    "crbp",
-    "always",
-    "evolvable",
-    "fixed",
-    "random",
-    "forward",
-    "back",
-    "turn",
-    "left",
-    "right",
-    "stop",
-    "toward",
-    "wait",
-    "recharge",
-    "arena",
-    "charger",
-    "battery",
-    "objects",
-    "body",
-    "wall",
-    "cylinder",
-    "lamp",
-    "zone",
-    "start",
-    "heading",
-    "grey",
-    "intensity",
-    "recurrent",
-    "population",
-    "generations",
-    "actions",
-    "seed",
-    "selection",
-    "mutation",
-    "crossover",
-    "proximity",
-    "ambient",
-    "level",
-    "optical",
-    "ground",
-    "lamp_distance",
-    "speed",
-    "lift",
-    "grip",
-    "max",
-    "min",
-    "sum",
-    "mean",
-    "abs",
-    "sign",
-    "sqrt",
-];
-
-/// Where the cursor is, as completion sees it.
-#[derive(Debug, PartialEq, Eq)]
-enum Context {
-    /// After `sense` (or in its list), in `toward(`: the robot's sensors.
-    Sensors,
-    /// After `link` or `link A ->`: the modules of the stage.
-    Modules,
-    /// After `extends`: the other stages.
-    Stages,
-    /// After `trained`: the training stages.
-    TrainingStages,
-    /// In a `world { }` block: its items.
-    World,
-    /// After `on` in a world: the walls.
-    Walls,
-    /// After `behavior`, `->` or `|` of a decoding table: the motions.
-    Motions,
-    /// Anywhere else: keywords and names.
-    Anywhere,
-}
-
-/// The words that start a world item, from the grammar's `world_item` rule
-/// (each item's first keyword), so that they follow the grammar.
-fn world_items() -> Vec<String> {
-    const GRAMMAR: &str = include_str!("../../grammar/shaping.pest");
-    // The first quoted word of a rule's definition, through `k_...` rules.
-    fn first_word(rule: &str, depth: usize) -> Option<String> {
-        let line = GRAMMAR.lines().find(|l| l.split_whitespace().next() == Some(rule) && l.contains('='))?;
-        let body = &line[line.find('=')? + 1..];
-        let body = body.trim_start_matches([' ', '_', '@', '{']);
-        if let Some(rest) = body.strip_prefix('"') {
-            return rest.split('"').next().map(str::to_string);
-        }
-        let head: String = body.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
-        (depth < 4).then(|| first_word(&head, depth + 1)).flatten()
-    }
-    let Some(line) = GRAMMAR.lines().find(|l| l.starts_with("world_item")) else { return vec![] };
-    let alts = line.split_once('{').map_or("", |x| x.1).trim_end().trim_end_matches('}');
-    alts.split('|').filter_map(|r| first_word(r.trim(), 0)).collect()
-}
-
-/// The kind of the innermost block open at `offset` (`stage`, `module`,
-/// `world`, ...: the keyword before its `{`), `None` at top level.
-fn block_at<'t>(text: &'t str, tokens: &[Token]) -> Option<&'t str> {
-    let mut stack: Vec<Option<&str>> = Vec::new();
-    for (i, t) in tokens.iter().enumerate() {
-        match &text[t.span.start..t.span.end] {
-            "{" => {
-                let head = tokens[i.saturating_sub(4)..i]
-                    .iter()
-                    .rev()
-                    .map(|t| &text[t.span.start..t.span.end])
-                    .find(|w| {
-                        matches!(
-                            *w,
-                            "stage"
-                                | "module"
-                                | "world"
-                                | "robot"
-                                | "genome"
-                                | "evolve"
-                                | "body"
-                                | "neural"
-                                | "script"
-                                | "behavior"
-                        )
-                    });
-                stack.push(head);
-            }
-            "}" => {
-                stack.pop();
-            }
-            _ => {}
-        }
-    }
-    stack.pop().flatten()
-}
-
-/// The completion context at `offset`.
-fn context(text: &str, offset: usize) -> Context {
-    let all = lex(text).tokens;
-    // The tokens before the word being typed.
-    let before: Vec<Token> = all
-        .into_iter()
-        .take_while(|t| t.span.end < offset || (t.span.start < offset && t.kind != TokenKind::Word))
-        .collect();
-    let w = |k: usize| -> &str {
-        before.len().checked_sub(k + 1).map_or("", |i| &text[before[i].span.start..before[i].span.end])
-    };
-    match (w(0), w(1)) {
-        ("sense", _) | ("(", "toward") => return Context::Sensors,
-        ("link", _) => return Context::Modules,
-        (">", "-") if w(3) == "link" => return Context::Modules,
-        (">", "-") | ("|", _) | ("behavior", _) => return Context::Motions,
-        ("extends", _) => return Context::Stages,
-        ("trained", _) => return Context::TrainingStages,
-        _ => {}
-    }
-    // In a list of sensors: `sense ir, light[2..5], `.
-    if w(0) == "," {
-        for k in 1..before.len() {
-            match w(k) {
-                "sense" => return Context::Sensors,
-                "toward" => return Context::Sensors,
-                "," | "[" | "]" | "." | "(" => {}
-                x if x.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') => {}
-                _ => break,
-            }
-        }
-    }
-    match block_at(text, &before) {
-        Some("world") if w(0) == "on" => Context::Walls,
-        Some("world") => Context::World,
-        _ => Context::Anywhere,
-    }
-}
-
-/// The stage declared around `offset`, and its ancestors by `extends`.
-fn lineage(file: &ast::File, offset: usize) -> Vec<&ast::StageDecl> {
-    let mut out: Vec<&ast::StageDecl> = Vec::new();
-    let mut cur = file.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end);
-    while let Some(s) = cur {
-        if out.iter().any(|o| std::ptr::eq(*o, s)) {
-            break;
-        }
-        out.push(s);
-        cur = s.extends.as_ref().and_then(|e| file.stages.iter().find(|p| p.name.text == e.text));
-    }
-    out
-}
-
-fn item(label: &str, kind: lt::CompletionItemKind, detail: &str) -> lt::CompletionItem {
-    lt::CompletionItem {
-        label: label.to_string(),
-        kind: Some(kind),
-        detail: (!detail.is_empty()).then(|| detail.to_string()),
-        ..Default::default()
-    }
-}
-
-/// The motions of scripts and decoding tables.
-const MOTIONS: &[&str] = &["forward", "back", "turn left", "turn right", "left", "right", "stop"];
-
 fn completion(text: &str, offset: usize) -> Value {
+    use ide::CompletionKind as C;
     use lt::CompletionItemKind as K;
-    let ctx = context(text, offset);
-    let file = parse_recovering(text).0;
-    let file = file.as_ref();
-    let stages = lineage_or_all(file, offset);
-    let hardware = |sensor: bool| -> Vec<String> {
-        let mut names: Vec<String> = Vec::new();
-        let robots = file.iter().flat_map(|f| f.robots.iter()).flat_map(|r| r.hardware.iter());
-        let added = stages.iter().flat_map(|s| s.items.iter()).flat_map(|i| match i {
-            ast::StageItem::RobotAdds(h, _) => h.iter().collect(),
-            _ => Vec::new(),
-        });
-        for h in robots.chain(added) {
-            if h.is_sensor == sensor && !names.contains(&h.name.text) {
-                names.push(h.name.text.clone());
-            }
-        }
-        names
-    };
-    let items: Vec<lt::CompletionItem> = match ctx {
-        Context::Sensors => hardware(true).iter().map(|n| item(n, K::VARIABLE, "sensor")).collect(),
-        Context::Modules => {
-            let mut names: Vec<&str> = Vec::new();
-            for s in stages.iter().rev() {
-                for i in &s.items {
-                    if let ast::StageItem::Module(m) = i {
-                        if !names.contains(&m.name.text.as_str()) {
-                            names.push(&m.name.text);
-                        }
-                    }
-                }
-            }
-            names.iter().map(|n| item(n, K::MODULE, "module")).collect()
-        }
-        Context::Stages | Context::TrainingStages => {
-            let here =
-                file.and_then(|f| f.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end));
-            file.iter()
-                .flat_map(|f| f.stages.iter())
-                .filter(|s| here.is_none_or(|h| h.name.text != s.name.text))
-                .filter(|s| {
-                    ctx == Context::Stages
-                        || s.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }))
-                })
-                .map(|s| item(&s.name.text, K::CLASS, "stage"))
-                .collect()
-        }
-        Context::World => world_items().iter().map(|w| item(w, K::KEYWORD, "world item")).collect(),
-        Context::Walls => {
-            ["north", "south", "east", "west"].iter().map(|w| item(w, K::KEYWORD, "wall")).collect()
-        }
-        Context::Motions => {
-            let mut out: Vec<lt::CompletionItem> =
-                MOTIONS.iter().map(|m| item(m, K::KEYWORD, "motion")).collect();
-            for a in hardware(false) {
-                out.push(item(&format!("{a}(0.5, 0.5)"), K::FUNCTION, "wheel speeds"));
-            }
-            out
-        }
-        Context::Anywhere => {
-            let mut out: Vec<lt::CompletionItem> =
-                syntax::RESERVED.iter().chain(WORDS).map(|k| item(k, K::KEYWORD, "")).collect();
-            let mut seen = std::collections::HashSet::new();
-            for (name, kind, _, _) in file.map(declarations).unwrap_or_default() {
-                if seen.insert(name.clone()) {
-                    let k = match kind {
-                        Kind::Stage => K::CLASS,
-                        Kind::Module => K::MODULE,
-                        Kind::Sensor | Kind::Actuator => K::VARIABLE,
-                    };
-                    out.push(item(&name, k, &format!("{kind:?}").to_lowercase()));
-                }
-            }
-            out
-        }
-    };
-    serde_json::to_value(items).unwrap_or(Value::Null)
-}
-
-/// The stage at `offset` and its ancestors; outside any stage, every stage.
-fn lineage_or_all(file: Option<&ast::File>, offset: usize) -> Vec<&ast::StageDecl> {
-    let Some(f) = file else { return Vec::new() };
-    let l = lineage(f, offset);
-    if l.is_empty() {
-        f.stages.iter().collect()
-    } else {
-        l
-    }
+    let items: Vec<lt::CompletionItem> = ide::complete(text, offset)
+        .into_iter()
+        .map(|c| lt::CompletionItem {
+            kind: Some(match c.kind {
+                C::Keyword | C::Motion => K::KEYWORD,
+                C::Function => K::FUNCTION,
+                C::Sensor | C::Actuator => K::VARIABLE,
+                C::Module => K::MODULE,
+                C::Stage => K::CLASS,
+            }),
+            detail: (!c.detail.is_empty()).then_some(c.detail),
+            label: c.label,
+            ..Default::default()
+        })
+        .collect();
+    serde_json::to_value(items).expect("completions serialise")
 }
 
 #[allow(deprecated)] // `DocumentSymbol::deprecated` must be given

@@ -116,6 +116,11 @@ fn capabilities() -> lt::ServerCapabilities {
         document_symbol_provider: Some(lt::OneOf::Left(true)),
         document_formatting_provider: Some(lt::OneOf::Left(true)),
         completion_provider: Some(lt::CompletionOptions::default()),
+        rename_provider: Some(lt::OneOf::Right(lt::RenameOptions {
+            prepare_provider: Some(true),
+            work_done_progress_options: Default::default(),
+        })),
+        code_action_provider: Some(lt::CodeActionProviderCapability::Simple(true)),
         ..Default::default()
     }
 }
