@@ -271,3 +271,75 @@ pub fn words() -> Vec<Word> {
 pub fn word(text: &str) -> Option<Word> {
     words().into_iter().find(|w| w.text == text)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lower::{expr, module, training, world};
+    use crate::syntax::RESERVED;
+
+    fn has(text: &str) -> bool {
+        words().iter().any(|w| w.text == text)
+    }
+
+    #[test]
+    fn words_are_listed_once_with_a_meaning_and_a_section() {
+        let all = words();
+        for (i, w) in all.iter().enumerate() {
+            assert!(!all[..i].iter().any(|o| o.text == w.text), "`{}` twice", w.text);
+            assert!(!w.meaning.is_empty() && !w.section.is_empty(), "`{}`", w.text);
+            assert!(w.places != 0, "`{}` has no place", w.text);
+        }
+    }
+
+    /// The reserved words are exactly the keywords.
+    #[test]
+    fn reserved_words_are_the_keywords() {
+        for r in RESERVED {
+            assert_eq!(word(r).map(|w| w.kind), Some(WordKind::Keyword), "`{r}`");
+        }
+        for w in words().iter().filter(|w| w.kind == WordKind::Keyword) {
+            assert!(RESERVED.contains(&w.text), "`{}` is listed as reserved, and is not", w.text);
+        }
+    }
+
+    /// Every word the checks accept by name is listed.
+    #[test]
+    fn the_compilers_lists_are_in_the_words() {
+        let lists: [&[&str]; 5] = [
+            &expr::FUNCTIONS,
+            &module::ACTIONS,
+            &training::EVOLVE_SETTINGS,
+            &training::EVENTS,
+            &world::BODY_SETTINGS,
+        ];
+        for list in lists {
+            for entry in list {
+                for w in entry.split(' ') {
+                    assert!(has(w), "the compiler accepts `{w}`, which ide/words.rs does not list");
+                }
+            }
+        }
+        for w in ["darwinian", "lamarckian", "truncation", "roulette"] {
+            assert!(has(w), "{w}");
+        }
+    }
+
+    /// Every word the grammar spells out (`"stage"`) is listed.
+    #[test]
+    fn the_grammars_words_are_in_the_words() {
+        const GRAMMAR: &str = include_str!("../../../grammar/shaping.pest");
+        let mut missing = Vec::new();
+        for (i, _) in GRAMMAR.match_indices('"') {
+            let rest = &GRAMMAR[i + 1..];
+            let Some(end) = rest.find('"') else { break };
+            let lit = &rest[..end];
+            if lit.len() > 1 && lit.chars().all(|c| c.is_ascii_lowercase() || c == '_') && !has(lit) {
+                missing.push(lit);
+            }
+        }
+        missing.sort();
+        missing.dedup();
+        assert_eq!(missing, Vec::<&str>::new(), "words of grammar/shaping.pest that ide/words.rs lacks");
+    }
+}

@@ -47,7 +47,7 @@ enum Val {
     Err,
 }
 
-const FUNCTIONS: [&str; 7] = ["max", "min", "sum", "mean", "abs", "sign", "sqrt"];
+pub(crate) const FUNCTIONS: [&str; 7] = ["max", "min", "sum", "mean", "abs", "sign", "sqrt"];
 
 impl Lower<'_> {
     /// Lowers an expression that must give a number; `None` after an error.

@@ -7,11 +7,11 @@
 //! pushed into a sink and lowering goes on with placeholders, so one mistake
 //! is reported once and every independent mistake is reported.
 
-mod expr;
+pub(crate) mod expr;
 mod genes;
-mod module;
-mod training;
-mod world;
+pub(crate) mod module;
+pub(crate) mod training;
+pub(crate) mod world;
 
 use std::collections::HashMap;
 

@@ -10,7 +10,8 @@ use crate::syntax::ast::{self, ActionDecl, EndDecl, ModuleItem, Motion};
 use crate::syntax::Span;
 
 /// The words that start an action (`turn toward(...)` starts with `turn`).
-const ACTIONS: [&str; 8] = ["forward", "back", "turn", "stop", "toward", "wait", "recharge", "reinforce"];
+pub(crate) const ACTIONS: [&str; 8] =
+    ["forward", "back", "turn", "stop", "toward", "wait", "recharge", "reinforce"];
 
 impl Lower<'_> {
     /// Declares a new module, or changes an inherited one.

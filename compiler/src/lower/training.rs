@@ -10,6 +10,23 @@ use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast;
 use crate::syntax::Span;
 
+/// The settings of `evolve { }`.
+pub(crate) const EVOLVE_SETTINGS: [&str; 10] = [
+    "population",
+    "generations",
+    "actions",
+    "seed",
+    "selection",
+    "crossover",
+    "mutation",
+    "elitism",
+    "evaluations",
+    "inheritance",
+];
+
+/// The events of fitness bonuses.
+pub(crate) const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
+
 impl Lower<'_> {
     pub(super) fn run(&mut self, st: &mut StageSt, decl: &ast::StageDecl, has_parent: bool) {
         use ast::StageItem as I;
@@ -108,18 +125,6 @@ impl Lower<'_> {
     }
 
     pub(super) fn evolve(&mut self, st: &mut StageSt, settings: &[ast::Setting]) {
-        const NAMES: [&str; 10] = [
-            "population",
-            "generations",
-            "actions",
-            "seed",
-            "selection",
-            "crossover",
-            "mutation",
-            "elitism",
-            "evaluations",
-            "inheritance",
-        ];
         let ev = &mut st.evolution;
         let mut keep_span = None;
         let mut population_span = None;
@@ -209,7 +214,7 @@ impl Lower<'_> {
                         }
                     }
                 }
-                _ if NAMES.contains(&n) => {
+                _ if EVOLVE_SETTINGS.contains(&n) => {
                     self.value_error(
                         set.span,
                         format!("`{n}` has the wrong kind of value"),
@@ -221,7 +226,7 @@ impl Lower<'_> {
                     span: set.name.span.into(),
                     what: "evolution setting",
                     name: n.to_string(),
-                    help: did_you_mean(n, NAMES),
+                    help: did_you_mean(n, EVOLVE_SETTINGS),
                 }),
             }
         }
@@ -296,7 +301,6 @@ impl Lower<'_> {
                 }
             }
         }
-        const EVENTS: [&str; 4] = ["grip", "release outside", "recharge", "collision"];
         self.repeated("bonus for the event", f.bonuses.iter().map(|b| (b.event.text.clone(), b.span)));
         for b in &f.bonuses {
             let event = match b.event.text.as_str() {

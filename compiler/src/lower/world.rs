@@ -10,6 +10,10 @@ use super::*;
 use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, Unit};
 
+/// The settings of `body { }`.
+pub(crate) const BODY_SETTINGS: [&str; 6] =
+    ["radius", "wheel_base", "v_max", "action", "wheel_noise", "sensor_noise"];
+
 impl Lower<'_> {
     pub(super) fn world(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str) {
         use ast::WorldItem as W;
@@ -549,19 +553,18 @@ impl Lower<'_> {
     }
 
     pub(super) fn body(&mut self, body: &mut Body, settings: &[ast::Setting]) {
-        const NAMES: [&str; 6] = ["radius", "wheel_base", "v_max", "action", "wheel_noise", "sensor_noise"];
         self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
             let n = set.name.text.as_str();
             let ast::SettingValue::Quantity(q) = &set.value else {
-                if NAMES.contains(&n) {
+                if BODY_SETTINGS.contains(&n) {
                     self.value_error(set.span, format!("`{n}` needs a number"), "not a number", None);
                 } else {
                     self.errors.push(Error::Unknown {
                         span: set.name.span.into(),
                         what: "body setting",
                         name: n.into(),
-                        help: did_you_mean(n, NAMES),
+                        help: did_you_mean(n, BODY_SETTINGS),
                     });
                 }
                 continue;
@@ -606,7 +609,7 @@ impl Lower<'_> {
                     span: set.name.span.into(),
                     what: "body setting",
                     name: n.into(),
-                    help: did_you_mean(n, NAMES),
+                    help: did_you_mean(n, BODY_SETTINGS),
                 }),
             }
         }

@@ -11,6 +11,7 @@ mod parse;
 mod props;
 mod recover;
 mod ui;
+mod words;
 
 use std::path::Path;
 
