@@ -59,6 +59,9 @@ enum Command {
     },
     /// Run the language server on standard input and output (for editors).
     Lsp,
+    /// Explain a diagnostic code (`S0006`): what it means, a file that
+    /// produces it and the same file fixed.
+    Explain { code: String },
     /// Show the genome layout the compiler derived for a stage.
     Layout {
         file: PathBuf,
@@ -362,6 +365,16 @@ fn dispatch(command: Command) -> Result<(), CliError> {
         Command::Check { files, error_format } => check(&files, error_format),
         Command::Fmt { files, check, error_format } => fmt::fmt(&files, check, error_format),
         Command::Lsp => lsp::stdio().map_err(|e| CliError::io(format!("error: language server: {e}"))),
+        Command::Explain { code } => match shaping_compiler::explain::explain(&code) {
+            Some(e) => out!("{}", shaping_compiler::explain::render(e)),
+            None => Err(CliError::new(
+                shaping_engine::ErrorKind::Invalid,
+                format!(
+                    "error: no diagnostic has the code `{code}` (the codes are S0001 to S{:04})",
+                    shaping_compiler::explain::EXPLANATIONS.len()
+                ),
+            )),
+        },
         Command::Layout { file, stage, format, error_format } => {
             let program = load::load_program(&file, error_format)?;
             let index = load::stage_index(&program, stage.as_deref())?;

@@ -210,6 +210,7 @@ fn diagnostics_as_you_type_with_related_information() {
     assert_eq!(d.len(), 2, "{d:?}");
     let ligth = &d.iter().find(|d| d["message"].as_str().unwrap().contains("ligth")).unwrap();
     assert!(ligth["message"].as_str().unwrap().contains("did you mean `light`?"), "{ligth}");
+    assert_eq!(ligth["code"], json!("S0006"), "{ligth}");
     let line = bad[..bad.find("sense ligth").unwrap()].matches('\n').count();
     assert_eq!(ligth["range"]["start"]["line"], json!(line));
     // a module declared twice: the first declaration is related information

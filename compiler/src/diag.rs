@@ -12,6 +12,7 @@ use thiserror::Error;
 pub enum Error {
     /// "expected X, found Y", or a bracket that is not closed.
     #[error("{message}")]
+    #[diagnostic(code(S0001))]
     Syntax {
         #[label("{label}")]
         span: SourceSpan,
@@ -24,7 +25,7 @@ pub enum Error {
     },
 
     #[error("the file is too complex to parse: {reason}")]
-    #[diagnostic(help("architecture files are a few kilobytes; split this one or simplify it"))]
+    #[diagnostic(code(S0002), help("architecture files are a few kilobytes; split this one or simplify it"))]
     TooComplex {
         #[label("parsing gave up here")]
         span: SourceSpan,
@@ -32,7 +33,7 @@ pub enum Error {
     },
 
     #[error("line {line} is longer than {limit} bytes")]
-    #[diagnostic(help("break it into shorter lines"))]
+    #[diagnostic(code(S0003), help("break it into shorter lines"))]
     LineTooLong {
         #[label("this line")]
         span: SourceSpan,
@@ -41,7 +42,7 @@ pub enum Error {
     },
 
     #[error("{what} deeper than {limit} levels")]
-    #[diagnostic(help("split the construct into simpler parts"))]
+    #[diagnostic(code(S0004), help("split the construct into simpler parts"))]
     TooDeep {
         #[label("too deep")]
         span: SourceSpan,
@@ -50,7 +51,7 @@ pub enum Error {
     },
 
     #[error("the expression has more than {limit} parts")]
-    #[diagnostic(help("split it, for example into several fitness terms"))]
+    #[diagnostic(code(S0005), help("split it, for example into several fitness terms"))]
     TooLarge {
         #[label("too large")]
         span: SourceSpan,
@@ -58,6 +59,7 @@ pub enum Error {
     },
 
     #[error("unknown {what} `{name}`")]
+    #[diagnostic(code(S0006))]
     Unknown {
         #[label("not declared")]
         span: SourceSpan,
@@ -68,6 +70,7 @@ pub enum Error {
     },
 
     #[error("{what} `{name}` is declared twice")]
+    #[diagnostic(code(S0007))]
     Duplicate {
         #[label("declared again here")]
         span: SourceSpan,
@@ -78,6 +81,7 @@ pub enum Error {
     },
 
     #[error("index {index} is out of range for `{name}`, which has {count} elements")]
+    #[diagnostic(code(S0008))]
     IndexOutOfRange {
         #[label("out of range")]
         span: SourceSpan,
@@ -89,6 +93,7 @@ pub enum Error {
     },
 
     #[error("the range `{range}` is {why}")]
+    #[diagnostic(code(S0009))]
     BadRange {
         #[label("{why} range")]
         span: SourceSpan,
@@ -99,6 +104,7 @@ pub enum Error {
     },
 
     #[error("expected {expected}, found {found}")]
+    #[diagnostic(code(S0010))]
     Type {
         #[label("{found}")]
         span: SourceSpan,
@@ -109,6 +115,7 @@ pub enum Error {
     },
 
     #[error("a gene has 1 to 16 bits, not {value}")]
+    #[diagnostic(code(S0011))]
     Bits {
         #[label("bits out of range")]
         span: SourceSpan,
@@ -116,7 +123,7 @@ pub enum Error {
     },
 
     #[error("stages extend each other in a cycle: {cycle}")]
-    #[diagnostic(help("a stage can only extend a stage that does not depend on it"))]
+    #[diagnostic(code(S0012), help("a stage can only extend a stage that does not depend on it"))]
     Cycle {
         #[label("this stage is part of the cycle")]
         span: SourceSpan,
@@ -126,6 +133,7 @@ pub enum Error {
     },
 
     #[error("the reinforcement program of `{module}` reads `{sensor}`, which the module does not sense")]
+    #[diagnostic(code(S0013))]
     NotSensed {
         /// Primary: two reads in one module are two errors at two places,
         /// though the module's inputs come first in the file.
@@ -140,13 +148,14 @@ pub enum Error {
     },
 
     #[error("`until` has no bound")]
-    #[diagnostic(help("add `within N actions` so that the step cannot run forever"))]
+    #[diagnostic(code(S0014), help("add `within N actions` so that the step cannot run forever"))]
     UnboundedUntil {
         #[label("this condition may never become true")]
         span: SourceSpan,
     },
 
     #[error("stage `{stage}` has no {what} `{name}`")]
+    #[diagnostic(code(S0015))]
     MissingHardware {
         #[label("used here")]
         span: SourceSpan,
@@ -158,7 +167,7 @@ pub enum Error {
     },
 
     #[error("stage `{stage}` changes {what}, frozen by stage `{by}`")]
-    #[diagnostic(help("a later stage may add modules and links, but the genes of earlier stages are masked; declare a new module instead"))]
+    #[diagnostic(code(S0016), help("a later stage may add modules and links, but the genes of earlier stages are masked; declare a new module instead"))]
     Frozen {
         #[label("changed here")]
         span: SourceSpan,
@@ -170,6 +179,7 @@ pub enum Error {
     },
 
     #[error("expected {expected}, found {found}")]
+    #[diagnostic(code(S0017))]
     Unit {
         #[label("wrong unit")]
         span: SourceSpan,
@@ -180,6 +190,7 @@ pub enum Error {
     },
 
     #[error("{message}")]
+    #[diagnostic(code(S0018))]
     Value {
         #[label("{label}")]
         span: SourceSpan,
@@ -190,7 +201,7 @@ pub enum Error {
     },
 
     #[error("the expression needs {depth} stack slots, more than {max}")]
-    #[diagnostic(help("simplify it, for example by aggregating fewer values at once"))]
+    #[diagnostic(code(S0019), help("simplify it, for example by aggregating fewer values at once"))]
     StackTooDeep {
         #[label("too deep")]
         span: SourceSpan,
@@ -200,7 +211,7 @@ pub enum Error {
 
     /// A warning: the file compiles, but a name looks like a typo.
     #[error("new module `{name}` is one edit away from inherited module `{similar}`")]
-    #[diagnostic(severity(Warning))]
+    #[diagnostic(code(S0020), severity(Warning))]
     SimilarName {
         #[label("a new module")]
         span: SourceSpan,
@@ -214,6 +225,7 @@ pub enum Error {
     },
 
     #[error("{message}")]
+    #[diagnostic(code(S0021))]
     Conflict {
         #[label("{label}")]
         span: SourceSpan,

@@ -9,11 +9,13 @@
 //! - [`lower`]: resolves names, checks everything, derives genome layouts;
 //! - [`layout`]: readable renderings of a compiled stage (layout table, DOT graph);
 //! - [`fmt`]: the formatter (`shaping fmt`, the language server's formatting);
-//! - [`diag`]: the error enum and the [`Diagnostics`] collection;
+//! - [`diag`]: the error enum (each variant a stable code, `S0001`...) and the
+//!   [`Diagnostics`] collection; [`explain`]: each code's long explanation;
 //! - [`ide`]: what an editor asks (completion, hover words, rename, quick
 //!   fixes), as plain data for the language server.
 
 pub mod diag;
+pub mod explain;
 pub mod fmt;
 pub mod ide;
 pub mod layout;

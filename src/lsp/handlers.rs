@@ -178,6 +178,7 @@ pub fn diagnostics(uri: &Uri, text: &str) -> Vec<lt::Diagnostic> {
                     lt::DiagnosticSeverity::ERROR
                 }),
                 source: Some("shaping".into()),
+                code: e.code().map(|c| lt::NumberOrString::String(c.to_string())),
                 message,
                 related_information: (!related.is_empty()).then_some(related),
                 ..Default::default()

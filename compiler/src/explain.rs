@@ -1,0 +1,222 @@
+//! The long explanation of every diagnostic code (`shaping explain S0006`):
+//! what the code means, a file that produces it and the same file fixed.
+//! A test compiles both: the wrong one must produce the code, the right
+//! one must compile without it.
+//!
+//! Examples too long to print (a line of 5000 bytes) are written with a
+//! repetition, `[[N*TEXT]]` (TEXT N times), which [`expand`] spells out.
+
+/// The explanation of one code.
+#[derive(Clone, Copy, Debug)]
+pub struct Explanation {
+    pub code: &'static str,
+    /// What the diagnostic says, in a few words.
+    pub title: &'static str,
+    /// Why it happens and how to fix it.
+    pub text: &'static str,
+    /// A file that produces the code.
+    pub wrong: &'static str,
+    /// The same file, fixed.
+    pub right: &'static str,
+}
+
+/// The robot of most examples.
+macro_rules! robot {
+    () => {
+        "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n"
+    };
+}
+
+/// A stage of one module, with a fitness.
+macro_rules! stage {
+    ($($item:expr),*) => {
+        concat!("stage s {\n  fitness per action wheels[0]\n", $("  ", $item, "\n",)* "}\n")
+    };
+}
+
+pub const EXPLANATIONS: &[Explanation] = &[
+    Explanation {
+        code: "S0001",
+        title: "a syntax error",
+        text: "The file does not follow the grammar: a bracket left open, a misspelt keyword, a word where a number belongs. The message names what was expected; an unclosed `{` or `(` is named where it opens.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward\n}\n"),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0002",
+        title: "the file is too complex to parse",
+        text: "The parser gives up on a file that needs more steps than an architecture file ever does (megabytes of modules). Split the file or simplify it.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0]\n[[200000*  module m { sense ir behavior forward }\n]]}\n"),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0003",
+        title: "a line is too long",
+        text: "A line longer than 4096 bytes is refused before parsing. Break it into shorter lines.",
+        wrong: concat!(robot!(), "// [[5000*x]]\n", stage!("module m { sense ir  behavior forward }")),
+        right: concat!(robot!(), "// a short comment\n", stage!("module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0004",
+        title: "nested too deeply",
+        text: "Brackets nested more than 48 levels deep are refused. Remove the brackets that are not needed, or split the expression.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action [[60*(]]ir[0][[60*)]]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  fitness per action (ir[0])\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0005",
+        title: "an expression with too many parts",
+        text: "An expression has at most 256 parts. Aggregate (`sum(ir)`) or split it into several fitness terms.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action sum([[300*ir[0], ]]ir[0])\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  fitness per action sum(ir)\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0006",
+        title: "an unknown name",
+        text: "A sensor, actuator, module, stage, function, setting or action that is not declared (or not a word of the language). The help names the closest word when there is one; an actuator used as a sensor, a file without a robot and a misspelt keyword get their own hint.",
+        wrong: concat!(robot!(), stage!("module m { sense irr  behavior forward }")),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0007",
+        title: "a name declared twice",
+        text: "Two modules of a stage, two sensors, two stages or two settings with the same name. Rename or remove one; a later stage changes an inherited module by naming it, which is no duplicate.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward }", "module m { sense ir  behavior back }")),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }", "module n { sense ir  behavior back }")),
+    },
+    Explanation {
+        code: "S0008",
+        title: "an index out of range",
+        text: "An element or slice beyond the array declared: `ir[8]` has elements 0 to 7.",
+        wrong: concat!(robot!(), stage!("module m { sense ir[0..9]  behavior forward }")),
+        right: concat!(robot!(), stage!("module m { sense ir[0..7]  behavior forward }")),
+    },
+    Explanation {
+        code: "S0009",
+        title: "a bad range",
+        text: "A range whose low end is above its high end, or one that is empty where an interval is needed. Write the low end first.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action max(ir[5..2])\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  fitness per action max(ir[2..5])\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0010",
+        title: "a value of the wrong type",
+        text: "A number where a condition is needed, or a whole array where one number is: `ir` is eight values; `ir[0]`, `max(ir)` or `mean(ir)` is one.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action ir\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  fitness per action mean(ir)\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0011",
+        title: "bits out of range",
+        text: "A gene has 1 to 16 bits.",
+        wrong: concat!(robot!(), "genome { bits 17 }\n", stage!("module m { sense ir  behavior forward }")),
+        right: concat!(robot!(), "genome { bits 16 }\n", stage!("module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0012",
+        title: "stages that extend each other in a cycle",
+        text: "A stage starts from the stage it extends, so the stages must form a tree: a stage cannot extend itself or a stage that depends on it.",
+        wrong: concat!(robot!(), "stage a extends b {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage b extends a { module n { sense ir  behavior back } }\n"),
+        right: concat!(robot!(), "stage a {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage b extends a { module n { sense ir  behavior back } }\n"),
+    },
+    Explanation {
+        code: "S0013",
+        title: "a reinforcement program reads what the module does not sense",
+        text: "A module's reinforcement program may read only its own inputs. Add the sensor to `sense`, or read another element.",
+        wrong: concat!(robot!(), stage!("module m {\n    sense ir[0..5]\n    behavior stop\n    learn crbp on activation always\n    reinforce ir[7] < 0.1 ? 1 : -1\n  }")),
+        right: concat!(robot!(), stage!("module m {\n    sense ir\n    behavior stop\n    learn crbp on activation always\n    reinforce ir[7] < 0.1 ? 1 : -1\n  }")),
+    },
+    Explanation {
+        code: "S0014",
+        title: "`until` without a bound",
+        text: "A step that lasts until a condition holds needs `within N actions`, so that it cannot run forever.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior script { forward until ir[0] > 0.5 } }")),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior script { forward until ir[0] > 0.5 within 20 actions } }")),
+    },
+    Explanation {
+        code: "S0015",
+        title: "hardware the stage does not have",
+        text: "A sensor or actuator that neither the robot nor this stage's `robot adds` (nor an earlier stage's) declares. The help says what to declare.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior script { claw closed; forward } }")),
+        right: "robot r { sensor ir[8] proximity  actuator wheels[2] speed  actuator claw grip }\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir  behavior script { claw closed; forward } }\n}\n",
+    },
+    Explanation {
+        code: "S0016",
+        title: "a change to what an earlier stage froze",
+        text: "The genes of earlier stages are masked: a later stage may add modules and links, and change an inherited module only where nothing was evolved. Declare a new module instead.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage t extends s { module m { sense ir[0..3]  behavior forward } }\n"),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage t extends s { module n { sense ir[0..3]  behavior forward } }\n"),
+    },
+    Explanation {
+        code: "S0017",
+        title: "a wrong or unknown unit",
+        text: "Lengths are in `mm` or `cm` (a bare length is in millimetres), durations in `ms`, counts in `actions`. Every unit mistake of a file is reported at once.",
+        wrong: concat!(robot!(), stage!("world { arena 400ms x 600mm }", "module m { sense ir  behavior forward }")),
+        right: concat!(robot!(), stage!("world { arena 400mm x 600mm }", "module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0018",
+        title: "a value out of its bounds",
+        text: "A setting whose value is outside what it allows (a population of 0, a probability above 1), or settings that contradict each other. The message names the bound.",
+        wrong: concat!(robot!(), stage!("evolve { population 0 }", "module m { sense ir  behavior forward }")),
+        right: concat!(robot!(), stage!("evolve { population 10 }", "module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0019",
+        title: "an expression that needs too deep a stack",
+        text: "Expressions run on a fixed stack. Aggregating many arrays at once (`max(ir, ir, ir, ir, ir)`) fills it; aggregate fewer values, or split the expression.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action max(ir, ir, ir, ir, ir)\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  fitness per action max(ir)\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0020",
+        title: "a new module named almost like an inherited one (a warning)",
+        text: "A later stage that names an inherited module changes it; a name one edit away from one declares a new module, which is usually a typo. The file compiles; rename the module if the new one is meant.",
+        wrong: concat!(robot!(), stage!("module wander { sense ir  behavior forward }"), "stage t extends s { module wandr { sense ir  behavior back } }\n"),
+        right: concat!(robot!(), stage!("module wander { sense ir  behavior forward }"), "stage t extends s { module avoid { sense ir  behavior back } }\n"),
+    },
+    Explanation {
+        code: "S0021",
+        title: "declarations that conflict",
+        text: "Two declarations that cannot both hold: two sensors of a kind the robot has one of, a setting that contradicts another. The labels show both.",
+        wrong: "robot r {\n  sensor ir[8] proximity\n  sensor front[2] proximity\n  actuator wheels[2] speed\n}\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n",
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }")),
+    },
+];
+
+/// The explanation of a code (`S0006`, any case).
+pub fn explain(code: &str) -> Option<&'static Explanation> {
+    EXPLANATIONS.iter().find(|e| e.code.eq_ignore_ascii_case(code.trim()))
+}
+
+/// An example with its repetitions `[[N*TEXT]]` spelt out.
+pub fn expand(example: &str) -> String {
+    let mut out = String::new();
+    let mut rest = example;
+    while let Some(at) = rest.find("[[") {
+        out.push_str(&rest[..at]);
+        let inner = &rest[at + 2..];
+        let end = inner.find("]]").unwrap_or(inner.len());
+        let (n, text) = inner[..end].split_once('*').unwrap_or(("1", &inner[..end]));
+        out.push_str(&text.repeat(n.parse().unwrap_or(1)));
+        rest = inner.get(end + 2..).unwrap_or("");
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The explanation as `shaping explain` prints it.
+pub fn render(e: &Explanation) -> String {
+    format!(
+        "{}: {}\n\n{}\n\nFor example, this file:\n\n{}\nis fixed so:\n\n{}",
+        e.code,
+        e.title,
+        e.text,
+        indent(e.wrong),
+        indent(e.right)
+    )
+}
+
+fn indent(s: &str) -> String {
+    s.lines().map(|l| format!("    {l}\n")).collect()
+}
