@@ -338,7 +338,9 @@ pub enum Suggestion {
 impl Error {
     /// The suggestion of the help: a "did you mean `x`?" of
     /// [`did_you_mean`] on a diagnostic labelled on one word, or a
-    /// "declare `sensor ...`" or "declare ... `actuator ...`".
+    /// "declare `sensor ...`" or "declare ... `actuator ...`". The span of
+    /// a replacement is the diagnostic's label: [`Suggestion::in_source`]
+    /// narrows it to the word.
     pub fn suggestion(&self) -> Option<Suggestion> {
         let help = self.help()?.to_string();
         let quoted = |from: &str| -> Option<String> {
@@ -348,10 +350,8 @@ impl Error {
         if let Some(with) = quoted(DID_YOU_MEAN) {
             let mut labels = self.labels()?;
             let l = labels.find(|l| l.primary()).or_else(|| self.labels()?.next())?;
-            return Some(Suggestion::Replace {
-                span: crate::syntax::Span { start: l.offset(), end: l.offset() + l.len() },
-                with,
-            });
+            let span = crate::syntax::Span { start: l.offset(), end: l.offset() + l.len() };
+            return Some(Suggestion::Replace { span, with });
         }
         if help.starts_with("declare") {
             let line = quoted("`")?;
@@ -360,6 +360,33 @@ impl Error {
             }
         }
         None
+    }
+}
+
+impl Suggestion {
+    /// The suggestion on `source`: a replacement labelled on more than the
+    /// misspelt word (`lamp bb at (1mm, 1mm)`) narrowed to the word of the
+    /// label closest to the suggested one.
+    pub fn in_source(self, source: &str) -> Option<Suggestion> {
+        let Suggestion::Replace { span, with } = self else { return Some(self) };
+        let text = source.get(span.start..span.end)?;
+        let word = |c: char| c.is_ascii_alphanumeric() || c == '_';
+        if !text.is_empty() && text.chars().all(word) {
+            return Some(Suggestion::Replace { span, with });
+        }
+        let limit = with.chars().count().div_ceil(3).max(1);
+        text.split(|c: char| !word(c))
+            .filter(|w| !w.is_empty() && *w != with && w.starts_with(|c: char| !c.is_ascii_digit()))
+            .map(|w| (strsim::levenshtein(w, &with), w))
+            .filter(|(d, _)| *d <= limit)
+            .min_by_key(|(d, _)| *d)
+            .map(|(_, w)| {
+                let start = span.start + (w.as_ptr() as usize - text.as_ptr() as usize);
+                Suggestion::Replace {
+                    span: crate::syntax::Span { start, end: start + w.len() },
+                    with: with.clone(),
+                }
+            })
     }
 }
 

@@ -489,7 +489,7 @@ pub struct Fix {
 
 /// The fixes a diagnostic proposes: its suggestion, made an edit.
 pub fn fixes(text: &str, e: &Error) -> Vec<Fix> {
-    let Some(s) = e.suggestion() else { return Vec::new() };
+    let Some(s) = e.suggestion().and_then(|s| s.in_source(text)) else { return Vec::new() };
     match s {
         Suggestion::Replace { span, with } => {
             vec![Fix { title: format!("replace with `{with}`"), edits: vec![(span, with)] }]

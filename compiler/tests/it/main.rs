@@ -5,6 +5,7 @@
 mod codes;
 mod docs;
 mod examples;
+mod fixes;
 mod fmt;
 mod layout;
 mod limits;
