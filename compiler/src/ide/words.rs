@@ -103,7 +103,7 @@ const EXPRESSIONS: &str = "14-expressions";
 /// and actuator kinds of the runtime's catalog added by [`words`].
 const LIST: &[Word] = &[
     // reserved words
-    w("robot", K, TOP | STAGE, "declares the robot's sensors and actuators; `robot adds { }` in a stage adds hardware", ROBOT_S),
+    w("robot", K, TOP | STAGE | EXPR, "declares the robot's sensors and actuators; `robot adds { }` in a stage adds hardware; in a fitness, `robot.x`, `robot.distance`, ...: the robot's state", ROBOT_S),
     w("sensor", K, ROBOT, "`sensor NAME[COUNT] KIND`: a sensor (or an array of them) of the robot", ROBOT_S),
     w("actuator", K, ROBOT, "`actuator NAME[COUNT] KIND`: an actuator of the robot", ROBOT_S),
     w("genome", K, TOP | STAGE, "`genome { bits 4 range -1..1 }`: how genes are encoded (top level: every stage's default)", GENOME_S),
@@ -130,6 +130,7 @@ const LIST: &[Word] = &[
     w("for", K, CLAUSE, "`for N actions`: how long a step lasts (`test best for`, `train for`)", SCRIPTS),
     w("uses", K, CLAUSE, "`uses charger`: the step recharges the battery at the charger", SCRIPTS),
     w("per", K, CLAUSE, "`per action EXPR` or `0.5 per grip`: a fitness term", FITNESS),
+    w("end", C, CLAUSE, "`at end EXPR`: a fitness term added once, after the life's last action", FITNESS),
     w("adds", K, CLAUSE, "`robot adds`, `world adds`, `fitness adds`: adds to what the parent stage declared", STAGES),
     w("changes", K, CLAUSE, "`world changes { }`: restates items of the parent's world", WORLD_S),
     w("if", K, CLAUSE, "`STEP if COND`: the step runs only when the condition holds as it is reached", SCRIPTS),
@@ -198,7 +199,7 @@ const LIST: &[Word] = &[
     w("virtual", C, CLAUSE, "objects that only add sensor readings", WORLD_S),
     w("from", C, CLAUSE, "`from (X, Y) to (X, Y)`: the ends of a wall or the corners of a zone", ITEMS),
     w("to", C, CLAUSE, "`from (X, Y) to (X, Y)`", ITEMS),
-    w("at", C, CLAUSE, "`at (X, Y)`: a position, mm east and north of the south-west corner", ITEMS),
+    w("at", C, CLAUSE, "`at (X, Y)`: a position, mm east and north of the south-west corner; in a fitness, `at end EXPR`", ITEMS),
     w("height", C, CLAUSE, "`height H`: a lamp's height above the floor", ITEMS),
     w("intensity", C, CLAUSE, "`intensity K`: a lamp's brightness relative to the charger's lamp", ITEMS),
     w("grey", C, CLAUSE, "`grey G`: a zone's grey level, 0 black .. 1 white", ITEMS),
