@@ -3,53 +3,21 @@
 //! files that follow no link, nothing written before the checks pass,
 //! damage refused, not used).
 
+mod common;
+
 use std::cell::Cell;
-use std::path::{Path, PathBuf};
 use std::sync::{Arc, Barrier};
 
-use shaping_engine::files::{unseal, DirLock, Sealed};
+use common::{files, options, read_text, root, tiny};
+use shaping_engine::files::{unseal, Sealed};
 use shaping_engine::run::{Event, Observer, RunOptions, Runner, StageOutcome};
 use shaping_engine::{html, replay, ErrorKind};
 use shaping_runtime::evolve::fingerprint::fnv1a;
 use shaping_runtime::program::Program;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn tiny() -> Program {
-    let path = root().join("tests/cli/tiny.bat");
-    let (program, _) =
-        shaping_engine::load::load_program(&path, shaping_engine::diag::ErrorFormat::Plain).unwrap();
-    program
-}
-
-fn options(out: &Path) -> RunOptions {
-    RunOptions { out: out.to_path_buf(), no_report: true, jobs: Some(2), ..RunOptions::default() }
-}
-
-/// The files of a run directory, by relative path (not the lock).
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else if p.file_name().is_some_and(|n| n != DirLock::FILE) {
-                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
-                out.push((rel, std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 /// A run's files as hashes (a sealed file as the text it seals: the files
 /// as they were before checksums, byte for byte).
-fn hashes(dir: &Path) -> Vec<(String, u64)> {
+fn hashes(dir: &std::path::Path) -> Vec<(String, u64)> {
     files(dir)
         .into_iter()
         .filter(|(name, _)| !name.ends_with(".png") && !name.ends_with(".svg"))
@@ -99,6 +67,34 @@ const PINNED: &[(&str, u64)] = &[
     ("second/episode.json", 0x62ac0ba4bec0ace9),
     ("second/generations.csv", 0x66887ed62b1540ac),
 ];
+
+/// Each evolved stage writes its statistics, best genome, checkpoint and
+/// fitness pictures, the same on one thread as on two; `generations.csv`
+/// closes every row with the best individual's events, as counts.
+#[test]
+fn a_run_writes_its_files_the_same_on_one_or_two_threads() {
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    Runner::default().run(tiny(), &RunOptions { jobs: Some(1), ..options(a.path()) }).unwrap();
+    Runner::default().run(tiny(), &options(b.path())).unwrap();
+    for stage in ["first", "second"] {
+        for f in ["generations.csv", "best.genome", "checkpoint.json", "fitness.svg", "fitness.png"] {
+            assert!(a.path().join(stage).join(f).exists(), "{stage}/{f}");
+        }
+        let ca = std::fs::read(a.path().join(stage).join("checkpoint.json")).unwrap();
+        let cb = std::fs::read(b.path().join(stage).join("checkpoint.json")).unwrap();
+        assert!(ca == cb, "stage {stage}: 1 and 2 threads differ");
+    }
+    let csv = read_text(&a.path().join("second/generations.csv"));
+    assert_eq!(csv.lines().count(), 1 + 10, "{csv}");
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    assert_eq!(header[header.len() - 3..], ["best_recharges", "best_grips", "best_releases_outside"]);
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells.len(), header.len(), "{line}");
+        assert!(cells[cells.len() - 3..].iter().all(|c| c.parse::<u32>().is_ok()), "{line}");
+    }
+}
 
 /// Stops at its first generation until the test has tried a second run.
 struct Holding {

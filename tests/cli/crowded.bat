@@ -1,6 +1,7 @@
 // A world crowded for the random placement, but not certainly impossible:
-// 30 objects of 60 mm in 400 x 600 mm overlap in most episodes; the CLI
-// tests check that `run`, a test stage and `replay` say so.
+// 30 objects of 60 mm in 400 x 600 mm overlap in most episodes; the
+// engine's tests (`engine/tests/stages.rs`) check that a run, a test stage
+// and a replay say so.
 robot khepera {
   sensor ir[8]       proximity
   actuator wheels[2] speed

@@ -1,0 +1,190 @@
+//! Replays, called as a library: the individual a replay chooses, the
+//! files it writes, and its trace.
+
+mod common;
+
+use std::path::Path;
+
+use common::{error, load, options, read_json, read_text, root, run, sets, tiny, tiny_bat, Log};
+use shaping_engine::replay::{self, ReplayOptions};
+use shaping_engine::run::RunOptions;
+use shaping_engine::rundir;
+use shaping_engine::ErrorKind;
+
+/// A replay of `file` with the run in `run_dir`, written to `out`.
+fn opts(file: &Path, run_dir: &Path, out: &Path) -> ReplayOptions {
+    ReplayOptions {
+        file: file.to_path_buf(),
+        run: Some(run_dir.to_path_buf()),
+        out: Some(out.to_path_buf()),
+        ..ReplayOptions::default()
+    }
+}
+
+#[test]
+fn an_unknown_stage_is_refused_and_a_replay_writes_its_pictures() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let err = error(run(tiny(), &RunOptions { stage: Some("fifth".into()), ..options(d) }));
+    assert_eq!(err.kind(), ErrorKind::Invalid, "{err}");
+    assert!(err.message().contains("no stage `fifth`"), "{err}");
+
+    // Nothing run yet: what to do.
+    let err = error(replay::replay(tiny(), &opts(&tiny_bat(), d, &d.join("none")), &Log::default()));
+    assert!(err.message().contains("shaping run"), "{err}");
+
+    run(tiny(), &options(d)).unwrap();
+    let pics = d.join("pics");
+    let args =
+        ReplayOptions { stage: Some("second".into()), actions: Some(80), ..opts(&tiny_bat(), d, &pics) };
+    let replayed = replay::replay(tiny(), &args, &Log::default()).unwrap();
+    assert_eq!((replayed.stage.as_str(), replayed.out.as_path()), ("second", pics.as_path()));
+    for f in ["trace.csv", "activations.png", "activations.svg", "trajectory.png", "trajectory.svg"] {
+        assert!(pics.join(f).exists(), "{f}");
+    }
+    let trace = read_text(&pics.join("trace.csv"));
+    assert!(trace.lines().count() > 1 && trace.lines().count() <= 81);
+
+    let short = ReplayOptions {
+        stage: Some("second".into()),
+        genome: Some("0101".into()),
+        ..opts(&tiny_bat(), d, &pics)
+    };
+    let err = error(replay::replay(tiny(), &short, &Log::default()));
+    assert!(err.message().contains("bits"), "{err}");
+}
+
+/// A stage with nothing evolved replays without a genome, and its avoid
+/// module's performance indicator is high by action 300 (figure 5).
+#[test]
+fn a_replay_of_a_stage_without_genes_needs_no_genome() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = root().join("examples/avoid.bat");
+    let args =
+        ReplayOptions { file: file.clone(), out: Some(dir.path().to_path_buf()), ..ReplayOptions::default() };
+    let replayed = replay::replay(load(&file), &args, &Log::default()).unwrap();
+    assert_eq!((replayed.stage.as_str(), replayed.result.actions), ("avoid", 1000));
+    assert!(dir.path().join("reinforcement.png").exists());
+    let trace = read_text(&dir.path().join("trace.csv"));
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "perf_avoid").expect("a performance column");
+    let perf: Vec<f32> =
+        trace.lines().skip(1).map(|l| l.split(',').nth(col).unwrap().parse().unwrap()).collect();
+    let mean = |s: &[f32]| s.iter().sum::<f32>() / s.len() as f32;
+    let (first, at300) = (mean(&perf[..100]), perf[299]);
+    assert!(
+        at300 >= 0.5 && at300 > first + 0.2,
+        "performance {first} in the first 100 actions, {at300} at 300"
+    );
+}
+
+/// Replaying a training stage of a run replays its training life.
+#[test]
+fn a_replay_of_a_training_stage_replays_its_life() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = root().join("examples/pretrained.bat");
+    let out = dir.path().join("out");
+    run(load(&file), &RunOptions { stage: Some("avoidance".into()), seed: Some(5), ..options(&out) })
+        .unwrap();
+    let args =
+        ReplayOptions { stage: Some("avoidance".into()), ..opts(&file, &out, &dir.path().join("life")) };
+    let life = replay::replay(load(&file), &args, &Log::default()).unwrap();
+    let trained = rundir::read_trained(&out.join("avoidance")).unwrap().unwrap();
+    let (r, t) = (&life.result, &trained.result);
+    assert_eq!(
+        (r.actions, r.grips, r.releases_outside, r.recharges, r.collisions),
+        (t.actions, t.grips, t.releases_outside, t.recharges, t.collisions),
+        "not the training life"
+    );
+    assert_eq!(r.fitness, t.fitness, "not the training life's fitness");
+    let trace = read_text(&dir.path().join("life/trace.csv"));
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "perf_avoid").unwrap();
+    let last: f64 = trace.lines().last().unwrap().split(',').nth(col).unwrap().parse().unwrap();
+    let learned = f64::from(trained.performance[1]);
+    assert!((last - learned).abs() < 1e-3, "performance {last} at the end of the replay, {learned} trained");
+}
+
+/// Every way of running a stage binds the trained weights the same way: a
+/// replay of every stage of every example (the training stages trained on
+/// the fly: no run directory has them).
+#[test]
+fn a_replay_runs_every_stage_of_every_example() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("no-run");
+    for example in std::fs::read_dir(root().join("examples")).unwrap() {
+        let file = example.unwrap().path();
+        if file.extension().is_none_or(|e| e != "bat") {
+            continue;
+        }
+        let program = load(&file);
+        for stage in &program.stages {
+            let args = ReplayOptions {
+                stage: Some(stage.name.clone()),
+                actions: Some(5),
+                genome: Some("0".repeat(stage.layout.bits as usize)),
+                ..opts(&file, &empty, &dir.path().join("r"))
+            };
+            replay::replay(program.clone(), &args, &Log::default())
+                .unwrap_or_else(|e| panic!("{} {}: {e}", file.display(), stage.name));
+        }
+    }
+}
+
+/// `trace.csv` has a column per declared sensor and actuator element, named
+/// after the declaration, and `episode.json` the ambient light readings.
+#[test]
+fn the_trace_has_what_the_robot_sensed_and_did() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = ReplayOptions {
+        stage: Some("first".into()),
+        actions: Some(30),
+        genome: Some("0".repeat(84)),
+        ..opts(&tiny_bat(), &d.join("no-run"), d)
+    };
+    replay::replay(tiny(), &args, &Log::default()).unwrap();
+    let trace = read_text(&d.join("trace.csv"));
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> =
+        trace.lines().skip(1).map(|l| l.split(',').skip(2).map(|v| v.parse().unwrap()).collect()).collect();
+    let col =
+        |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no `{name}`")) - 2;
+    let episode = read_json(&d.join("episode.json"));
+    let light = episode["actions"]["light"].as_array().unwrap();
+    assert_eq!(light.len(), rows.len());
+    for (k, row) in rows.iter().enumerate() {
+        for i in 0..8 {
+            let ir = episode["actions"]["ir"][k][i].as_f64().unwrap();
+            assert!((row[col(&format!("ir[{i}]"))] - ir).abs() < 1e-3, "ir[{i}] at {k}");
+            assert!((row[col(&format!("light[{i}]"))] - light[k][i].as_f64().unwrap()).abs() < 1e-3);
+        }
+        assert_eq!(row[col("battery[0]")], row[col("battery")]);
+        for i in 0..2 {
+            let w = episode["actions"]["wheels"][k][i].as_f64().unwrap();
+            assert!((row[col(&format!("wheels[{i}]"))] - w).abs() < 1e-3);
+        }
+    }
+    // The lamp lights the arena: the light readings are not all zero.
+    assert!(rows.iter().any(|r| r[col("light[0]")] > 0.0));
+    assert!(rows.iter().any(|r| r[col("wheels[0]")] != 0.0));
+}
+
+/// A replay takes `--set` as a run does: a run made with a setting changed
+/// on a parent stage replays with the same setting.
+#[test]
+fn a_replay_takes_the_settings_the_run_was_made_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = d.join("run");
+    let set = sets(&["first.evolve.generations=2"]);
+    run(tiny(), &RunOptions { sets: set.clone(), ..options(&out) }).unwrap();
+    let plain = ReplayOptions { stage: Some("second".into()), ..opts(&tiny_bat(), &out, &d.join("plain")) };
+    let err = error(replay::replay(tiny(), &plain, &Log::default()));
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    assert!(err.message().contains("is not of this program"), "{err}");
+    let with = ReplayOptions { sets: set, ..opts(&tiny_bat(), &out, &d.join("with")) };
+    let with = ReplayOptions { stage: Some("second".into()), ..with };
+    replay::replay(tiny(), &with, &Log::default()).unwrap();
+    assert!(d.join("with/trace.csv").exists());
+}
