@@ -321,6 +321,61 @@ fn ctrl_c_sigterm_and_sighup_stop_the_motors() {
     }
 }
 
+/// The lines of `trace` that are whole (ended by a newline).
+fn whole_lines(trace: &str) -> Vec<&str> {
+    trace.split_inclusive('\n').filter(|l| l.ends_with('\n')).map(|l| l.trim_end()).collect()
+}
+
+/// `drive` writes its trace as it goes: killed with SIGKILL (no handler
+/// runs, nothing is written at the end), it leaves the header and a whole
+/// row for every action but the last few, in order.
+#[test]
+fn a_drive_killed_with_sigkill_keeps_its_trace() {
+    let dir = scratch("sigkill");
+    let emu = Emulator::start(&dir, &[]);
+    let genome = "1".repeat(80);
+    let mut child = shaping()
+        .arg("drive")
+        .arg(file())
+        .args(["--stage", "roam", "--period", "20", "--actions", "300", "--genome", &genome])
+        .arg("--port")
+        .arg(&emu.port)
+        .arg("--out")
+        .arg(dir.join("d"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let path = dir.join("d/trace.csv");
+    // Killed once 30 actions are on disk, about 0.6 s into 6 s of driving.
+    let start = Instant::now();
+    let seen = loop {
+        let driving = child.try_wait().unwrap().is_none();
+        let rows = std::fs::read_to_string(&path).map_or(0, |t| whole_lines(&t).len().saturating_sub(1));
+        assert!(driving, "drive ended before it was killed, {rows} actions on disk");
+        if rows >= 30 {
+            break rows;
+        }
+        assert!(start.elapsed() < Duration::from_secs(120), "{rows} actions on disk after 120 s");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let trace = std::fs::read_to_string(&path).unwrap();
+    assert!(trace.ends_with('\n'), "a part of a line: {trace}");
+    let lines = whole_lines(&trace);
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(header[..2], ["action", "winner"]);
+    let rows = &lines[1..];
+    assert!(rows.len() >= seen && rows.len() < 300, "{} rows after the kill, {seen} before", rows.len());
+    for (k, row) in rows.iter().enumerate() {
+        let cells: Vec<&str> = row.split(',').collect();
+        assert_eq!(cells.len(), header.len(), "row {k}: {row}");
+        assert_eq!(cells[0], k.to_string(), "row {k}: {row}");
+    }
+    assert!(!dir.join("d/summary.json").exists(), "drive ran to its end");
+}
+
 #[test]
 fn a_port_in_use_is_refused() {
     let dir = scratch("busy");

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 use shaping_runtime::catalog::{
     ActuatorKind, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, SENSOR_BEARING_DEG,
 };
-use shaping_runtime::controller::{Robot, Trace};
+use shaping_runtime::controller::{Robot, Trace, TraceRow};
 use shaping_runtime::robot::{Link, SerialRobot};
 use shaping_runtime::sim::{ir, Command, ObjectState, Outcome, Pose, Scene, Sim};
 
@@ -238,6 +238,50 @@ pub struct EpisodeColumns {
     pub objects: Vec<[f32; 6]>,
 }
 
+impl EpisodeColumns {
+    /// Columns of `modules` modules and no action yet.
+    pub fn new(modules: usize) -> EpisodeColumns {
+        EpisodeColumns {
+            activation: vec![Vec::new(); modules],
+            reinforcement: vec![Vec::new(); modules],
+            performance: vec![Vec::new(); modules],
+            ..EpisodeColumns::default()
+        }
+    }
+
+    /// Adds what the controller did at one action (its trace row).
+    pub fn push_row(&mut self, r: &TraceRow) {
+        self.x.push(round(r.pose.x, 2));
+        self.y.push(round(r.pose.y, 2));
+        self.theta.push(round(r.pose.theta, 4));
+        self.winner.push(r.winner);
+        self.battery.push(round(r.battery, 4));
+        self.holding.push(r.holding as u8);
+        self.grips.push(r.grips);
+        self.releases.push(r.releases_outside);
+        self.recharged.push(r.recharged as u8);
+        self.collided.push(r.collided as u8);
+        for m in 0..self.activation.len() {
+            self.activation[m].push(round(r.activations.get(m).copied().unwrap_or(0.0), 4));
+            self.reinforcement[m].push(round(r.reinforcement.get(m).copied().unwrap_or(0.0), 4));
+            self.performance[m].push(round(r.performance.get(m).copied().unwrap_or(0.0), 4));
+        }
+    }
+
+    /// Adds what the robot sensed after one action and the wheel command
+    /// that led there (the objects aside: they are kept as changes).
+    pub fn push_frame(&mut self, f: &Frame) {
+        self.ir.push(f.ir.map(|v| round(v, 3)));
+        self.light.push(f.light.map(|v| round(v, 3)));
+        self.barrier.push(f.barrier as u8);
+        self.floor.push(round(f.floor, 3));
+        self.lamp_distance.push(round(f.lamp_distance, 3));
+        self.arm_down.push(f.arm_down as u8);
+        self.claw_closed.push(f.claw_closed as u8);
+        self.wheels.push(f.wheels.map(|v| round(v, 3)));
+    }
+}
+
 /// `episode.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Episode {
@@ -295,29 +339,9 @@ pub fn episode(
     trace: &Trace,
     parts: &[Part<'_>],
 ) -> Episode {
-    let n = trace.modules.len();
-    let mut c = EpisodeColumns {
-        activation: vec![Vec::new(); n],
-        reinforcement: vec![Vec::new(); n],
-        performance: vec![Vec::new(); n],
-        ..EpisodeColumns::default()
-    };
+    let mut c = EpisodeColumns::new(trace.modules.len());
     for r in &trace.rows {
-        c.x.push(round(r.pose.x, 2));
-        c.y.push(round(r.pose.y, 2));
-        c.theta.push(round(r.pose.theta, 4));
-        c.winner.push(r.winner);
-        c.battery.push(round(r.battery, 4));
-        c.holding.push(r.holding as u8);
-        c.grips.push(r.grips);
-        c.releases.push(r.releases_outside);
-        c.recharged.push(r.recharged as u8);
-        c.collided.push(r.collided as u8);
-        for m in 0..n {
-            c.activation[m].push(round(r.activations.get(m).copied().unwrap_or(0.0), 4));
-            c.reinforcement[m].push(round(r.reinforcement.get(m).copied().unwrap_or(0.0), 4));
-            c.performance[m].push(round(r.performance.get(m).copied().unwrap_or(0.0), 4));
-        }
+        c.push_row(r);
     }
     let mut worlds = Vec::new();
     let mut from = 0u32;
@@ -341,14 +365,7 @@ pub fn episode(
         let mut prev: Vec<[f32; 4]> = start.map(|f| f.objects.clone()).unwrap_or_default();
         for (k, f) in part.frames.iter().skip(1).enumerate() {
             let action = from + k as u32;
-            c.ir.push(f.ir.map(|v| round(v, 3)));
-            c.light.push(f.light.map(|v| round(v, 3)));
-            c.barrier.push(f.barrier as u8);
-            c.floor.push(round(f.floor, 3));
-            c.lamp_distance.push(round(f.lamp_distance, 3));
-            c.arm_down.push(f.arm_down as u8);
-            c.claw_closed.push(f.claw_closed as u8);
-            c.wheels.push(f.wheels.map(|v| round(v, 3)));
+            c.push_frame(f);
             for (i, o) in f.objects.iter().enumerate() {
                 if prev.get(i) != Some(o) {
                     c.objects.push([action as f32, i as f32, o[0], o[1], o[2], o[3]]);

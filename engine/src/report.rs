@@ -1,16 +1,19 @@
 //! Turning runtime results into files: CSV tables and pictures.
 
 use std::fmt::Write as _;
+use std::fs::File;
+use std::io::Write as _;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT};
-use shaping_runtime::controller::Trace;
+use shaping_runtime::controller::{Trace, TraceRow};
 use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
-use crate::episode::{Episode, EpisodeColumns};
+use crate::episode::{Episode, EpisodeColumns, Frame};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::plot;
@@ -136,47 +139,162 @@ fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
 /// `episode`, `NaN` where it has no value).
 pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
     let declared = declared_columns(stage);
+    let mut s = trace_header(&trace.modules, &declared);
+    for (k, r) in trace.rows.iter().enumerate() {
+        trace_row(&mut s, &trace.modules, &declared, r, &episode.actions, k);
+    }
+    s
+}
+
+/// The first line of `trace.csv`.
+fn trace_header(modules: &[String], declared: &[(String, Source)]) -> String {
     let mut s =
         String::from("action,winner,battery,holding,grips,releases_outside,recharged,collided,x,y,theta");
-    for m in &trace.modules {
+    for m in modules {
         let _ = write!(s, ",act_{m}");
     }
-    for m in &trace.modules {
+    for m in modules {
         let _ = write!(s, ",reinf_{m}");
     }
-    for m in &trace.modules {
+    for m in modules {
         let _ = write!(s, ",perf_{m}");
     }
-    for (name, _) in &declared {
+    for (name, _) in declared {
         let _ = write!(s, ",{name}");
     }
     s.push('\n');
-    for (k, r) in trace.rows.iter().enumerate() {
-        let winner = trace.modules.get(r.winner as usize).map_or("", |m| m.as_str());
-        let _ = write!(
-            s,
-            "{},{},{:.4},{},{},{},{},{},{:.2},{:.2},{:.4}",
-            r.action,
-            winner,
-            r.battery,
-            r.holding as u8,
-            r.grips,
-            r.releases_outside,
-            r.recharged as u8,
-            r.collided as u8,
-            r.pose.x,
-            r.pose.y,
-            r.pose.theta
-        );
-        for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
-            let _ = write!(s, ",{v:.4}");
-        }
-        for (_, source) in &declared {
-            let _ = write!(s, ",{:.4}", source.at(&episode.actions, k));
-        }
-        s.push('\n');
-    }
     s
+}
+
+/// Appends the line of trace row `r` to `s`, the declared sensors and
+/// actuators read from `columns` at action `k`.
+fn trace_row(
+    s: &mut String,
+    modules: &[String],
+    declared: &[(String, Source)],
+    r: &TraceRow,
+    columns: &EpisodeColumns,
+    k: usize,
+) {
+    let winner = modules.get(r.winner as usize).map_or("", |m| m.as_str());
+    let _ = write!(
+        s,
+        "{},{},{:.4},{},{},{},{},{},{:.2},{:.2},{:.4}",
+        r.action,
+        winner,
+        r.battery,
+        r.holding as u8,
+        r.grips,
+        r.releases_outside,
+        r.recharged as u8,
+        r.collided as u8,
+        r.pose.x,
+        r.pose.y,
+        r.pose.theta
+    );
+    for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
+        let _ = write!(s, ",{v:.4}");
+    }
+    for (_, source) in declared {
+        let _ = write!(s, ",{:.4}", source.at(columns, k));
+    }
+    s.push('\n');
+}
+
+/// The longest a row of [`TraceWriter`] waits in memory before it is
+/// written: a process killed loses the actions of the last 0.1 s.
+pub const TRACE_WRITE_EVERY: Duration = Duration::from_millis(100);
+
+/// `trace.csv` written as an episode goes (`drive`: a robot's episode
+/// lasts minutes, and a process killed with SIGKILL loses only its last
+/// actions): the header at once, then the rows, written in whole lines
+/// at least every [`TRACE_WRITE_EVERY`]. The file is the one [`trace_csv`]
+/// writes at the end, byte for byte; unlike the other files of the engine,
+/// it is written in place, in parts, so that a part is there to keep.
+pub struct TraceWriter {
+    path: PathBuf,
+    /// `None` once a write failed.
+    file: Option<File>,
+    modules: Vec<String>,
+    declared: Vec<(String, Source)>,
+    /// Whole lines not written yet.
+    pending: String,
+    written: Instant,
+    /// The first failure to write.
+    error: Option<Error>,
+}
+
+impl TraceWriter {
+    /// Creates `path` (emptied if it exists) and writes the header of the
+    /// trace of `stage`.
+    pub fn create(path: &Path, stage: &Stage) -> Result<TraceWriter, Error> {
+        let file = File::create(path)
+            .map_err(|e| Error::io(format!("error: cannot write `{}`: {e}", path.display())))?;
+        let modules: Vec<String> = stage.modules.iter().map(|m| m.name.clone()).collect();
+        let declared = declared_columns(stage);
+        let pending = trace_header(&modules, &declared);
+        let mut w = TraceWriter {
+            path: path.to_path_buf(),
+            file: Some(file),
+            modules,
+            declared,
+            pending,
+            written: Instant::now(),
+            error: None,
+        };
+        w.write_pending();
+        match w.error.take() {
+            Some(e) => Err(e),
+            None => Ok(w),
+        }
+    }
+
+    /// Adds the row of one action: what the controller did (`row`) and what
+    /// the robot sensed after it (`frame`, the recorder's last; `None`: the
+    /// declared sensors' values are `NaN`). A failure to write is kept for
+    /// [`TraceWriter::finish`]: the episode goes on.
+    pub fn push(&mut self, row: &TraceRow, frame: Option<&Frame>) {
+        let mut one = EpisodeColumns::new(self.modules.len());
+        one.push_row(row);
+        if let Some(f) = frame {
+            one.push_frame(f);
+        }
+        trace_row(&mut self.pending, &self.modules, &self.declared, row, &one, 0);
+        if self.written.elapsed() >= TRACE_WRITE_EVERY {
+            self.write_pending();
+        }
+    }
+
+    fn write_pending(&mut self) {
+        self.written = Instant::now();
+        let Some(file) = self.file.as_mut() else { return };
+        if self.pending.is_empty() {
+            return;
+        }
+        // One write of whole lines.
+        match file.write_all(self.pending.as_bytes()) {
+            Ok(()) => self.pending.clear(),
+            Err(e) => {
+                self.error = Some(Error::io(format!("error: cannot write `{}`: {e}", self.path.display())));
+                self.file = None;
+            }
+        }
+    }
+
+    /// Writes the rows still in memory and syncs the file; the first
+    /// failure to write, if there was one.
+    pub fn finish(mut self) -> Result<(), Error> {
+        self.write_pending();
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        match &self.file {
+            Some(file) => file
+                .sync_all()
+                .map_err(|e| Error::io(format!("error: cannot write `{}`: {e}", self.path.display()))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Writes `trace.csv` and the pictures of one episode into `dir`:
@@ -218,13 +336,45 @@ pub fn episode_files_until(
     path: Option<(Range<usize>, &str)>,
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
-    let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
-    let check = || if stop() { Err(Error::io(STOPPED)) } else { Ok(()) };
     write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());
     }
-    check()?;
+    if stop() {
+        return Err(Error::io(STOPPED));
+    }
+    pictures(dir, title, stage, trace, scene, marks, path, stop)
+}
+
+/// The pictures of one episode whose `trace.csv` is written (see
+/// [`TraceWriter`]): `activations`, `reinforcement`, `trajectory`, as
+/// [`episode_files`] draws them.
+pub fn episode_pictures(
+    dir: &Path,
+    title: &str,
+    stage: &Stage,
+    trace: &Trace,
+    scene: &Scene,
+) -> Result<(), Error> {
+    pictures(dir, title, stage, trace, scene, &[], None, &|| false)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn pictures(
+    dir: &Path,
+    title: &str,
+    stage: &Stage,
+    trace: &Trace,
+    scene: &Scene,
+    marks: &[(u32, String)],
+    path: Option<(Range<usize>, &str)>,
+    stop: &dyn Fn() -> bool,
+) -> Result<(), Error> {
+    let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
+    let check = || if stop() { Err(Error::io(STOPPED)) } else { Ok(()) };
+    if trace.rows.is_empty() {
+        return Ok(());
+    }
     let act = plot::ActivationTrace {
         modules: trace.modules.clone(),
         activations: trace.rows.iter().map(|r| r.activations.clone()).collect(),

@@ -1,15 +1,21 @@
 //! Replays, called as a library: the individual a replay chooses, the
-//! files it writes, and its trace.
+//! files it writes, and its trace (also written as it goes, as `drive`
+//! writes it).
 
 mod common;
 
 use std::path::Path;
 
-use common::{error, load, options, read_json, read_text, root, run, sets, tiny, tiny_bat, Log};
+use common::{error, load, options, read_json, read_text, root, run, sets, test_file, tiny, tiny_bat, Log};
+use shaping_engine::episode::{self, Recorder};
 use shaping_engine::replay::{self, ReplayOptions};
+use shaping_engine::report::{self, TraceWriter};
 use shaping_engine::run::RunOptions;
 use shaping_engine::rundir;
 use shaping_engine::ErrorKind;
+use shaping_runtime::controller::{episode_rngs, Controller, EpisodeOptions, Trace};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::sim::Sim;
 
 /// A replay of `file` with the run in `run_dir`, written to `out`.
 fn opts(file: &Path, run_dir: &Path, out: &Path) -> ReplayOptions {
@@ -187,4 +193,49 @@ fn a_replay_takes_the_settings_the_run_was_made_with() {
     let with = ReplayOptions { stage: Some("second".into()), ..with };
     replay::replay(tiny(), &with, &Log::default()).unwrap();
     assert!(d.join("with/trace.csv").exists());
+}
+
+/// `trace.csv` written as an episode goes (as `drive` writes it) is, once
+/// complete, the file written at the episode's end, byte for byte (a stage
+/// with columns of every kind: proximity, light, battery, barrier, wheels,
+/// arm and claw); its rows reach the file while the episode runs.
+#[test]
+fn a_trace_written_as_it_goes_is_the_trace_written_at_the_end() {
+    let program = load(&test_file("report.bat"));
+    let (_, stage) = program.stage("collect").unwrap();
+    let genome = Genome { bits: (0..stage.layout.bits as usize).map(|i| u8::from(i % 3 == 0)).collect() };
+    let opts = EpisodeOptions { actions: 80, learning: true, seed: 9 };
+    let (_, trace, ep) = episode::run_recorded(stage, &genome, &opts).unwrap();
+    let whole = report::trace_csv(&trace, stage, &ep);
+    assert_eq!(whole.lines().count(), 1 + 80);
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("trace.csv");
+    let mut writer = TraceWriter::create(&path, stage).unwrap();
+    assert_eq!(read_text(&path), whole.lines().next().unwrap().to_string() + "\n", "the header at once");
+    let (sim_seed, rng) = episode_rngs(opts.seed);
+    let mut ctl = Controller::new(stage, &genome, rng).unwrap();
+    let mut sim = Sim::new(&stage.world, sim_seed);
+    let mut rec = Recorder::new(&mut sim);
+    let mut streamed = Trace::default();
+    let mut on_disk = Vec::new();
+    ctl.run_traced(&mut rec, &opts, &mut streamed, |row, rec| {
+        writer.push(row, rec.frames.last());
+        if row.action == 40 {
+            // Rows wait in memory at most `TRACE_WRITE_EVERY`: the next one writes them.
+            std::thread::sleep(report::TRACE_WRITE_EVERY);
+        }
+        if row.action == 41 {
+            on_disk = std::fs::read(&path).unwrap();
+        }
+    });
+    writer.finish().unwrap();
+    assert_eq!(streamed, trace);
+    assert!(read_text(&path) == whole, "the trace written as it went differs");
+    let lines: Vec<&str> = whole.split_inclusive('\n').take(1 + 42).collect();
+    assert_eq!(
+        String::from_utf8(on_disk).unwrap(),
+        lines.concat(),
+        "rows 0 to 41 on disk during the episode"
+    );
 }

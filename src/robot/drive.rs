@@ -1,5 +1,5 @@
 //! `shaping drive`: one individual on a robot over its serial port, with the
-//! same trace and pictures as `replay`.
+//! same trace and pictures as `replay`; the trace is written as it goes.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -112,6 +112,11 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
         start.theta.to_degrees()
     );
     let scene = robot.host().scene();
+    // The trace is written as the robot drives: a process killed (even with
+    // SIGKILL) keeps every action but the last few.
+    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
+    create_dir(&out)?;
+    let mut written = report::TraceWriter::create(&out.join("trace.csv"), stage)?;
     let started = Instant::now();
     let mut trace = Trace::default();
     let mut frames = Vec::new();
@@ -120,7 +125,9 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
             // Recorded as `replay` records the simulator: what the robot sensed, for
             // `trace.csv` and `episode.json`.
             let mut rec = Recorder::new(&mut robot);
-            let r = ctl.run(&mut rec, &EpisodeOptions { actions, learning, seed }, Some(&mut trace));
+            let opts = EpisodeOptions { actions, learning, seed };
+            let r =
+                ctl.run_traced(&mut rec, &opts, &mut trace, |row, rec| written.push(row, rec.frames.last()));
             frames = rec.frames;
             Some(r)
         }
@@ -133,11 +140,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let requests = robot.requests;
     let bytes = robot.into_link().bytes;
 
-    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
-    create_dir(&out)?;
+    written.finish()?;
     let parts = [Part { stage: &stage.name, scene: scene.clone(), frames }];
     let ep = episode::episode(stage, seed, learning, &trace, &parts);
-    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
+    report::episode_pictures(&out, &stage.name, stage, &trace, &scene)?;
     write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).unwrap_or_default().as_bytes())?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
     let done = trace.rows.len();

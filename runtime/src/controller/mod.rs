@@ -756,8 +756,33 @@ impl<'s> Controller<'s> {
         &mut self,
         sim: &mut R,
         opts: &EpisodeOptions,
+        trace: Option<&mut Trace>,
+        before: impl FnMut(&mut Self, &R),
+    ) -> EpisodeResult {
+        self.run_hooked(sim, opts, trace, before, |_, _| {})
+    }
+
+    /// [`Controller::run`] with `after` called after every action with the
+    /// trace's row of that action and the robot as the action left it: for
+    /// a caller that writes the trace as it goes (`drive`, where a killed
+    /// process keeps what it wrote).
+    pub fn run_traced<R: Robot>(
+        &mut self,
+        sim: &mut R,
+        opts: &EpisodeOptions,
+        trace: &mut Trace,
+        after: impl FnMut(&TraceRow, &R),
+    ) -> EpisodeResult {
+        self.run_hooked(sim, opts, Some(trace), |_, _| {}, after)
+    }
+
+    fn run_hooked<R: Robot>(
+        &mut self,
+        sim: &mut R,
+        opts: &EpisodeOptions,
         mut trace: Option<&mut Trace>,
         mut before: impl FnMut(&mut Self, &R),
+        mut after: impl FnMut(&TraceRow, &R),
     ) -> EpisodeResult {
         self.set_learning(opts.learning);
         if let Some(t) = trace.as_deref_mut() {
@@ -794,6 +819,9 @@ impl<'s> Controller<'s> {
                     recharged: rep.outcome.recharged,
                     collided: rep.outcome.collided,
                 });
+                if let Some(row) = t.rows.last() {
+                    after(row, sim);
+                }
             }
         }
         if let Some(e) = &self.at_end {
