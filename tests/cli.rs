@@ -618,7 +618,12 @@ fn wide_bat(dir: &Path) -> PathBuf {
 fn a_closed_standard_output_is_not_a_panic() {
     let dir = scratch("pipe");
     let wide = wide_bat(&dir);
-    let many: Vec<&Path> = vec![wide.as_path(); 1000];
+    // `check` prints a line per file: many small files.
+    let small = dir.join("small.bat");
+    std::fs::copy(tiny(), &small).unwrap();
+    let many: Vec<&Path> = vec![small.as_path(); 2000];
+    let all = run(shaping().arg("check").args(&many));
+    assert!(all.stdout.len() > 64 << 10, "{} bytes fit in a pipe's buffer", all.stdout.len());
     let commands: Vec<Vec<std::ffi::OsString>> = vec![
         vec!["layout".into(), wide.clone().into()],
         vec!["layout".into(), "--format".into(), "json".into(), wide.clone().into()],
