@@ -170,6 +170,8 @@ pub struct Sim {
     cylinders: Vec<Cyl>,
     /// Declared lamps (the charger's is `lamp`).
     lamps: Vec<Lamp>,
+    /// Inner walls or cylinders may shade a sensor from a lamp.
+    shades: bool,
     zones: Vec<FloorZone>,
     // precomputed IR
     geo: ir::Geometry,
@@ -321,8 +323,8 @@ impl Sim {
         let model = &ir::KHEPERA;
         let items = &world.items;
         let pt = |p: [f32; 2]| Point2::new(finite_or(p[0], 0.0), finite_or(p[1], 0.0));
-        let inner = items.walls.iter().map(|w| [pt(w.from), pt(w.to)]).collect();
-        let cylinders = items
+        let inner: Vec<[Point2<f32>; 2]> = items.walls.iter().map(|w| [pt(w.from), pt(w.to)]).collect();
+        let cylinders: Vec<Cyl> = items
             .cylinders
             .iter()
             .map(|c| {
@@ -369,6 +371,7 @@ impl Sim {
             obj_radius,
             obj_virtual,
             objects: Vec::with_capacity(count),
+            shades: !inner.is_empty() || !cylinders.is_empty(),
             inner,
             cylinders,
             lamps,
@@ -725,9 +728,8 @@ impl Sim {
         let intensity = lamp.k / (rho2 + lamp.height * lamp.height);
         let rho = rho2.sqrt();
         let along = self.geo.rays * rel;
-        let shadows = !self.inner.is_empty() || !self.cylinders.is_empty();
         for i in 0..ir::SENSORS {
-            if shadows && self.shaded(&(self.pose * self.geo.position(i)), &lamp.at) {
+            if self.shades && self.shaded(&(self.pose * self.geo.position(i)), &lamp.at) {
                 continue;
             }
             // cos of the bearing off the axis; straight below the lamp every
