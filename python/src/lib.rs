@@ -288,9 +288,7 @@ impl Program {
                 if matches!(self.program.stages[index].run, StageRun::Train { .. }) { "training" } else { "test" }
             )));
         }
-        if jobs == Some(0) {
-            return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
-        }
+        check_jobs(jobs)?;
         let run_dir: Option<PathBuf> = match run {
             None => None,
             Some(r) => Some(match r.getattr("out") {
@@ -668,9 +666,7 @@ impl VecStepper {
         if num_envs == 0 {
             return Err(value_error("error: num_envs must be at least 1"));
         }
-        if jobs == Some(0) {
-            return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
-        }
+        check_jobs(jobs)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs.unwrap_or(0))
             .build()
@@ -936,29 +932,28 @@ impl Observer for PyObserver {
 
 /// `set`: a dict of `STAGE.SECTION.FIELD` to one value each.
 fn assignments(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<sweep::Assignment>> {
-    let Some(set) = set else { return Ok(Vec::new()) };
-    let mut out = Vec::new();
-    for (k, v) in set.iter() {
-        let key: String =
-            k.extract().map_err(|_| value_error("set: the keys are STAGE.SECTION.FIELD strings"))?;
-        if v.is_instance_of::<PyList>() || v.is_instance_of::<pyo3::types::PyTuple>() {
-            return Err(value_error(format!(
-                "error: `--set {key}`: `run` takes one value (`experiment` sweeps several)"
-            )));
-        }
-        let text = if let Ok(b) = v.extract::<bool>() { b.to_string() } else { v.str()?.to_string() };
-        let parsed =
-            sweep::parse_set(&format!("{key}={text}")).map_err(|e| value_error(format!("error: {e}")))?;
-        let [value] = <[String; 1]>::try_from(parsed.values).map_err(|values| {
-            value_error(format!(
-                "error: `--set {}={}`: `run` takes one value (`experiment` sweeps several)",
-                parsed.target,
-                values.join(",")
-            ))
-        })?;
-        out.push((parsed.target, value));
+    sweep_sets(set)?
+        .into_iter()
+        .map(|parsed| {
+            <[String; 1]>::try_from(parsed.values).map(|[value]| (parsed.target.clone(), value)).map_err(
+                |values| {
+                    value_error(format!(
+                        "error: `--set {}={}`: `run` takes one value (`experiment` sweeps several)",
+                        parsed.target,
+                        values.join(",")
+                    ))
+                },
+            )
+        })
+        .collect()
+}
+
+/// `jobs`: None (one thread per core) or at least 1.
+fn check_jobs(jobs: Option<usize>) -> PyResult<()> {
+    if jobs == Some(0) {
+        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Runs the file `path` like `shaping run` into `out` (default
@@ -990,9 +985,7 @@ fn run(
     fresh: bool,
     report: bool,
 ) -> PyResult<Run> {
-    if jobs == Some(0) {
-        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
-    }
+    check_jobs(jobs)?;
     check_callback(py, &callback)?;
     let sets = assignments(set)?;
     let program = load(py, &path)?;
@@ -1176,9 +1169,7 @@ fn experiment(
     fresh: bool,
     report: bool,
 ) -> PyResult<Experiment> {
-    if jobs == Some(0) {
-        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
-    }
+    check_jobs(jobs)?;
     check_callback(py, &callback)?;
     let sets = sweep_sets(set)?;
     let mut criteria = Vec::new();
