@@ -448,3 +448,8 @@ fm_c = [x if x is not None else 241 for x in fm]
 nav_c = [x if x is not None else 41 for x in nav]
 print(f"  medians (never = past the last generation): from scratch {med(fm_c)}, shaped {med(nav_c)}; "
       f"ratio {med(fm_c) / med(nav_c):.2f} (the paper: 240 / 40 = 6)")
+
+print("\n== the charger example of docs/language.md (section 18): recharges of the last generation's best")
+ch = [int(rows(f"{R}/charger/seed-{s}/s/generations.csv")[-1]["best_recharges"]) for s in SEEDS]
+fin = [history("charger", s, "s")[-1] for s in SEEDS]
+print(f"  best_recharges per seed: {' '.join(map(str, ch))}; median {statistics.median(ch)}; final best {spread(fin, 1)}")

@@ -80,6 +80,16 @@ $B experiment examples/khepera.bat --stage navigation --seeds $SEEDS --out $R/mu
 # khepera.bat's navigation is the paper's "almost one order of magnitude".
 $B experiment examples/floreano-mondada-1994.bat --seeds $SEEDS --out $R/fm1994 --fresh > /dev/null
 $B experiment examples/floreano-mondada-1996.bat --seeds $SEEDS --out $R/fm1996 --fresh > /dev/null
+# The charger example of docs/language.md (section 18), verbatim: does its
+# best farm recharges? (the code block that declares `1 per recharge`)
+python3 - > $R/charger.bat <<'PY'
+import re
+text = open("docs/language.md").read()
+blocks = re.findall(r"```bat\n(.*?)```", text, re.S)
+print(next(b for b in blocks if "1 per recharge" in b), end="")
+PY
+grep -q 'uses charger' $R/charger.bat
+$B experiment $R/charger.bat --seeds $SEEDS --out $R/charger --fresh > /dev/null
 
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
