@@ -7,9 +7,7 @@ use lsp_types::{self as lt, Uri};
 use miette::Diagnostic as _;
 use serde_json::Value;
 use shaping_compiler::ide::{self, Kind};
-use shaping_compiler::lower::lower_partial;
 use shaping_compiler::syntax::{ast, parse_recovering};
-use shaping_compiler::{render_layout, Program};
 
 use super::rpc::RpcError;
 use super::{params, Document};
@@ -260,114 +258,12 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
 // ------------------------------------------------------------------ hover
 
 fn hover(text: &str, offset: usize) -> Option<Value> {
-    let markdown = |value: String, (a, b): (usize, usize)| {
-        let h = lt::Hover {
-            contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value }),
-            range: Some(Lines::new(text).range(a, b)),
-        };
-        serde_json::to_value(h).ok()
+    let (span, value) = ide::hover(text, offset)?;
+    let h = lt::Hover {
+        contents: lt::HoverContents::Markup(lt::MarkupContent { kind: lt::MarkupKind::Markdown, value }),
+        range: Some(Lines::new(text).range(span.start, span.end)),
     };
-    if let Some((span, w)) = ide::keyword_at(text, offset) {
-        let md = format!(
-            "**`{}`**: {}\n\n[docs/language.md#{2}](docs/language.md#{2})",
-            w.text, w.meaning, w.section
-        );
-        return markdown(md, (span.start, span.end));
-    }
-    let (a, b) = word_at(text, offset)?;
-    let word = &text[a..b];
-    let file = parse_recovering(text).0?;
-    let decls = declarations(&file);
-    let (_, kind, _, _) = decls.iter().find(|d| d.0 == word)?;
-    // The stage the cursor is in (else the last one).
-    let here = file.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end);
-    // What stands of the program, errors or not (the parts with errors show
-    // their placeholders; their diagnostics say what is wrong).
-    let program = lower_partial(&file, "document.bat").0;
-    let p = &program;
-    let md = || -> Option<String> {
-        Some(match kind {
-            Kind::Stage => {
-                let (i, st) = p.stage(word)?;
-                let table = render_layout(p, i);
-                let totals = table.lines().find(|l| l.starts_with("genes:")).unwrap_or("");
-                let added: Vec<&str> =
-                    st.modules.iter().filter(|m| m.stage as usize == i).map(|m| m.name.as_str()).collect();
-                let parent =
-                    st.parent.map(|j| format!(", extends `{}`", p.stages[j].name)).unwrap_or_default();
-                format!(
-                    "**stage `{word}`** ({} of {}{parent})\n\nadds modules: {}\n\n{totals}",
-                    i + 1,
-                    p.stages.len(),
-                    if added.is_empty() { "none".to_string() } else { added.join(", ") }
-                )
-            }
-            Kind::Module => {
-                let stage_name = here.map(|s| s.name.text.as_str());
-                let (i, st) = match stage_name.and_then(|n| p.stage(n)) {
-                    Some((i, st)) if st.modules.iter().any(|m| m.name == word) => (i, st),
-                    _ => p
-                        .stages
-                        .iter()
-                        .enumerate()
-                        .rev()
-                        .find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
-                };
-                let m = st.modules.iter().find(|m| m.name == word)?;
-                let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
-                let table = render_layout(p, i);
-                let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
-                rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(word)));
-                // Weights that are not genes: what a training stage learned.
-                let trained = format!("trained: `{word}` ");
-                let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
-                let genes = if rows.len() > 1 {
-                    format!("```text\n{}\n```", rows.join("\n"))
-                } else {
-                    "no genes in this stage".to_string()
-                };
-                let extra =
-                    if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
-                format!(
-                    "**module `{word}`** in stage `{}`\n\nsenses: {}\n\n{genes}{extra}",
-                    st.name,
-                    if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
-                )
-            }
-            Kind::Sensor => {
-                let s = p.stages.iter().find_map(|st| st.sensors.iter().find(|s| s.name == word))?;
-                let chans = if s.count == 1 {
-                    format!("channel {}", s.channel)
-                } else {
-                    format!("{} elements, channels {}..{}", s.count, s.channel, s.channel + s.count - 1)
-                };
-                let kind = format!("{:?}", s.kind).to_lowercase();
-                format!("**sensor `{word}`**: `{kind}`, {chans}")
-            }
-            Kind::Actuator => {
-                let a = p.stages.iter().find_map(|st| st.actuators.iter().find(|a| a.name == word))?;
-                let kind = format!("{:?}", a.kind).to_lowercase();
-                let slots = match kind.as_str() {
-                    "speed" => "two wheel speeds, -1..1 of v_max: `[0]` left, `[1]` right",
-                    "lift" => "states `up`, `down`",
-                    _ => "states `open`, `closed`",
-                };
-                format!("**actuator `{word}`**: `{kind}`, {slots}")
-            }
-        })
-    };
-    // What the program does not hold (a stage in an `extends` cycle, say) is named only.
-    let md = md().unwrap_or_else(|| format!("**{} `{word}`**", kind.as_str()));
-    markdown(md, (a, b))
-}
-
-/// The name of a percept channel: `ir[3]`, `battery`.
-fn channel(p: &Program, stage: usize, c: u16) -> String {
-    match p.stages[stage].sensors.iter().find(|s| s.channel <= c && c < s.channel + s.count) {
-        Some(s) if s.count == 1 => s.name.clone(),
-        Some(s) => format!("{}[{}]", s.name, c - s.channel),
-        None => format!("channel {c}"),
-    }
+    serde_json::to_value(h).ok()
 }
 
 // ------------------------------------------------------------------ completion, symbols, formatting
