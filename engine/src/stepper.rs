@@ -27,10 +27,10 @@ use std::sync::Arc;
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use shaping_runtime::catalog::{ActuatorKind, ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
-use shaping_runtime::controller::FastExpr;
+use shaping_runtime::catalog::{ActuatorKind, ACT_SLOTS, CHANNELS};
+use shaping_runtime::controller::{bonus_points, record_command, FastExpr};
 use shaping_runtime::expr::Env;
-use shaping_runtime::program::{Event, Stage};
+use shaping_runtime::program::Stage;
 use shaping_runtime::sim::{Command, Outcome, Pose, Scene, Sim};
 
 use crate::descriptors::{self, Descriptors};
@@ -259,26 +259,19 @@ impl Stepper {
         let Some(sim) = &mut self.sim else { return Step::default() };
         let outcome = sim.step(cmd);
         self.odo.moved(sim.position());
-        self.slots[ACT_LEFT] = cmd.wheels[0];
-        self.slots[ACT_RIGHT] = cmd.wheels[1];
-        if let Some(d) = cmd.arm {
-            self.slots[ACT_ARM] = f32::from(u8::from(d));
-        }
-        if let Some(c) = cmd.claw {
-            self.slots[ACT_CLAW] = f32::from(u8::from(c));
-        }
+        record_command(&mut self.slots, cmd);
         sim.sense(&mut self.next);
         let state = if self.reads_state { self.odo.state(sim.pose().theta) } else { Default::default() };
         let env = Env { now: &self.next, prev: &self.now, act: &self.slots, state: &state };
         let mut reward = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
-        for b in &self.stage.fitness.bonuses {
-            let n = match b.event {
-                Event::Grip => outcome.grips,
-                Event::ReleaseOutside => outcome.releases_outside,
-                Event::Recharge => u32::from(outcome.recharged),
-                Event::Collision => u32::from(outcome.collided),
-            };
-            reward += b.points * n as f32;
+        let counts = [
+            outcome.grips,
+            outcome.releases_outside,
+            u32::from(outcome.recharged),
+            u32::from(outcome.collided),
+        ];
+        for points in bonus_points(&self.stage, counts) {
+            reward += points;
         }
         let terminated = !sim.alive();
         let truncated = !terminated && self.actions + 1 >= self.life;

@@ -642,16 +642,9 @@ impl<'s> Controller<'s> {
         let outcome = sim.step(&cmd);
         self.odo.moved(sim.position());
         self.observe_state(sim);
-        self.slots[ACT_LEFT] = cmd.wheels[0];
-        self.slots[ACT_RIGHT] = cmd.wheels[1];
-        if let Some(d) = cmd.arm {
-            self.slots[ACT_ARM] = if d { 1.0 } else { 0.0 };
-        }
-        if let Some(c) = cmd.claw {
-            self.slots[ACT_CLAW] = if c { 1.0 } else { 0.0 };
-            if !c {
-                self.holding = false;
-            }
+        record_command(&mut self.slots, &cmd);
+        if cmd.claw == Some(false) {
+            self.holding = false;
         }
         if outcome.grips > 0 {
             self.holding = true;
@@ -891,14 +884,37 @@ pub fn episode_rngs(seed: u64) -> (u64, ChaCha8Rng) {
 
 /// Adds to `fitness` the stage's bonuses for the events counted in `res`.
 pub fn add_bonuses(stage: &Stage, res: &EpisodeResult, fitness: &mut f64) {
-    for b in &stage.fitness.bonuses {
+    let counts = [res.grips, res.releases_outside, res.recharges, res.collisions];
+    for points in bonus_points(stage, counts) {
+        *fitness += points as f64;
+    }
+}
+
+/// Each bonus of `stage`'s fitness for the event counts `[grips, releases
+/// outside, recharges, collisions]`: its points times its event's count.
+pub fn bonus_points(stage: &Stage, counts: [u32; 4]) -> impl Iterator<Item = f32> + '_ {
+    stage.fitness.bonuses.iter().map(move |b| {
         let n = match b.event {
-            Event::Grip => res.grips,
-            Event::ReleaseOutside => res.releases_outside,
-            Event::Recharge => res.recharges,
-            Event::Collision => res.collisions,
+            Event::Grip => counts[0],
+            Event::ReleaseOutside => counts[1],
+            Event::Recharge => counts[2],
+            Event::Collision => counts[3],
         };
-        *fitness += (b.points * n as f32) as f64;
+        b.points * n as f32
+    })
+}
+
+/// Writes what `cmd` commands into the actuator slots expressions read
+/// (`wheels[0]`, the arm and the claw as 0 or 1; an arm or claw not
+/// commanded keeps its slot).
+pub fn record_command(slots: &mut [f32; ACT_SLOTS], cmd: &Command) {
+    slots[ACT_LEFT] = cmd.wheels[0];
+    slots[ACT_RIGHT] = cmd.wheels[1];
+    if let Some(d) = cmd.arm {
+        slots[ACT_ARM] = f32::from(u8::from(d));
+    }
+    if let Some(c) = cmd.claw {
+        slots[ACT_CLAW] = f32::from(u8::from(c));
     }
 }
 
