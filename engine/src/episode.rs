@@ -295,7 +295,8 @@ pub struct Episode {
     /// The robot has a gripper (arm and claw).
     pub gripper: bool,
     pub modules: Vec<String>,
-    /// Bearings of the proximity sensors, degrees counter-clockwise from the heading.
+    /// Bearings of the proximity sensors, degrees counter-clockwise from the
+    /// heading: the body's declared ones, else the Khepera's nominal ones.
     pub sensor_bearings: [f32; ir::SENSORS],
     /// Reach of the proximity sensors beyond the body, mm.
     pub sensor_range: f32,
@@ -383,7 +384,8 @@ pub fn episode(
         learning,
         gripper,
         modules: trace.modules.clone(),
-        sensor_bearings: SENSOR_BEARING_DEG,
+        // a declared layout's bearings (`body e-puck`), else the Khepera's
+        sensor_bearings: stage.world.body.ir.as_ref().map_or(SENSOR_BEARING_DEG, |l| l.facing),
         sensor_range: ir::RANGE,
         worlds,
         actions: c,

@@ -10,7 +10,7 @@
 use serde::{Deserialize, Serialize};
 
 /// Number of percept channels the simulator fills each action.
-pub const CHANNELS: usize = 20;
+pub const CHANNELS: usize = 23;
 /// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`, arm, claw).
 pub const ACT_SLOTS: usize = 4;
 
@@ -22,10 +22,12 @@ pub const CH_LIGHT: usize = 8;
 pub const CH_BATTERY: usize = 16;
 /// Channel index of the gripper's optical barrier.
 pub const CH_BARRIER: usize = 17;
-/// Channel index of the ground (floor) sensor.
+/// Channel index of the first ground (floor) sensor.
 pub const CH_FLOOR: usize = 18;
+/// Most ground sensors a robot may have (channels `CH_FLOOR..CH_FLOOR + 4`).
+pub const GROUND_SENSORS: usize = 4;
 /// Channel index of the distance to the nearest lamp.
-pub const CH_LAMP_DISTANCE: usize = 19;
+pub const CH_LAMP_DISTANCE: usize = CH_FLOOR + GROUND_SENSORS;
 
 /// Actuator slot of the left wheel's commanded speed (normalised to -1..1).
 pub const ACT_LEFT: usize = 0;
@@ -51,8 +53,8 @@ pub enum SensorKind {
     Level,
     /// Optical barrier between the gripper's arms, 0 or 1.
     Optical,
-    /// Ground sensor under the body centre: the floor's grey level, 0
-    /// black .. 1 white.
+    /// Ground sensors under the body (the centre unless the body places
+    /// them): the floor's grey level, 0 black .. 1 white.
     Ground,
     /// The distance from the body centre to the nearest lamp, 0 .. 1 (1 m
     /// or more, or no lamp): the simulator's knowledge, for fitness terms.
@@ -129,9 +131,9 @@ pub const SENSORS: [SensorInfo; 6] = [
     SensorInfo {
         kind: SensorKind::Ground,
         keyword: "ground",
-        max_count: 1,
+        max_count: GROUND_SENSORS,
         channel: CH_FLOOR,
-        doc: "ground sensor under the body: the floor's grey level, 0 black .. 1 white",
+        doc: "ground sensors under the body: the floor's grey level, 0 black .. 1 white",
     },
     SensorInfo {
         kind: SensorKind::LampDistance,

@@ -2,6 +2,7 @@
 //!
 //! - [`program`]: the `Program` types, the compiler's target (serde, no spans);
 //! - [`catalog`]: the sensors and actuators of the simulated platform;
+//! - [`bodies`]: the named bodies (`khepera`, `e-puck`);
 //! - [`expr`]: compiled expressions (reinforcement, fitness, `until`);
 //! - [`genome`]: bit-string genomes and decoding;
 //! - [`sim`]: the simulated Khepera world;
@@ -13,6 +14,7 @@
 //!
 //! This crate never depends on the compiler and does no file I/O.
 
+pub mod bodies;
 pub mod catalog;
 pub mod controller;
 pub mod evolve;

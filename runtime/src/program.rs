@@ -170,6 +170,42 @@ pub struct Body {
     pub wheel_noise: f32,
     /// Additive uniform sensor noise amplitude (0.01).
     pub sensor_noise: f32,
+    /// The preset the body was declared from (`body e-puck`); `None` for
+    /// the default, `khepera`. Informative: the values above and below are
+    /// what the simulator uses.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Where the eight IR (and ambient light) sensors sit and look;
+    /// `None`: the geometry fitted to the Khepera ([`crate::sim::ir::KHEPERA`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ir: Option<IrLayout>,
+    /// Where the ground sensors sit, body frame (mm, x ahead, y to the
+    /// left), sensor `k` at `ground[k]`; a ground sensor without a place
+    /// here sits under the body centre.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub ground: Vec<[f32; 2]>,
+}
+
+/// A declared layout of the eight IR sensors (the ambient light sensors
+/// share it). The response to a surface at a given distance and angle stays
+/// the one fitted to the Khepera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IrLayout {
+    /// Where each sensor sits.
+    pub at: [SensorSpot; 8],
+    /// Where each sensor looks, degrees counter-clockwise from the heading.
+    pub facing: [f32; 8],
+}
+
+/// Where a sensor sits on the body.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorSpot {
+    /// On the body rim, at this angle (degrees counter-clockwise from the
+    /// heading): it follows the body's radius.
+    Rim(f32),
+    /// At this point of the body frame, mm (x ahead, y to the left).
+    Point([f32; 2]),
 }
 
 impl Default for Body {
@@ -181,6 +217,9 @@ impl Default for Body {
             action_ms: 250.0,
             wheel_noise: 0.05,
             sensor_noise: 0.01,
+            preset: None,
+            ir: None,
+            ground: Vec::new(),
         }
     }
 }

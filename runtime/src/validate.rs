@@ -494,7 +494,31 @@ fn body(at: &At, b: &Body) -> R {
     at.field("v_max").within(b.v_max, 1e-3, 1e4)?;
     at.field("action_ms").within(b.action_ms, 1.0, 1e5)?;
     at.field("wheel_noise").within(b.wheel_noise, 0.0, 1.0)?;
-    at.field("sensor_noise").within(b.sensor_noise, 0.0, 1.0)
+    at.field("sensor_noise").within(b.sensor_noise, 0.0, 1.0)?;
+    let inside = |at: &At, p: [f32; 2]| {
+        at.ensure(p[0].is_finite() && p[1].is_finite() && p[0].hypot(p[1]) <= b.radius, || {
+            format!("({}, {}) is not on or inside the body (radius {} mm)", p[0], p[1], b.radius)
+        })
+    };
+    if let Some(ir) = &b.ir {
+        for (k, spot) in ir.at.iter().enumerate() {
+            let at = at.field("ir").field("at").index(k);
+            match *spot {
+                SensorSpot::Rim(deg) => at.within(deg, -180.0, 180.0)?,
+                SensorSpot::Point(p) => inside(&at, p)?,
+            }
+        }
+        for (k, &deg) in ir.facing.iter().enumerate() {
+            at.field("ir").field("facing").index(k).within(deg, -180.0, 180.0)?;
+        }
+    }
+    at.field("ground").ensure(b.ground.len() <= catalog::GROUND_SENSORS, || {
+        format!("{} ground sensors, at most {}", b.ground.len(), catalog::GROUND_SENSORS)
+    })?;
+    for (k, &p) in b.ground.iter().enumerate() {
+        inside(&at.field("ground").index(k), p)?;
+    }
+    Ok(())
 }
 
 /// The genome layout: contiguous genes of 1 to 16 bits with finite ranges,

@@ -547,6 +547,8 @@ fn arb_world() -> impl Strategy<Value = World> {
                 action_ms: ms,
                 wheel_noise: wn,
                 sensor_noise: sn,
+                ground: vec![[v, ms], [bar, lamp]],
+                ..Body::default()
             },
             charger: Some(Charger { wall: Wall::East, length: bar, lamp_height: Some(lamp) }),
             battery: battery

@@ -735,12 +735,42 @@ impl F<'_> {
                 }
                 t
             }
-            WorldItem::Body(settings, span) => {
-                let items = settings.iter().map(|s| self.item(s.span, Doc::Text(self.setting(s)))).collect();
-                return self.item(*span, self.block("body".into(), *span, items));
+            WorldItem::Body { preset, items, span } => {
+                let head = preset.as_ref().map_or("body".to_string(), |p| format!("body {}", p.text));
+                if !self.lx.tokens_in(*span).iter().any(|t| self.text(t.span) == "{") {
+                    return self.item(*span, Doc::Text(head));
+                }
+                let items = items
+                    .iter()
+                    .map(|i| match i {
+                        BodyItem::Setting(s) => self.item(s.span, Doc::Text(self.setting(s))),
+                        BodyItem::Layout(l) => self.item(l.span, Doc::Text(self.layout(l))),
+                    })
+                    .collect();
+                return self.item(*span, self.block(head, *span, items));
             }
         };
         self.item(x.span(), Doc::Text(t))
+    }
+
+    /// `proximity at [...] facing [...]`, `ground at [...]`.
+    fn layout(&self, l: &SensorLayout) -> String {
+        let mut t = l.kind.text.clone();
+        if let Some((spots, _)) = &l.at {
+            let spots: Vec<String> = spots
+                .iter()
+                .map(|s| match s {
+                    Spot::Angle(q) => self.qty(q),
+                    Spot::Point(p) => self.point(p),
+                })
+                .collect();
+            t += &format!(" at [{}]", spots.join(", "));
+        }
+        if let Some((qs, _)) = &l.facing {
+            let qs: Vec<String> = qs.iter().map(|q| self.qty(q)).collect();
+            t += &format!(" facing [{}]", qs.join(", "));
+        }
+        t
     }
 
     fn point(&self, p: &Point) -> String {

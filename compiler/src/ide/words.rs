@@ -90,6 +90,7 @@ const GENOME_S: &str = "4-the-genome";
 const STAGES: &str = "5-stages";
 const WORLD_S: &str = "6-the-world";
 const ITEMS: &str = "walls-cylinders-lamps-floor-zones-and-the-start";
+const BODIES: &str = "bodies-and-sensor-layouts";
 const EVOLUTION: &str = "7-evolution";
 const FITNESS: &str = "8-fitness";
 const MODULES: &str = "9-modules";
@@ -188,7 +189,9 @@ const LIST: &[Word] = &[
     w("charger", C, WORLD | CLAUSE, "`charger L on north wall [with lamp]`: a charging bar on a wall", WORLD_S),
     w("battery", C, WORLD, "`battery N actions`: how long a full battery lasts", WORLD_S),
     w("objects", C, WORLD, "`objects N diameter D physical|virtual`: objects to collect", WORLD_S),
-    w("body", C, WORLD, "`body { v_max 80 ... }`: the robot's motion parameters", WORLD_S),
+    w("body", C, WORLD, "`body [khepera | e-puck] { v_max 80 ... }`: the robot's body, from a preset, with single values changed", WORLD_S),
+    w("khepera", C, CLAUSE, "`body khepera`: the Khepera's body and sensors (the default)", BODIES),
+    w("e-puck", C, CLAUSE, "`body e-puck`: the e-puck's body, its IR sensors' places and bearings and 3 ground sensors", BODIES),
     w("wall", C, WORLD | CLAUSE, "`wall [NAME] from (X, Y) to (X, Y)`: a wall inside the arena", ITEMS),
     w("cylinder", C, WORLD, "`cylinder [NAME] at (X, Y) diameter D`: a cylinder on the floor", ITEMS),
     w("lamp", C, WORLD | CLAUSE, "`lamp [NAME] at (X, Y) [height H] [intensity K]`: a lamp", ITEMS),
@@ -215,6 +218,7 @@ const LIST: &[Word] = &[
     w("action", C, BODY | CLAUSE, "`action T ms`: the length of an action (in a fitness: `per action`)", WORLD_S),
     w("wheel_noise", C, BODY, "`wheel_noise K`: relative noise of the wheel speeds", WORLD_S),
     w("sensor_noise", C, BODY, "`sensor_noise K`: noise added to the sensor readings", WORLD_S),
+    w("facing", C, CLAUSE, "`proximity at [...] facing [B0, ..., B7]`: where the 8 IR sensors look, degrees counter-clockwise from the heading", BODIES),
     // evolution settings
     w("population", C, EVOLVE, "`population N`: individuals per generation", EVOLUTION),
     w("generations", C, EVOLVE, "`generations N`", EVOLUTION),
@@ -255,7 +259,9 @@ const LIST: &[Word] = &[
 pub fn words() -> Vec<Word> {
     let mut out: Vec<Word> = LIST.to_vec();
     for s in catalog::SENSORS {
-        out.push(w(s.keyword, WordKind::SensorKind, SENSOR_KIND, s.doc, ROBOT_S));
+        // `proximity` and `ground` also start a sensor layout in a body.
+        let body = if matches!(s.keyword, "proximity" | "ground") { BODY } else { 0 };
+        out.push(w(s.keyword, WordKind::SensorKind, SENSOR_KIND | body, s.doc, ROBOT_S));
     }
     for a in catalog::ACTUATORS {
         // `grip` is also a fitness event: one entry, both places.

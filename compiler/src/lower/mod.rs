@@ -1047,6 +1047,7 @@ impl<'a> Lower<'a> {
         }
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span, decl.span);
+        self.check_ground(&st, s, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
         self.run(&mut st, decl, parent.is_some());

@@ -4,7 +4,9 @@
 
 use shaping_runtime::limits::{MAX_ITEMS, MAX_OBJECTS};
 use shaping_runtime::program::*;
+use shaping_runtime::sim::ir;
 use shaping_runtime::world::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
+use shaping_runtime::{bodies, catalog};
 
 use super::*;
 use crate::diag::{did_you_mean, Error};
@@ -26,7 +28,7 @@ impl Lower<'_> {
                 W::Battery(..) => Some("battery"),
                 W::Recharge(..) => Some("recharge"),
                 W::Objects { .. } => Some("objects"),
-                W::Body(..) => Some("body"),
+                W::Body { .. } => Some("body"),
                 W::Start { .. } => Some("start"),
                 _ => None,
             };
@@ -172,8 +174,8 @@ impl Lower<'_> {
                     ws.world.objects = Some(o);
                     ws.spans.insert("objects", *span);
                 }
-                W::Body(settings, span) => {
-                    self.body(&mut ws.world.body, settings);
+                W::Body { preset, items, span } => {
+                    self.body(ws, preset.as_ref(), items, *span);
                     ws.spans.insert("body", *span);
                 }
                 W::Wall { name, from, to, span } => {
@@ -521,6 +523,43 @@ impl Lower<'_> {
         }
     }
 
+    /// A robot with several ground sensors needs the body to place them:
+    /// reported at the stage that declares the sensors, or at the stage
+    /// whose body places too few.
+    pub(super) fn check_ground(&mut self, st: &StageSt, s: u16, stage: Span) {
+        if st.world.refused.contains(&("body", "ground".into())) {
+            // A refused body or ground layout said so already.
+            return;
+        }
+        let placed = st.world.world.body.ground.len();
+        let here =
+            st.world.spans.get("body.ground").filter(|sp| stage.start <= sp.start && sp.end <= stage.end);
+        for d in st.sensors.iter().filter(|d| d.kind == SensorKind::Ground) {
+            let n = usize::from(d.count);
+            if n <= 1 || n <= placed {
+                continue;
+            }
+            let (span, label) = match here {
+                Some(sp) => (*sp, format!("places {placed}")),
+                None if d.stage == s => (d.span, format!("{n} ground sensors")),
+                None => continue,
+            };
+            self.value_error(
+                span,
+                format!(
+                    "`{}` has {n} ground sensors, but the body places {placed}",
+                    d.name
+                ),
+                &label,
+                Some(
+                    "say where each sits in the world's body: `body { ground at [(30mm, 10mm), (30mm, -10mm)] }` \
+                     (mm ahead of the centre and to its left); one ground sensor alone sits under the centre"
+                        .into(),
+                ),
+            );
+        }
+    }
+
     /// The body must fit in the arena: labelled on the arena, or on the
     /// body when only the body was declared by this stage (`within`).
     pub(super) fn check_fit(&mut self, ws: &WorldSt, stage: Span, within: Span) {
@@ -552,7 +591,267 @@ impl Lower<'_> {
         }
     }
 
-    pub(super) fn body(&mut self, body: &mut Body, settings: &[ast::Setting]) {
+    /// `body [PRESET] { ... }`: the preset (if any) replaces the whole body,
+    /// then the settings and layouts change single values.
+    pub(super) fn body(
+        &mut self,
+        ws: &mut WorldSt,
+        preset: Option<&ast::Name>,
+        items: &[ast::BodyItem],
+        span: Span,
+    ) {
+        if let Some(p) = preset {
+            match bodies::preset(&p.text) {
+                Some(b) => {
+                    ws.world.body = b;
+                    ws.refused.remove(&("body", "ground".to_string()));
+                }
+                None => {
+                    ws.refused.insert(("body", "ground".into()));
+                    self.errors.push(Error::Unknown {
+                        span: p.span.into(),
+                        what: "body preset",
+                        name: p.text.clone(),
+                        help: did_you_mean(&p.text, bodies::PRESETS)
+                            .or_else(|| Some("the presets are `khepera` (the default) and `e-puck`".into())),
+                    })
+                }
+            }
+        }
+        let settings: Vec<&ast::Setting> = items
+            .iter()
+            .filter_map(|i| match i {
+                ast::BodyItem::Setting(s) => Some(s),
+                ast::BodyItem::Layout(_) => None,
+            })
+            .collect();
+        let body = &mut ws.world.body;
+        self.body_settings(body, &settings);
+        let mut seen: HashMap<String, Span> = HashMap::new();
+        for item in items {
+            let ast::BodyItem::Layout(l) = item else { continue };
+            if let Some(first) = seen.insert(l.kind.text.clone(), l.span) {
+                self.errors.push(Error::Duplicate {
+                    span: l.span.into(),
+                    first: first.into(),
+                    what: "sensor layout",
+                    name: l.kind.text.clone(),
+                });
+                continue;
+            }
+            if l.kind.text == "ground" {
+                match self.ground_layout(l, body.radius) {
+                    Some(ground) => {
+                        body.ground = ground;
+                        ws.spans.insert("body.ground", l.span);
+                        ws.refused.remove(&("body", "ground".to_string()));
+                    }
+                    None => {
+                        ws.refused.insert(("body", "ground".into()));
+                    }
+                }
+            } else if let Some(ir) = self.ir_layout(l, body.radius) {
+                body.ir = Some(ir);
+            }
+        }
+        self.check_sensor_places(body, span);
+    }
+
+    /// `ground at [(X, Y), ...]`: 1 to 4 points of the body frame.
+    fn ground_layout(&mut self, l: &ast::SensorLayout, radius: f32) -> Option<Vec<[f32; 2]>> {
+        if let Some((_, sp)) = &l.facing {
+            self.value_error(
+                *sp,
+                "ground sensors look at the floor below them: they have no bearing".into(),
+                "not for ground sensors",
+                Some("write only where they sit: `ground at [(30mm, 10mm), (30mm, -10mm)]`".into()),
+            );
+        }
+        let (list, sp) = l.at.as_ref()?;
+        let max = catalog::GROUND_SENSORS;
+        if list.len() > max {
+            self.value_error(
+                *sp,
+                format!("a body has at most {max} ground sensors; this list places {}", list.len()),
+                "too many",
+                None,
+            );
+            return None;
+        }
+        let mut out = Vec::new();
+        let mut ok = true;
+        for spot in list {
+            match spot {
+                ast::Spot::Point(p) => match self.body_point(p, radius, "ground sensor") {
+                    Some(q) => out.push(q),
+                    None => ok = false,
+                },
+                ast::Spot::Angle(q) => {
+                    self.value_error(
+                        q.span,
+                        "a ground sensor sits at a point of the body frame, not an angle".into(),
+                        "not a point",
+                        Some("write `(X, Y)`: mm ahead of the centre and to its left".into()),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        ok.then_some(out)
+    }
+
+    /// `proximity at [...] facing [...]`: eight places and eight bearings.
+    /// A missing list is derived from the other: a sensor looks straight
+    /// out from where it sits, and sits on the rim where it looks.
+    fn ir_layout(&mut self, l: &ast::SensorLayout, radius: f32) -> Option<IrLayout> {
+        let n = ir::SENSORS;
+        let count_ok = |me: &mut Self, len: usize, sp: Span, what: &str| {
+            if len != n {
+                me.value_error(
+                    sp,
+                    format!("the robot has exactly {n} proximity sensors, but this list {what} {len}"),
+                    &format!("{len}, not {n}"),
+                    Some(format!(
+                        "give one value per sensor, in the order of `ir[0]` to `ir[{}]`; the count of \
+                         proximity sensors is fixed",
+                        n - 1
+                    )),
+                );
+                false
+            } else {
+                true
+            }
+        };
+        let mut at: Option<Vec<SensorSpot>> = None;
+        let mut ok = true;
+        if let Some((list, sp)) = &l.at {
+            if count_ok(self, list.len(), *sp, "places") {
+                let mut v = Vec::new();
+                for spot in list {
+                    match spot {
+                        ast::Spot::Angle(q) => match self.bearing(q, "a sensor's angle on the rim") {
+                            Some(d) => v.push(SensorSpot::Rim(d)),
+                            None => ok = false,
+                        },
+                        ast::Spot::Point(p) => match self.body_point(p, radius, "proximity sensor") {
+                            Some(q) => v.push(SensorSpot::Point(q)),
+                            None => ok = false,
+                        },
+                    }
+                }
+                at = Some(v);
+            } else {
+                ok = false;
+            }
+        }
+        let mut facing: Option<Vec<f32>> = None;
+        if let Some((list, sp)) = &l.facing {
+            if count_ok(self, list.len(), *sp, "gives") {
+                let v: Vec<Option<f32>> = list.iter().map(|q| self.bearing(q, "a bearing")).collect();
+                ok &= v.iter().all(Option::is_some);
+                facing = Some(v.into_iter().flatten().collect());
+            } else {
+                ok = false;
+            }
+        }
+        if !ok {
+            return None;
+        }
+        let at: Vec<SensorSpot> = match (&at, &facing) {
+            (Some(a), _) => a.clone(),
+            (None, Some(f)) => f.iter().map(|&d| SensorSpot::Rim(d)).collect(),
+            (None, None) => return None,
+        };
+        let facing: Vec<f32> = match facing {
+            Some(f) => f,
+            None => at
+                .iter()
+                .map(|s| match *s {
+                    SensorSpot::Rim(d) => d,
+                    SensorSpot::Point([x, y]) => {
+                        let d = y.atan2(x).to_degrees();
+                        if d.is_finite() {
+                            d
+                        } else {
+                            0.0
+                        }
+                    }
+                })
+                .collect(),
+        };
+        Some(IrLayout { at: at.try_into().ok()?, facing: facing.try_into().ok()? })
+    }
+
+    /// An angle in degrees, counter-clockwise from the heading: -180..180.
+    fn bearing(&mut self, q: &ast::Quantity, what: &str) -> Option<f32> {
+        if let Some(u) = q.unit {
+            self.errors.push(Error::Unit {
+                span: q.span.into(),
+                expected: "a plain number",
+                found: unit_desc(u),
+                help: Some(format!("{what} is in degrees, written without a unit")),
+            });
+            return None;
+        }
+        if !(-180.0..=180.0).contains(&q.value) {
+            self.value_error(
+                q.span,
+                format!("{what} must be between -180 and 180 degrees, counter-clockwise from the heading"),
+                "out of range",
+                Some("90 is the left side, -90 the right side, 180 straight back".into()),
+            );
+            return None;
+        }
+        Some(q.value as f32)
+    }
+
+    /// `(X, Y)` of the body frame, mm, on or inside the body of `radius`.
+    fn body_point(&mut self, p: &ast::Point, radius: f32, what: &str) -> Option<[f32; 2]> {
+        let x = self.coordinate(&p.x, "a sensor's place");
+        let y = self.coordinate(&p.y, "a sensor's place");
+        let q = [x?, y?];
+        let d = q[0].hypot(q[1]);
+        if d > radius {
+            self.value_error(
+                p.x.span.to(p.y.span),
+                format!(
+                    "this {what} is {d:.1} mm from the body centre, outside the body (radius {radius} mm)"
+                ),
+                "outside the body",
+                Some(
+                    "a sensor's place is mm ahead of the body centre and to its left, within the radius"
+                        .into(),
+                ),
+            );
+            return None;
+        }
+        Some(q)
+    }
+
+    /// The sensors this block did not place (inherited, or a preset's) lie
+    /// on or inside the body, whose radius this block may have changed.
+    fn check_sensor_places(&mut self, body: &Body, span: Span) {
+        let r = body.radius;
+        let points = body.ground.iter().chain(body.ir.iter().flat_map(|l| {
+            l.at.iter().filter_map(|s| match s {
+                SensorSpot::Point(p) => Some(p),
+                SensorSpot::Rim(_) => None,
+            })
+        }));
+        if let Some(p) = points.into_iter().find(|p| p[0].hypot(p[1]) > r) {
+            self.value_error(
+                span,
+                format!("a sensor at ({}, {}) mm lies outside this body (radius {r} mm)", p[0], p[1]),
+                "sensors outside the body",
+                Some(
+                    "place the sensors again for this radius (`proximity at [...]`, `ground at [...]`)"
+                        .into(),
+                ),
+            );
+        }
+    }
+
+    fn body_settings(&mut self, body: &mut Body, settings: &[&ast::Setting]) {
         self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
             let n = set.name.text.as_str();

@@ -137,17 +137,64 @@ pub struct WorldBlock {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum WorldItem {
-    Arena { width: Quantity, depth: Quantity, span: Span },
-    Charger { length: Quantity, wall: Name, lamp: Option<Option<Quantity>>, span: Span },
+    Arena {
+        width: Quantity,
+        depth: Quantity,
+        span: Span,
+    },
+    Charger {
+        length: Quantity,
+        wall: Name,
+        lamp: Option<Option<Quantity>>,
+        span: Span,
+    },
     Battery(Quantity, Span),
     Recharge(Quantity, Span),
-    Objects { count: Option<Quantity>, diameter: Option<Quantity>, virtual_: Option<bool>, span: Span },
-    Body(Vec<Setting>, Span),
-    Wall { name: Option<Name>, from: Point, to: Point, span: Span },
-    Cylinder { name: Option<Name>, at: Point, diameter: Quantity, span: Span },
-    Lamp { name: Option<Name>, at: Point, height: Option<Quantity>, intensity: Option<Quantity>, span: Span },
-    Zone { name: Option<Name>, from: Point, to: Point, grey: Option<Quantity>, charger: bool, span: Span },
-    Start { from: Point, to: Option<Point>, heading: Option<Quantity>, span: Span },
+    Objects {
+        count: Option<Quantity>,
+        diameter: Option<Quantity>,
+        virtual_: Option<bool>,
+        span: Span,
+    },
+    /// `body [PRESET] [{ ... }]`
+    Body {
+        preset: Option<Name>,
+        items: Vec<BodyItem>,
+        span: Span,
+    },
+    Wall {
+        name: Option<Name>,
+        from: Point,
+        to: Point,
+        span: Span,
+    },
+    Cylinder {
+        name: Option<Name>,
+        at: Point,
+        diameter: Quantity,
+        span: Span,
+    },
+    Lamp {
+        name: Option<Name>,
+        at: Point,
+        height: Option<Quantity>,
+        intensity: Option<Quantity>,
+        span: Span,
+    },
+    Zone {
+        name: Option<Name>,
+        from: Point,
+        to: Point,
+        grey: Option<Quantity>,
+        charger: bool,
+        span: Span,
+    },
+    Start {
+        from: Point,
+        to: Option<Point>,
+        heading: Option<Quantity>,
+        span: Span,
+    },
 }
 
 /// `(X, Y)` in a world item.
@@ -165,7 +212,7 @@ impl WorldItem {
             | WorldItem::Battery(_, span)
             | WorldItem::Recharge(_, span)
             | WorldItem::Objects { span, .. }
-            | WorldItem::Body(_, span)
+            | WorldItem::Body { span, .. }
             | WorldItem::Wall { span, .. }
             | WorldItem::Cylinder { span, .. }
             | WorldItem::Lamp { span, .. }
@@ -173,6 +220,32 @@ impl WorldItem {
             | WorldItem::Start { span, .. } => *span,
         }
     }
+}
+
+/// One item of a `body { }` block, in the order written.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BodyItem {
+    Setting(Setting),
+    Layout(SensorLayout),
+}
+
+/// `proximity at [...] facing [...]` or `ground at [...]` in a body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorLayout {
+    /// `proximity` or `ground`.
+    pub kind: Name,
+    /// Where the sensors sit, with the span of the list.
+    pub at: Option<(Vec<Spot>, Span)>,
+    /// Where they look (degrees), with the span of the list.
+    pub facing: Option<(Vec<Quantity>, Span)>,
+    pub span: Span,
+}
+
+/// Where one sensor sits: a rim angle, or a point of the body frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Spot {
+    Angle(Quantity),
+    Point(Point),
 }
 
 /// `NAME VALUE` in `evolve { }` and `body { }`.

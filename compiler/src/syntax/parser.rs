@@ -304,6 +304,11 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::diameter => "`diameter`",
         Rule::object_kind => "`physical` or `virtual`",
         Rule::body => "`body`",
+        Rule::body_preset => "a body preset (`khepera` or `e-puck`)",
+        Rule::sensor_layout | Rule::layout_kind => "`proximity` or `ground`",
+        Rule::layout_at => "`at [...]`",
+        Rule::layout_spot => "an angle or a point `(X, Y)`",
+        Rule::layout_facing | Rule::k_facing => "`facing [...]`",
         Rule::inner_wall | Rule::k_wall => "`wall`",
         Rule::cylinder | Rule::k_cylinder => "`cylinder`",
         Rule::lamp_item | Rule::k_lamp => "`lamp`",
@@ -1264,7 +1269,18 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 }
                 items.push(WorldItem::Objects { count, diameter, virtual_, span: csp });
             }
-            Rule::body => items.push(WorldItem::Body(c.into_inner().map(setting).collect(), csp)),
+            Rule::body => {
+                let mut preset = None;
+                let mut body = Vec::new();
+                for o in c.into_inner() {
+                    match o.as_rule() {
+                        Rule::body_preset => preset = Some(name(o)),
+                        Rule::sensor_layout => body.push(BodyItem::Layout(sensor_layout(o))),
+                        _ => body.push(BodyItem::Setting(setting(o))),
+                    }
+                }
+                items.push(WorldItem::Body { preset, items: body, span: csp });
+            }
             Rule::inner_wall | Rule::cylinder | Rule::lamp_item | Rule::zone | Rule::start => {
                 let rule = c.as_rule();
                 let mut name_ = None;
@@ -1324,6 +1340,43 @@ fn world(p: Pair<Rule>) -> WorldBlock {
         }
     }
     WorldBlock { mode, items, span: sp }
+}
+
+/// `proximity at [...] facing [...]`, `ground at [...]`.
+fn sensor_layout(p: Pair<Rule>) -> SensorLayout {
+    let sp = span(&p);
+    let mut kind = Name { text: String::new(), span: sp };
+    let (mut at, mut facing) = (None, None);
+    for o in p.into_inner() {
+        let osp = span(&o);
+        match o.as_rule() {
+            Rule::layout_kind => kind = name(o),
+            Rule::layout_at => {
+                let spots = o
+                    .into_inner()
+                    .filter(|s| s.as_rule() == Rule::layout_spot)
+                    .filter_map(|s| s.into_inner().next())
+                    .map(|s| match s.as_rule() {
+                        Rule::point => {
+                            let mut q = s.into_inner().map(quantity);
+                            let q0 = Quantity { value: 0.0, unit: None, span: osp };
+                            let x = q.next().unwrap_or(q0.clone());
+                            let y = q.next().unwrap_or(q0);
+                            Spot::Point(Point { x, y })
+                        }
+                        _ => Spot::Angle(quantity(s)),
+                    })
+                    .collect();
+                at = Some((spots, osp));
+            }
+            Rule::layout_facing => {
+                let qs = o.into_inner().filter(|q| q.as_rule() == Rule::quantity).map(quantity).collect();
+                facing = Some((qs, osp));
+            }
+            _ => {}
+        }
+    }
+    SensorLayout { kind, at, facing, span: sp }
 }
 
 fn setting(p: Pair<Rule>) -> Setting {

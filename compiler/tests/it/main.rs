@@ -2,6 +2,7 @@
 //! Test data lives at the repository root: `examples/`, `tests/parse/`,
 //! `tests/ui/`, `tests/lower/`.
 
+mod bodies;
 mod codes;
 mod docs;
 mod examples;

@@ -29,7 +29,10 @@ fn textmate_words() -> Vec<String> {
                                 group
                                     .split('|')
                                     .filter(|w| {
-                                        !w.is_empty() && w.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+                                        // `e-puck`: a preset's name may hold a `-`
+                                        !w.is_empty()
+                                            && w.chars()
+                                                .all(|c| c.is_ascii_lowercase() || c == '_' || c == '-')
                                     })
                                     .map(str::to_string),
                             );
@@ -101,6 +104,12 @@ fn code_words(md: &str) -> Vec<String> {
     }
     for w in code.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
         if !w.is_empty() {
+            out.push(w.to_string());
+        }
+    }
+    // and the words with an inner `-` (`e-puck`)
+    for w in code.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-')) {
+        if w.contains('-') {
             out.push(w.to_string());
         }
     }

@@ -389,7 +389,9 @@ impl<'s> Controller<'s> {
                 a.params.iter().map(&mut value).collect(),
             );
             let gen = match &m.behavior {
-                Behavior::Script(s) => Gen::Script(ScriptRun::new(s)),
+                Behavior::Script(s) => {
+                    Gen::Script(ScriptRun::new(s, stage.world.body.ir.as_ref().map(|l| &l.facing)))
+                }
                 Behavior::Neural(nb) => Gen::Neural {
                     net: Net::with_context(
                         nb.inputs.clone(),

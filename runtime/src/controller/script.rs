@@ -81,7 +81,9 @@ pub struct ScriptRun {
 }
 
 impl ScriptRun {
-    pub fn new(script: &Script) -> ScriptRun {
+    /// `facing`: the bearings (degrees) of a declared IR layout, which
+    /// `toward` steers by instead of the catalog's nominal ones.
+    pub fn new(script: &Script, facing: Option<&[f32; 8]>) -> ScriptRun {
         let steps = script
             .steps
             .iter()
@@ -91,7 +93,7 @@ impl ScriptRun {
                     Action::Toward { channels, speed } => Op::Toward {
                         dirs: channels
                             .iter()
-                            .filter_map(|&c| Some((c, bearing_vector(c as usize)?)))
+                            .filter_map(|&c| Some((c, bearing_vector(c as usize, facing)?)))
                             .collect(),
                         speed: *speed,
                     },
@@ -198,9 +200,15 @@ impl ScriptRun {
     }
 }
 
-/// The unit vector (body frame) along a channel's bearing.
-fn bearing_vector(channel: usize) -> Option<Vector2<f32>> {
-    channel_bearing(channel).map(|b| Vector2::new(b.cos(), b.sin()))
+/// The unit vector (body frame) along a channel's bearing: the declared
+/// layout's when there is one, else the catalog's.
+fn bearing_vector(channel: usize, facing: Option<&[f32; 8]>) -> Option<Vector2<f32>> {
+    let b = channel_bearing(channel)?;
+    let b = match facing {
+        Some(f) => f[channel % 8].to_radians(),
+        None => b,
+    };
+    Some(Vector2::new(b.cos(), b.sin()))
 }
 
 /// Wheel speeds steering toward the vector sum of the channel readings.
@@ -229,7 +237,7 @@ mod tests {
     use crate::catalog::{CH_IR, CH_LIGHT};
 
     fn dirs(chans: std::ops::Range<usize>) -> Vec<(u16, Vector2<f32>)> {
-        chans.map(|c| (c as u16, bearing_vector(c).unwrap())).collect()
+        chans.map(|c| (c as u16, bearing_vector(c, None).unwrap())).collect()
     }
 
     #[test]
@@ -253,7 +261,7 @@ mod tests {
             let mut p = [0.0; CHANNELS];
             p[CH_BARRIER] = barrier;
             let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
-            let mut s = ScriptRun::new(&script);
+            let mut s = ScriptRun::new(&script, None);
             assert_eq!(s.command(&env, &mut r).arm, Some(true));
             s.after_action(&env);
             let cmd = s.command(&env, &mut r);
@@ -272,7 +280,7 @@ mod tests {
         // Every step skipped: nothing moves and nothing is counted.
         let never = Expr { ops: vec![Op::Const(0.0)], depth: 1 };
         let script = Script { steps: vec![step(Action::Arm(true), Some(never))], commit: false };
-        let mut s = ScriptRun::new(&script);
+        let mut s = ScriptRun::new(&script, None);
         let p = [0.0; CHANNELS];
         let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
         assert_eq!(s.command(&env, &mut r), Command::default());
@@ -300,5 +308,30 @@ mod tests {
         let mut p = [0.0; CHANNELS];
         p[CH_IR + 6] = 1.0; // back right
         assert_eq!(toward(&d, 1.0, &p), [1.0, -1.0]);
+    }
+
+    #[test]
+    fn toward_steers_by_a_declared_layouts_bearings() {
+        // The e-puck's order: sensor 0 looks ahead and a little right, 2 to
+        // the right, 5 to the left.
+        let facing = [-17.2, -45.9, -90.0, -151.5, 151.2, 90.0, 45.8, 17.1];
+        let chans: Vec<u16> = (CH_IR as u16..CH_IR as u16 + 8).collect();
+        let d: Vec<(u16, Vector2<f32>)> =
+            chans.iter().map(|&c| (c, bearing_vector(c as usize, Some(&facing)).unwrap())).collect();
+        let mut p = [0.0; CHANNELS];
+        p[CH_IR + 5] = 1.0;
+        assert_eq!(toward(&d, 0.5, &p), [-0.5, 0.5], "sensor 5 is on the left");
+        p[CH_IR + 5] = 0.0;
+        p[CH_IR + 2] = 1.0;
+        assert_eq!(toward(&d, 0.5, &p), [0.5, -0.5], "sensor 2 is on the right");
+        p[CH_IR + 2] = 0.0;
+        p[CH_IR] = 1.0;
+        p[CH_IR + 7] = 1.0;
+        assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5], "0 and 7 look ahead");
+        // the light channels share the bearings
+        let v = bearing_vector(CH_LIGHT + 5, Some(&facing)).unwrap();
+        assert!((v.y - 1.0).abs() < 1e-6);
+        // without a layout, the catalog's: sensor 5 on the right
+        assert!(bearing_vector(CH_IR + 5, None).unwrap().y < -0.99);
     }
 }

@@ -31,6 +31,8 @@ use std::sync::OnceLock;
 
 use nalgebra::{Point2, SMatrix, UnitComplex, Vector2};
 
+use crate::program::{IrLayout, SensorSpot};
+
 /// Number of IR sensors.
 pub const SENSORS: usize = 8;
 /// Radius of the cylinder the cylinder constants were measured with, mm.
@@ -146,6 +148,15 @@ impl IrModel {
     }
 }
 
+/// The rotation by `deg` degrees. sin and cos in f64, rounded once: the
+/// correctly rounded values, the same whether or not the compiler folds the
+/// model's constants (an f32 `sin_cos` at run time can be one unit in the
+/// last place off).
+fn turn(deg: f32) -> UnitComplex<f32> {
+    let (s, c) = f64::from(deg.to_radians()).sin_cos();
+    UnitComplex::from_cos_sin_unchecked(c as f32, s as f32)
+}
+
 /// The sensors in the body frame (x ahead, y to the left; mm), precomputed
 /// for a body radius. One row per sensor, so that a product with a vector
 /// projects every sensor on it at once (`pos * n`, `rays * n`).
@@ -159,15 +170,20 @@ pub struct Geometry {
 
 impl Geometry {
     pub fn new(model: &IrModel, body: f32) -> Geometry {
-        // sin and cos in f64, rounded once: the correctly rounded values,
-        // the same whether or not the compiler folds the model's constants
-        // (an f32 `sin_cos` at run time can be one unit in the last place off).
-        let turn = |deg: f32| {
-            let (s, c) = f64::from(deg.to_radians()).sin_cos();
-            UnitComplex::from_cos_sin_unchecked(c as f32, s as f32)
-        };
         let pos = model.position_deg.map(|deg| (turn(deg) * Point2::new(body, 0.0)).coords.transpose());
         let rays = model.axis_deg.map(|deg| (turn(deg) * Vector2::x()).transpose());
+        Geometry { pos: SMatrix::from_rows(&pos), rays: SMatrix::from_rows(&rays) }
+    }
+
+    /// The geometry of a declared layout (`body { proximity at [...] facing
+    /// [...] }`) for a body radius: a sensor on the rim sits at `body` mm
+    /// from the centre at its angle, a sensor at a point sits there.
+    pub fn from_layout(layout: &IrLayout, body: f32) -> Geometry {
+        let pos = layout.at.map(|spot| match spot {
+            SensorSpot::Rim(deg) => (turn(deg) * Point2::new(body, 0.0)).coords.transpose(),
+            SensorSpot::Point([x, y]) => Vector2::new(x, y).transpose(),
+        });
+        let rays = layout.facing.map(|deg| (turn(deg) * Vector2::x()).transpose());
         Geometry { pos: SMatrix::from_rows(&pos), rays: SMatrix::from_rows(&rays) }
     }
 

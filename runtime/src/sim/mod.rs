@@ -49,7 +49,9 @@ use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
 use rand::{Rng, RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use crate::catalog::{CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT};
+use crate::catalog::{
+    CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, GROUND_SENSORS,
+};
 use crate::program::{Wall, World};
 
 pub use scene::{ObjectState, Scene, SceneObject, SceneZone};
@@ -173,6 +175,8 @@ pub struct Sim {
     /// Inner walls or cylinders may shade a sensor from a lamp.
     shades: bool,
     zones: Vec<FloorZone>,
+    /// Where each ground sensor sits, body frame (the centre unless declared).
+    ground: [Point2<f32>; GROUND_SENSORS],
     // precomputed IR
     geo: ir::Geometry,
     wall_k: ir::Coeffs,
@@ -376,7 +380,11 @@ impl Sim {
             cylinders,
             lamps,
             zones,
-            geo: ir::Geometry::new(model, radius),
+            ground: std::array::from_fn(|k| body.ground.get(k).map_or(Point2::origin(), |&p| pt(p))),
+            geo: match &body.ir {
+                Some(layout) => ir::Geometry::from_layout(layout, radius),
+                None => ir::Geometry::new(model, radius),
+            },
             wall_k: ir::Coeffs::new(&model.wall.reach, &model.wall),
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
             pose: Isometry2::identity(),
@@ -571,15 +579,27 @@ impl Sim {
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
-        out[CH_FLOOR] = self.floor();
+        self.sense_ground(out);
         out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
     }
 
-    /// What a ground sensor under the body centre reads: the grey level of
-    /// the last declared floor zone there, else the white floor's 1.
+    /// What the first ground sensor reads (under the body centre unless
+    /// the body places it elsewhere).
     pub fn floor(&self) -> f32 {
-        let c = self.centre();
-        self.zones.iter().rev().find(|z| z.contains(&c)).map_or(1.0, |z| z.grey)
+        self.floor_at(&(self.pose * self.ground[0]))
+    }
+
+    /// The grey level of the floor at `p` (world frame): the last declared
+    /// floor zone there, else the white floor's 1.
+    fn floor_at(&self, p: &Point2<f32>) -> f32 {
+        self.zones.iter().rev().find(|z| z.contains(p)).map_or(1.0, |z| z.grey)
+    }
+
+    /// Fills the ground channels: each sensor reads the floor under it.
+    fn sense_ground(&self, out: &mut [f32; CHANNELS]) {
+        for (k, at) in self.ground.iter().enumerate() {
+            out[CH_FLOOR + k] = if self.zones.is_empty() { 1.0 } else { self.floor_at(&(self.pose * at)) };
+        }
     }
 
     /// Distance from the body centre to the nearest lamp, seen from above
@@ -999,7 +1019,7 @@ impl Sim {
         }
         out[CH_BATTERY] = self.battery();
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
-        out[CH_FLOOR] = self.floor();
+        self.sense_ground(out);
         out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
     }
 
