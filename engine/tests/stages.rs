@@ -355,3 +355,45 @@ fn a_stopped_test_stage_stops_at_once_and_writes_nothing_of_it() {
     }
     assert!(!out.join("report.html").exists());
 }
+
+/// An e-puck file runs end to end: its episode carries the e-puck's
+/// bearings for the pictures, its trace a column per ground sensor, and a
+/// test stage that turns the sensors runs the same best with them.
+#[test]
+fn an_e_puck_file_runs_with_its_preset() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = "robot epuck {
+  sensor ir[8] proximity  sensor floor[3] ground  actuator wheels[2] speed
+}
+stage roam {
+  world {
+    arena 400mm x 400mm
+    body e-puck
+    zone line from (0mm, 190mm) to (400mm, 210mm) grey 0
+  }
+  evolve { population 8 generations 2 actions 40 seed 5 }
+  fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) * (1 - floor[1])
+  module go { sense ir, floor  behavior neural { hidden 2  outputs linear  weights evolvable } }
+  module away { sense ir  behavior toward(ir) }
+  links all evolvable
+}
+stage turned extends roam {
+  world changes { body { proximity facing [0, -45, -90, -150, 150, 90, 45, 0] } }
+  test best for 40 actions
+}
+";
+    let (_, program) = write_bat(d, "epuck.bat", source);
+    let body = &program.stages[0].world.body;
+    assert_eq!(body.radius, 35.0);
+    run(program, &options(&d.join("a"))).unwrap();
+    let ep = read_json(&d.join("a/roam/episode.json"));
+    let bearings: Vec<f64> =
+        ep["sensor_bearings"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert!((bearings[0] + 17.2).abs() < 1e-3 && (bearings[5] - 90.0).abs() < 1e-3, "{bearings:?}");
+    let trace = read_text(&d.join("a/turned/trace.csv"));
+    let header = trace.lines().next().unwrap();
+    assert!(header.contains("floor[0]") && header.contains("floor[2]"), "{header}");
+    let ep = read_json(&d.join("a/turned/episode.json"));
+    assert_eq!(ep["sensor_bearings"][0].as_f64(), Some(0.0));
+}

@@ -143,3 +143,19 @@ fn the_e_puck_sees_a_wall_ahead_with_ps0_and_ps7() {
     assert!(ir[0] > 5.0 * ir[2].max(1e-6) && ir[7] > 5.0 * ir[5].max(1e-6), "{ir:?}");
     assert!(ir[3] < 1e-3 && ir[4] < 1e-3, "{ir:?}");
 }
+
+#[test]
+fn a_robot_link_refuses_a_body_that_is_not_the_kheperas() {
+    use shaping_runtime::robot::unfit_for_robot;
+    use shaping_runtime::testkit::{arena_world, bare_stage};
+    let with = |body: Body| bare_stage("s", World { body, ..arena_world() });
+    assert_eq!(unfit_for_robot(&with(Body::default())), None);
+    assert_eq!(unfit_for_robot(&with(bodies::preset("khepera").unwrap())), None);
+    // calibrations and a virtual floor's ground sensors are the host's: allowed
+    let calibrated = Body { radius: 28.0, wheel_base: 52.5, ground: vec![[10.0, 0.0]], ..Body::default() };
+    assert_eq!(unfit_for_robot(&with(calibrated)), None);
+    let epuck = unfit_for_robot(&with(bodies::preset("e-puck").unwrap())).unwrap();
+    assert!(epuck.contains("`e-puck` body"), "{epuck}");
+    let declared = unfit_for_robot(&with(Body { ir: Some(khepera_layout()), ..Body::default() })).unwrap();
+    assert!(declared.contains("declared sensor layout"), "{declared}");
+}

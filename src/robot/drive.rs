@@ -40,15 +40,10 @@ pub fn has_gripper(stage: &Stage) -> bool {
     stage.actuators.iter().any(|a| matches!(a.kind, ActuatorKind::Lift | ActuatorKind::Grip))
 }
 
-/// A robot cannot move physical objects the host does not see.
+/// A stage a Khepera can run (`robot::unfit_for_robot`).
 pub fn check_robot_world(stage: &Stage) -> Result<(), CliError> {
-    match &stage.world.objects {
-        Some(o) if !o.virtual_ && o.count > 0 => Err(CliError::io(format!(
-            "error: stage `{}` has physical objects; on a robot the objects must be `virtual` (simulated on the host, as in the paper)",
-            stage.name
-        ))),
-        _ => Ok(()),
-    }
+    shaping_runtime::robot::unfit_for_robot(stage)
+        .map_or(Ok(()), |m| Err(CliError::io(format!("error: {m}"))))
 }
 
 /// The action period: `--period`, else the world's action length.

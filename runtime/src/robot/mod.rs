@@ -18,8 +18,33 @@ pub mod serial;
 pub use emulator::Emulator;
 pub use serial::{odometry, Link, LinkError, RobotError, SerialRobot};
 
-use crate::program::World;
+use crate::program::{Stage, World};
 use crate::sim::{Pose, Sim};
+
+/// Why `stage` cannot run on a Khepera over its serial link, if it cannot:
+/// physical objects (the host does not see them move), or a body whose IR
+/// sensors are not the Khepera's (another preset, a declared layout: the
+/// robot's own sensors read the walls, the host's layout the virtual
+/// objects, and the two would disagree).
+pub fn unfit_for_robot(stage: &Stage) -> Option<String> {
+    let name = &stage.name;
+    if stage.world.objects.as_ref().is_some_and(|o| !o.virtual_ && o.count > 0) {
+        return Some(format!(
+            "stage `{name}` has physical objects; on a robot the objects must be `virtual` (simulated on the host, as in the paper)"
+        ));
+    }
+    let body = &stage.world.body;
+    if body.ir.is_some() || body.preset.as_deref().is_some_and(|p| p != "khepera") {
+        let what = body
+            .preset
+            .as_deref()
+            .map_or("a declared sensor layout".to_string(), |p| format!("the `{p}` body"));
+        return Some(format!(
+            "stage `{name}` has {what}; the robot link speaks to a Khepera, whose IR sensors are the Khepera's (`body khepera`, no `proximity` layout)"
+        ));
+    }
+    None
+}
 
 /// The world a robot has physically: the arena, lamp and charger bar, and
 /// physical objects, without the virtual objects and the battery (which the
