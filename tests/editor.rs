@@ -1057,3 +1057,23 @@ fn an_oversized_message_is_an_error_not_an_abort() {
         assert!(!err.contains("memory allocation"), "{err}");
     }
 }
+
+#[test]
+fn completion_in_a_body_offers_presets_settings_and_layouts() {
+    let mut c = Client::start();
+    let text = TUTOR.replacen(
+        "fitness per action wheels[0]",
+        "world { body e-puck { wheel_noise 0  proximity facing [0, 0, 0, 0, 0, 0, 0, 0] } }
+  fitness per action wheels[0]",
+        1,
+    );
+    c.open(URI, &text);
+    assert_eq!(completions(&mut c, &text, "world { body "), ["khepera", "e-puck"]);
+    let labels = completions(&mut c, &text, "body e-puck { wheel_noise 0 ");
+    for want in ["radius", "wheel_base", "v_max", "sensor_noise", "proximity", "ground"] {
+        assert!(labels.contains(&want.to_string()), "{want} missing from {labels:?}");
+    }
+    assert!(!labels.contains(&"arena".to_string()), "{labels:?}");
+    assert_eq!(completions(&mut c, &text, "wheel_noise 0  proximity "), ["at", "facing"]);
+    c.stop();
+}

@@ -219,6 +219,9 @@ fn context(text: &str, offset: usize) -> Context {
         ("action", "per") => return Context::Expression,
         ("uses", _) => return Context::Only(&["charger"]),
         ("selection", _) => return Context::Only(&["truncation", "roulette"]),
+        ("body", _) => return Context::Only(&["khepera", "e-puck"]),
+        ("proximity", _) if block == Some("body") => return Context::Only(&["at", "facing"]),
+        ("ground", _) if block == Some("body") => return Context::Only(&["at"]),
         ("inheritance", _) => return Context::Only(&["darwinian", "lamarckian"]),
         ("stage" | "robot" | "sensor" | "actuator" | "lamp" | "wall" | "zone" | "cylinder", _) => {
             return Context::Nothing
