@@ -273,7 +273,8 @@ enum Command {
         /// elitism, evaluations, keep, selection, inheritance; `world.`
         /// arena, charger, lamp, battery, recharge, objects, diameter;
         /// `world.body.` radius, wheel_base, v_max, action, wheel_noise,
-        /// sensor_noise; `test.actions`, `test.lives`; `train.actions`; `MODULE.` reward,
+        /// sensor_noise; `variants.` aggregate, draw; `test.actions`,
+        /// `test.lives`; `train.actions`; `MODULE.` reward,
         /// punish, window, threshold, range. STAGE may be `*` (every stage).
         #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=V1,V2,...", value_parser = sweep::parse_set)]
         sets: Vec<sweep::Set>,

@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Part, Program, Stage, StageRun};
+use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Part, Program, Stage, StageRun, World};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
 fn channel_name(stage: &Stage, c: u16) -> String {
@@ -149,6 +149,80 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
     }
     if let StageRun::Train { actions } = st.run {
         let _ = writeln!(out, "training stage: its modules learn for {actions} actions; nothing is evolved");
+    }
+    if let Some(v) = &st.variants {
+        let n = v.list.len();
+        let how = match (v.draw, &st.run) {
+            (_, StageRun::Test { .. }) => format!("life k in variant k mod {n}"),
+            (Some(d), _) if (d as usize) < n => format!("{d} of them drawn per generation"),
+            _ => "each individual in every one".to_string(),
+        };
+        let fitness = match &st.run {
+            StageRun::Test { .. } => "the mean per life".to_string(),
+            _ => format!("the {} of the variants'", v.aggregate.word()),
+        };
+        let _ = writeln!(out, "variants: {n} ({how}); fitness: {fitness}");
+        for x in &v.list {
+            let changes = variant_changes(&st.world, &x.world);
+            let what = if changes.is_empty() { "the stage's world".to_string() } else { changes.join("; ") };
+            let _ = writeln!(out, "  {}: {what}", x.name);
+        }
+    }
+    out
+}
+
+/// The items of `variant` that differ from `base`'s, in words.
+fn variant_changes(base: &World, variant: &World) -> Vec<String> {
+    fn name(n: &Option<String>) -> String {
+        n.as_ref().map_or(String::new(), |n| format!(" `{n}`"))
+    }
+    let p = |a: [f32; 2]| format!("({}, {})", a[0], a[1]);
+    let mut out = Vec::new();
+    let (b, v) = (&base.items, &variant.items);
+    for (i, w) in v.walls.iter().enumerate() {
+        if b.walls.get(i) != Some(w) {
+            out.push(format!("wall{} from {} to {}", name(&w.name), p(w.from), p(w.to)));
+        }
+    }
+    for (i, c) in v.cylinders.iter().enumerate() {
+        if b.cylinders.get(i) != Some(c) {
+            out.push(format!("cylinder{} at {} diameter {}", name(&c.name), p(c.at), c.diameter));
+        }
+    }
+    for (i, l) in v.lamps.iter().enumerate() {
+        if b.lamps.get(i) != Some(l) {
+            let switch = l
+                .switch
+                .map_or(String::new(), |s| format!(" {} at {}", if s.on { "on" } else { "off" }, s.at));
+            out.push(format!(
+                "lamp{} at {} height {} intensity {}{switch}",
+                name(&l.name),
+                p(l.at),
+                l.height,
+                l.intensity
+            ));
+        }
+    }
+    for (i, z) in v.zones.iter().enumerate() {
+        if b.zones.get(i) != Some(z) {
+            let charger = if z.charger { " charger" } else { "" };
+            out.push(format!(
+                "zone{} from {} to {} grey {}{charger}",
+                name(&z.name),
+                p(z.from),
+                p(z.to),
+                z.grey
+            ));
+        }
+    }
+    if v.start != b.start {
+        if let Some(s) = &v.start {
+            out.push(format!("start from {} to {}", p(s.from), p(s.to)));
+        }
+    }
+    if (&base.charger, &base.battery, &base.objects) != (&variant.charger, &variant.battery, &variant.objects)
+    {
+        out.push("the charger, battery or objects".into());
     }
     out
 }

@@ -42,13 +42,21 @@ pub struct Described {
 /// a run with run seed `seed` gives the individual of that index in that
 /// generation of the stage ([`seed::episode_seed`]`(seed, stage,
 /// generation, individual, e)`, `e` from 0 to the stage's `evaluations` -
-/// 1; one episode if it declares none).
+/// 1; one episode if it declares none). In a stage with variants, those
+/// episodes in every variant ([`seed::variant_seed`]), variant after
+/// variant (a run draws some with `draw N`; here all are run).
 pub fn seeds(stage: &Stage, index: usize, seed: u64, generation: u32, individual: usize) -> Vec<u64> {
     let episodes = match &stage.run {
         StageRun::Evolve(evo) => evo.evaluations.max(1),
         StageRun::Test { .. } | StageRun::Train { .. } => 1,
     };
-    (0..episodes).map(|e| seed::episode_seed(seed, index, generation, individual, e)).collect()
+    let one = |e| seed::episode_seed(seed, index, generation, individual, e);
+    match &stage.variants {
+        None => (0..episodes).map(one).collect(),
+        Some(v) => (0..v.list.len())
+            .flat_map(|k| (0..episodes).map(move |e| seed::variant_seed(one(e), k)))
+            .collect(),
+    }
 }
 
 /// The length of the episodes of `stage`: its evolution's `actions`, a
@@ -64,7 +72,8 @@ pub fn actions(stage: &Stage) -> u32 {
 /// stage's actions, learning on), combined as `evolve` combines an
 /// individual's episodes: the fitness is the mean (summed in f64), the
 /// events and collisions and placement failures are summed, the learned
-/// genome is the last episode's; the final pose is the last episode's, the
+/// genome is the last episode's (with variants, the fitness is the mean
+/// per variant, aggregated as the stage declares); the final pose is the last episode's, the
 /// path length and the squares visited the means over the episodes.
 pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
     let actions = actions(stage);
@@ -74,9 +83,16 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
     let mut learned = None;
     let (mut path, mut squares) = (0.0f64, 0.0f64);
     let mut last = Descriptors::default();
+    let worlds = shaping_runtime::evolve::VariantStages::of(stage);
+    // With variants: each variant's fitness sum and episodes.
+    let mut per = vec![(0.0f64, 0u32); stage.variants.as_ref().map_or(0, |v| v.list.len())];
     for &s in seeds {
-        let (r, d) = episode(stage, genome, &EpisodeOptions { actions, learning: true, seed: s });
+        let (r, d) = episode(worlds.stage(s), genome, &EpisodeOptions { actions, learning: true, seed: s });
         sum += f64::from(r.fitness);
+        if let Some(p) = per.get_mut(seed::seed_variant(s)) {
+            p.0 += f64::from(r.fitness);
+            p.1 += 1;
+        }
         collisions = collisions.saturating_add(r.collisions);
         placement_failures = placement_failures.saturating_add(r.placement_failures);
         let ev = Evaluation::of_episode(r);
@@ -89,8 +105,12 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
         last = d;
     }
     let n = seeds.len().max(1) as f64;
+    let fitness = match &stage.variants {
+        None => (sum / n) as f32,
+        Some(v) => v.aggregate.of(per.iter().filter(|p| p.1 > 0).map(|p| (p.0 / f64::from(p.1)) as f32)),
+    };
     Described {
-        evaluation: Evaluation { fitness: (sum / n) as f32, learned, events, placement_failures },
+        evaluation: Evaluation { fitness, learned, events, placement_failures },
         collisions,
         descriptors: Descriptors {
             path_length: (path / n) as f32,

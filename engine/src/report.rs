@@ -19,12 +19,20 @@ use crate::files::write_atomic;
 use crate::plot;
 
 /// `generations.csv`: one row per generation of the stage and its ancestors.
-pub fn generations_csv(history: &[GenStats]) -> String {
+/// A stage with variants adds a column `best_variant_NAME` per variant
+/// (`variants`, the stage's, in declaration order): the best individual's
+/// fitness in that variant, empty where the generation did not draw it (or
+/// in a row of an ancestor without those variants).
+pub fn generations_csv(history: &[GenStats], variants: &[String]) -> String {
     let mut s = String::from(
-        "stage,generation,stage_generation,best,mean,worst,best_index,best_recharges,best_grips,best_releases_outside\n",
+        "stage,generation,stage_generation,best,mean,worst,best_index,best_recharges,best_grips,best_releases_outside",
     );
+    for v in variants {
+        let _ = write!(s, ",best_variant_{v}");
+    }
+    s.push('\n');
     for h in history {
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{},{},{:.6},{:.6},{:.6},{},{},{},{}",
             h.stage,
@@ -38,8 +46,21 @@ pub fn generations_csv(history: &[GenStats]) -> String {
             h.best_grips,
             h.best_releases_outside
         );
+        let mine = h.best_variants.len() == variants.len();
+        for i in 0..variants.len() {
+            match h.best_variants.get(i).copied().flatten().filter(|_| mine) {
+                Some(f) => _ = write!(s, ",{f:.6}"),
+                None => s.push(','),
+            }
+        }
+        s.push('\n');
     }
     s
+}
+
+/// The names of a stage's variants (none without variants).
+pub fn variant_names(stage: &shaping_runtime::program::Stage) -> Vec<String> {
+    stage.variants.as_ref().map_or_else(Vec::new, |v| v.list.iter().map(|x| x.name.clone()).collect())
 }
 
 /// Points for the fitness pictures, and where each stage starts.

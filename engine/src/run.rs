@@ -248,10 +248,13 @@ pub fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
 }
 
 /// Evaluation of one genome in an evolved stage: one episode with local learning on.
+/// In a stage with variants, the episode seed names the variant the
+/// episode runs in (`evolve::seed::variant_seed`).
 pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evaluation + Sync + '_ {
+    let worlds = evolve::VariantStages::of(stage);
     move |genome: &Genome, seed: u64| {
         Evaluation::of_episode(run_episode(
-            stage,
+            worlds.stage(seed),
             genome,
             &EpisodeOptions { actions, learning: true, seed },
             None,
@@ -630,7 +633,10 @@ impl Runner<'_> {
             evaluator.context(format!("generation {} of stage `{}`", cp.generation, stage.name), &path);
             let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
             rundir::write_checkpoint(dir, &cp)?;
-            write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+            write_atomic(
+                &dir.join("generations.csv"),
+                report::generations_csv(&cp.history, &report::variant_names(stage)).as_bytes(),
+            )?;
             self.observer.event(Event::Generation { stage: &stage.name, stats: &stats });
             if stats.crowded_episodes > 0 && !warned {
                 // Said at once (a long run may be stopped), and again with the
@@ -686,7 +692,10 @@ impl Runner<'_> {
         let (genome, fitness) = evolve::best_of(&cp)
             .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
         rundir::write_best_genome(dir, &genome)?;
-        write_atomic(&dir.join("generations.csv"), report::generations_csv(&cp.history).as_bytes())?;
+        write_atomic(
+            &dir.join("generations.csv"),
+            report::generations_csv(&cp.history, &report::variant_names(stage)).as_bytes(),
+        )?;
         report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
         self.observer.event(Event::Evolved {
             stage: &stage.name,
@@ -725,7 +734,8 @@ fn stage_crowding(
 /// to life and across the change (the paper's section 4.9). Every life is a
 /// fresh world (full battery, objects placed anew) with its own simulator
 /// seed, [`evolve::seed::test_life_seed`]; a life ends early when the battery
-/// is empty.
+/// is empty. In a world with variants, life `k` runs in variant `k` mod
+/// their number.
 pub struct BeforeAfter {
     /// Every life, in order, the action index running on.
     pub trace: Trace,
@@ -780,7 +790,10 @@ pub fn before_after(
     let mut results = [Vec::new(), Vec::new()];
     for (half, world) in [parent, stage].into_iter().enumerate() {
         for k in 0..lives {
-            let sim = Sim::new(&world.world, evolve::seed::test_life_seed(seed, half == 1, k));
+            // With variants, life k runs in variant k mod their number.
+            let w = world.variant_world(k as usize % world.variant_count());
+            ctl.use_world(w);
+            let sim = Sim::new(w, evolve::seed::test_life_seed(seed, half == 1, k));
             let scene = sim.scene();
             let mut robot = Stoppable::new(sim, stop);
             let mut rec = Recorder::new(&mut robot);
@@ -973,6 +986,21 @@ fn test_files(
     };
     let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
     let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
+    // Per variant: its lives (k mod the number of variants) and their mean fitness.
+    let variants = |st: &Stage, v: &[EpisodeResult]| -> Option<Value> {
+        let vars = st.variants.as_ref()?;
+        let n = vars.list.len().max(1);
+        let rows: Vec<Value> = vars
+            .list
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                let mine: Vec<EpisodeResult> = v.iter().skip(i).step_by(n).cloned().collect();
+                serde_json::json!({"variant": x.name, "lives": mine.len(), "fitness": lives_total(&mine).fitness})
+            })
+            .collect();
+        Some(Value::Array(rows))
+    };
     let mut summary = serde_json::json!({
         "stage": stage.name, "learning": learning, "seed": outcome.seed,
         "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
@@ -982,6 +1010,12 @@ fn test_files(
         "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
         "reinforcement_counts": reinforcement_counts(stage, ba),
     });
+    if let Some(v) = variants(parent_stage, &ba.before) {
+        summary["before_variants"] = v;
+    }
+    if let Some(v) = variants(stage, &ba.after) {
+        summary["after_variants"] = v;
+    }
     // Only when a world was too crowded to place apart: the lives that
     // overlap and their overlapping placements (absent: none).
     let crowding = lives_crowding(ba);

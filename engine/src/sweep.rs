@@ -12,7 +12,7 @@
 
 use shaping_compiler::diag::did_you_mean;
 use shaping_runtime::program::{
-    Evolution, Inheritance, LearnWhen, Module, Program, Selection, Stage, StageRun, World,
+    Aggregate, Evolution, Inheritance, LearnWhen, Module, Program, Selection, Stage, StageRun, World,
 };
 
 use crate::error::Error;
@@ -177,6 +177,8 @@ const FIELDS: &[(&str, Kind)] = &[
     ("test.actions", Kind::Count(Some("actions"))),
     ("test.lives", Kind::Count(None)),
     ("train.actions", Kind::Count(Some("actions"))),
+    ("variants.aggregate", Kind::Word(&["mean", "min"])),
+    ("variants.draw", Kind::Count(None)),
     ("world.arena", Kind::Arena),
     ("world.charger", Kind::Real(Some("mm"))),
     ("world.lamp", Kind::Real(Some("mm"))),
@@ -385,6 +387,14 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
             StageRun::Train { actions } => count(actions),
             _ => Err(format!("stage `{}` is not a training stage", s.name)),
         },
+        "variants.aggregate" | "variants.draw" => {
+            let v = s.variants.as_ref().ok_or_else(|| format!("stage `{}` has no variants", s.name))?;
+            if path == "variants.draw" {
+                count(v.draw.unwrap_or(v.list.len() as u32))
+            } else {
+                Ok(Value::Word(v.aggregate.word().to_string()))
+            }
+        }
         "world.arena" => Ok(Value::Pair(w.arena[0] as f64, w.arena[1] as f64)),
         "world.charger" => real(w.charger.as_ref().ok_or_else(|| missing(s, "charger"))?.length),
         "world.lamp" => {
@@ -429,6 +439,51 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
             }
         }
     }
+}
+
+/// Writes `value` into the setting `path` (`world.…`) of a world of stage `name`.
+fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(), String> {
+    let whole = |v: u64| u32::try_from(v).map_err(|_| format!("{v} is too large"));
+    let (n, r) = match value {
+        Value::Count(v) => (*v, *v as f64),
+        Value::Real(v) => (0, *v),
+        _ => (0, 0.0),
+    };
+    let r32 = r as f32;
+    match path {
+        "world.arena" => {
+            if let Value::Pair(a, b) = value {
+                w.arena = [*a as f32, *b as f32];
+            }
+        }
+        "world.charger" => {
+            w.charger.as_mut().ok_or_else(|| format!("stage `{name}` has no charger"))?.length = r32
+        }
+        "world.lamp" => {
+            w.charger.as_mut().ok_or_else(|| format!("stage `{name}` has no charger"))?.lamp_height =
+                Some(r32)
+        }
+        "world.battery" => {
+            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.capacity = whole(n)?
+        }
+        "world.recharge" => {
+            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.recharge = whole(n)?
+        }
+        "world.objects" => {
+            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.count = whole(n)?
+        }
+        "world.diameter" => {
+            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.diameter = r32
+        }
+        "world.body.radius" => w.body.radius = r32,
+        "world.body.wheel_base" => w.body.wheel_base = r32,
+        "world.body.v_max" => w.body.v_max = r32,
+        "world.body.action" => w.body.action_ms = r32,
+        "world.body.wheel_noise" => w.body.wheel_noise = r32,
+        "world.body.sensor_noise" => w.body.sensor_noise = r32,
+        _ => return Err(format!("`{path}` is not a setting")),
+    }
+    Ok(())
 }
 
 /// Writes `value` into `path` of stage `s` (its presence checked by [`get`]).
@@ -480,7 +535,25 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
         }
         return Ok(());
     }
-    let w = &mut s.world;
+    if let Some(rest) = path.strip_prefix("variants.") {
+        let v = s.variants.as_mut().ok_or_else(|| format!("stage `{name}` has no variants"))?;
+        match rest {
+            "aggregate" => v.aggregate = if word == "min" { Aggregate::Min } else { Aggregate::Mean },
+            "draw" => v.draw = Some(whole(n)?),
+            _ => return Err(format!("`{path}` is not a setting")),
+        }
+        return Ok(());
+    }
+    if path.starts_with("world.") {
+        // The variants' worlds have the stage's arena, body, charger ...
+        // (a variant changes items): the setting changes them too.
+        if let Some(v) = s.variants.as_mut() {
+            for x in &mut v.list {
+                put_world(&mut x.world, &name, path, value)?;
+            }
+        }
+        return put_world(&mut s.world, &name, path, value);
+    }
     match path {
         "test.actions" | "train.actions" => match &mut s.run {
             StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions = whole(n)?,
@@ -490,36 +563,6 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
             StageRun::Test { lives, .. } => *lives = whole(n)?,
             _ => return Err(format!("stage `{name}` is not a test stage")),
         },
-        "world.arena" => {
-            if let Value::Pair(a, b) = value {
-                w.arena = [*a as f32, *b as f32];
-            }
-        }
-        "world.charger" => {
-            w.charger.as_mut().ok_or_else(|| format!("stage `{name}` has no charger"))?.length = r32
-        }
-        "world.lamp" => {
-            w.charger.as_mut().ok_or_else(|| format!("stage `{name}` has no charger"))?.lamp_height =
-                Some(r32)
-        }
-        "world.battery" => {
-            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.capacity = whole(n)?
-        }
-        "world.recharge" => {
-            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.recharge = whole(n)?
-        }
-        "world.objects" => {
-            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.count = whole(n)?
-        }
-        "world.diameter" => {
-            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.diameter = r32
-        }
-        "world.body.radius" => w.body.radius = r32,
-        "world.body.wheel_base" => w.body.wheel_base = r32,
-        "world.body.v_max" => w.body.v_max = r32,
-        "world.body.action" => w.body.action_ms = r32,
-        "world.body.wheel_noise" => w.body.wheel_noise = r32,
-        "world.body.sensor_noise" => w.body.sensor_noise = r32,
         _ => {
             let (module_name, field) =
                 path.split_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;

@@ -19,6 +19,9 @@ pub const MAX_GENERATIONS: u32 = 1_000_000;
 pub const MAX_ACTIONS: u32 = 10_000_000;
 /// Most episodes averaged per evaluation.
 pub const MAX_EVALUATIONS: u32 = 1_000;
+/// Most variants of a stage's world (`variants { ... }`): an episode seed
+/// names its variant in 8 bits.
+pub const MAX_VARIANTS: usize = 64;
 /// Most objects in a world (the simulator checks every object at every action).
 pub const MAX_OBJECTS: u32 = 1_024;
 /// Most inner walls, cylinders, lamps or floor zones a world may have (each).

@@ -44,6 +44,110 @@ pub struct Stage {
     pub fitness: Fitness,
     pub run: StageRun,
     pub inheritance: Inheritance,
+    /// The named variants of the world an individual is evaluated in
+    /// (`variants mean { ... }`); `None`: only `world`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub variants: Option<Variants>,
+    /// The items a fitness measures the distance to (`distance_to(goal)`):
+    /// state slot [`crate::state::ST_TARGETS`]` + i` reads target `i`, found
+    /// by kind and name in the world of each episode (a variant's included).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub targets: Vec<Target>,
+}
+
+/// The conditions an individual is evaluated in: named variants of the
+/// stage's world, each its own complete world.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Variants {
+    /// How the fitness of the variants makes the individual's.
+    pub aggregate: Aggregate,
+    /// Variants drawn per generation (the same for every individual of a
+    /// generation, from the run seed); `None`: every variant.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub draw: Option<u32>,
+    /// In declaration order (at least one).
+    pub list: Vec<Variant>,
+}
+
+/// One named variant: the stage's world with the variant's changes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Variant {
+    pub name: String,
+    pub world: World,
+}
+
+/// How per-variant fitness values are combined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Aggregate {
+    Mean,
+    Min,
+}
+
+impl Aggregate {
+    /// Combines per-variant fitness values (f64 sums; none gives 0).
+    pub fn of(self, values: impl IntoIterator<Item = f32>) -> f32 {
+        let mut n = 0usize;
+        let (mut sum, mut min) = (0.0f64, f32::INFINITY);
+        for v in values {
+            n += 1;
+            sum += f64::from(v);
+            min = if v.is_nan() { v } else { min.min(v) };
+        }
+        match (n, self) {
+            (0, _) => 0.0,
+            (_, Aggregate::Mean) => (sum / n as f64) as f32,
+            (_, Aggregate::Min) => min,
+        }
+    }
+
+    /// `mean` or `min`, as written.
+    pub fn word(self) -> &'static str {
+        match self {
+            Aggregate::Mean => "mean",
+            Aggregate::Min => "min",
+        }
+    }
+}
+
+/// A named item of the world (`distance_to(NAME)`).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Target {
+    pub kind: ItemKind,
+    pub name: String,
+}
+
+/// The kinds of named world items.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ItemKind {
+    Wall,
+    Cylinder,
+    Lamp,
+    Zone,
+}
+
+impl Stage {
+    /// The number of worlds an individual is evaluated in: its variants, or 1.
+    pub fn variant_count(&self) -> usize {
+        self.variants.as_ref().map_or(1, |v| v.list.len().max(1))
+    }
+
+    /// This stage in variant `v` alone: its world is the variant's, and it
+    /// has no variants (itself, without variants, for a stage that has none
+    /// or a `v` out of range).
+    pub fn in_variant(&self, v: usize) -> Stage {
+        let mut st = self.clone();
+        if let Some(var) = st.variants.take() {
+            if let Some(x) = var.list.into_iter().nth(v) {
+                st.world = x.world;
+            }
+        }
+        st
+    }
+
+    /// The world of variant `v` (the stage's own without variants).
+    pub fn variant_world(&self, v: usize) -> &World {
+        self.variants.as_ref().and_then(|x| x.list.get(v)).map_or(&self.world, |x| &x.world)
+    }
 }
 
 /// A named sensor of the robot: `count` consecutive channels from `channel`.
@@ -130,6 +234,20 @@ pub struct Lamp {
     /// 1: a sensor facing it from 100 mm (horizontally) reads 1, as under
     /// the charger's lamp; the irradiance scales with it.
     pub intensity: f32,
+    /// `off at N` / `on at N`: the lamp switches after the life's `N`th
+    /// action (off before it for `on`; lit at `intensity` before it for
+    /// `off`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub switch: Option<LampSwitch>,
+}
+
+/// A lamp that switches on or off during a life.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LampSwitch {
+    /// Switches on (`true`) or off.
+    pub on: bool,
+    /// After this many actions of the life (at least 1).
+    pub at: u32,
 }
 
 /// A rectangle of the floor with a grey level (what a ground sensor reads

@@ -9,8 +9,14 @@ use serde::{Deserialize, Serialize};
 use crate::expr::{Expr, Op};
 use crate::program::{Action, Behavior, Stage, StepEnd};
 
-/// Number of state slots an expression can read (`robot.x` ...).
-pub const STATE_SLOTS: usize = 6;
+/// Number of state slots an expression can read (`robot.x` ...,
+/// `distance_to(NAME)`).
+pub const STATE_SLOTS: usize = ST_TARGETS + MAX_TARGETS;
+/// The first slot of the distances to the stage's targets
+/// (`Stage::targets`): slot `ST_TARGETS + i` is target `i`'s.
+pub const ST_TARGETS: usize = 6;
+/// The most named items one stage's expressions measure the distance to.
+pub const MAX_TARGETS: usize = 8;
 /// The body centre, mm from the arena's south-west corner.
 pub const ST_X: usize = 0;
 pub const ST_Y: usize = 1;

@@ -259,6 +259,8 @@ pub fn bare_stage(name: &str, world: World) -> Stage {
         fitness: Fitness { per_action: None, at_end: None, bonuses: Vec::new() },
         run: evolution(300),
         inheritance: Inheritance::Darwinian,
+        variants: None,
+        targets: Vec::new(),
     }
 }
 

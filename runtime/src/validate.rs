@@ -282,6 +282,45 @@ pub fn stage(s: &Stage) -> R {
     links(&at, s)?;
     fitness(&at.field("fitness"), &s.fitness)?;
     run(&at.field("run"), s)?;
+    variants(&at, s)?;
+    Ok(())
+}
+
+/// The variants: 1 to [`crate::limits::MAX_VARIANTS`] of them, named once
+/// each, a draw of 1 to their number, each world valid and with the arena
+/// and body of the stage's; every target of the stage (at most
+/// [`crate::state::MAX_TARGETS`]) found in every world.
+fn variants(at: &At, s: &Stage) -> R {
+    at.field("targets").ensure(s.targets.len() <= crate::state::MAX_TARGETS, || {
+        format!("{} targets, more than {}", s.targets.len(), crate::state::MAX_TARGETS)
+    })?;
+    let found = |at: &At, w: &World| -> R {
+        for (i, t) in s.targets.iter().enumerate() {
+            at.field("targets").index(i).ensure(crate::world::Place::of(w, t).is_some(), || {
+                format!("its world has no {:?} `{}`", t.kind, t.name).to_lowercase()
+            })?;
+        }
+        Ok(())
+    };
+    found(at, &s.world)?;
+    let Some(v) = &s.variants else { return Ok(()) };
+    let at = at.field("variants");
+    at.field("list").count(v.list.len() as u32, 1, crate::limits::MAX_VARIANTS as u32)?;
+    if let Some(d) = v.draw {
+        at.field("draw").count(d, 1, v.list.len() as u32)?;
+    }
+    for (i, x) in v.list.iter().enumerate() {
+        let at = at.field("list").index(i);
+        at.field("name").name(&x.name)?;
+        at.field("name").ensure(!v.list[..i].iter().any(|y| y.name == x.name), || {
+            format!("`{}` names two variants", x.name)
+        })?;
+        world(&at.field("world"), &x.world)?;
+        at.field("world").ensure(x.world.arena == s.world.arena && x.world.body == s.world.body, || {
+            "a variant has the stage's arena and body".into()
+        })?;
+        found(&at.field("world"), &x.world)?;
+    }
     Ok(())
 }
 
@@ -455,6 +494,9 @@ fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
         point(&at.field("at"), l.at)?;
         at.field("height").length(l.height)?;
         at.field("intensity").within(l.intensity, 0.0, 1e6)?;
+        if let Some(sw) = &l.switch {
+            at.field("switch").field("at").count(sw.at, 1, crate::limits::MAX_ACTIONS)?;
+        }
     }
     for (i, z) in it.zones.iter().enumerate() {
         let at = at.field("zones").index(i);

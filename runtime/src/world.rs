@@ -7,7 +7,7 @@
 use nalgebra::Point2;
 
 use crate::limits::MAX_OBJECTS;
-use crate::program::{Items, World};
+use crate::program::{ItemKind, Items, Target, World};
 
 /// Minimum clearance between the body and the walls at the start, mm.
 pub const START_CLEARANCE: f32 = 40.0;
@@ -120,4 +120,56 @@ pub fn crowded(world: &World) -> Option<Crowded> {
 /// overlaps wherever in the rectangle `x` by `y` its centre is.
 fn covering(items: &Items, x: (f32, f32), y: (f32, f32), radius: f32) -> Option<Blocker> {
     blocking_all(items, &[[x.0, y.0], [x.0, y.1], [x.1, y.0], [x.1, y.1]], radius)
+}
+
+/// Where a target item (`distance_to(NAME)`) is, in one world.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Place {
+    /// A segment (an inner wall).
+    Segment([f32; 2], [f32; 2]),
+    /// A point (a lamp, seen from above; a cylinder's centre) and a radius
+    /// (a cylinder's; 0 for a lamp).
+    Disc([f32; 2], f32),
+    /// A rectangle (a floor zone): south-west and north-east corners.
+    Rect([f32; 2], [f32; 2]),
+}
+
+impl Place {
+    /// Where the item of `target`'s kind and name is in `world`, if it has one.
+    pub fn of(world: &World, target: &Target) -> Option<Place> {
+        let items = &world.items;
+        let named = |n: &Option<String>| n.as_deref() == Some(target.name.as_str());
+        match target.kind {
+            ItemKind::Wall => {
+                items.walls.iter().find(|w| named(&w.name)).map(|w| Place::Segment(w.from, w.to))
+            }
+            ItemKind::Cylinder => {
+                items.cylinders.iter().find(|c| named(&c.name)).map(|c| Place::Disc(c.at, c.diameter / 2.0))
+            }
+            ItemKind::Lamp => items.lamps.iter().find(|l| named(&l.name)).map(|l| Place::Disc(l.at, 0.0)),
+            ItemKind::Zone => items.zones.iter().find(|z| named(&z.name)).map(|z| {
+                let lo = [z.from[0].min(z.to[0]), z.from[1].min(z.to[1])];
+                let hi = [z.from[0].max(z.to[0]), z.from[1].max(z.to[1])];
+                Place::Rect(lo, hi)
+            }),
+        }
+    }
+
+    /// The distance from the point `p` (mm) to the item, seen from above:
+    /// to the segment, to the disc's edge, to the rectangle (0 on or inside
+    /// them).
+    pub fn distance(&self, p: [f32; 2]) -> f32 {
+        let pt = Point2::new(p[0], p[1]);
+        match *self {
+            Place::Segment(a, b) => {
+                segment_distance2(&pt, &Point2::new(a[0], a[1]), &Point2::new(b[0], b[1])).sqrt()
+            }
+            Place::Disc(c, r) => ((p[0] - c[0]).hypot(p[1] - c[1]) - r).max(0.0),
+            Place::Rect(lo, hi) => {
+                let dx = (lo[0] - p[0]).max(p[0] - hi[0]).max(0.0);
+                let dy = (lo[1] - p[1]).max(p[1] - hi[1]).max(0.0);
+                dx.hypot(dy)
+            }
+        }
+    }
 }

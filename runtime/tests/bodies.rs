@@ -42,7 +42,7 @@ fn by_the_west_wall(gap: f32) -> Pose {
 #[test]
 fn the_fitted_geometry_declared_reads_exactly_as_the_default() {
     let declared = Body { ir: Some(khepera_layout()), ..Body::default() };
-    let lamp = Lamp { name: None, at: [300.0, 500.0], height: 100.0, intensity: 1.0 };
+    let lamp = Lamp { name: None, at: [300.0, 500.0], height: 100.0, intensity: 1.0, switch: None };
     let items = Items { lamps: vec![lamp], ..Items::default() };
     for gap in [3.0, 10.0, 20.0, 35.0] {
         for theta in [0.3, FRAC_PI_2, 2.0, -2.5] {
@@ -100,7 +100,7 @@ fn a_sensor_placed_inside_the_body_reads_less_than_one_on_the_rim() {
 fn light_follows_the_declared_bearings() {
     // A lamp due west: the sensor turned to face west reads it, the same
     // sensor facing east does not.
-    let lamp = Lamp { name: None, at: [0.0, 300.0], height: 50.0, intensity: 1.0 };
+    let lamp = Lamp { name: None, at: [0.0, 300.0], height: 50.0, intensity: 1.0, switch: None };
     let items = Items { lamps: vec![lamp], ..Items::default() };
     let read = |facing0: f32| {
         let mut layout = khepera_layout();

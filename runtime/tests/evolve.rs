@@ -65,6 +65,8 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, run: StageRun)
         fitness: Fitness { per_action: None, at_end: None, bonuses: vec![] },
         run,
         inheritance: Inheritance::Darwinian,
+        variants: None,
+        targets: Vec::new(),
     }
 }
 

@@ -81,6 +81,8 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, evo: Evolution
         fitness: Fitness { per_action: None, at_end: None, bonuses: vec![] },
         run: StageRun::Evolve(evo),
         inheritance: Inheritance::Darwinian,
+        variants: None,
+        targets: Vec::new(),
     }
 }
 

@@ -47,7 +47,7 @@ fn with_items() -> Stage {
     stage.world.items = Items {
         walls: vec![InnerWall { name: None, from: [100.0, 200.0], to: [300.0, 200.0] }],
         cylinders: vec![Cylinder { name: None, at: [100.0, 450.0], diameter: 40.0 }],
-        lamps: vec![Lamp { name: None, at: [300.0, 100.0], height: 100.0, intensity: 1.0 }],
+        lamps: vec![Lamp { name: None, at: [300.0, 100.0], height: 100.0, intensity: 1.0, switch: None }],
         zones: vec![Zone { name: None, from: [0.0, 0.0], to: [120.0, 120.0], grey: 0.0, charger: true }],
         start: Some(Start { from: [150.0, 300.0], to: [250.0, 400.0], heading: None }),
     };

@@ -71,7 +71,8 @@ fn a_cylinder_blocks_and_reflects() {
 
 #[test]
 fn lamps_add_up_and_scale_with_intensity() {
-    let lamp = |intensity: f32| Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity };
+    let lamp =
+        |intensity: f32| Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity, switch: None };
     let read = |lamps: Vec<Lamp>| {
         let mut sim = Sim::new(&world(Items { lamps, ..Items::default() }), 1);
         assert!(sim.set_pose(Pose { x: 200.0, y: 100.0, theta: std::f32::consts::FRAC_PI_2 }));
@@ -86,7 +87,7 @@ fn lamps_add_up_and_scale_with_intensity() {
 
 #[test]
 fn walls_and_cylinders_between_a_lamp_and_a_sensor_shade_it() {
-    let lamp = Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity: 1.0 };
+    let lamp = Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity: 1.0, switch: None };
     let north = std::f32::consts::FRAC_PI_2;
     let read = |items: Items, x: f32| {
         let mut sim = Sim::new(&world(Items { lamps: vec![lamp.clone()], ..items }), 1);
@@ -202,7 +203,7 @@ fn the_validation_refuses_items_outside_the_arena_and_a_start_where_the_body_doe
 #[test]
 fn the_lamp_distance_channel_reads_metres_to_the_nearest_lamp() {
     use shaping_runtime::catalog::CH_LAMP_DISTANCE;
-    let lamp = |at| Lamp { name: None, at, height: 150.0, intensity: 1.0 };
+    let lamp = |at| Lamp { name: None, at, height: 150.0, intensity: 1.0, switch: None };
     let items = Items { lamps: vec![lamp([200.0, 500.0]), lamp([200.0, 0.0])], ..Items::default() };
     let mut sim = Sim::new(&world(items), 1);
     assert!(sim.set_pose(Pose { x: 200.0, y: 350.0, theta: 0.0 }));
@@ -262,4 +263,43 @@ fn worlds_that_can_never_be_placed_are_refused() {
     let e = check(many).unwrap();
     assert!(e.contains("`world.objects`: the objects do not fit in the arena"), "{e}");
     assert_eq!(check(dense), None);
+}
+
+#[test]
+fn a_lamp_switches_after_the_declared_action() {
+    use shaping_runtime::program::LampSwitch;
+    let north = std::f32::consts::FRAC_PI_2;
+    let still = Command::default();
+    // Light seen by a front sensor before each of the first 6 actions.
+    let readings = |switch: LampSwitch| -> Vec<f32> {
+        let lamp =
+            Lamp { name: None, at: [200.0, 500.0], height: 150.0, intensity: 1.0, switch: Some(switch) };
+        let mut sim = Sim::new(&world(Items { lamps: vec![lamp], ..Items::default() }), 1);
+        assert!(sim.set_pose(Pose { x: 200.0, y: 100.0, theta: north }));
+        let mut out = vec![percept(&mut sim)[CH_LIGHT + 2]];
+        for _ in 0..5 {
+            sim.step(&still);
+            out.push(percept(&mut sim)[CH_LIGHT + 2]);
+        }
+        out
+    };
+    let off = readings(LampSwitch { on: false, at: 3 });
+    let lit = off[0];
+    assert!(lit > 0.05, "{off:?}");
+    // Lit before actions 1 to 3, dark after the third.
+    assert_eq!(off, vec![lit, lit, lit, 0.0, 0.0, 0.0]);
+    let on = readings(LampSwitch { on: true, at: 2 });
+    assert_eq!(on, vec![0.0, 0.0, lit, lit, lit, lit]);
+    // A lamp that switches on is drawn dark until then.
+    let lamp = Lamp {
+        name: None,
+        at: [200.0, 500.0],
+        height: 150.0,
+        intensity: 1.0,
+        switch: Some(LampSwitch { on: true, at: 1 }),
+    };
+    let mut sim = Sim::new(&world(Items { lamps: vec![lamp], ..Items::default() }), 1);
+    assert_eq!(sim.scene().dark_lamps, vec![0]);
+    sim.step(&still);
+    assert!(sim.scene().dark_lamps.is_empty());
 }

@@ -650,6 +650,21 @@ impl F<'_> {
             StageItem::LinksAll(kind, span) => {
                 self.item(*span, Doc::Text(format!("links all {}", self.link_kind(kind, *span))))
             }
+            StageItem::Variants(v) => {
+                let mut head = format!("variants {}", v.aggregate.text);
+                if let Some(d) = &v.draw {
+                    head += &format!(" draw {}", self.qty(d));
+                }
+                let items = v
+                    .variants
+                    .iter()
+                    .map(|d| {
+                        let items = d.world.items.iter().map(|x| self.world_item(x)).collect();
+                        self.item(d.span, self.block(d.name.text.clone(), d.span, items))
+                    })
+                    .collect();
+                self.item(v.span, self.block(head, v.span, items))
+            }
             StageItem::Link(l) => self.item(
                 l.span,
                 Doc::Text(format!(
@@ -704,13 +719,16 @@ impl F<'_> {
                     self.qty(diameter)
                 )
             }
-            WorldItem::Lamp { name, at, height, intensity, .. } => {
+            WorldItem::Lamp { name, at, height, intensity, switch, .. } => {
                 let mut t = format!("lamp{} at {}", self.item_name(name), self.point(at));
                 if let Some(h) = height {
                     t += &format!(" height {}", self.qty(h));
                 }
                 if let Some(k) = intensity {
                     t += &format!(" intensity {}", self.qty(k));
+                }
+                if let Some((on, n)) = switch {
+                    t += &format!(" {} at {}", if *on { "on" } else { "off" }, self.qty(n));
                 }
                 t
             }

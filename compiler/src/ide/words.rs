@@ -91,6 +91,7 @@ const STAGES: &str = "5-stages";
 const WORLD_S: &str = "6-the-world";
 const ITEMS: &str = "walls-cylinders-lamps-floor-zones-and-the-start";
 const BODIES: &str = "bodies-and-sensor-layouts";
+const VARIANTS: &str = "variants-conditions-per-evaluation";
 const EVOLUTION: &str = "7-evolution";
 const FITNESS: &str = "8-fitness";
 const MODULES: &str = "9-modules";
@@ -174,7 +175,7 @@ const LIST: &[Word] = &[
     w("scale", C, CLAUSE, "`scale S`: the factor of linear outputs", NEURAL_S),
     // learning
     w("crbp", C, CLAUSE, "`crbp(REWARD, PUNISH[, error difference])`: complementary reinforcement back-propagation", LEARNING),
-    w("on", C, CLAUSE, "`on behavior` or `on activation`: the network that learns (in a world: `on north wall`)", LEARNING),
+    w("on", C, CLAUSE, "`on behavior` or `on activation`: the network that learns (in a world: `on north wall`; a lamp: `on at N`)", LEARNING),
     w("always", C, CLAUSE, "learn after every action", LEARNING),
     w("when", C, CLAUSE, "`when performance < X`: learn only while the module performs poorly", LEARNING),
     w("performance", C, CLAUSE, "the module's performance indicator, averaged over a window", LEARNING),
@@ -207,6 +208,9 @@ const LIST: &[Word] = &[
     w("intensity", C, CLAUSE, "`intensity K`: a lamp's brightness relative to the charger's lamp", ITEMS),
     w("grey", C, CLAUSE, "`grey G`: a zone's grey level, 0 black .. 1 white", ITEMS),
     w("heading", C, CLAUSE, "`heading A`: degrees counter-clockwise from east", ITEMS),
+    w("off", C, CLAUSE, "`off at N`: a lamp that switches off after the life's Nth action (`on at N`: on)", ITEMS),
+    w("variants", C, STAGE, "`variants mean [draw N] { NAME { ITEMS } ... }`: named variants of the world; each individual is evaluated in every one", VARIANTS),
+    w("draw", C, CLAUSE, "`draw N`: the variants drawn per generation (all, without it)", VARIANTS),
     w("north", C, CLAUSE, "the north wall of the arena", WORLD_S),
     w("south", C, CLAUSE, "the south wall of the arena", WORLD_S),
     w("east", C, CLAUSE, "the east wall of the arena", WORLD_S),
@@ -242,12 +246,13 @@ const LIST: &[Word] = &[
     w("collision", C, EVENT, "`-1 per collision`: the robot hit something", FITNESS),
     // functions
     w("max", F, EXPR, "`max(x, ...)`: the largest value", EXPRESSIONS),
-    w("min", F, EXPR, "`min(x, ...)`: the smallest value", EXPRESSIONS),
+    w("min", F, EXPR | CLAUSE, "`min(x, ...)`: the smallest value (`variants min`: the lowest of the variants' fitness)", EXPRESSIONS),
     w("sum", F, EXPR, "`sum(x, ...)`: the sum", EXPRESSIONS),
-    w("mean", F, EXPR, "`mean(x, ...)`: the mean", EXPRESSIONS),
+    w("mean", F, EXPR | CLAUSE, "`mean(x, ...)`: the mean (`variants mean`: the mean of the variants' fitness)", EXPRESSIONS),
     w("abs", F, EXPR, "`abs(x)`: the absolute value", EXPRESSIONS),
     w("sign", F, EXPR | CLAUSE, "`sign(x)`: -1, 0 or 1 (in `outputs sign(N)`: N outputs read as bits)", EXPRESSIONS),
     w("sqrt", F, EXPR, "`sqrt(x)`: the square root", EXPRESSIONS),
+    w("distance_to", F, EXPR, "`distance_to(NAME)`: mm from the body centre to a named wall, cylinder, lamp or zone (a fitness only)", FITNESS),
     // units
     w("mm", U, CLAUSE, "millimetres (a bare length is in millimetres)", LEXICAL),
     w("cm", U, CLAUSE, "centimetres", LEXICAL),

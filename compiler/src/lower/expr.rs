@@ -5,6 +5,8 @@
 //! aggregates `max min sum mean`; a one-element array is a number.
 
 use shaping_runtime::expr::{Expr, Op, MAX_STACK};
+use shaping_runtime::program::{ItemKind, Target};
+use shaping_runtime::state::{MAX_TARGETS, ST_TARGETS};
 
 use super::{Hw, Lower};
 use crate::diag::{did_you_mean, Error};
@@ -47,7 +49,7 @@ enum Val {
     Err,
 }
 
-pub(crate) const FUNCTIONS: [&str; 7] = ["max", "min", "sum", "mean", "abs", "sign", "sqrt"];
+pub(crate) const FUNCTIONS: [&str; 8] = ["max", "min", "sum", "mean", "abs", "sign", "sqrt", "distance_to"];
 
 impl Lower<'_> {
     /// Lowers an expression that must give a number; `None` after an error.
@@ -226,6 +228,7 @@ impl Lower<'_> {
                 });
                 Val::Num
             }
+            "distance_to" => self.distance_to(f, args, span, scope, prev, ops),
             _ => {
                 self.errors.push(Error::Unknown {
                     span: f.span.into(),
@@ -237,6 +240,81 @@ impl Lower<'_> {
                 Val::Err
             }
         }
+    }
+
+    /// `distance_to(NAME)`: the distance from the body centre to the named
+    /// wall, cylinder, lamp or zone of the stage's world, mm (a fitness only).
+    fn distance_to(
+        &mut self,
+        f: &ast::Name,
+        args: &[ast::Expr],
+        span: Span,
+        scope: &Scope,
+        prev: bool,
+        ops: &mut Vec<Op>,
+    ) -> Val {
+        let target = match args {
+            [ast::Expr { kind: ExprKind::Ref(n, None), .. }] => n,
+            _ => {
+                self.errors.push(Error::Value {
+                    span: span.into(),
+                    message: "`distance_to` takes the name of one item of the world".into(),
+                    label: "not an item's name".into(),
+                    help: Some("name a wall, cylinder, lamp or zone: `distance_to(goal)`".into()),
+                });
+                return Val::Err;
+            }
+        };
+        if !scope.state || prev {
+            self.errors.push(Error::Value {
+                span: span.into(),
+                message: "`distance_to` is the simulator's knowledge of the robot: only a fitness reads it"
+                    .into(),
+                label: "not a sensor".into(),
+                help: Some("a module's reinforcement and conditions read the robot's sensors".into()),
+            });
+            return Val::Err;
+        }
+        let _ = f;
+        let items = &self.items;
+        let kinds = [
+            (ItemKind::Wall, items.walls.iter().map(|x| x.name.clone()).collect::<Vec<_>>()),
+            (ItemKind::Cylinder, items.cylinders.iter().map(|x| x.name.clone()).collect()),
+            (ItemKind::Lamp, items.lamps.iter().map(|x| x.name.clone()).collect()),
+            (ItemKind::Zone, items.zones.iter().map(|x| x.name.clone()).collect()),
+        ];
+        let found =
+            kinds.iter().find(|(_, names)| names.iter().any(|n| n.as_deref() == Some(target.text.as_str())));
+        let Some((kind, _)) = found else {
+            let all: Vec<String> = kinds.iter().flat_map(|(_, n)| n.iter().flatten().cloned()).collect();
+            self.errors.push(Error::Unknown {
+                span: target.span.into(),
+                what: "item of the world",
+                name: target.text.clone(),
+                help: did_you_mean(&target.text, all.iter().map(String::as_str))
+                    .or_else(|| Some("name a wall, cylinder, lamp or zone of the stage's world".into())),
+            });
+            return Val::Err;
+        };
+        let t = Target { kind: *kind, name: target.text.clone() };
+        let i = match self.targets.iter().position(|x| *x == t) {
+            Some(i) => i,
+            None if self.targets.len() < MAX_TARGETS => {
+                self.targets.push(t);
+                self.targets.len() - 1
+            }
+            None => {
+                self.value_error(
+                    target.span,
+                    format!("a stage measures the distance to at most {MAX_TARGETS} items"),
+                    "one too many",
+                    None,
+                );
+                return Val::Err;
+            }
+        };
+        ops.push(Op::State((ST_TARGETS + i) as u16));
+        Val::Num
     }
 
     /// `robot.FIELD`.

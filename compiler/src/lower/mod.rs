@@ -11,6 +11,7 @@ pub(crate) mod expr;
 mod genes;
 pub(crate) mod module;
 pub(crate) mod training;
+pub(crate) mod variants;
 pub(crate) mod world;
 
 use std::collections::HashMap;
@@ -174,6 +175,9 @@ struct StageSt {
     links: Vec<LinkSt>,
     genes: Vec<Gene>,
     bits: u32,
+    /// The items the fitness measures the distance to (`distance_to`).
+    targets: Vec<Target>,
+    variants: Option<variants::VariantsSt>,
 }
 
 pub(crate) struct Lower<'a> {
@@ -193,6 +197,10 @@ pub(crate) struct Lower<'a> {
     /// The first use of hardware in a file that declares no robot: the
     /// one error reported for all of them.
     no_robot: Option<Span>,
+    /// While a stage's fitness is lowered: its world's items and its
+    /// targets (`distance_to(NAME)`).
+    pub(crate) items: Items,
+    pub(crate) targets: Vec<Target>,
 }
 
 /// A module of a training stage: its name, its behavior's shape and its
@@ -307,6 +315,8 @@ pub fn lower_partial(file: &ast::File, file_name: &str) -> (Program, Vec<Error>)
         poisoned: Default::default(),
         trained: HashMap::new(),
         no_robot: None,
+        items: Items::default(),
+        targets: Vec::new(),
     };
     let program = lw.program(file_name);
     if let Some(at) = lw.no_robot {
@@ -838,6 +848,8 @@ impl<'a> Lower<'a> {
             links: Vec::new(),
             genes: Vec::new(),
             bits: 0,
+            targets: Vec::new(),
+            variants: None,
         };
         let file = self.file;
         if let Some(r) = file.robots.first() {
@@ -1050,6 +1062,7 @@ impl<'a> Lower<'a> {
         self.check_ground(&st, s, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
+        self.variants_decl(&mut st, decl);
         self.run(&mut st, decl, parent.is_some());
         let hw = Hw {
             stage: sname.clone(),
@@ -1103,6 +1116,8 @@ impl<'a> Lower<'a> {
         // A `fitness` without `adds` replaces the fitness: after another
         // `fitness` of the same stage, it would silently drop that one.
         let mut first_fitness: Option<Span> = None;
+        self.items = st.world.world.items.clone();
+        self.targets = std::mem::take(&mut st.targets);
         for item in &decl.items {
             if let I::Fitness(f) = item {
                 if let (Some(first), false) = (first_fitness, f.adds) {
@@ -1130,9 +1145,11 @@ impl<'a> Lower<'a> {
                 Some("add `fitness per action EXPR` or declare a `test` stage".into()),
             );
         }
+        st.targets = std::mem::take(&mut self.targets);
         self.allocate(&mut st, s);
         self.check_genome_size(&st, decl);
-        let stage = assemble(&st, &sname, s, parent);
+        let mut stage = assemble(&st, &sname, s, parent);
+        stage.variants = self.variant_worlds(&st, &sname, decl);
         (st, stage)
     }
 }
@@ -1256,6 +1273,8 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
         fitness: st.fitness.clone(),
         run: st.run.clone(),
         inheritance: st.inheritance,
+        variants: None,
+        targets: st.targets.clone(),
     }
 }
 

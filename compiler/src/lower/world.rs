@@ -2,7 +2,7 @@
 //! each), inner walls, cylinders, lamps and floor zones (any number), with
 //! `world adds` and `world changes` checked against the inherited world.
 
-use shaping_runtime::limits::{MAX_ITEMS, MAX_OBJECTS};
+use shaping_runtime::limits::{MAX_ACTIONS, MAX_ITEMS, MAX_OBJECTS};
 use shaping_runtime::program::*;
 use shaping_runtime::sim::ir;
 use shaping_runtime::world::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
@@ -199,7 +199,7 @@ impl Lower<'_> {
                     let place = self.place(ws, block, stage, "cylinder", name.as_ref(), *span);
                     put(&mut ws.world.items.cylinders, place, cyl);
                 }
-                W::Lamp { name, at, height, intensity, span } => {
+                W::Lamp { name, at, height, intensity, switch, span } => {
                     let at = self.point(at, "a lamp's position");
                     let h = match height {
                         Some(q) => self.length(q, "the lamp height"),
@@ -209,11 +209,18 @@ impl Lower<'_> {
                         Some(q) => self.plain(q, "the lamp intensity", 0.0, 1e6),
                         None => Some(1.0),
                     };
-                    let (Some(at), Some(height), Some(intensity)) = (at, h, k) else {
+                    let sw = match switch {
+                        Some((on, q)) => self
+                            .count_in(q, "the action a lamp switches at", 1, MAX_ACTIONS.into())
+                            .map(|n| Some(LampSwitch { on: *on, at: n as u32 })),
+                        None => Some(None),
+                    };
+                    let (Some(at), Some(height), Some(intensity), Some(switch)) = (at, h, k, sw) else {
                         refuse(ws, "lamp", name.as_ref());
                         continue;
                     };
-                    let lamp = Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity };
+                    let lamp =
+                        Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity, switch };
                     let place = self.place(ws, block, stage, "lamp", name.as_ref(), *span);
                     put(&mut ws.world.items.lamps, place, lamp);
                 }

@@ -119,6 +119,26 @@ pub enum StageItem {
     Module(ModuleDecl),
     LinksAll(LinkKind, Span),
     Link(LinkDecl),
+    Variants(VariantsDecl),
+}
+
+/// `variants mean [draw N] { NAME { ITEMS } ... }`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantsDecl {
+    /// `mean` or `min` (any word: the compiler names an unknown one).
+    pub aggregate: Name,
+    pub draw: Option<Quantity>,
+    pub variants: Vec<VariantDecl>,
+    pub span: Span,
+}
+
+/// `NAME { ITEMS }`: one variant; its items are a `world changes` block
+/// (`world.mode` is `Changes`, `world.span` the braces and items).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VariantDecl {
+    pub name: Name,
+    pub world: WorldBlock,
+    pub span: Span,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -179,6 +199,8 @@ pub enum WorldItem {
         at: Point,
         height: Option<Quantity>,
         intensity: Option<Quantity>,
+        /// `on at N` (true) or `off at N`.
+        switch: Option<(bool, Quantity)>,
         span: Span,
     },
     Zone {

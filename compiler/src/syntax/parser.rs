@@ -805,6 +805,7 @@ impl Builder {
                 }
                 Rule::genome => items.push(StageItem::Genome(genome(c))),
                 Rule::world => items.push(StageItem::World(world(c))),
+                Rule::variants => items.push(StageItem::Variants(variants(c))),
                 Rule::evolve => items.push(StageItem::Evolve(c.into_inner().map(setting).collect(), csp)),
                 Rule::train_run => {
                     let actions = c.into_inner().next().map(quantity).unwrap_or(Quantity {
@@ -1287,6 +1288,7 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 let mut points = Vec::new();
                 let (mut diameter, mut height, mut intensity, mut grey, mut heading) =
                     (None, None, None, None, None);
+                let mut switch = None;
                 let mut charger = false;
                 for o in c.into_inner() {
                     match o.as_rule() {
@@ -1301,6 +1303,11 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                         Rule::diameter => diameter = o.into_inner().next().map(quantity),
                         Rule::lamp_height => height = o.into_inner().next().map(quantity),
                         Rule::lamp_intensity => intensity = o.into_inner().next().map(quantity),
+                        Rule::lamp_switch => {
+                            let mut it = o.into_inner();
+                            let on = it.next().is_some_and(|w| w.as_str() == "on");
+                            switch = it.find(|q| q.as_rule() == Rule::quantity).map(|q| (on, quantity(q)));
+                        }
                         Rule::zone_grey => grey = o.into_inner().next().map(quantity),
                         Rule::zone_charger => charger = true,
                         Rule::heading => heading = o.into_inner().next().map(quantity),
@@ -1323,7 +1330,7 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                         span: csp,
                     },
                     Rule::lamp_item => {
-                        WorldItem::Lamp { name: name_, at: first, height, intensity, span: csp }
+                        WorldItem::Lamp { name: name_, at: first, height, intensity, switch, span: csp }
                     }
                     Rule::zone => WorldItem::Zone {
                         name: name_,
@@ -1377,6 +1384,36 @@ fn sensor_layout(p: Pair<Rule>) -> SensorLayout {
         }
     }
     SensorLayout { kind, at, facing, span: sp }
+}
+
+/// `variants mean [draw N] { NAME { ITEMS } ... }`.
+fn variants(p: Pair<Rule>) -> VariantsDecl {
+    let sp = span(&p);
+    let mut aggregate = Name { text: String::new(), span: sp };
+    let mut draw = None;
+    let mut list = Vec::new();
+    for c in p.into_inner() {
+        match c.as_rule() {
+            Rule::ident => aggregate = name(c),
+            Rule::variants_draw => {
+                draw = c.into_inner().find(|q| q.as_rule() == Rule::quantity).map(quantity)
+            }
+            Rule::variant => {
+                let vsp = span(&c);
+                let n = c
+                    .clone()
+                    .into_inner()
+                    .next()
+                    .map(name)
+                    .unwrap_or(Name { text: String::new(), span: vsp });
+                let mut world = world(c);
+                world.mode = WorldMode::Changes;
+                list.push(VariantDecl { name: n, world, span: vsp });
+            }
+            _ => {}
+        }
+    }
+    VariantsDecl { aggregate, draw, variants: list, span: sp }
 }
 
 fn setting(p: Pair<Rule>) -> Setting {

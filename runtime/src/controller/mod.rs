@@ -136,6 +136,10 @@ pub struct EpisodeResult {
     pub descriptors: Descriptors,
 }
 
+/// What `distance_to(NAME)` reads when the life's world lacks the item
+/// (the validation refuses such a program; a robot's world has none), mm.
+pub const FAR: f32 = 1.0e6;
+
 /// For `skip_serializing_if`: counts added to saved results are left out
 /// while 0, so files without them stay as they were.
 pub(crate) fn is_zero(n: &u32) -> bool {
@@ -349,6 +353,9 @@ pub struct Controller<'s> {
     /// The state the expressions read (`robot.x` ...), filled only when one does.
     state: [f32; STATE_SLOTS],
     reads_state: bool,
+    /// Where the stage's targets (`distance_to(NAME)`) are in the world of
+    /// the life (`None`: not in it; its distance reads [`FAR`]).
+    targets: Vec<Option<crate::world::Place>>,
 }
 
 impl<'s> Controller<'s> {
@@ -444,6 +451,7 @@ impl<'s> Controller<'s> {
             odo: Odometer::default(),
             state: [0.0; STATE_SLOTS],
             reads_state: crate::state::reads_state(stage),
+            targets: stage.targets.iter().map(|t| crate::world::Place::of(&stage.world, t)).collect(),
         })
     }
 
@@ -489,6 +497,18 @@ impl<'s> Controller<'s> {
     fn observe_state<R: Robot>(&mut self, sim: &R) {
         if self.reads_state {
             self.state = self.odo.state(sim.pose().theta);
+            let at = sim.position();
+            for (slot, place) in self.state[crate::state::ST_TARGETS..].iter_mut().zip(&self.targets) {
+                *slot = place.map_or(FAR, |p| p.distance(at));
+            }
+        }
+    }
+
+    /// Finds the stage's targets (`distance_to(NAME)`) in `world`, the
+    /// world of the lives that follow (a test's lives run in several).
+    pub fn use_world(&mut self, world: &crate::program::World) {
+        for (place, t) in self.targets.iter_mut().zip(&self.stage.targets) {
+            *place = crate::world::Place::of(world, t);
         }
     }
 

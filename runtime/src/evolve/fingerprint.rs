@@ -26,7 +26,7 @@ use crate::program::{Program, Stage, StageRun};
 
 /// The parts of a stage a fingerprint hashes separately, in the order
 /// [`changes`] names them.
-pub const PARTS: [&str; 11] = [
+pub const PARTS: [&str; 12] = [
     "position",
     "extends",
     "robot",
@@ -38,6 +38,7 @@ pub const PARTS: [&str; 11] = [
     "settings",
     "generations",
     "inheritance",
+    "variants",
 ];
 
 /// The part of a result's own stage that may differ: its generations.
@@ -70,8 +71,21 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
     let Some(stage) = program.stages.get(index) else {
         return StagePrint { stage: format!("#{index}"), parts: BTreeMap::new() };
     };
-    let Stage { name, parent, sensors, actuators, world, modules, links, layout, fitness, run, inheritance } =
-        stage;
+    let Stage {
+        name,
+        parent,
+        sensors,
+        actuators,
+        world,
+        modules,
+        links,
+        layout,
+        fitness,
+        run,
+        inheritance,
+        variants,
+        targets,
+    } = stage;
     let parent = parent.and_then(|p| program.stages.get(p)).map(|p| p.name.as_str());
     let (settings, generations) = match run {
         StageRun::Evolve(evo) => {
@@ -89,14 +103,24 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
         hash(modules),
         hash(links),
         hash(layout),
-        hash(fitness),
+        // The targets only where there are some, so the prints of stages
+        // without them stay as they were.
+        if targets.is_empty() { hash(fitness) } else { hash(&(fitness, targets)) },
         settings,
         generations,
         hash(inheritance),
+        variants.as_ref().map_or(0, hash),
     ];
+    // A stage without variants has no `variants` part: its print is the
+    // one saved before variants existed.
     StagePrint {
         stage: name.clone(),
-        parts: PARTS.iter().zip(values).map(|(p, v)| (p.to_string(), v)).collect(),
+        parts: PARTS
+            .iter()
+            .zip(values)
+            .filter(|(p, _)| **p != "variants" || variants.is_some())
+            .map(|(p, v)| (p.to_string(), v))
+            .collect(),
     }
 }
 

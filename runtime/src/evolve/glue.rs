@@ -40,8 +40,35 @@ pub fn evaluate_with_controller(
     opts: EvalOptions,
 ) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + '_, ControllerError> {
     controller::validate(stage, &Genome::zeros(stage.layout.bits as usize))?;
+    let worlds = VariantStages::of(stage);
     Ok(move |genome: &Genome, seed: u64| {
         let episode = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed };
-        Evaluation::of_episode(controller::run_episode(stage, genome, &episode, None))
+        Evaluation::of_episode(controller::run_episode(worlds.stage(seed), genome, &episode, None))
     })
+}
+
+/// A stage in each of its variants: which stage an episode seed runs
+/// ([`super::seed::variant_seed`] names the variant in a stage with
+/// variants). Made once per evaluation function, not per episode.
+pub struct VariantStages<'s> {
+    stage: &'s Stage,
+    each: Vec<Stage>,
+}
+
+impl<'s> VariantStages<'s> {
+    /// `stage` in each of its variants (none without variants).
+    pub fn of(stage: &'s Stage) -> VariantStages<'s> {
+        let each =
+            (0..stage.variants.as_ref().map_or(0, |v| v.list.len())).map(|v| stage.in_variant(v)).collect();
+        VariantStages { stage, each }
+    }
+
+    /// The stage an episode of seed `seed` runs: the variant its seed
+    /// names, or the stage itself without variants.
+    pub fn stage(&self, seed: u64) -> &Stage {
+        if self.each.is_empty() {
+            return self.stage;
+        }
+        &self.each[super::seed::seed_variant(seed).min(self.each.len() - 1)]
+    }
 }

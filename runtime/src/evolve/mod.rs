@@ -54,7 +54,7 @@ use serde::{Deserialize, Serialize};
 pub use error::EvolveError;
 pub use fingerprint::{fingerprint, Fingerprint};
 pub use ga::{frozen_mask, next_generation, ranking};
-pub use glue::{evaluate_with_controller, EvalOptions};
+pub use glue::{evaluate_with_controller, EvalOptions, VariantStages};
 pub use train::{train_all, train_stage, Trained};
 
 use crate::genome::Genome;
@@ -163,6 +163,72 @@ pub struct GenStats {
     pub crowded_episodes: u32,
     #[serde(default, skip_serializing_if = "crate::controller::is_zero")]
     pub placement_failures: u32,
+    /// In a stage with variants, the best individual's fitness in each
+    /// declared variant (its mean over the variant's episodes), `None` for
+    /// a variant not drawn this generation. Empty without variants.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub best_variants: Vec<Option<f32>>,
+}
+
+/// The variants generation `generation` of `stage` (index `index`) is
+/// evaluated in, in declaration order: every variant, or the `draw N`
+/// drawn from [`seed::draw_seed`] (the same for every individual). Empty for
+/// a stage without variants.
+pub fn drawn_variants(stage: &Stage, run_seed: u64, index: usize, generation: u32) -> Vec<usize> {
+    let Some(vars) = &stage.variants else { return Vec::new() };
+    let n = vars.list.len();
+    let mut all: Vec<usize> = (0..n).collect();
+    let Some(k) = vars.draw.map(|d| d as usize).filter(|&d| d < n) else { return all };
+    // A partial Fisher-Yates shuffle: the first `k` are a uniform draw.
+    let mut rng = seed::rng(seed::draw_seed(run_seed, index, generation));
+    for i in 0..k {
+        let j = rand::Rng::random_range(&mut rng, i..n);
+        all.swap(i, j);
+    }
+    all.truncate(k);
+    all.sort_unstable();
+    all
+}
+
+/// The jobs of one individual: `episodes` episodes per variant of
+/// `variants` (episode `e` of variant `v` seeded by `seed(e)` with the
+/// variant in its low bits), or `episodes` episodes without variants.
+fn individual_jobs<'g>(
+    genome: &'g Genome,
+    variants: &'g [usize],
+    episodes: u32,
+    seed: impl Fn(u32) -> u64 + Copy + 'g,
+) -> impl Iterator<Item = (&'g Genome, u64)> + 'g {
+    let plain = variants.is_empty().then(|| (0..episodes).map(move |e| (genome, seed(e))));
+    let varied = variants
+        .iter()
+        .copied()
+        .flat_map(move |v| (0..episodes).map(move |e| (genome, seed::variant_seed(seed(e), v))));
+    plain.into_iter().flatten().chain(varied)
+}
+
+/// An individual's fitness from its episodes' (`episodes` per variant of
+/// `variants`, in the order of [`individual_jobs`]): the mean over its
+/// episodes without variants; with them, the mean per variant, aggregated
+/// as the stage declares. Also the per-variant means (by declared index).
+fn individual_fitness(
+    stage: &Stage,
+    variants: &[usize],
+    episodes: u32,
+    scores: &[f32],
+) -> (f32, Vec<Option<f32>>) {
+    let mean = |xs: &[f32]| (xs.iter().map(|&f| f as f64).sum::<f64>() / xs.len().max(1) as f64) as f32;
+    let Some(vars) = stage.variants.as_ref().filter(|_| !variants.is_empty()) else {
+        return (mean(scores), Vec::new());
+    };
+    let mut per = vec![None; vars.list.len()];
+    for (k, &v) in variants.iter().enumerate() {
+        let chunk = &scores[k * episodes as usize..(k + 1) * episodes as usize];
+        if let Some(slot) = per.get_mut(v) {
+            *slot = Some(mean(chunk));
+        }
+    }
+    (vars.aggregate.of(per.iter().flatten().copied()), per)
 }
 
 /// Everything needed to continue a run: plain data, serde (JSON) friendly.
@@ -334,11 +400,15 @@ pub fn step_generation_with(
 
     let (run_seed, stage) = (cp.seed, cp.stage);
     let episodes = evo.evaluations.max(1);
+    let variants = drawn_variants(st, run_seed, stage, g);
+    let per_individual = episodes as usize * variants.len().max(1);
     let jobs: Vec<(&Genome, u64)> = population
         .iter()
         .enumerate()
         .flat_map(|(i, genome)| {
-            (0..episodes).map(move |e| (genome, seed::episode_seed(run_seed, stage, g, i, e)))
+            individual_jobs(genome, &variants, episodes, move |e| {
+                seed::episode_seed(run_seed, stage, g, i, e)
+            })
         })
         .collect();
     let evaluations = many(&jobs);
@@ -351,17 +421,21 @@ pub fn step_generation_with(
     let crowded_episodes = evaluations.iter().filter(|ev| ev.placement_failures > 0).count() as u32;
     let placement_failures = evaluations.iter().fold(0u32, |n, ev| n.saturating_add(ev.placement_failures));
     let mut evaluations = evaluations.into_iter();
+    let mut scores = Vec::with_capacity(per_individual);
+    let mut per_variant = Vec::with_capacity(population.len());
     let results: Vec<(f32, Option<Genome>, Events)> = (0..population.len())
         .map(|_| {
-            let mut sum = 0.0f64;
             let mut learned = None;
             let mut events = Events::default();
-            for ev in evaluations.by_ref().take(episodes as usize) {
-                sum += ev.fitness as f64;
+            scores.clear();
+            for ev in evaluations.by_ref().take(per_individual) {
+                scores.push(ev.fitness);
                 learned = ev.learned;
                 events.add(ev.events);
             }
-            ((sum / episodes as f64) as f32, learned, events)
+            let (f, per) = individual_fitness(st, &variants, episodes, &scores);
+            per_variant.push(per);
+            (f, learned, events)
         })
         .collect();
 
@@ -424,6 +498,7 @@ pub fn step_generation_with(
         best_releases_outside: events_all[best_index].releases_outside,
         crowded_episodes,
         placement_failures,
+        best_variants: per_variant.swap_remove(best_index),
     };
     cp.population = population;
     cp.fitness = fitness;
@@ -550,9 +625,16 @@ pub fn validate_best_with(
     }
     let episodes = episodes.max(1);
     let (run_seed, stage) = (cp.seed, cp.stage);
+    let st = get_stage(program, stage)?;
+    // Every variant, not a generation's draw.
+    let variants = st.variants.as_ref().map_or(0, |v| v.list.len());
+    let variants: Vec<usize> = (0..variants).collect();
+    let per_candidate = episodes as usize * variants.len().max(1);
     let jobs: Vec<(&Genome, u64)> = pool
         .iter()
-        .flat_map(|&g| (0..episodes).map(move |e| (g, seed::validate_seed(run_seed, stage, e))))
+        .flat_map(|&g| {
+            individual_jobs(g, &variants, episodes, move |e| seed::validate_seed(run_seed, stage, e))
+        })
         .collect();
     let scores: Vec<f32> = many(&jobs).into_iter().map(|ev| ev.fitness).collect();
     if scores.len() != jobs.len() {
@@ -563,7 +645,7 @@ pub fn validate_best_with(
     }
     let mut best = (0usize, f64::NEG_INFINITY);
     for c in 0..pool.len() {
-        let per = &scores[c * episodes as usize..(c + 1) * episodes as usize];
+        let per = &scores[c * per_candidate..(c + 1) * per_candidate];
         if let Some(bad) = per.iter().find(|f| !f.is_finite()) {
             return Err(EvolveError::NonFiniteFitness {
                 stage: name,
@@ -572,7 +654,11 @@ pub fn validate_best_with(
                 value: *bad,
             });
         }
-        let mean = per.iter().map(|&f| f as f64).sum::<f64>() / episodes as f64;
+        let mean = if variants.is_empty() {
+            per.iter().map(|&f| f as f64).sum::<f64>() / episodes as f64
+        } else {
+            f64::from(individual_fitness(st, &variants, episodes, per).0)
+        };
         if mean > best.1 {
             best = (c, mean);
         }

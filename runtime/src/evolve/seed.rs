@@ -18,6 +18,7 @@ const DOMAIN_EVAL: u64 = 0x4556_414c; // "EVAL"
 const DOMAIN_TEST: u64 = 0x5445_5354; // "TEST"
 const DOMAIN_VALIDATE: u64 = 0x5641_4c49_4441_5445; // "VALIDATE"
 const DOMAIN_LIFE: u64 = 0x4c49_4645; // "LIFE"
+const DOMAIN_DRAW: u64 = 0x4452_4157; // "DRAW"
 
 /// What the simulator seed of a test stage's first life in its own world
 /// differs from the episode seed by (xor): the one-life test's derivation.
@@ -77,6 +78,30 @@ pub fn test_life_seed(episode_seed: u64, after: bool, life: u32) -> u64 {
 /// Seed of episode `episode` of the re-evaluation that picks a stage's best.
 pub fn validate_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
     mix(run_seed, &[DOMAIN_VALIDATE, stage as u64, episode as u64])
+}
+
+/// The low bits of an episode seed that name its variant, in a stage with
+/// variants ([`variant_seed`]): 8, for at most
+/// [`crate::limits::MAX_VARIANTS`] variants.
+const VARIANT_MASK: u64 = 0xff;
+
+/// The seed of an episode of a stage with variants in variant `variant`:
+/// `seed` with its low 8 bits replaced by the variant's index, so the
+/// evaluation of the episode ([`super::glue`], the engine's) finds the
+/// variant in the seed it is given, whatever runs it (threads, MPI ranks).
+pub fn variant_seed(seed: u64, variant: usize) -> u64 {
+    (seed & !VARIANT_MASK) | (variant as u64 & VARIANT_MASK)
+}
+
+/// The variant an episode seed of a stage with variants names ([`variant_seed`]).
+pub fn seed_variant(seed: u64) -> usize {
+    (seed & VARIANT_MASK) as usize
+}
+
+/// Seed of the RNG that draws the variants generation `generation` of a
+/// stage is evaluated in (`variants ... draw N`).
+pub fn draw_seed(run_seed: u64, stage: usize, generation: u32) -> u64 {
+    mix(run_seed, &[DOMAIN_DRAW, stage as u64, generation as u64])
 }
 
 pub(crate) fn rng(seed: u64) -> ChaCha8Rng {

@@ -172,6 +172,10 @@ pub struct Sim {
     cylinders: Vec<Cyl>,
     /// Declared lamps (the charger's is `lamp`).
     lamps: Vec<Lamp>,
+    /// Some declared lamp switches on or off during the life.
+    switches: bool,
+    /// Actions done (the clock of the lamps' switches).
+    actions: u32,
     /// Inner walls or cylinders may shade a sensor from a lamp.
     shades: bool,
     zones: Vec<FloorZone>,
@@ -228,8 +232,12 @@ struct Lamp {
     /// Where it is, seen from above.
     at: Point2<f32>,
     height: f32,
-    /// The intensity constant `K` of `K / (rho^2 + h^2)`.
+    /// The intensity constant `K` of `K / (rho^2 + h^2)` (0 while off).
     k: f32,
+    /// `K` while lit.
+    lit: f32,
+    /// Switches on (`true`) or off after this many actions.
+    switch: Option<(u32, bool)>,
 }
 
 /// The segments `p1 p2` and `q1 q2` cross or touch.
@@ -312,7 +320,8 @@ impl Sim {
         let lamp = world.charger.as_ref().and_then(|c| {
             let h = finite_or(c.lamp_height?, 150.0).max(0.0);
             let [a, b] = bar_segment(c.wall, c.length, width, depth);
-            Some(Lamp { at: nalgebra::center(&a, &b), height: h, k: LAMP_FULL * LAMP_FULL + h * h })
+            let k = LAMP_FULL * LAMP_FULL + h * h;
+            Some(Lamp { at: nalgebra::center(&a, &b), height: h, k, lit: k, switch: None })
         });
         let battery_spec =
             world.battery.as_ref().map(|b| (u64::from(b.capacity.max(1)), u64::from(b.recharge.max(1))));
@@ -337,13 +346,16 @@ impl Sim {
                 Cyl { at: pt(c.at), radius, k }
             })
             .collect();
-        let lamps = items
+        let lamps: Vec<Lamp> = items
             .lamps
             .iter()
             .map(|l| {
                 let h = finite_or(l.height, 0.0).max(0.0);
-                let k = (LAMP_FULL * LAMP_FULL + h * h) * finite_or(l.intensity, 0.0).max(0.0);
-                Lamp { at: pt(l.at), height: h, k }
+                let lit = (LAMP_FULL * LAMP_FULL + h * h) * finite_or(l.intensity, 0.0).max(0.0);
+                let switch = l.switch.map(|s| (s.at, s.on));
+                // A lamp that switches on is off until then.
+                let k = if switch.is_some_and(|(_, on)| on) { 0.0 } else { lit };
+                Lamp { at: pt(l.at), height: h, k, lit, switch }
             })
             .collect();
         let zones = items
@@ -378,6 +390,8 @@ impl Sim {
             shades: !inner.is_empty() || !cylinders.is_empty(),
             inner,
             cylinders,
+            switches: lamps.iter().any(|l: &Lamp| l.switch.is_some()),
+            actions: 0,
             lamps,
             zones,
             ground: std::array::from_fn(|k| body.ground.get(k).map_or(Point2::origin(), |&p| pt(p))),
@@ -803,7 +817,23 @@ impl Sim {
         let mut out = self.actuate(cmd);
         out.collided = self.drive(cmd.wheels);
         out.recharged = self.tick_battery(cmd.charge);
+        self.actions = self.actions.saturating_add(1);
+        if self.switches {
+            let done = self.actions;
+            for lamp in &mut self.lamps {
+                if let Some((at, on)) = lamp.switch {
+                    if at == done {
+                        lamp.k = if on { lamp.lit } else { 0.0 };
+                    }
+                }
+            }
+        }
         out
+    }
+
+    /// Actions done in this world so far.
+    pub fn actions(&self) -> u32 {
+        self.actions
     }
 
     /// The gripper part of an action (arm, then claw, at the current pose):
