@@ -453,3 +453,15 @@ print("\n== the charger example of docs/language.md (section 18): recharges of t
 ch = [int(rows(f"{R}/charger/seed-{s}/s/generations.csv")[-1]["best_recharges"]) for s in SEEDS]
 fin = [history("charger", s, "s")[-1] for s in SEEDS]
 print(f"  best_recharges per seed: {' '.join(map(str, ch))}; median {statistics.median(ch)}; final best {spread(fin, 1)}")
+
+print("\n== the T-maze (examples/t-maze.bat): share of 100 fresh lives in the cued arm, per seed")
+for net in ["recurrent", "feedforward"]:
+    shares, per = [], []
+    for s in SEEDS:
+        with open(f"{R}/t-maze/seed-{s}/{net}_test/summary.json") as f:
+            d = json.load(f)
+        shares.append(d["fitness"])
+        per.append("/".join(f"{v['fitness']:.2f}" for v in d["after_variants"]))
+    print(f"  {net}: {' '.join(f'{x:.2f}' for x in shares)}; median {statistics.median(shares):.2f}, "
+          f"seeds at 0.8 or more: {sum(x >= 0.8 for x in shares)}")
+    print(f"    per variant (left/right): {' '.join(per)}")

@@ -90,6 +90,9 @@ print(next(b for b in blocks if "1 per recharge" in b), end="")
 PY
 grep -q 'uses charger' $R/charger.bat
 $B experiment $R/charger.bat --seeds $SEEDS --out $R/charger --fresh > /dev/null
+# The cue-then-choose T-maze: a recurrent network and the feed-forward
+# control, each best tested on 100 fresh lives in the task's two variants.
+$B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/null
 
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
