@@ -390,6 +390,23 @@ fn world_parts(w: &World) -> Vec<String> {
     parts
 }
 
+/// A stage's variants in words: their names, how many are drawn, and how
+/// their fitness is combined.
+fn variants_part(st: &Stage) -> Option<String> {
+    let v = st.variants.as_ref()?;
+    let names: Vec<&str> = v.list.iter().map(|x| x.name.as_str()).collect();
+    let drawn = v
+        .draw
+        .filter(|&d| (d as usize) < names.len())
+        .map_or(String::new(), |d| format!(", {d} drawn per generation"));
+    Some(format!(
+        "{} variants ({}){drawn}, fitness their {}",
+        names.len(),
+        names.join(", "),
+        v.aggregate.word()
+    ))
+}
+
 fn event(e: Event) -> &'static str {
     match e {
         Event::Grip => "grip",
@@ -547,7 +564,7 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
         name: st.name.clone(),
         parent: st.parent.map(|p| program.stages[p].name.clone()),
         run: run_text(st, None),
-        world: world_parts(&st.world).join("; "),
+        world: world_parts(&st.world).into_iter().chain(variants_part(st)).collect::<Vec<_>>().join("; "),
         fitness: fitness_parts(st).join(", "),
         added: added(program, index),
         sensors: st
