@@ -121,9 +121,10 @@ fn crowded_episodes_are_counted_from_the_episode_to_the_generation() {
     let episode = |stage: &shaping_runtime::program::Stage, seed| {
         run_episode(stage, &genome, &EpisodeOptions { actions: 5, learning: false, seed }, None)
     };
-    // The simulator's seed is the episode seed: 13 fails (runtime/tests/sim.rs).
-    assert!(episode(&stage, 13).placement_failures > 0);
-    assert_eq!(episode(&stage, 0).placement_failures, 0);
+    // The simulator's seed is the episode seed: 25 fails, 1 does not
+    // (runtime/tests/sim.rs).
+    assert!(episode(&stage, 25).placement_failures > 0);
+    assert_eq!(episode(&stage, 1).placement_failures, 0);
 
     let run = |stage: shaping_runtime::program::Stage, seed| {
         let program = Program { format: FORMAT_VERSION, name: "crowded".into(), stages: vec![stage] };

@@ -668,7 +668,7 @@ fn failed_placements(w: &World, n: u64) -> (Vec<u64>, u32) {
 /// A world crowded for the random placement but not certainly impossible
 /// (`world::crowded` does not refuse it) says, episode by episode, when its
 /// objects could not be placed apart: 25 objects of 60 mm in the paper's
-/// arena fail now and then (seed 13), 40 always. The counts are what the
+/// arena fail now and then (seed 25), 40 always. The counts are what the
 /// seed draws, like everything else.
 #[test]
 fn a_crowded_world_counts_the_placements_that_overlap() {
@@ -677,11 +677,11 @@ fn a_crowded_world_counts_the_placements_that_overlap() {
         let some = with_objects(25, 60.0, virtual_);
         assert_eq!(crowded(&some), None);
         let (seeds, total) = failed_placements(&some, 200);
-        assert!(seeds.contains(&13), "{seeds:?}");
+        assert!(seeds.contains(&25), "{seeds:?}");
         assert!(!seeds.is_empty() && seeds.len() < 20, "{seeds:?}");
         assert!(total as usize >= seeds.len());
-        // Seed 13 overlaps: some object's disc meets another's.
-        let scene = Sim::new(&some, 13).scene();
+        // Seed 25 overlaps: some object's disc meets another's.
+        let scene = Sim::new(&some, 25).scene();
         let overlap = scene.objects.iter().enumerate().any(|(i, a)| {
             scene.objects[i + 1..].iter().any(|b| (a.x - b.x).hypot(a.y - b.y) < a.radius + b.radius)
                 || a.x < 30.0 + a.radius
@@ -690,8 +690,8 @@ fn a_crowded_world_counts_the_placements_that_overlap() {
                 || a.y > 600.0 - 30.0 - a.radius
                 || (a.x - scene.pose.x).hypot(a.y - scene.pose.y) < a.radius + scene.body_radius
         });
-        assert!(overlap, "seed 13 reports a failed placement but nothing overlaps");
-        assert_eq!(Sim::new(&some, 13).placement_failures(), Sim::new(&some, 13).placement_failures());
+        assert!(overlap, "seed 25 reports a failed placement but nothing overlaps");
+        assert_eq!(Sim::new(&some, 25).placement_failures(), Sim::new(&some, 25).placement_failures());
 
         let full = with_objects(40, 60.0, virtual_);
         assert_eq!(crowded(&full), None);

@@ -303,3 +303,56 @@ fn a_lamp_switches_after_the_declared_action() {
     sim.step(&still);
     assert!(sim.scene().dark_lamps.is_empty());
 }
+
+/// The per-sensor code gives the same bits on the AVX2 path (where the CPU
+/// has it) as on the portable one: percepts and poses of whole lives in a
+/// world with every kind of surface and light (inner walls, cylinders,
+/// physical and virtual objects, the charger's lamp and declared ones,
+/// shading), with noise, driven by a rule that reads the percepts.
+#[test]
+fn both_lanes_paths_give_the_same_lives() {
+    use shaping_runtime::program::{Charger, Objects, Wall};
+    println!("AVX2 path in use: {}", shaping_runtime::sim::simd::avx2_in_use());
+    let items = Items {
+        walls: vec![InnerWall { name: None, from: [100.0, 200.0], to: [300.0, 260.0] }],
+        cylinders: vec![
+            Cylinder { name: None, at: [300.0, 450.0], diameter: 50.0 },
+            Cylinder { name: None, at: [90.0, 420.0], diameter: 30.0 },
+        ],
+        lamps: vec![
+            Lamp { name: None, at: [50.0, 550.0], height: 80.0, intensity: 0.7, switch: None },
+            Lamp { name: None, at: [380.0, 100.0], height: 0.0, intensity: 1.0, switch: None },
+        ],
+        ..Items::default()
+    };
+    let (mut seen_ir, mut seen_light) = (0, 0);
+    for virtual_ in [false, true] {
+        let mut w = world(items.clone());
+        w.body.sensor_noise = 0.05;
+        w.body.wheel_noise = 0.1;
+        w.charger = Some(Charger { wall: Wall::North, length: 150.0, lamp_height: Some(120.0) });
+        w.objects = Some(Objects { count: 10, diameter: 25.0, virtual_ });
+        for seed in 0..20u64 {
+            let (mut best, mut portable) = (Sim::new(&w, seed), Sim::new(&w, seed));
+            portable.force_portable_lanes();
+            for step in 0..400 {
+                let (a, b) = (percept(&mut best), percept(&mut portable));
+                assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "seed {seed} step {step}: {a:?} {b:?}");
+                let near = a[CH_IR + 1..CH_IR + 5].iter().any(|&v| v > 0.3);
+                seen_ir += u32::from(near);
+                seen_light += u32::from(a[CH_LIGHT..CH_LIGHT + 8].iter().any(|&v| v > 0.1 && v < 0.9));
+                let bright = a[CH_LIGHT..CH_LIGHT + 8].iter().any(|&v| v > 0.5);
+                let wheels = match (near, bright) {
+                    (true, _) => [-0.3, -1.0],
+                    (false, true) => [0.4, 1.0],
+                    _ => [1.0, 0.9],
+                };
+                let cmd = Command { wheels, ..Command::default() };
+                assert_eq!(best.step(&cmd), portable.step(&cmd));
+                assert_eq!(best.pose(), portable.pose(), "seed {seed} step {step}");
+            }
+        }
+    }
+    // The lives saw surfaces and lamps, not an empty arena.
+    assert!(seen_ir > 1000 && seen_light > 1000, "{seen_ir} {seen_light}");
+}

@@ -228,7 +228,7 @@ impl Coeffs {
 
 const Z_MIN: f32 = -9.0;
 const Z_MAX: f32 = 8.0;
-const TABLE_LEN: usize = 1024;
+pub(crate) const TABLE_LEN: usize = 1024;
 const Z_SCALE: f32 = (TABLE_LEN - 1) as f32 / (Z_MAX - Z_MIN);
 
 /// A lookup table of [`saturate`] over `Z_MIN..Z_MAX` (linear interpolation).
@@ -248,6 +248,15 @@ impl SatTable {
         v[TABLE_LEN - 1] = 1.0;
         v[TABLE_LEN] = 1.0;
         SatTable { v }
+    }
+
+    /// `Z_MIN` and the scale that maps `Z_MIN..Z_MAX` to the table's
+    /// indices (`t = (z - Z_MIN) * scale`).
+    pub(crate) const SCALE: (f32, f32) = (Z_MIN, Z_SCALE);
+
+    /// The table's values (the last two are 1).
+    pub(crate) fn values(&self) -> &[f32; TABLE_LEN + 1] {
+        &self.v
     }
 
     /// [`saturate`] at `z`, interpolated (no branches on the value).

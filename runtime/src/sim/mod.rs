@@ -15,8 +15,8 @@
 //! [`Pose`] is the same pose as plain data for reports, traces and tests.
 //!
 //! One [`Sim`] is one episode. Everything random (start pose, object
-//! placement, wheel and sensor noise) comes from one `ChaCha8Rng` seeded with
-//! the `seed` given to [`Sim::new`], so the same seed and commands give the
+//! placement, wheel and sensor noise) comes from one xoshiro256++ generator
+//! ([`rng::Xoshiro256pp`]) seeded with the `seed` given to [`Sim::new`], so the same seed and commands give the
 //! same trajectory. [`Sim::sense`] and [`Sim::step`] never allocate.
 //!
 //! The models, in brief (constants below and in [`ir`]):
@@ -42,12 +42,15 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod ir;
+pub mod rng;
 mod scene;
+pub mod simd;
 
 use crate::world::{segment_distance2, OBJECT_CLEARANCE, START_CLEARANCE};
 use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
 use rand::{Rng, RngCore, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use rng::Xoshiro256pp;
+use simd::{Kernel, Lanes};
 
 use crate::catalog::{
     CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, GROUND_SENSORS,
@@ -146,7 +149,7 @@ struct Obj {
 /// One simulated episode's world state.
 #[derive(Clone, Debug)]
 pub struct Sim {
-    rng: ChaCha8Rng,
+    rng: Xoshiro256pp,
     // world
     width: f32,
     depth: f32,
@@ -183,6 +186,10 @@ pub struct Sim {
     ground: [Point2<f32>; GROUND_SENSORS],
     // precomputed IR
     geo: ir::Geometry,
+    /// The sensors' positions and axes as lanes.
+    lanes: SensorLanes,
+    /// The per-sensor code's path (AVX2 where the CPU has it).
+    path: simd::Path,
     wall_k: ir::Coeffs,
     cyl_k: ir::Coeffs,
     // state
@@ -240,6 +247,62 @@ struct Lamp {
     switch: Option<(u32, bool)>,
 }
 
+/// The sensors' positions and axes in the body frame, one array per
+/// coordinate (what the lanes load), from [`ir::Geometry`].
+#[derive(Clone, Copy, Debug)]
+struct SensorLanes {
+    pos_x: [f32; ir::SENSORS],
+    pos_y: [f32; ir::SENSORS],
+    ray_x: [f32; ir::SENSORS],
+    ray_y: [f32; ir::SENSORS],
+}
+
+impl SensorLanes {
+    fn new(g: &ir::Geometry) -> SensorLanes {
+        SensorLanes {
+            pos_x: std::array::from_fn(|s| g.position(s).x),
+            pos_y: std::array::from_fn(|s| g.position(s).y),
+            ray_x: std::array::from_fn(|s| g.axis(s).x),
+            ray_y: std::array::from_fn(|s| g.axis(s).y),
+        }
+    }
+}
+
+/// The log-intensity [`ir::Coeffs::z`] of every sensor.
+#[inline(always)]
+fn ir_z<L: Lanes>(k: &ir::Coeffs, d: L, cos_a: L) -> L {
+    let lobe = L::load(&k.focus).mul(cos_a.sub(L::splat(1.0)));
+    L::load(&k.offset).sub(d.mul(L::load(&k.inv_decay))).add(lobe)
+}
+
+/// The noise-free readings of a state: IR (walls if `walls`, then
+/// cylinders and objects; unclamped) and, if `light`, light (clamped at 1).
+struct Readings<'a> {
+    sim: &'a Sim,
+    walls: bool,
+    light: bool,
+}
+
+impl Kernel for Readings<'_> {
+    type Out = ([f32; ir::SENSORS], [f32; ir::SENSORS]);
+
+    #[inline(always)]
+    fn run<L: Lanes>(self) -> Self::Out {
+        let sim = self.sim;
+        let mut acc = L::splat(0.0);
+        if self.walls {
+            acc = sim.ir_walls(acc);
+        }
+        acc = sim.ir_objects(acc);
+        let (mut ir, mut light) = ([0.0; ir::SENSORS], [0.0; ir::SENSORS]);
+        acc.store(&mut ir);
+        if self.light {
+            sim.light::<L>().store(&mut light);
+        }
+        (ir, light)
+    }
+}
+
 /// The segments `p1 p2` and `q1 q2` cross or touch.
 fn segments_cross(p1: &Point2<f32>, p2: &Point2<f32>, q1: &Point2<f32>, q2: &Point2<f32>) -> bool {
     let cross = |o: &Point2<f32>, a: &Point2<f32>, b: &Point2<f32>| (a - o).perp(&(b - o));
@@ -258,7 +321,7 @@ fn segments_cross(p1: &Point2<f32>, p2: &Point2<f32>, q1: &Point2<f32>, q2: &Poi
 }
 
 /// A uniform draw in `lo..hi` that never panics (the middle if `hi <= lo`).
-fn uniform(rng: &mut ChaCha8Rng, lo: f32, hi: f32) -> f32 {
+fn uniform(rng: &mut Xoshiro256pp, lo: f32, hi: f32) -> f32 {
     let u: f32 = rng.random();
     if hi > lo {
         lo + (hi - lo) * u
@@ -267,12 +330,25 @@ fn uniform(rng: &mut ChaCha8Rng, lo: f32, hi: f32) -> f32 {
     }
 }
 
-/// Two uniform draws in `-n..n` from one 32-bit word (16 bits each: plenty
-/// for noise, and half the generator work).
-fn noise_pair(rng: &mut ChaCha8Rng, n: f32) -> (f32, f32) {
-    let u: u32 = rng.random();
+/// Two uniform draws in `-n..n` from the high 32 bits of one generator word
+/// (16 bits each: plenty for noise).
+fn noise_pair(rng: &mut Xoshiro256pp, n: f32) -> (f32, f32) {
+    let u = rng.next_u64() >> 32;
     let scale = 2.0 * n / 65535.0;
     ((u & 0xffff) as f32 * scale - n, (u >> 16) as f32 * scale - n)
+}
+
+/// `out.len()` uniform draws in `-n..n`, 16 bits each, four from each
+/// generator word (lowest bits first).
+#[inline]
+fn noise_fill(rng: &mut Xoshiro256pp, n: f32, out: &mut [f32; 2 * ir::SENSORS]) {
+    let scale = 2.0 * n / 65535.0;
+    for quad in out.chunks_exact_mut(4) {
+        let w = rng.next_u64();
+        for (k, x) in quad.iter_mut().enumerate() {
+            *x = ((w >> (16 * k)) & 0xffff) as f32 * scale - n;
+        }
+    }
 }
 
 /// `sin(x) / x`, given `sin(x)`.
@@ -309,7 +385,7 @@ fn renormalized(r: UnitComplex<f32>) -> UnitComplex<f32> {
 impl Sim {
     /// A fresh world for one episode; everything random comes from `seed`.
     pub fn new(world: &World, seed: u64) -> Sim {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut rng = Xoshiro256pp::seed_from_u64(seed);
         let body = &world.body;
         let width = finite_or(world.arena[0], 0.0).max(1.0);
         let depth = finite_or(world.arena[1], 0.0).max(1.0);
@@ -334,6 +410,10 @@ impl Sim {
             None => (0, 5.0, true),
         };
         let model = &ir::KHEPERA;
+        let geo = match &body.ir {
+            Some(layout) => ir::Geometry::from_layout(layout, radius),
+            None => ir::Geometry::new(model, radius),
+        };
         let items = &world.items;
         let pt = |p: [f32; 2]| Point2::new(finite_or(p[0], 0.0), finite_or(p[1], 0.0));
         let inner: Vec<[Point2<f32>; 2]> = items.walls.iter().map(|w| [pt(w.from), pt(w.to)]).collect();
@@ -372,7 +452,7 @@ impl Sim {
             })
             .collect();
         let mut sim = Sim {
-            rng: ChaCha8Rng::seed_from_u64(0),
+            rng: Xoshiro256pp::seed_from_u64(0),
             width,
             depth,
             radius,
@@ -395,10 +475,9 @@ impl Sim {
             lamps,
             zones,
             ground: std::array::from_fn(|k| body.ground.get(k).map_or(Point2::origin(), |&p| pt(p))),
-            geo: match &body.ir {
-                Some(layout) => ir::Geometry::from_layout(layout, radius),
-                None => ir::Geometry::new(model, radius),
-            },
+            geo,
+            lanes: SensorLanes::new(&geo),
+            path: simd::Path::Best,
             wall_k: ir::Coeffs::new(&model.wall.reach, &model.wall),
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
             pose: Isometry2::identity(),
@@ -457,7 +536,7 @@ impl Sim {
     /// used and whether the spot is free (false: the last try, overlapping).
     fn free_spot(
         &self,
-        rng: &mut ChaCha8Rng,
+        rng: &mut Xoshiro256pp,
         robot: Option<Point2<f32>>,
         tries: u32,
     ) -> (Point2<f32>, u32, bool) {
@@ -571,20 +650,15 @@ impl Sim {
 
     /// Fills the percept channels for the current state.
     pub fn sense(&mut self, out: &mut [f32; CHANNELS]) {
-        let mut irv = [0.0f32; ir::SENSORS];
-        self.sense_ir(&mut irv);
-        let mut light = [0.0f32; ir::SENSORS];
-        self.sense_light(&mut light);
+        let (mut irv, mut light) = simd::run(Readings { sim: self, walls: true, light: true }, self.path);
         let n = self.sensor_noise;
         if n > 0.0 {
-            // 16 bits of randomness per channel, one generator call.
-            let mut bits = [0u8; 4 * ir::SENSORS];
-            self.rng.fill_bytes(&mut bits);
-            let scale = 2.0 * n / 65535.0;
-            let noise = |k: usize| f32::from(u16::from_le_bytes([bits[2 * k], bits[2 * k + 1]])) * scale - n;
+            // 16 bits of randomness per channel, four channels a word.
+            let mut noise = [0.0f32; 2 * ir::SENSORS];
+            noise_fill(&mut self.rng, n, &mut noise);
             for s in 0..ir::SENSORS {
-                irv[s] += noise(s);
-                light[s] += noise(ir::SENSORS + s);
+                irv[s] += noise[s];
+                light[s] += noise[ir::SENSORS + s];
             }
         }
         for s in 0..ir::SENSORS {
@@ -595,6 +669,14 @@ impl Sim {
         out[CH_BARRIER] = if self.barrier() { 1.0 } else { 0.0 };
         self.sense_ground(out);
         out[CH_LAMP_DISTANCE] = self.lamp_distance().map_or(1.0, |d| (d / 1000.0).min(1.0));
+    }
+
+    /// Runs the per-sensor code on the portable lanes even where the CPU
+    /// has AVX2 (for tests that compare the two paths: they must give the
+    /// same bits).
+    #[doc(hidden)]
+    pub fn force_portable_lanes(&mut self) {
+        self.path = simd::Path::Portable;
     }
 
     /// What the first ground sensor reads (under the body centre unless
@@ -623,47 +705,43 @@ impl Sim {
         self.lamp.iter().chain(&self.lamps).map(|l| (l.at - c).norm()).reduce(f32::min)
     }
 
-    /// Noise-free IR readings of the current state.
-    fn sense_ir(&self, out: &mut [f32; ir::SENSORS]) {
-        self.ir_walls(out);
-        self.ir_objects(out);
-    }
-
-    /// Adds the walls' noise-free IR readings to `out`.
-    fn ir_walls(&self, out: &mut [f32; ir::SENSORS]) {
+    /// Adds the walls' noise-free IR readings to `acc`.
+    #[inline(always)]
+    fn ir_walls<L: Lanes>(&self, mut acc: L) -> L {
         let centre = self.centre();
         let reach = self.radius + ir::RANGE;
         for (dist, normal) in self.walls(&centre) {
             if dist <= reach {
-                self.wall_ir(out, dist, &normal);
+                acc = self.wall_ir(acc, dist, &normal);
             }
         }
         if !self.inner.is_empty() {
-            self.ir_inner_walls(out, &centre, reach);
+            acc = self.ir_inner_walls(acc, &centre, reach);
         }
+        acc
     }
 
     /// Adds one flat wall's readings: `dist` from the body centre, `normal`
     /// its unit normal toward the wall (world frame).
     #[inline(always)]
-    fn wall_ir(&self, out: &mut [f32; ir::SENSORS], dist: f32, normal: &Vector2<f32>) {
+    fn wall_ir<L: Lanes>(&self, acc: L, dist: f32, normal: &Vector2<f32>) -> L {
         let wt = &ir::tables().0;
-        let g = &self.geo;
+        let (g, k) = (&self.lanes, &self.wall_k);
         // With `n` the normal in the body frame, each sensor is `pos . n`
         // nearer the wall than the centre, and its axis makes an angle
         // of cosine `ray . n` with the normal: all eight at once.
         let n = self.pose.rotation.inverse_transform_vector(normal);
-        let nearer = g.pos * n;
-        let cos_a = g.rays * n;
-        for k in 0..ir::SENSORS {
-            out[k] += wt.get(self.wall_k.z(k, dist - nearer[k], cos_a[k]));
-        }
+        let (nx, ny) = (L::splat(n.x), L::splat(n.y));
+        let nearer = L::load(&g.pos_x).mul(nx).add(L::load(&g.pos_y).mul(ny));
+        let cos_a = L::load(&g.ray_x).mul(nx).add(L::load(&g.ray_y).mul(ny));
+        let d = L::splat(dist).sub(nearer);
+        acc.add(simd::saturate(ir_z(k, d, cos_a), wt))
     }
 
     /// An inner wall reads as a flat wall through its point nearest the
     /// centre, facing the body.
-    #[inline(never)]
-    fn ir_inner_walls(&self, out: &mut [f32; ir::SENSORS], centre: &Point2<f32>, reach: f32) {
+    #[inline(always)]
+    fn ir_inner_walls<L: Lanes>(&self, mut acc: L, centre: &Point2<f32>, reach: f32) -> L {
         for [a, b] in &self.inner {
             let d2 = segment_distance2(centre, a, b);
             if d2 > reach * reach || d2 <= 0.0 {
@@ -674,16 +752,19 @@ impl Sim {
             let len2 = ab.norm_squared();
             let t = if len2 > 0.0 { ((centre - a).dot(&ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
             let nearest = a + ab * t;
-            self.wall_ir(out, dist, &((nearest - centre) / dist));
+            acc = self.wall_ir(acc, dist, &((nearest - centre) / dist));
         }
+        acc
     }
 
-    /// Adds the floor objects' noise-free IR readings to `out`.
-    fn ir_objects(&self, out: &mut [f32; ir::SENSORS]) {
+    /// Adds the floor objects' and cylinders' noise-free IR readings to
+    /// `acc`. An object or cylinder beyond the sensing range costs one
+    /// squared distance.
+    #[inline(always)]
+    fn ir_objects<L: Lanes>(&self, mut acc: L) -> L {
         let ct = &ir::tables().1;
         let centre = self.centre();
         let rot = &self.pose.rotation;
-        let g = &self.geo;
         let reach = self.radius + ir::RANGE;
         let r = self.obj_radius;
         let reach = reach + r;
@@ -694,13 +775,8 @@ impl Sim {
             if offset.norm_squared() > far * far {
                 continue;
             }
-            let at = Point2::from(rot.inverse_transform_vector(&offset));
-            for k in 0..ir::SENSORS {
-                let v = at - g.position(k);
-                let dist = v.norm().max(1e-3);
-                let cos_a = g.axis(k).dot(&v) / dist;
-                out[k] += ct.get(c.k.z(k, dist - c.radius, cos_a));
-            }
+            let at = rot.inverse_transform_vector(&offset);
+            acc = acc.add(self.cylinder_ir(at, c.radius, &c.k, ct));
         }
         for o in &self.objects {
             if o.state != ObjectState::Floor {
@@ -711,23 +787,31 @@ impl Sim {
                 continue;
             }
             // The object's centre in the body frame.
-            let mut at = Point2::from(rot.inverse_transform_vector(&offset));
+            let mut at = rot.inverse_transform_vector(&offset);
             // Closer than the nearest measured distance (a virtual object under
             // the body): read it as if it were at that distance, same bearing.
             let near = self.radius + r + ir::NEAREST;
-            let d2 = at.coords.norm_squared();
+            let d2 = at.norm_squared();
             if d2 < near * near {
                 let d = d2.sqrt();
-                let u = if d > 1e-3 { at.coords / d } else { Vector2::x() };
-                at = Point2::from(u * near);
+                let u = if d > 1e-3 { at / d } else { Vector2::x() };
+                at = u * near;
             }
-            for k in 0..ir::SENSORS {
-                let v = at - g.position(k);
-                let dist = v.norm().max(1e-3);
-                let cos_a = g.axis(k).dot(&v) / dist;
-                out[k] += ct.get(self.cyl_k.z(k, dist - r, cos_a));
-            }
+            acc = acc.add(self.cylinder_ir(at, r, &self.cyl_k, ct));
         }
+        acc
+    }
+
+    /// One cylinder's readings: its centre `at` in the body frame, its
+    /// radius, its constants.
+    #[inline(always)]
+    fn cylinder_ir<L: Lanes>(&self, at: Vector2<f32>, radius: f32, k: &ir::Coeffs, ct: &ir::SatTable) -> L {
+        let g = &self.lanes;
+        let vx = L::splat(at.x).sub(L::load(&g.pos_x));
+        let vy = L::splat(at.y).sub(L::load(&g.pos_y));
+        let dist = vx.mul(vx).add(vy.mul(vy)).sqrt().max(L::splat(1e-3));
+        let cos_a = L::load(&g.ray_x).mul(vx).add(L::load(&g.ray_y).mul(vy)).div(dist);
+        simd::saturate(ir_z(k, dist.sub(L::splat(radius)), cos_a), ct)
     }
 
     /// Noise-free ambient light readings: the lamp's irradiance
@@ -735,45 +819,53 @@ impl Sim {
     /// `K` such that a sensor facing the lamp from [`LAMP_FULL`] mm reads 1)
     /// times the lobe `cos(1.5 a)` for a horizontal bearing `|a| < 60` degrees
     /// off the sensor's axis (0 beyond), clamped at 1.
-    fn sense_light(&self, out: &mut [f32; ir::SENSORS]) {
+    #[inline(always)]
+    fn light<L: Lanes>(&self) -> L {
+        let mut acc = L::splat(0.0);
         if let Some(lamp) = &self.lamp {
-            self.add_lamp(lamp, out);
+            acc = self.add_lamp(lamp, acc);
         }
         for lamp in &self.lamps {
-            self.add_lamp(lamp, out);
+            acc = self.add_lamp(lamp, acc);
         }
-        for v in out.iter_mut() {
-            *v = v.min(1.0);
-        }
+        acc.min(L::splat(1.0))
     }
 
-    /// Adds one lamp's readings to `out` (unclamped). An inner wall or a
+    /// Adds one lamp's readings to `acc` (unclamped). An inner wall or a
     /// cylinder on the line from a sensor to the point below the lamp,
     /// seen from above, shades that sensor from it (the arena's walls do
     /// not: they are the table's low border, and a lamp may stand outside).
     #[inline(always)]
-    fn add_lamp(&self, lamp: &Lamp, out: &mut [f32; ir::SENSORS]) {
+    fn add_lamp<L: Lanes>(&self, lamp: &Lamp, acc: L) -> L {
         if lamp.k <= 0.0 {
-            return;
+            return acc;
         }
+        let g = &self.lanes;
         // The lamp in the body frame.
         let rel = self.pose.inverse_transform_point(&lamp.at).coords;
         let rho2 = rel.norm_squared();
         let intensity = lamp.k / (rho2 + lamp.height * lamp.height);
         let rho = rho2.sqrt();
-        let along = self.geo.rays * rel;
-        for i in 0..ir::SENSORS {
-            if self.shades && self.shaded(&(self.pose * self.geo.position(i)), &lamp.at) {
-                continue;
-            }
-            // cos of the bearing off the axis; straight below the lamp every
-            // sensor sees it head-on.
-            let cos_a = if rho > 1e-3 { along[i] / rho } else { 1.0 };
-            // cos(1.5 a) = 4 q^3 - 3 q with q = cos(a / 2).
-            let q = ((1.0 + cos_a) * 0.5).max(0.0).sqrt();
-            let lobe = (4.0 * q * q * q - 3.0 * q).max(0.0);
-            out[i] += intensity * lobe;
+        let along = L::load(&g.ray_x).mul(L::splat(rel.x)).add(L::load(&g.ray_y).mul(L::splat(rel.y)));
+        // cos of the bearing off the axis; straight below the lamp every
+        // sensor sees it head-on.
+        let cos_a = if rho > 1e-3 { along.div(L::splat(rho)) } else { L::splat(1.0) };
+        // cos(1.5 a) = 4 q^3 - 3 q with q = cos(a / 2).
+        let q = cos_a.add(L::splat(1.0)).mul(L::splat(0.5)).max(L::splat(0.0)).sqrt();
+        let cubic = L::splat(4.0).mul(q).mul(q).mul(q).sub(L::splat(3.0).mul(q));
+        let lit = L::splat(intensity).mul(cubic.max(L::splat(0.0)));
+        if !self.shades {
+            return acc.add(lit);
         }
+        let (mut sum, mut add) = ([0.0; ir::SENSORS], [0.0; ir::SENSORS]);
+        acc.store(&mut sum);
+        lit.store(&mut add);
+        for i in 0..ir::SENSORS {
+            if !self.shaded(&(self.pose * self.geo.position(i)), &lamp.at) {
+                sum[i] += add[i];
+            }
+        }
+        L::load(&sum)
     }
 
     /// An inner wall or a cylinder crosses the segment from `from` to `to`.
@@ -1039,10 +1131,11 @@ impl Sim {
     /// senses those), the battery, the optical barrier and the floor zone
     /// under the body. Light channels are 0.
     pub fn sense_virtual(&self, out: &mut [f32; CHANNELS]) {
-        let mut irv = [0.0f32; ir::SENSORS];
-        if self.obj_virtual {
-            self.ir_objects(&mut irv);
-        }
+        let irv = if self.obj_virtual {
+            simd::run(Readings { sim: self, walls: false, light: false }, self.path).0
+        } else {
+            [0.0f32; ir::SENSORS]
+        };
         for s in 0..ir::SENSORS {
             out[CH_IR + s] = irv[s].clamp(0.0, 1.0);
             out[CH_LIGHT + s] = 0.0;
