@@ -99,3 +99,36 @@ fn drawn_variants_are_the_same_for_a_generation_and_any_thread_count() {
     }
     assert_eq!(seen, [true; 3]);
 }
+
+#[test]
+fn set_reaches_the_variants_and_their_worlds() {
+    use shaping_engine::sweep::apply;
+    let mut p = program();
+    let point = vec![
+        ("s.variants.aggregate".to_string(), "min".to_string()),
+        ("s.variants.draw".to_string(), "2".to_string()),
+        ("s.world.body.wheel_noise".to_string(), "0.1".to_string()),
+    ];
+    apply(&mut p, &point).unwrap();
+    let v = p.stages[0].variants.as_ref().unwrap();
+    assert_eq!((v.aggregate, v.draw), (Aggregate::Min, Some(2)));
+    assert!(v.list.iter().all(|x| x.world.body.wheel_noise == 0.1), "every variant's body too");
+    // Drawing more than declared is refused, naming the field.
+    let mut q = program();
+    let err = apply(&mut q, &[("s.variants.draw".to_string(), "4".to_string())]).unwrap_err();
+    assert!(err.to_string().contains("draw"), "{err}");
+}
+
+#[test]
+fn the_variants_are_part_of_the_fingerprint() {
+    use shaping_runtime::evolve::fingerprint::{changes, fingerprint};
+    let p = program();
+    let mut q = program();
+    q.stages[0].variants.as_mut().unwrap().list[1].world.items.start.as_mut().unwrap().from[0] = 310.0;
+    let said = changes(&fingerprint(&p, 0), &fingerprint(&q, 0));
+    assert_eq!(said, ["the variants of `s` changed"]);
+    let mut r = program();
+    r.stages[0].variants.as_mut().unwrap().aggregate = Aggregate::Min;
+    assert_eq!(changes(&fingerprint(&p, 0), &fingerprint(&r, 0)).len(), 1);
+    assert!(changes(&fingerprint(&p, 0), &fingerprint(&program(), 0)).is_empty());
+}
