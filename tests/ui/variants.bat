@@ -31,3 +31,6 @@ stage practice {
 stage empty extends s {
   variants mean { }
 }
+stage inherits extends s {
+  test best for 1 life of 100 actions    // the inherited variants need 3 lives
+}

@@ -118,7 +118,6 @@ impl Lower<'_> {
     ) -> Option<Variants> {
         let v = st.variants.as_ref()?;
         let here = decl.span.start <= v.span.start && v.span.end <= decl.span.end;
-        let saved = self.errors.len();
         match &st.run {
             StageRun::Train { .. } if here => self.value_error(
                 v.span,
@@ -134,7 +133,8 @@ impl Lower<'_> {
                 self.value_error(
                     at.unwrap_or(v.span),
                     format!(
-                        "test stage `{sname}` runs {lives} lives, fewer than its {} variants",
+                        "test stage `{sname}` runs {lives} {}, fewer than its {} variants",
+                        if *lives == 1 { "life" } else { "lives" },
                         v.decls.len()
                     ),
                     "not every variant is tested",
@@ -143,6 +143,8 @@ impl Lower<'_> {
             }
             _ => {}
         }
+        // Errors of the variants themselves are reported where declared.
+        let saved = self.errors.len();
         let mut list = Vec::with_capacity(v.decls.len());
         for d in &v.decls {
             for item in &d.world.items {
