@@ -88,7 +88,16 @@ impl Odometer {
     #[inline]
     pub fn moved(&mut self, at: [f32; 2]) {
         self.actions += 1;
-        let d = f64::from(at[0] - self.at[0]).hypot(f64::from(at[1] - self.at[1]));
+        let (dx, dy) = (f64::from(at[0] - self.at[0]), f64::from(at[1] - self.at[1]));
+        // hypot(d, 0) is |d| exactly: a robot that stood still or moved
+        // along an axis needs no call.
+        let d = if dy == 0.0 {
+            dx.abs()
+        } else if dx == 0.0 {
+            dy.abs()
+        } else {
+            dx.hypot(dy)
+        };
         if d.is_finite() {
             self.path += d;
         }

@@ -78,6 +78,7 @@
 //! weights that are (unfrozen) genes are written back into
 //! [`EpisodeResult::learned`].
 
+mod block;
 mod fast_expr;
 mod net;
 mod perf;
@@ -325,6 +326,9 @@ pub struct ActionReport {
 pub struct Controller<'s> {
     stage: &'s Stage,
     mods: Vec<Mod<'s>>,
+    /// The activation networks evaluated together, when they all fit
+    /// ([`block::Block::new`]); else one by one.
+    block: Option<block::Block>,
     /// Activations of the current action and of the previous one.
     act: Vec<f32>,
     prev_act: Vec<f32>,
@@ -432,6 +436,7 @@ impl<'s> Controller<'s> {
         let n = mods.len();
         Ok(Controller {
             stage,
+            block: block::Block::new(mods.iter().map(|m| &m.activation)),
             mods,
             act: vec![0.0; n],
             prev_act: vec![0.0; n],
@@ -591,14 +596,29 @@ impl<'s> Controller<'s> {
         // would otherwise tie and fall back to declaration order.
         let mut winner = 0usize;
         let mut best = f32::NEG_INFINITY;
-        for m in 0..self.mods.len() {
-            let module = &mut self.mods[m];
-            let link: f32 = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
-            self.act[m] = module.activation.forward(&self.now, link)[0];
-            let z = module.activation.net_inputs()[0];
-            if z > best && !self.forbidden[m] {
-                best = z;
-                winner = m;
+        if let Some(block) = &self.block {
+            let mut link = [0.0f32; block::LANES];
+            for (l, module) in link.iter_mut().zip(&self.mods) {
+                *l = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
+            }
+            let z = block.net_inputs(&self.now, &link);
+            for (m, &z) in z[..block.lanes()].iter().enumerate() {
+                self.act[m] = self.mods[m].activation.record_single(z);
+                if z > best && !self.forbidden[m] {
+                    best = z;
+                    winner = m;
+                }
+            }
+        } else {
+            for m in 0..self.mods.len() {
+                let module = &mut self.mods[m];
+                let link: f32 = module.links.iter().map(|&(from, w)| w * self.prev_act[from]).sum();
+                self.act[m] = module.activation.forward(&self.now, link)[0];
+                let z = module.activation.net_inputs()[0];
+                if z > best && !self.forbidden[m] {
+                    best = z;
+                    winner = m;
+                }
             }
         }
         self.reinf.fill(0.0);
@@ -705,6 +725,9 @@ impl<'s> Controller<'s> {
                                 module.activation.train(&p, |_| t, rate, l.error);
                             } else {
                                 module.activation.train(&self.now, |_| t, rate, l.error);
+                            }
+                            if let Some(b) = &mut self.block {
+                                b.load(winner, &module.activation);
                             }
                         }
                         LearnTarget::Behavior => {

@@ -105,6 +105,27 @@ impl Net {
         &self.z
     }
 
+    /// One sigmoid unit straight on the inputs (no hidden layer, one output).
+    pub(crate) fn is_single_unit(&self) -> bool {
+        self.hidden == 0 && self.outputs == 1 && self.ctx.is_empty()
+    }
+
+    /// The percept channels feeding the inputs, in order.
+    pub(crate) fn channels(&self) -> &[u16] {
+        &self.chans
+    }
+
+    /// Records a forward pass of a single unit computed elsewhere (by a
+    /// [`super::block::Block`]) from its net input `z`, as [`Net::forward`]
+    /// would have: the output is `sigmoid(z)`, returned.
+    #[inline]
+    pub(crate) fn record_single(&mut self, z: f32) -> f32 {
+        let y = sigmoid(z);
+        self.z[0] = z;
+        self.y[0] = y;
+        y
+    }
+
     /// Forgets the last forward pass: a recurrent network's next context is
     /// zero again, as in a fresh network (the weights stay).
     pub fn forget(&mut self) {

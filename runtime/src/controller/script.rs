@@ -219,15 +219,60 @@ fn toward(dirs: &[(u16, Vector2<f32>)], speed: f32, now: &[f32; CHANNELS]) -> [f
     if sum.norm_squared() < TOWARD_MIN_LENGTH * TOWARD_MIN_LENGTH {
         return [speed, speed];
     }
-    // The bearing of the sum, counter-clockwise from the heading.
-    let angle = sum.y.atan2(sum.x);
-    if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
-        [speed, speed]
-    } else if angle > 0.0 {
+    let side = match ahead(sum.x, sum.y) {
+        Some(ahead) => ahead,
+        None => {
+            // The bearing of the sum, counter-clockwise from the heading.
+            let angle = sum.y.atan2(sum.x);
+            if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
+                Side::Ahead
+            } else if angle > 0.0 {
+                Side::Left
+            } else {
+                Side::Right
+            }
+        }
+    };
+    match side {
+        Side::Ahead => [speed, speed],
         // Target on the left (counter-clockwise): turn left in place.
-        [-speed, speed]
+        Side::Left => [-speed, speed],
+        Side::Right => [speed, -speed],
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Ahead,
+    Left,
+    Right,
+}
+
+/// Where the vector `(x, y)` points, without the arc tangent, when it is
+/// clearly within or outside the dead zone (tangent ratios 0.1% inside and
+/// outside `tan(20 deg)` = 0.36397; `atan2` errs by far less); `None` in the
+/// thin band between, and for values that are not finite, which are left to
+/// `atan2` so that every decision is the one `atan2` makes.
+#[inline]
+fn ahead(x: f32, y: f32) -> Option<Side> {
+    const TAN_IN: f32 = 0.3636;
+    const TAN_OUT: f32 = 0.3644;
+    if !(x.is_finite() && y.is_finite()) {
+        return None;
+    }
+    // atan2 is positive for y = +0 behind (pi), negative for y = -0 (-pi).
+    let outside = if y.is_sign_positive() { Side::Left } else { Side::Right };
+    if x <= 0.0 {
+        // At least 90 degrees off (the zero vector returned earlier).
+        return Some(outside);
+    }
+    let t = y.abs();
+    if t <= x * TAN_IN {
+        Some(Side::Ahead)
+    } else if t >= x * TAN_OUT {
+        Some(outside)
     } else {
-        [speed, -speed]
+        None
     }
 }
 
@@ -308,6 +353,47 @@ mod tests {
         let mut p = [0.0; CHANNELS];
         p[CH_IR + 6] = 1.0; // back right
         assert_eq!(toward(&d, 1.0, &p), [1.0, -1.0]);
+    }
+
+    #[test]
+    fn the_dead_zone_without_atan2_decides_as_atan2_does() {
+        let by_atan2 = |x: f32, y: f32| {
+            let angle = y.atan2(x);
+            if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
+                Side::Ahead
+            } else if angle > 0.0 {
+                Side::Left
+            } else {
+                Side::Right
+            }
+        };
+        let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(5);
+        let mut decided = 0;
+        let mut check = |x: f32, y: f32| {
+            if let Some(side) = ahead(x, y) {
+                decided += 1;
+                assert_eq!(side, by_atan2(x, y), "({x}, {y})");
+            }
+        };
+        use rand::Rng;
+        for _ in 0..200_000 {
+            // Anywhere, and close to the dead zone's edges.
+            let r = rng.random_range(0.001f32..8.0);
+            let a = if rng.random::<bool>() {
+                rng.random_range(-std::f32::consts::PI..std::f32::consts::PI)
+            } else {
+                let edge = TOWARD_DEAD_ZONE_DEG.to_radians() * if rng.random::<bool>() { 1.0 } else { -1.0 };
+                edge + rng.random_range(-0.01f32..0.01)
+            };
+            check(r * a.cos(), r * a.sin());
+        }
+        for (x, y) in
+            [(1.0, 0.0), (1.0, -0.0), (-1.0, 0.0), (-1.0, -0.0), (0.0, 1.0), (-0.0, -1.0), (0.0, -0.5)]
+        {
+            check(x, y);
+        }
+        assert!(decided > 150_000, "the shortcut should decide most cases: {decided}");
+        assert_eq!(ahead(f32::NAN, 1.0), None);
     }
 
     #[test]
