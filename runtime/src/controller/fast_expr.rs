@@ -18,6 +18,12 @@ enum FOp {
         start: u16,
         n: u16,
     },
+    /// A push (`Const`, `Chan`, `Prev` or `Act`) and the binary op that
+    /// follows it: one dispatch instead of two, the same operations.
+    Then {
+        push: Op,
+        op: Op,
+    },
 }
 
 /// A prepared expression; build it from a valid [`Expr`].
@@ -35,6 +41,11 @@ impl FastExpr {
             if let Some((fused, len)) = fuse(&src[i..]) {
                 ops.push(fused);
                 i += len;
+            } else if let (push @ (Op::Const(_) | Op::Chan(_) | Op::Prev(_) | Op::Act(_)), Some(&op)) =
+                (src[i], src.get(i + 1).filter(|op| is_binary(**op)))
+            {
+                ops.push(FOp::Then { push, op });
+                i += 2;
             } else {
                 ops.push(FOp::Op(src[i]));
                 i += 1;
@@ -55,11 +66,34 @@ impl FastExpr {
                     stack[sp] = aggregate(agg, &src[start as usize..start as usize + n as usize]);
                     sp += 1;
                 }
+                FOp::Then { push, op } => {
+                    sp = apply(push, &mut stack, sp, env);
+                    sp = apply(op, &mut stack, sp, env);
+                }
                 FOp::Op(op) => sp = apply(op, &mut stack, sp, env),
             }
         }
         stack[0]
     }
+}
+
+/// An op that pops two values and pushes one.
+fn is_binary(op: Op) -> bool {
+    matches!(
+        op,
+        Op::Add
+            | Op::Sub
+            | Op::Mul
+            | Op::Div
+            | Op::Lt
+            | Op::Le
+            | Op::Gt
+            | Op::Ge
+            | Op::Eq
+            | Op::Ne
+            | Op::And
+            | Op::Or
+    )
 }
 
 /// `Chan(c) Chan(c+1) .. Chan(c+n-1) Agg(n)` (or the same with `Prev`) at the
@@ -199,5 +233,25 @@ mod tests {
         let e = crate::testkit::ir_decrease();
         let f = FastExpr::new(&e);
         assert_eq!(f.ops.len(), 4, "{:?}", f.ops);
+    }
+
+    #[test]
+    fn a_push_and_the_binary_op_after_it_are_one_instruction() {
+        // abs(wheels[0] + wheels[1]) / 2: Act Act Add Abs Const Div.
+        let e =
+            Expr { ops: vec![Op::Act(0), Op::Act(1), Op::Add, Op::Abs, Op::Const(2.0), Op::Div], depth: 2 };
+        let f = FastExpr::new(&e);
+        assert_eq!(
+            f.ops,
+            vec![
+                FOp::Op(Op::Act(0)),
+                FOp::Then { push: Op::Act(1), op: Op::Add },
+                FOp::Op(Op::Abs),
+                FOp::Then { push: Op::Const(2.0), op: Op::Div },
+            ]
+        );
+        let act = [0.25, -0.75, 0.0, 1.0];
+        let p = [0.0; CHANNELS];
+        assert_eq!(f.eval(&Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE }), 0.25);
     }
 }
