@@ -192,6 +192,9 @@ pub struct Sim {
     path: simd::Path,
     wall_k: ir::Coeffs,
     cyl_k: ir::Coeffs,
+    /// From this squared distance of its centre on, a floor object reads
+    /// exactly 0 on every sensor ([`unseen_beyond2`]).
+    obj_unseen2: f32,
     // state
     /// The body frame in the world frame.
     pose: Isometry2<f32>,
@@ -273,6 +276,54 @@ impl SensorLanes {
 fn ir_z<L: Lanes>(k: &ir::Coeffs, d: L, cos_a: L) -> L {
     let lobe = L::load(&k.focus).mul(cos_a.sub(L::splat(1.0)));
     L::load(&k.offset).sub(d.mul(L::load(&k.inv_decay))).add(lobe)
+}
+
+/// One cylinder's readings by the sensors `g`: its centre `at` in the body
+/// frame, its radius, its constants.
+#[inline(always)]
+fn cylinder_lanes<L: Lanes>(
+    g: &SensorLanes,
+    at: Vector2<f32>,
+    radius: f32,
+    k: &ir::Coeffs,
+    ct: &ir::SatTable,
+) -> L {
+    let vx = L::splat(at.x).sub(L::load(&g.pos_x));
+    let vy = L::splat(at.y).sub(L::load(&g.pos_y));
+    let dist = vx.mul(vx).add(vy.mul(vy)).sqrt().max(L::splat(1e-3));
+    let cos_a = L::load(&g.ray_x).mul(vx).add(L::load(&g.ray_y).mul(vy)).div(dist);
+    simd::saturate(ir_z(k, dist.sub(L::splat(radius)), cos_a), ct)
+}
+
+/// The squared distance from the body centre beyond which a cylinder of
+/// radius `r` with constants `k` reads exactly 0 on every sensor (infinite
+/// if the constants give no such bound). A sensor's log-intensity is at most
+/// `offset - d * inv_decay` (the lobe is never positive: focus >= 0, cosine
+/// <= 1), which is below the saturation table's foot, where the lookup gives
+/// exactly 0, once the sensor's distance `d` to the surface passes
+/// `(offset - Z_MIN) / inv_decay`; and `d` is at least the centre's distance
+/// less the sensor's distance from the body centre and `r`. One millimetre
+/// more covers every rounding (a thousand times over), so skipping such an
+/// object changes no reading's bits.
+fn unseen_beyond2(g: &SensorLanes, k: &ir::Coeffs, r: f32) -> f32 {
+    let (z_min, _) = ir::SatTable::SCALE;
+    let mut far = 0.0f32;
+    for s in 0..ir::SENSORS {
+        if !(k.focus[s] >= 0.0 && k.inv_decay[s] > 0.0) {
+            return f32::INFINITY;
+        }
+        let pos = g.pos_x[s].hypot(g.pos_y[s]);
+        if !pos.is_finite() {
+            return f32::INFINITY;
+        }
+        far = far.max(pos + (k.offset[s] - z_min) / k.inv_decay[s]);
+    }
+    let far = far + r + 1.0;
+    if far.is_finite() {
+        far * far
+    } else {
+        f32::INFINITY
+    }
 }
 
 /// The noise-free readings of a state: IR (walls if `walls`, then
@@ -480,6 +531,7 @@ impl Sim {
             path: simd::Path::Best,
             wall_k: ir::Coeffs::new(&model.wall.reach, &model.wall),
             cyl_k: ir::Coeffs::new(&model.cylinder_reach(obj_radius), &model.cylinder),
+            obj_unseen2: f32::INFINITY,
             pose: Isometry2::identity(),
             charge: battery_spec.map_or(0, |(c, r)| c * r),
             charging: false,
@@ -489,6 +541,7 @@ impl Sim {
             held: None,
             placement_failures: 0,
         };
+        sim.obj_unseen2 = unseen_beyond2(&sim.lanes, &sim.cyl_k, obj_radius);
         // Objects first, then the robot somewhere free.
         let mut budget = PLACE_BUDGET;
         for _ in 0..count {
@@ -769,6 +822,8 @@ impl Sim {
         let r = self.obj_radius;
         let reach = reach + r;
         let reach2 = reach * reach;
+        // Objects seen by no sensor cost no more than those out of range.
+        let cull2 = reach2.min(self.obj_unseen2);
         for c in &self.cylinders {
             let offset = c.at - centre;
             let far = reach - r + c.radius;
@@ -783,7 +838,7 @@ impl Sim {
                 continue;
             }
             let offset = o.at - centre;
-            if offset.norm_squared() > reach2 {
+            if offset.norm_squared() > cull2 {
                 continue;
             }
             // The object's centre in the body frame.
@@ -806,12 +861,7 @@ impl Sim {
     /// radius, its constants.
     #[inline(always)]
     fn cylinder_ir<L: Lanes>(&self, at: Vector2<f32>, radius: f32, k: &ir::Coeffs, ct: &ir::SatTable) -> L {
-        let g = &self.lanes;
-        let vx = L::splat(at.x).sub(L::load(&g.pos_x));
-        let vy = L::splat(at.y).sub(L::load(&g.pos_y));
-        let dist = vx.mul(vx).add(vy.mul(vy)).sqrt().max(L::splat(1e-3));
-        let cos_a = L::load(&g.ray_x).mul(vx).add(L::load(&g.ray_y).mul(vy)).div(dist);
-        simd::saturate(ir_z(k, dist.sub(L::splat(radius)), cos_a), ct)
+        cylinder_lanes(&self.lanes, at, radius, k, ct)
     }
 
     /// Noise-free ambient light readings: the lamp's irradiance
@@ -1288,5 +1338,48 @@ fn bar_segment(wall: Wall, length: f32, width: f32, depth: f32) -> [Point2<f32>;
         Wall::South => [p(mid - half, 0.0), p(mid + half, 0.0)],
         Wall::East => [p(width, mid - half), p(width, mid + half)],
         Wall::West => [p(0.0, mid - half), p(0.0, mid + half)],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every sensor reads exactly 0 for an object just beyond the distance
+    /// from which floor objects are skipped as unseen, at every bearing and
+    /// for several object sizes, on both lanes paths; and just inside it,
+    /// some bearing reads more (the bound is not loose beyond its margin).
+    #[test]
+    fn objects_skipped_as_unseen_read_zero() {
+        for diameter in [2.0f32, 10.0, 25.0, 60.0] {
+            let r = diameter / 2.0;
+            let model = &ir::KHEPERA;
+            let geo = ir::Geometry::new(model, 27.5);
+            let lanes = SensorLanes::new(&geo);
+            let k = ir::Coeffs::new(&model.cylinder_reach(r), &model.cylinder);
+            let far = unseen_beyond2(&lanes, &k, r).sqrt();
+            assert!(far.is_finite() && far < 27.5 + ir::RANGE + r, "{diameter}: {far}");
+            struct One<'a>(&'a SensorLanes, &'a ir::Coeffs, Vector2<f32>, f32);
+            impl Kernel for One<'_> {
+                type Out = [f32; ir::SENSORS];
+                #[inline(always)]
+                fn run<L: Lanes>(self) -> Self::Out {
+                    let mut out = [0.0; ir::SENSORS];
+                    cylinder_lanes::<L>(self.0, self.2, self.3, self.1, &ir::tables().1).store(&mut out);
+                    out
+                }
+            }
+            let mut inside_max = 0.0f32;
+            for b in 0..720 {
+                let (sin, cos) = (b as f32 * 0.5).to_radians().sin_cos();
+                for path in [simd::Path::Best, simd::Path::Portable] {
+                    let beyond = simd::run(One(&lanes, &k, Vector2::new(cos, sin) * far, r), path);
+                    assert!(beyond.iter().all(|v| v.to_bits() == 0), "{diameter} {b}: {beyond:?}");
+                    let inside = simd::run(One(&lanes, &k, Vector2::new(cos, sin) * (far - 2.0), r), path);
+                    inside_max = inside.iter().fold(inside_max, |m, &v| m.max(v));
+                }
+            }
+            assert!(inside_max > 0.0, "{diameter}");
+        }
     }
 }
