@@ -221,17 +221,7 @@ fn toward(dirs: &[(u16, Vector2<f32>)], speed: f32, now: &[f32; CHANNELS]) -> [f
     }
     let side = match ahead(sum.x, sum.y) {
         Some(ahead) => ahead,
-        None => {
-            // The bearing of the sum, counter-clockwise from the heading.
-            let angle = sum.y.atan2(sum.x);
-            if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
-                Side::Ahead
-            } else if angle > 0.0 {
-                Side::Left
-            } else {
-                Side::Right
-            }
-        }
+        None => side_by_atan2(sum.x, sum.y),
     };
     match side {
         Side::Ahead => [speed, speed],
@@ -273,6 +263,19 @@ fn ahead(x: f32, y: f32) -> Option<Side> {
         Some(outside)
     } else {
         None
+    }
+}
+
+/// Where the vector `(x, y)` points by its bearing's arc tangent,
+/// counter-clockwise from the heading: the rule [`ahead`] follows.
+fn side_by_atan2(x: f32, y: f32) -> Side {
+    let angle = y.atan2(x);
+    if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
+        Side::Ahead
+    } else if angle > 0.0 {
+        Side::Left
+    } else {
+        Side::Right
     }
 }
 
@@ -357,16 +360,7 @@ mod tests {
 
     #[test]
     fn the_dead_zone_without_atan2_decides_as_atan2_does() {
-        let by_atan2 = |x: f32, y: f32| {
-            let angle = y.atan2(x);
-            if angle.abs() <= TOWARD_DEAD_ZONE_DEG.to_radians() {
-                Side::Ahead
-            } else if angle > 0.0 {
-                Side::Left
-            } else {
-                Side::Right
-            }
-        };
+        let by_atan2 = side_by_atan2;
         let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(5);
         let mut decided = 0;
         let mut check = |x: f32, y: f32| {
