@@ -275,13 +275,11 @@ fn a_closed_link_ends_with_a_message() {
     assert!(err.contains("closed the link") && err.contains("may still be driving"), "{err}");
 }
 
-/// `drive` sent `signal` (`INT`, `TERM`, `HUP`) once it drives: what it
-/// printed after, and the speed the robot was left with.
-fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
-    let dir = scratch(&format!("signal-{signal}"));
-    let emu = Emulator::start(&dir, &[]);
+/// `drive` of the roam stage for 300 actions of 20 ms on the emulator,
+/// writing into `dir/d`; its stdout and stderr both `out`'s kind.
+fn spawn_drive(dir: &std::path::Path, emu: &Emulator, out: fn() -> Stdio) -> std::process::Child {
     let genome = "1".repeat(80);
-    let mut child = shaping()
+    shaping()
         .arg("drive")
         .arg(file())
         .args(["--stage", "roam", "--period", "20", "--actions", "300", "--genome", &genome])
@@ -289,10 +287,18 @@ fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
         .arg(&emu.port)
         .arg("--out")
         .arg(dir.join("d"))
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
+        .stdout(out())
+        .stderr(out())
         .spawn()
-        .unwrap();
+        .unwrap()
+}
+
+/// `drive` sent `signal` (`INT`, `TERM`, `HUP`) once it drives: what it
+/// printed after, and the speed the robot was left with.
+fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
+    let dir = scratch(&format!("signal-{signal}"));
+    let emu = Emulator::start(&dir, &[]);
+    let mut child = spawn_drive(&dir, &emu, Stdio::piped);
     // Interrupted once it drives (its signal handlers are set by then).
     let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut first = String::new();
@@ -333,19 +339,7 @@ fn whole_lines(trace: &str) -> Vec<&str> {
 fn a_drive_killed_with_sigkill_keeps_its_trace() {
     let dir = scratch("sigkill");
     let emu = Emulator::start(&dir, &[]);
-    let genome = "1".repeat(80);
-    let mut child = shaping()
-        .arg("drive")
-        .arg(file())
-        .args(["--stage", "roam", "--period", "20", "--actions", "300", "--genome", &genome])
-        .arg("--port")
-        .arg(&emu.port)
-        .arg("--out")
-        .arg(dir.join("d"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_drive(&dir, &emu, Stdio::null);
     let path = dir.join("d/trace.csv");
     // Killed once 30 actions are on disk, about 0.6 s into 6 s of driving.
     let start = Instant::now();
