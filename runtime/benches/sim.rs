@@ -26,6 +26,7 @@ fn world(virtual_: bool) -> World {
         battery: Some(Battery { capacity: u32::MAX, recharge: 20 }),
         objects: Some(Objects { count: 8, diameter: 25.0, virtual_ }),
         items: Default::default(),
+        robots: 1,
     }
 }
 

@@ -26,6 +26,8 @@ pub const MAX_VARIANTS: usize = 64;
 pub const MAX_OBJECTS: u32 = 1_024;
 /// Most inner walls, cylinders, lamps or floor zones a world may have (each).
 pub const MAX_ITEMS: usize = 1_024;
+/// Most robots in one world (`robots N`).
+pub const MAX_ROBOTS: u32 = 10_000;
 /// Longest genome of a stage, in bits.
 pub const MAX_GENOME_BITS: u32 = 1 << 20;
 /// Most bits of a whole population (population times genome bits).

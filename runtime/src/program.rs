@@ -76,11 +76,14 @@ pub struct Variant {
     pub world: World,
 }
 
-/// How per-variant fitness values are combined.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// How several fitness values make one: a stage's variants' (`mean` or
+/// `min`), a team's robots' (`sum`, `mean` or `min`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Aggregate {
+    #[default]
     Mean,
     Min,
+    Sum,
 }
 
 impl Aggregate {
@@ -97,15 +100,22 @@ impl Aggregate {
             (0, _) => 0.0,
             (_, Aggregate::Mean) => (sum / n as f64) as f32,
             (_, Aggregate::Min) => min,
+            (_, Aggregate::Sum) => sum as f32,
         }
     }
 
-    /// `mean` or `min`, as written.
+    /// `mean`, `min` or `sum`, as written.
     pub fn word(self) -> &'static str {
         match self {
             Aggregate::Mean => "mean",
             Aggregate::Min => "min",
+            Aggregate::Sum => "sum",
         }
+    }
+
+    /// For `skip_serializing_if`: the default is left out of files.
+    pub fn is_mean(&self) -> bool {
+        *self == Aggregate::Mean
     }
 }
 
@@ -181,6 +191,19 @@ pub struct World {
     /// Inner walls, cylinders, lamps, floor zones and the start pose.
     #[serde(default, skip_serializing_if = "Items::is_empty")]
     pub items: Items,
+    /// Robots in the world: a team of clones of the evaluated individual,
+    /// each with its own controller, battery and gripper, all starting in
+    /// the start region (left out of files while 1, one robot).
+    #[serde(default = "one_robot", skip_serializing_if = "is_one_robot")]
+    pub robots: u32,
+}
+
+fn one_robot() -> u32 {
+    1
+}
+
+fn is_one_robot(n: &u32) -> bool {
+    *n == 1
 }
 
 /// The items a world may have any number of (and the start pose), in
@@ -688,6 +711,10 @@ pub struct Fitness {
     pub at_end: Option<Expr>,
     /// Points per event, added to the sum.
     pub bonuses: Vec<Bonus>,
+    /// How the robots' fitness makes a team's (`World::robots` above 1):
+    /// `sum`, `mean` or `min` (left out of files while `mean`).
+    #[serde(default, skip_serializing_if = "Aggregate::is_mean")]
+    pub team: Aggregate,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -10,8 +10,13 @@ use crate::expr::{Expr, Op};
 use crate::program::{Action, Behavior, Stage, StepEnd};
 
 /// Number of state slots an expression can read (`robot.x` ...,
-/// `distance_to(NAME)`).
-pub const STATE_SLOTS: usize = ST_TARGETS + MAX_TARGETS;
+/// `distance_to(NAME)`, `team.spread`).
+pub const STATE_SLOTS: usize = ST_SPREAD + 1;
+/// The team's spread (`team.spread`): the mean distance of its robots'
+/// centres to the team's centre (their mean), mm, after the last action
+/// all of them did (0 for one robot). After the targets, so the slots
+/// before it keep their numbers.
+pub const ST_SPREAD: usize = ST_TARGETS + MAX_TARGETS;
 /// The first slot of the distances to the stage's targets
 /// (`Stage::targets`): slot `ST_TARGETS + i` is target `i`'s.
 pub const ST_TARGETS: usize = 6;

@@ -201,6 +201,7 @@ pub fn arena_world() -> World {
         battery: Some(Battery { capacity: 200, recharge: 20 }),
         objects: None,
         items: Default::default(),
+        robots: 1,
     }
 }
 
@@ -256,7 +257,7 @@ pub fn bare_stage(name: &str, world: World) -> Stage {
         modules: Vec::new(),
         links: Vec::new(),
         layout: GenomeLayout { genes: Vec::new(), bits: 0 },
-        fitness: Fitness { per_action: None, at_end: None, bonuses: Vec::new() },
+        fitness: Fitness { per_action: None, at_end: None, bonuses: Vec::new(), team: Default::default() },
         run: evolution(300),
         inheritance: Inheritance::Darwinian,
         variants: None,

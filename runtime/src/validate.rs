@@ -418,6 +418,11 @@ fn world(at: &At, w: &World) -> R {
             at.field("lamp_height").length(h)?;
         }
     }
+    at.field("robots").count(w.robots, 1, MAX_ROBOTS)?;
+    let room = crate::world::team_room(w);
+    at.field("robots").ensure(w.robots <= room, || {
+        format!("{} robots do not fit in the start region, which holds {room}", w.robots)
+    })?;
     if let Some(b) = &w.battery {
         let at = at.field("battery");
         at.field("capacity").count(b.capacity, 1, u32::MAX)?;

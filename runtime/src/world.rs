@@ -118,6 +118,35 @@ pub fn crowded(world: &World) -> Option<Crowded> {
 
 /// The first inner wall or cylinder of `items` that a disc of `radius`
 /// overlaps wherever in the rectangle `x` by `y` its centre is.
+/// How many robots the start region holds: half the places of a square
+/// grid whose spacing is a body and [`START_CLEARANCE`] (random placement
+/// jams at about half the densest packing). The region is the declared
+/// start's (a point holds one robot) or the arena less the clearance.
+/// A team (`World::robots`) larger than this is refused.
+pub fn team_room(world: &World) -> u32 {
+    let [w, d] = world.arena;
+    let body = world.body.radius;
+    let m = body + START_CLEARANCE;
+    let ((x0, x1), (y0, y1)) = match &world.items.start {
+        Some(s) => ((s.from[0], s.to[0]), (s.from[1], s.to[1])),
+        None => ((m, w - m), (m, d - m)),
+    };
+    let spacing = 2.0 * body + START_CLEARANCE;
+    let places = |a: f32, b: f32| {
+        let n = ((a - b).abs() / spacing).floor();
+        if n.is_finite() {
+            n.min(1.0e5) as u64 + 1
+        } else {
+            1
+        }
+    };
+    let grid = places(x0, x1) * places(y0, y1);
+    if grid <= 1 {
+        return 1;
+    }
+    u32::try_from(grid / 2).unwrap_or(u32::MAX).max(1)
+}
+
 fn covering(items: &Items, x: (f32, f32), y: (f32, f32), radius: f32) -> Option<Blocker> {
     blocking_all(items, &[[x.0, y.0], [x.0, y.1], [x.1, y.0], [x.1, y.1]], radius)
 }

@@ -18,6 +18,7 @@ fn world(body: Body, items: Items) -> World {
         battery: None,
         objects: None,
         items,
+        robots: 1,
     }
 }
 

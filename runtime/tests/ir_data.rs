@@ -97,6 +97,7 @@ fn test_world(objects: Option<Objects>) -> World {
         battery: None,
         objects,
         items: Default::default(),
+        robots: 1,
     }
 }
 

@@ -14,6 +14,7 @@ fn world() -> World {
         battery: Some(Battery { capacity: 200, recharge: 20 }),
         objects: None,
         items: Default::default(),
+        robots: 1,
     }
 }
 
@@ -555,6 +556,7 @@ fn arb_world() -> impl Strategy<Value = World> {
                 .map(|(capacity, recharge)| Battery { capacity: capacity % 1000, recharge: recharge % 100 }),
             objects: objects.map(|(count, virtual_)| Objects { count: count % 64, diameter: diam, virtual_ }),
             items: Default::default(),
+            robots: 1,
         })
 }
 

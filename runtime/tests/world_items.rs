@@ -14,6 +14,7 @@ fn world(items: Items) -> World {
         battery: None,
         objects: None,
         items,
+        robots: 1,
     }
 }
 

@@ -345,7 +345,7 @@ impl Lower<'_> {
             }
             bonuses.push(Bonus { event, points: b.points as f32 });
         }
-        st.fitness = Fitness { per_action, at_end, bonuses };
+        st.fitness = Fitness { per_action, at_end, bonuses, team: st.fitness.team };
         st.fitness_declared = true;
     }
 }

@@ -58,6 +58,7 @@ mod world_facts {
             battery: Some(Battery { capacity: 200, recharge: 20 }),
             objects: None,
             items: Default::default(),
+            robots: 1,
         }
     }
 
