@@ -83,6 +83,7 @@ mod fast_expr;
 mod net;
 mod perf;
 pub mod script;
+mod team;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -99,6 +100,7 @@ pub use fast_expr::FastExpr;
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
+pub use team::{run_team_episode, TeamResult, TeamRun};
 
 /// How to run one episode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -356,6 +358,8 @@ pub struct Controller<'s> {
     odo: Odometer,
     /// The state the expressions read (`robot.x` ...), filled only when one does.
     state: [f32; STATE_SLOTS],
+    /// `team.spread`, as the team last gave it ([`Controller::set_spread`]).
+    spread: f32,
     reads_state: bool,
     /// Where the stage's targets (`distance_to(NAME)`) are in the world of
     /// the life (`None`: not in it; its distance reads [`FAR`]).
@@ -455,6 +459,7 @@ impl<'s> Controller<'s> {
             at_end: stage.fitness.at_end.as_ref().map(FastExpr::new),
             odo: Odometer::default(),
             state: [0.0; STATE_SLOTS],
+            spread: 0.0,
             reads_state: crate::state::reads_state(stage),
             targets: stage.targets.iter().map(|t| crate::world::Place::of(&stage.world, t)).collect(),
         })
@@ -506,6 +511,15 @@ impl<'s> Controller<'s> {
             for (slot, place) in self.state[crate::state::ST_TARGETS..].iter_mut().zip(&self.targets) {
                 *slot = place.map_or(FAR, |p| p.distance(at));
             }
+            self.state[crate::state::ST_SPREAD] = self.spread;
+        }
+    }
+
+    /// Gives the team's spread (`team.spread`) the expressions read from now on.
+    pub fn set_spread(&mut self, spread: f32) {
+        self.spread = spread;
+        if self.reads_state {
+            self.state[crate::state::ST_SPREAD] = spread;
         }
     }
 
@@ -824,8 +838,7 @@ impl<'s> Controller<'s> {
     ) -> EpisodeResult {
         self.set_learning(opts.learning);
         if let Some(t) = trace.as_deref_mut() {
-            t.modules = self.stage.modules.iter().map(|m| m.name.clone()).collect();
-            t.rows.clear();
+            self.begin_trace(t);
         }
         self.start(sim);
         let mut res = EpisodeResult::default();
@@ -836,32 +849,45 @@ impl<'s> Controller<'s> {
             }
             before(self, sim);
             let rep = self.act(sim);
-            fitness += rep.fitness as f64;
-            res.actions += 1;
-            res.grips += rep.outcome.grips;
-            res.releases_outside += rep.outcome.releases_outside;
-            res.recharges += rep.outcome.recharged as u32;
-            res.collisions += rep.outcome.collided as u32;
+            tally(&mut res, &mut fitness, &rep);
             if let Some(t) = trace.as_deref_mut() {
-                t.rows.push(TraceRow {
-                    action: a,
-                    activations: self.act.clone(),
-                    winner: rep.winner as u16,
-                    battery: sim.battery(),
-                    holding: self.holding,
-                    reinforcement: self.reinf.clone(),
-                    performance: self.mods.iter().map(|m| m.perf.mean()).collect(),
-                    pose: sim.pose(),
-                    grips: res.grips,
-                    releases_outside: res.releases_outside,
-                    recharged: rep.outcome.recharged,
-                    collided: rep.outcome.collided,
-                });
+                t.rows.push(self.trace_row(a, &rep, &res, sim));
                 if let Some(row) = t.rows.last() {
                     after(row, sim);
                 }
             }
         }
+        self.finish(sim, res, fitness)
+    }
+
+    /// Starts `trace` for a life of this controller's.
+    fn begin_trace(&self, trace: &mut Trace) {
+        trace.modules = self.stage.modules.iter().map(|m| m.name.clone()).collect();
+        trace.rows.clear();
+    }
+
+    /// The trace row of action `a`, just done with report `rep`, the life's
+    /// counts so far `res`.
+    fn trace_row<R: Robot>(&self, a: u32, rep: &ActionReport, res: &EpisodeResult, sim: &R) -> TraceRow {
+        TraceRow {
+            action: a,
+            activations: self.act.clone(),
+            winner: rep.winner as u16,
+            battery: sim.battery(),
+            holding: self.holding,
+            reinforcement: self.reinf.clone(),
+            performance: self.mods.iter().map(|m| m.perf.mean()).collect(),
+            pose: sim.pose(),
+            grips: res.grips,
+            releases_outside: res.releases_outside,
+            recharged: rep.outcome.recharged,
+            collided: rep.outcome.collided,
+        }
+    }
+
+    /// Ends a life: the at-end term and the bonuses added to the sum of the
+    /// per-action terms `fitness`, the placements and the descriptors.
+    fn finish<R: Robot>(&self, sim: &R, mut res: EpisodeResult, mut fitness: f64) -> EpisodeResult {
         if let Some(e) = &self.at_end {
             let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
             fitness += f64::from(e.eval(&env));
@@ -917,6 +943,16 @@ fn decode_wheels(decode: &Decode, bits: &[u8], y: &[f32], sampled: bool) -> [f32
             [v(0), v(1)]
         }
     }
+}
+
+/// Adds one action's report to a life's counts and its sum of per-action terms.
+fn tally(res: &mut EpisodeResult, fitness: &mut f64, rep: &ActionReport) {
+    *fitness += rep.fitness as f64;
+    res.actions += 1;
+    res.grips += rep.outcome.grips;
+    res.releases_outside += rep.outcome.releases_outside;
+    res.recharges += rep.outcome.recharged as u32;
+    res.collisions += rep.outcome.collided as u32;
 }
 
 /// Derives the simulator's seed and the controller's RNG from an episode seed
@@ -1015,6 +1051,11 @@ fn episode_on<R: Robot>(
     trace: Option<&mut Trace>,
     robot: impl FnOnce(Sim) -> R,
 ) -> Result<EpisodeResult, ControllerError> {
+    if stage.world.robots > 1 {
+        // A team (the robot wrapper, a watch or a stop, is for one robot;
+        // its trace is robot 0's).
+        return Ok(run_team_episode(stage, genome, opts, trace.map(std::slice::from_mut))?.team);
+    }
     let (sim_seed, rng) = episode_rngs(opts.seed);
     let mut ctl = Controller::new(stage, genome, rng)?;
     let mut sim = robot(Sim::new(&stage.world, sim_seed));

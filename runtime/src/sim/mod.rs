@@ -45,6 +45,7 @@ pub mod ir;
 pub mod rng;
 mod scene;
 pub mod simd;
+mod team;
 
 use crate::world::{segment_distance2, OBJECT_CLEARANCE, START_CLEARANCE};
 use nalgebra::{Isometry2, Point2, UnitComplex, Vector2};
@@ -58,6 +59,7 @@ use crate::catalog::{
 use crate::program::{Wall, World};
 
 pub use scene::{ObjectState, Scene, SceneObject, SceneZone};
+pub use team::{robot_seed, Team};
 
 /// What the controller asks of the robot for one action.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -211,6 +213,16 @@ pub struct Sim {
     /// Placements (objects, the robot's start, virtual objects coming back)
     /// that ran out of tries and kept their last, overlapping, try.
     placement_failures: u32,
+    // a team's
+    /// The centres of the other robots near this one ([`Team`] fills it
+    /// before this robot's action; empty for one robot): bodies its
+    /// sensors see and its moves cannot overlap.
+    others: Vec<Point2<f32>>,
+    /// IR constants of another robot's body (a cylinder of the body radius).
+    body_k: ir::Coeffs,
+    /// The charger may serve this robot (false while another robot of the
+    /// team holds it).
+    charger_free: bool,
 }
 
 /// A physical cylinder with its IR constants.
@@ -540,6 +552,9 @@ impl Sim {
             claw_closed: false,
             held: None,
             placement_failures: 0,
+            others: Vec::new(),
+            body_k: ir::Coeffs::new(&model.cylinder_reach(radius), &model.cylinder),
+            charger_free: true,
         };
         sim.obj_unseen2 = unseen_beyond2(&sim.lanes, &sim.cyl_k, obj_radius);
         // Objects first, then the robot somewhere free.
@@ -550,8 +565,26 @@ impl Sim {
             sim.placement_failures = sim.placement_failures.saturating_add(u32::from(!free));
             sim.objects.push(Obj { at, state: ObjectState::Floor, gripped: false });
         }
+        sim.place_start(&items.start, &mut rng, &[]);
+        sim.rng = rng;
+        sim
+    }
+
+    /// Places the robot in the start region (`start`, or anywhere free) at
+    /// the start's heading (or a random one), clear of the floor objects,
+    /// the inner walls, the cylinders and the bodies centred at `robots`
+    /// (a team's robots placed before it); counts a placement failure when
+    /// every try overlaps.
+    fn place_start(
+        &mut self,
+        start: &Option<crate::program::Start>,
+        rng: &mut Xoshiro256pp,
+        robots: &[Point2<f32>],
+    ) {
+        let (width, depth, radius) = (self.width, self.depth, self.radius);
+        let pt = |p: [f32; 2]| Point2::new(finite_or(p[0], 0.0), finite_or(p[1], 0.0));
         let margin = radius + START_CLEARANCE;
-        let (lo, hi) = match &items.start {
+        let (lo, hi) = match start {
             Some(s) => {
                 let (a, b) = (pt(s.from), pt(s.to));
                 (Point2::new(a.x.min(b.x), a.y.min(b.y)), Point2::new(a.x.max(b.x), a.y.max(b.y)))
@@ -560,26 +593,26 @@ impl Sim {
         };
         let mut centre = Point2::new(width / 2.0, depth / 2.0);
         let mut placed = false;
+        let apart = 2.0 * radius + 2.0;
         for _ in 0..PLACE_TRIES {
-            let x = uniform(&mut rng, lo.x, hi.x);
-            let y = uniform(&mut rng, lo.y, hi.y);
+            let x = uniform(rng, lo.x, hi.x);
+            let y = uniform(rng, lo.y, hi.y);
             centre = Point2::new(x, y);
-            let d = radius + sim.obj_radius + 2.0;
-            if sim.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d)
-                && sim.clear_of_items(&centre, radius + 2.0)
+            let d = radius + self.obj_radius + 2.0;
+            if self.objects.iter().all(|o| (o.at - centre).norm_squared() >= d * d)
+                && self.clear_of_items(&centre, radius + 2.0)
+                && robots.iter().all(|r| (r - centre).norm_squared() >= apart * apart)
             {
                 placed = true;
                 break;
             }
         }
-        sim.placement_failures = sim.placement_failures.saturating_add(u32::from(!placed));
-        let theta = match items.start.as_ref().and_then(|s| s.heading) {
+        self.placement_failures = self.placement_failures.saturating_add(u32::from(!placed));
+        let theta = match start.as_ref().and_then(|s| s.heading) {
             Some(h) => finite_or(h, 0.0),
-            None => uniform(&mut rng, -std::f32::consts::PI, std::f32::consts::PI),
+            None => uniform(rng, -std::f32::consts::PI, std::f32::consts::PI),
         };
-        sim.set_pose_unchecked(Pose { x: centre.x, y: centre.y, theta });
-        sim.rng = rng;
-        sim
+        self.set_pose_unchecked(Pose { x: centre.x, y: centre.y, theta });
     }
 
     /// A random position for an object centre, at least [`OBJECT_CLEARANCE`]
@@ -684,6 +717,10 @@ impl Sim {
             return false;
         }
         if !self.clear_of_items(p, r) {
+            return false;
+        }
+        let apart2 = 4.0 * r * r;
+        if !self.others.iter().all(|o| (o - p).norm_squared() >= apart2) {
             return false;
         }
         if self.obj_virtual {
@@ -832,6 +869,24 @@ impl Sim {
             }
             let at = rot.inverse_transform_vector(&offset);
             acc = acc.add(self.cylinder_ir(at, c.radius, &c.k, ct));
+        }
+        // The other robots of a team: bodies like cylinders (read, like an
+        // object, at the nearest measured distance if closer).
+        let body = self.radius;
+        let far = reach - r + body;
+        let near = 2.0 * body + ir::NEAREST;
+        for o in &self.others {
+            let offset = o - centre;
+            let d2 = offset.norm_squared();
+            if d2 > far * far {
+                continue;
+            }
+            let mut at = rot.inverse_transform_vector(&offset);
+            if d2 < near * near {
+                let d = d2.sqrt();
+                at = if d > 1e-3 { at * (near / d) } else { Vector2::x() * near };
+            }
+            acc = acc.add(self.cylinder_ir(at, body, &self.body_k, ct));
         }
         for o in &self.objects {
             if o.state != ObjectState::Floor {
@@ -1015,7 +1070,7 @@ impl Sim {
             return false;
         };
         let full = cap * rech;
-        if (charge && self.in_contact()) || self.on_charging_zone() {
+        if self.charger_free && ((charge && self.in_contact()) || self.on_charging_zone()) {
             if !self.charging {
                 self.charging = true;
                 self.bout_counts = 2 * self.charge <= full;

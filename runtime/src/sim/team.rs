@@ -1,0 +1,313 @@
+//! Several robots in one world: a team of `World::robots` bodies that see
+//! and block each other, share the world's objects and take turns at the
+//! charger.
+//!
+//! Each robot is a [`Sim`] of its own (pose, battery, gripper, random
+//! stream), all made from the same world: robot 0 is exactly the one robot
+//! [`Sim::new`] makes with the episode's seed; robot `i` copies its world
+//! (the objects where robot 0's seed put them) and is placed in the start
+//! region with its own seed ([`robot_seed`]), clear of the robots placed
+//! before it.
+//!
+//! What the team keeps in step:
+//! - **the other bodies**: before robot `i` acts, [`Team::prepare`] writes
+//!   into its `Sim` the centres of the robots within reach
+//!   ([`Team::reach`]: the IR range and two moves), found in a uniform grid
+//!   rebuilt at the start of each action ([`Team::begin_action`]), so the
+//!   cost per robot does not grow with the team;
+//! - **the objects**: a robot whose action gripped or released one passes
+//!   its objects to every other robot ([`Team::step`]);
+//! - **the charger**: it serves one robot at a time. The robot that
+//!   charges while no other does holds it until it stops charging or its
+//!   battery is full; meanwhile the others cannot charge.
+
+use nalgebra::Point2;
+use rand::SeedableRng;
+
+use super::rng::Xoshiro256pp;
+use super::{Command, Outcome, Sim, CHANNELS};
+use crate::program::World;
+
+/// The seed of robot `i`'s simulator and controller in the episode of
+/// seed `seed`: `seed` itself for robot 0 (a team's first robot is the
+/// one robot of the same seed), a SplitMix64 mix for the others.
+pub fn robot_seed(seed: u64, i: usize) -> u64 {
+    if i == 0 {
+        return seed;
+    }
+    let mut z = seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The robots of one episode in one world.
+#[derive(Clone, Debug)]
+pub struct Team {
+    sims: Vec<Sim>,
+    /// Each robot's centre now.
+    at: Vec<Point2<f32>>,
+    grid: Grid,
+    /// Centre distance within which another robot is seen or blocks, mm.
+    reach: f32,
+    /// The robot the charger serves.
+    charger: Option<usize>,
+}
+
+impl Team {
+    /// The `world.robots` robots of the episode of seed `seed` (at least one).
+    pub fn new(world: &World, seed: u64) -> Team {
+        let n = world.robots.max(1) as usize;
+        let first = Sim::new(world, seed);
+        let mut at = vec![first.centre()];
+        let mut sims = Vec::with_capacity(n);
+        sims.push(first);
+        for i in 1..n {
+            let mut sim = sims[0].clone();
+            let mut rng = Xoshiro256pp::seed_from_u64(robot_seed(seed, i));
+            // Robot 0's placement failures are the world's; count this one's own.
+            sim.placement_failures = 0;
+            sim.place_start(&world.items.start, &mut rng, &at);
+            sim.rng = rng;
+            at.push(sim.centre());
+            sims.push(sim);
+        }
+        let s = &sims[0];
+        // A body is seen up to the IR range from the surface; a robot moves
+        // at most one action's travel (with wheel noise) before the next
+        // grid, so the grid's cells hold everything within reach.
+        let travel = s.travel * (1.0 + s.wheel_noise);
+        let reach = 2.0 * s.radius + super::ir::RANGE + 2.0 * travel + 1.0;
+        let grid = Grid::new(s.width, s.depth, reach + 2.0 * travel, n);
+        let mut team = Team { sims, at, grid, reach, charger: None };
+        team.begin_action();
+        team
+    }
+
+    /// Robots in the team.
+    pub fn len(&self) -> usize {
+        self.sims.len()
+    }
+
+    /// A team has at least one robot.
+    pub fn is_empty(&self) -> bool {
+        self.sims.is_empty()
+    }
+
+    /// Robot `i`'s simulator.
+    pub fn sim(&self, i: usize) -> &Sim {
+        &self.sims[i]
+    }
+
+    /// Every robot's simulator, in order.
+    pub fn sims(&self) -> &[Sim] {
+        &self.sims
+    }
+
+    /// The centre distance within which another robot matters, mm.
+    pub fn reach(&self) -> f32 {
+        self.reach
+    }
+
+    /// Starts an action: the grid of the robots' centres now.
+    pub fn begin_action(&mut self) {
+        self.grid.build(&self.at);
+    }
+
+    /// Writes into robot `i`'s simulator the centres of the other robots
+    /// within reach, where they are now. Call before robot `i` senses or
+    /// acts; no allocation once the lists have grown to their size.
+    pub fn prepare(&mut self, i: usize) {
+        let p = self.at[i];
+        let reach2 = self.reach * self.reach;
+        let sim = &mut self.sims[i];
+        sim.others.clear();
+        let at = &self.at;
+        self.grid.near(p, |j| {
+            let q = at[j as usize];
+            if j as usize != i && (q - p).norm_squared() <= reach2 {
+                sim.others.push(q);
+            }
+        });
+    }
+
+    /// Robot `i` senses ([`Sim::sense`]); [`Team::prepare`] it first.
+    pub fn sense(&mut self, i: usize, out: &mut [f32; CHANNELS]) {
+        self.sims[i].sense(out);
+    }
+
+    /// Robot `i` executes one action ([`Sim::step`]) among the others
+    /// ([`Team::prepare`] it first): the charger only if it is free or
+    /// robot `i`'s, and the objects passed on if the action gripped or
+    /// released one.
+    pub fn step(&mut self, i: usize, cmd: &Command) -> Outcome {
+        let sim = &mut self.sims[i];
+        sim.charger_free = self.charger.is_none_or(|h| h == i);
+        let held = sim.held;
+        let out = sim.step(cmd);
+        if sim.charging && sim.battery() < 1.0 {
+            self.charger = Some(i);
+        } else if self.charger == Some(i) {
+            self.charger = None;
+        }
+        self.at[i] = sim.centre();
+        if sim.held != held || out.releases_outside > 0 {
+            let (before, rest) = self.sims.split_at_mut(i);
+            let (me, after) = rest.split_first_mut().expect("robot i exists");
+            for other in before.iter_mut().chain(after) {
+                other.objects.clone_from(&me.objects);
+            }
+        }
+        out
+    }
+
+    /// Puts robot `i` at `pose` (for tests and tools), as [`Sim::set_pose`]
+    /// does, and also refuses a pose overlapping another robot.
+    pub fn place(&mut self, i: usize, pose: super::Pose) -> bool {
+        let p = Point2::new(pose.x, pose.y);
+        let apart = 2.0 * self.sims[i].radius;
+        if self.at.iter().enumerate().any(|(j, q)| j != i && (q - p).norm_squared() < apart * apart) {
+            return false;
+        }
+        if !self.sims[i].set_pose(pose) {
+            return false;
+        }
+        self.at[i] = self.sims[i].centre();
+        self.begin_action();
+        true
+    }
+
+    /// The robot the charger serves now, if any.
+    pub fn charger_holder(&self) -> Option<usize> {
+        self.charger
+    }
+
+    /// The mean distance of the robots' centres to their mean, mm (0 for one).
+    pub fn spread(&self) -> f32 {
+        let n = self.at.len() as f64;
+        let (sx, sy) =
+            self.at.iter().fold((0.0f64, 0.0f64), |(x, y), p| (x + f64::from(p.x), y + f64::from(p.y)));
+        let c = Point2::new((sx / n) as f32, (sy / n) as f32);
+        let sum: f64 = self.at.iter().map(|p| f64::from((p - c).norm())).sum();
+        (sum / n) as f32
+    }
+}
+
+/// A uniform grid over the arena: the robots in each cell, by a counting
+/// sort of their centres (the arrays sized once).
+#[derive(Clone, Debug)]
+struct Grid {
+    cell: f32,
+    cols: usize,
+    rows: usize,
+    /// Cell `c`'s robots are `items[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+    /// Each robot's cell.
+    cell_of: Vec<u32>,
+}
+
+impl Grid {
+    fn new(width: f32, depth: f32, cell: f32, robots: usize) -> Grid {
+        let cell = cell.max(1.0);
+        // At most 4,096 cells a side: a coarser grid for a huge arena.
+        let side = |len: f32| ((len / cell).ceil() as usize).clamp(1, 4096);
+        let (cols, rows) = (side(width), side(depth));
+        let cell = cell.max(width / cols as f32).max(depth / rows as f32);
+        Grid {
+            cell,
+            cols,
+            rows,
+            start: vec![0; cols * rows + 1],
+            items: vec![0; robots],
+            cell_of: vec![0; robots],
+        }
+    }
+
+    fn coords(&self, p: Point2<f32>) -> (usize, usize) {
+        let c = |v: f32, n: usize| {
+            let k = (v / self.cell).floor();
+            if k.is_finite() && k > 0.0 {
+                (k as usize).min(n - 1)
+            } else {
+                0
+            }
+        };
+        (c(p.x, self.cols), c(p.y, self.rows))
+    }
+
+    fn build(&mut self, at: &[Point2<f32>]) {
+        let cells = self.cols * self.rows;
+        self.start.fill(0);
+        for (i, p) in at.iter().enumerate() {
+            let (x, y) = self.coords(*p);
+            let c = y * self.cols + x;
+            self.cell_of[i] = c as u32;
+            self.start[c + 1] += 1;
+        }
+        for c in 0..cells {
+            self.start[c + 1] += self.start[c];
+        }
+        // Each robot at its cell's cursor (robots in increasing order within
+        // a cell); the cursors end at their cells' ends, one place on.
+        for i in 0..at.len() {
+            let c = self.cell_of[i] as usize;
+            self.items[self.start[c] as usize] = i as u32;
+            self.start[c] += 1;
+        }
+        for c in (0..cells).rev() {
+            self.start[c + 1] = self.start[c];
+        }
+        self.start[0] = 0;
+    }
+
+    /// Calls `f` with every robot in the 3 x 3 cells around `p`.
+    fn near(&self, p: Point2<f32>, mut f: impl FnMut(u32)) {
+        let (x, y) = self.coords(p);
+        for cy in y.saturating_sub(1)..=(y + 1).min(self.rows - 1) {
+            let row = cy * self.cols;
+            let (a, b) = (row + x.saturating_sub(1), row + (x + 1).min(self.cols - 1));
+            for &j in &self.items[self.start[a] as usize..self.start[b + 1] as usize] {
+                f(j);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testkit::arena_world;
+
+    /// The grid finds exactly the robots a search of all of them finds.
+    #[test]
+    fn the_grid_finds_every_robot_within_reach() {
+        let world = World { arena: [3000.0, 2000.0], robots: 300, ..arena_world() };
+        let mut team = Team::new(&world, 5);
+        assert_eq!(team.len(), 300);
+        // Robots check their neighbours after the robots before them moved
+        // in the same action: the grid is as old as the action.
+        for round in 0..20 {
+            team.begin_action();
+            for i in 0..team.len() {
+                team.prepare(i);
+                let p = team.at[i];
+                let mut brute: Vec<[u32; 2]> = team
+                    .at
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, q)| j != i && (q - p).norm_squared() <= team.reach * team.reach)
+                    .map(|(_, q)| [q.x.to_bits(), q.y.to_bits()])
+                    .collect();
+                let mut found: Vec<[u32; 2]> =
+                    team.sims[i].others.iter().map(|q| [q.x.to_bits(), q.y.to_bits()]).collect();
+                brute.sort_unstable();
+                found.sort_unstable();
+                assert_eq!(found, brute, "robot {i}, round {round}");
+                let turn = if (i + round) % 3 == 0 { 0.2 } else { 1.0 };
+                team.step(i, &Command { wheels: [1.0, turn], ..Command::default() });
+            }
+        }
+        assert!(team.sims.iter().map(|s| s.others.len()).sum::<usize>() > 0, "some robots are near others");
+    }
+}

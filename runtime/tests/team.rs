@@ -1,0 +1,215 @@
+//! Several robots in one world: a team of one is the one robot, robots
+//! see and block each other, share the objects, take turns at the charger,
+//! and a team's fitness is its robots' aggregated.
+
+use shaping_runtime::catalog::{CHANNELS, CH_IR};
+use shaping_runtime::controller::{run_episode, run_team_episode, EpisodeOptions, Trace};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::*;
+use shaping_runtime::sim::{Command, ObjectState, Pose, Team};
+use shaping_runtime::testkit;
+
+fn quiet(mut w: World) -> World {
+    w.body.wheel_noise = 0.0;
+    w.body.sensor_noise = 0.0;
+    w
+}
+
+fn genome_of(stage: &Stage, seed: u64) -> Genome {
+    use rand::SeedableRng;
+    testkit::random_genome(stage, &mut rand_chacha::ChaCha8Rng::seed_from_u64(seed))
+}
+
+#[test]
+fn a_team_of_one_is_the_one_robot() {
+    let stage = testkit::collect();
+    for seed in 1..4 {
+        let g = genome_of(&stage, seed);
+        let opts = EpisodeOptions { actions: 400, learning: true, seed };
+        let one = run_episode(&stage, &g, &opts, None);
+        let team = run_team_episode(&stage, &g, &opts, None).unwrap();
+        assert_eq!(team.robots.len(), 1);
+        assert_eq!(team.team.fitness, one.fitness, "seed {seed}");
+        assert_eq!(team.team.descriptors, one.descriptors, "seed {seed}");
+        assert_eq!(team.robots[0].grips, one.grips);
+    }
+}
+
+#[test]
+fn robots_see_each_other_with_their_proximity_sensors() {
+    let world = quiet(World { robots: 2, ..testkit::arena_world() });
+    let mut team = Team::new(&world, 1);
+    // Robot 0 faces east at the middle; robot 1 is 10 mm ahead of its front.
+    assert!(team.place(0, Pose { x: 150.0, y: 300.0, theta: 0.0 }));
+    assert!(team.place(1, Pose { x: 150.0 + 55.0 + 10.0, y: 300.0, theta: std::f32::consts::PI }));
+    team.begin_action();
+    team.prepare(0);
+    let mut near = [0.0; CHANNELS];
+    team.sense(0, &mut near);
+    // Without the other robot the front sensors read nothing there.
+    assert!(team.place(1, Pose { x: 150.0, y: 520.0, theta: 0.0 }));
+    team.begin_action();
+    team.prepare(0);
+    let mut alone = [0.0; CHANNELS];
+    team.sense(0, &mut alone);
+    let front = |p: &[f32; CHANNELS]| p[CH_IR + 2] + p[CH_IR + 3];
+    assert!(front(&near) > 0.5, "front sensors {:?}", &near[CH_IR..CH_IR + 8]);
+    assert_eq!(front(&alone), 0.0, "front sensors {:?}", &alone[CH_IR..CH_IR + 8]);
+}
+
+#[test]
+fn a_robot_cannot_drive_into_another() {
+    let world = quiet(World { robots: 2, battery: None, ..testkit::arena_world() });
+    let mut team = Team::new(&world, 2);
+    assert!(team.place(0, Pose { x: 100.0, y: 300.0, theta: 0.0 }));
+    assert!(team.place(1, Pose { x: 200.0, y: 300.0, theta: 0.0 }));
+    let mut collided = false;
+    for _ in 0..40 {
+        team.begin_action();
+        team.prepare(0);
+        collided |= team.step(0, &Command { wheels: [1.0, 1.0], ..Command::default() }).collided;
+        team.prepare(1);
+        team.step(1, &Command::default());
+    }
+    let (a, b) = (team.sim(0).position(), team.sim(1).position());
+    let gap = (b[0] - a[0]).hypot(b[1] - a[1]);
+    assert!(collided, "the move into the other robot collides");
+    assert!((55.0..57.0).contains(&gap), "the bodies touch and do not overlap: centres {gap} mm apart");
+}
+
+#[test]
+fn the_robots_start_apart_in_the_start_region() {
+    let mut world = quiet(World { arena: [1000.0, 1000.0], robots: 12, ..testkit::arena_world() });
+    world.items.start = Some(Start { from: [300.0, 300.0], to: [700.0, 700.0], heading: None });
+    assert!(world.robots <= shaping_runtime::world::team_room(&world));
+    for seed in 0..5 {
+        let team = Team::new(&world, seed);
+        let at: Vec<[f32; 2]> = team.sims().iter().map(|s| s.position()).collect();
+        for (i, p) in at.iter().enumerate() {
+            assert!((300.0..=700.0).contains(&p[0]) && (300.0..=700.0).contains(&p[1]), "{p:?}");
+            for q in &at[..i] {
+                assert!((p[0] - q[0]).hypot(p[1] - q[1]) >= 55.0, "robots overlap at {p:?} and {q:?}");
+            }
+            assert_eq!(team.sim(i).placement_failures(), 0);
+        }
+        // The same seed places the same team.
+        let again: Vec<[f32; 2]> = Team::new(&world, seed).sims().iter().map(|s| s.position()).collect();
+        assert_eq!(at, again);
+    }
+}
+
+#[test]
+fn an_object_gripped_by_one_robot_is_gone_for_the_others() {
+    let mut world = quiet(World { robots: 2, battery: None, ..testkit::arena_world() });
+    world.objects = Some(Objects { count: 1, diameter: 25.0, virtual_: false });
+    let mut team = Team::new(&world, 3);
+    let o = &team.sim(0).scene().objects[0];
+    let obj = [o.x, o.y];
+    // Robot 0 just behind the object, facing it; robot 1 out of the way.
+    let r = 27.5 + 15.0;
+    assert!(
+        team.place(1, Pose { x: 40.0, y: 40.0, theta: 0.0 })
+            || team.place(1, Pose { x: 360.0, y: 40.0, theta: 0.0 })
+    );
+    let placed = {
+        use std::f32::consts::{FRAC_PI_2, PI};
+        [0.0f32, FRAC_PI_2, PI, -FRAC_PI_2]
+    }
+    .into_iter()
+    .any(|theta| team.place(0, Pose { x: obj[0] - r * theta.cos(), y: obj[1] - r * theta.sin(), theta }));
+    assert!(placed, "room behind the object at {obj:?}");
+    team.begin_action();
+    team.prepare(0);
+    let out = team.step(0, &Command { arm: Some(true), claw: Some(true), ..Command::default() });
+    assert_eq!(out.grips, 1);
+    for i in 0..2 {
+        assert_eq!(team.sim(i).scene().objects[0].state, ObjectState::Held, "robot {i}'s world");
+    }
+    assert!(team.sim(0).holding() && !team.sim(1).holding());
+}
+
+#[test]
+fn the_charger_serves_one_robot_at_a_time() {
+    let mut world = quiet(World { robots: 2, ..testkit::arena_world() });
+    world.battery = Some(Battery { capacity: 50, recharge: 10 });
+    let mut team = Team::new(&world, 4);
+    // Both against the north bar (200 mm long in the middle of the 400 mm wall).
+    let y = 600.0 - 27.5 - 1.0;
+    assert!(team.place(0, Pose { x: 160.0, y, theta: std::f32::consts::FRAC_PI_2 }));
+    assert!(team.place(1, Pose { x: 240.0, y, theta: std::f32::consts::FRAC_PI_2 }));
+    // Drain both a little first.
+    for _ in 0..30 {
+        team.begin_action();
+        for i in 0..2 {
+            team.prepare(i);
+            team.step(i, &Command::default());
+        }
+    }
+    let charge = Command { charge: true, ..Command::default() };
+    let mut holders = std::collections::BTreeSet::new();
+    let mut recharged = [0u32; 2];
+    let mut rises = [0u32; 2];
+    for _ in 0..60 {
+        team.begin_action();
+        for (i, r) in recharged.iter_mut().enumerate() {
+            let (before, other) = (team.sim(i).battery(), team.charger_holder());
+            team.prepare(i);
+            *r += u32::from(team.step(i, &charge).recharged);
+            if team.sim(i).battery() > before {
+                rises[i] += 1;
+                // Only a robot the charger served: free, or its own.
+                assert!(
+                    other.is_none_or(|h| h == i),
+                    "robot {i} charged while robot {other:?} held the charger"
+                );
+            }
+        }
+        holders.extend(team.charger_holder());
+    }
+    assert!(rises[0] > 0 && rises[1] > 0, "{rises:?}");
+    assert_eq!(holders.len(), 2, "each robot had its turn: {holders:?}");
+    assert_eq!(recharged, [1, 1], "both batteries were filled, one after the other");
+}
+
+#[test]
+fn a_teams_fitness_is_its_robots_aggregated() {
+    let mut stage = testkit::collect();
+    stage.world.robots = 3;
+    let g = genome_of(&stage, 9);
+    let opts = EpisodeOptions { actions: 300, learning: true, seed: 11 };
+    let mut traces = vec![Trace::default(); 3];
+    let res = run_team_episode(&stage, &g, &opts, Some(&mut traces)).unwrap();
+    let f: Vec<f32> = res.robots.iter().map(|r| r.fitness).collect();
+    assert_eq!(res.team.fitness, Aggregate::Mean.of(f.iter().copied()));
+    stage.fitness.team = Aggregate::Min;
+    let min = run_team_episode(&stage, &g, &opts, None).unwrap();
+    assert_eq!(min.team.fitness, f.iter().copied().fold(f32::INFINITY, f32::min));
+    stage.fitness.team = Aggregate::Sum;
+    let sum = run_team_episode(&stage, &g, &opts, None).unwrap();
+    assert!((sum.team.fitness - f.iter().sum::<f32>()).abs() <= 1e-3 * f.iter().sum::<f32>().abs().max(1.0));
+    // Each robot lived its own life, traced.
+    for (t, r) in traces.iter().zip(&res.robots) {
+        assert_eq!(t.rows.len() as u32, r.actions);
+    }
+    assert_ne!(traces[0].rows.last().unwrap().pose, traces[1].rows.last().unwrap().pose);
+    // Deterministic by seed.
+    stage.fitness.team = Aggregate::Mean;
+    assert_eq!(run_team_episode(&stage, &g, &opts, None).unwrap(), res);
+}
+
+#[test]
+fn team_spread_is_read_at_the_end() {
+    let mut stage =
+        testkit::bare_stage("spread", quiet(World { robots: 4, battery: None, ..testkit::arena_world() }));
+    stage.fitness.at_end =
+        Some(testkit::expr(vec![shaping_runtime::expr::Op::State(shaping_runtime::state::ST_SPREAD as u16)]));
+    let g = Genome { bits: vec![] };
+    let opts = EpisodeOptions { actions: 5, learning: false, seed: 3 };
+    let res = run_team_episode(&stage, &g, &opts, None).unwrap();
+    // No module: the robots stand still, so the spread is the start's.
+    let spread = Team::new(&stage.world, 3).spread();
+    assert!(spread > 10.0);
+    for r in &res.robots {
+        assert_eq!(r.fitness, spread);
+    }
+}
