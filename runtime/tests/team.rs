@@ -213,3 +213,12 @@ fn team_spread_is_read_at_the_end() {
         assert_eq!(r.fitness, spread);
     }
 }
+
+#[test]
+fn the_robot_link_refuses_a_team() {
+    let mut stage = testkit::collect();
+    assert_eq!(shaping_runtime::robot::unfit_for_robot(&stage), None);
+    stage.world.robots = 3;
+    let why = shaping_runtime::robot::unfit_for_robot(&stage).unwrap();
+    assert!(why.contains("a team of 3 robots") && why.contains("one serial port"), "{why}");
+}

@@ -28,6 +28,12 @@ use crate::sim::{Pose, Sim};
 /// objects, and the two would disagree).
 pub fn unfit_for_robot(stage: &Stage) -> Option<String> {
     let name = &stage.name;
+    if stage.world.robots > 1 {
+        return Some(format!(
+            "stage `{name}` has a team of {} robots; the robot link drives one robot on one serial port (`robots 1`, the default)",
+            stage.world.robots
+        ));
+    }
     if stage.world.objects.as_ref().is_some_and(|o| !o.virtual_ && o.count > 0) {
         return Some(format!(
             "stage `{name}` has physical objects; on a robot the objects must be `virtual` (simulated on the host, as in the paper)"
