@@ -67,6 +67,16 @@ fn with_items() -> Stage {
     stage
 }
 
+/// Collect with a team of 8 robots crowded in a small arena, so that
+/// they meet often.
+fn team() -> Stage {
+    let mut stage = testkit::collect();
+    stage.name = "team".into();
+    stage.world.robots = 8;
+    stage.world.arena = [500.0, 500.0];
+    stage
+}
+
 /// Allocations of one untraced episode of `actions` actions.
 fn episode_allocations(stage: &Stage, actions: u32) -> (u64, u32) {
     let genome = testkit::random_genome(stage, &mut ChaCha8Rng::seed_from_u64(9));
@@ -81,7 +91,7 @@ fn an_episode_allocates_the_same_whatever_its_length() {
     // Navigation (CRBP on a behavior network) and collect (scripts, gripper,
     // CRBP on activation networks), without a battery so every episode
     // lasts as long as asked.
-    for mut stage in [testkit::navigation(), testkit::collect(), with_items()] {
+    for mut stage in [testkit::navigation(), testkit::collect(), with_items(), team()] {
         stage.world.battery = None;
         let (short, n_short) = episode_allocations(&stage, 10);
         let (long, n_long) = episode_allocations(&stage, 3_000);

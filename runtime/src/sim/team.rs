@@ -79,6 +79,14 @@ impl Team {
         let travel = s.travel * (1.0 + s.wheel_noise);
         let reach = 2.0 * s.radius + super::ir::RANGE + 2.0 * travel + 1.0;
         let grid = Grid::new(s.width, s.depth, reach + 2.0 * travel, n);
+        // Room for every body that fits within reach (discs of the body
+        // radius whose centres are within `reach` cover at most the disc of
+        // radius `reach + radius`), so `prepare` never allocates.
+        let fit = ((reach + s.radius) / s.radius).powi(2).ceil();
+        let room = if fit.is_finite() { (fit as usize).min(n - 1) } else { n - 1 };
+        for sim in &mut sims {
+            sim.others.reserve_exact(room);
+        }
         let mut team = Team { sims, at, grid, reach, charger: None };
         team.begin_action();
         team
