@@ -235,6 +235,33 @@ pub enum Error {
         label: String,
         other_label: String,
     },
+
+    #[error("{robots} robots do not fit in the start region, which holds {room}")]
+    #[diagnostic(code(S0022))]
+    TeamTooLarge {
+        #[label(primary, "{robots} robots")]
+        span: SourceSpan,
+        /// The `start` item, or nothing when the region is the arena less
+        /// the clearance (then the arena's span, if known).
+        #[label("{region}")]
+        region_span: Option<SourceSpan>,
+        robots: u32,
+        room: u32,
+        region: String,
+        #[help]
+        help: String,
+    },
+
+    /// A warning: `team` in a stage whose world has one robot.
+    #[error("stage `{stage}` combines a team's fitness, but its world has one robot")]
+    #[diagnostic(code(S0023), severity(Warning))]
+    TeamOfOne {
+        #[label("no effect with one robot")]
+        span: SourceSpan,
+        stage: String,
+        #[help]
+        help: Option<String>,
+    },
 }
 
 impl Error {

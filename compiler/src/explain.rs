@@ -182,6 +182,20 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: "robot r {\n  sensor ir[8] proximity\n  sensor front[2] proximity\n  actuator wheels[2] speed\n}\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n",
         right: concat!(robot!(), stage!("module m { sense ir  behavior forward }")),
     },
+    Explanation {
+        code: "S0022",
+        title: "more robots than the start region holds",
+        text: "The robots of a team (`robots N`) start in the start region, clear of each other: the declared `start` (a point holds one robot), or without it the arena less 40 mm and a body's radius from the walls. The region holds half the places of a square grid whose spacing is a body's diameter and 40 mm. Declare a larger start region (or none), a larger arena, or fewer robots; the message says how many fit.",
+        wrong: concat!(robot!(), stage!("world { arena 400mm x 400mm  robots 4  start from (100, 100) to (150, 150) }", "module m { sense ir  behavior forward }")),
+        right: concat!(robot!(), stage!("world { arena 400mm x 400mm  robots 4  start from (60, 60) to (340, 340) }", "module m { sense ir  behavior forward }")),
+    },
+    Explanation {
+        code: "S0023",
+        title: "a team's fitness with one robot (a warning)",
+        text: "`team sum`, `team mean` or `team min` says how the fitness of a team's robots makes the team's; in a stage whose world (and every variant's) has one robot, it has no effect. The file compiles; declare `robots N` in the stage's `world`, or remove the clause.",
+        wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
+    },
 ];
 
 /// The explanation of a code (`S0006`, any case).

@@ -693,6 +693,7 @@ impl F<'_> {
             }
             WorldItem::Battery(q, _) => format!("battery {}", self.qty(q)),
             WorldItem::Recharge(q, _) => format!("recharge {}", self.qty(q)),
+            WorldItem::Robots(q, _) => format!("robots {}", self.qty(q)),
             WorldItem::Objects { count, diameter, virtual_, .. } => {
                 let mut t = "objects".to_string();
                 if let Some(c) = count {
@@ -816,6 +817,9 @@ impl F<'_> {
         }
         for b in &f.bonuses {
             terms.push((b.span.start, format!("{} per {}", self.num(b.points, b.span), b.event.text)));
+        }
+        for (w, span) in &f.team {
+            terms.push((span.start, format!("team {}", w.text)));
         }
         terms.sort_by_key(|t| t.0);
         let terms: Vec<String> = terms.into_iter().map(|t| t.1).collect();
@@ -1034,6 +1038,7 @@ impl F<'_> {
             }
             ExprKind::Ref(n, i) => format!("{}{}", n.text, Self::index(i)),
             ExprKind::State(n) => format!("robot.{}", n.text),
+            ExprKind::Team(n) => format!("team.{}", n.text),
             ExprKind::Call(n, args) => {
                 let a: Vec<String> = args.iter().map(|a| self.expr(a)).collect();
                 format!("{}({})", n.text, a.join(", "))
@@ -1073,6 +1078,10 @@ fn level(e: &Expr) -> u8 {
         },
         ExprKind::Unary(UnOp::Not, _) => 4,
         ExprKind::Unary(..) => 8,
-        ExprKind::Number(..) | ExprKind::Ref(..) | ExprKind::State(..) | ExprKind::Call(..) => 9,
+        ExprKind::Number(..)
+        | ExprKind::Ref(..)
+        | ExprKind::State(..)
+        | ExprKind::Team(..)
+        | ExprKind::Call(..) => 9,
     }
 }

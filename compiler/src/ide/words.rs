@@ -92,6 +92,7 @@ const WORLD_S: &str = "6-the-world";
 const ITEMS: &str = "walls-cylinders-lamps-floor-zones-and-the-start";
 const BODIES: &str = "bodies-and-sensor-layouts";
 const VARIANTS: &str = "variants-conditions-per-evaluation";
+const TEAMS: &str = "teams";
 const EVOLUTION: &str = "7-evolution";
 const FITNESS: &str = "8-fitness";
 const MODULES: &str = "9-modules";
@@ -190,6 +191,8 @@ const LIST: &[Word] = &[
     w("charger", C, WORLD | CLAUSE, "`charger L on north wall [with lamp]`: a charging bar on a wall", WORLD_S),
     w("battery", C, WORLD, "`battery N actions`: how long a full battery lasts", WORLD_S),
     w("objects", C, WORLD, "`objects N diameter D physical|virtual`: objects to collect", WORLD_S),
+    w("robots", C, WORLD, "`robots N`: a team of N clones of the evaluated individual, all starting in the start region", TEAMS),
+    w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm", TEAMS),
     w("body", C, WORLD, "`body [khepera | e-puck] { v_max 80 ... }`: the robot's body, from a preset, with single values changed", WORLD_S),
     w("khepera", C, CLAUSE, "`body khepera`: the Khepera's body and sensors (the default)", BODIES),
     w("e-puck", C, CLAUSE, "`body e-puck`: the e-puck's body, its IR sensors' places and bearings and 3 ground sensors", BODIES),
@@ -246,9 +249,9 @@ const LIST: &[Word] = &[
     w("collision", C, EVENT, "`-1 per collision`: the robot hit something", FITNESS),
     // functions
     w("max", F, EXPR, "`max(x, ...)`: the largest value", EXPRESSIONS),
-    w("min", F, EXPR | CLAUSE, "`min(x, ...)`: the smallest value (`variants min`: the lowest of the variants' fitness)", EXPRESSIONS),
-    w("sum", F, EXPR, "`sum(x, ...)`: the sum", EXPRESSIONS),
-    w("mean", F, EXPR | CLAUSE, "`mean(x, ...)`: the mean (`variants mean`: the mean of the variants' fitness)", EXPRESSIONS),
+    w("min", F, EXPR | CLAUSE, "`min(x, ...)`: the smallest value (`variants min`, `team min`: the lowest of the variants' or robots' fitness)", EXPRESSIONS),
+    w("sum", F, EXPR | CLAUSE, "`sum(x, ...)`: the sum (`team sum`: the sum of the robots' fitness)", EXPRESSIONS),
+    w("mean", F, EXPR | CLAUSE, "`mean(x, ...)`: the mean (`variants mean`, `team mean`: the mean of the variants' or robots' fitness)", EXPRESSIONS),
     w("abs", F, EXPR, "`abs(x)`: the absolute value", EXPRESSIONS),
     w("sign", F, EXPR | CLAUSE, "`sign(x)`: -1, 0 or 1 (in `outputs sign(N)`: N outputs read as bits)", EXPRESSIONS),
     w("sqrt", F, EXPR, "`sqrt(x)`: the square root", EXPRESSIONS),

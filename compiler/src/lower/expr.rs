@@ -6,7 +6,7 @@
 
 use shaping_runtime::expr::{Expr, Op, MAX_STACK};
 use shaping_runtime::program::{ItemKind, Target};
-use shaping_runtime::state::{MAX_TARGETS, ST_TARGETS};
+use shaping_runtime::state::{MAX_TARGETS, ST_SPREAD, ST_TARGETS};
 
 use super::{Hw, Lower};
 use crate::diag::{did_you_mean, Error};
@@ -39,6 +39,13 @@ pub const STATE_FIELDS: [(&str, usize, &str); 6] = [
     ("time", shaping_runtime::state::ST_TIME, "the actions done in this life so far"),
     ("squares", shaping_runtime::state::ST_SQUARES, "the 50 mm squares of the arena visited in this life"),
 ];
+
+/// The fields of `team.FIELD` and their state slots.
+pub const TEAM_FIELDS: [(&str, usize, &str); 1] = [(
+    "spread",
+    ST_SPREAD,
+    "the mean distance of the team's robots' centres to the team's centre, mm (0 for one robot)",
+)];
 
 enum Val {
     /// Emitted onto the code.
@@ -118,7 +125,8 @@ impl Lower<'_> {
                 Val::Num
             }
             ExprKind::Ref(name, index) => self.reference(hw, name, index.as_ref(), e.span, scope, prev, ops),
-            ExprKind::State(field) => self.state(field, e.span, scope, prev, ops),
+            ExprKind::State(field) => self.state("robot", &STATE_FIELDS, field, e.span, scope, prev, ops),
+            ExprKind::Team(field) => self.state("team", &TEAM_FIELDS, field, e.span, scope, prev, ops),
             ExprKind::Unary(op, inner) => match op {
                 UnOp::Prev => self.go(hw, inner, scope, true, ops),
                 UnOp::Neg | UnOp::Not => {
@@ -317,21 +325,29 @@ impl Lower<'_> {
         Val::Num
     }
 
-    /// `robot.FIELD`.
-    fn state(&mut self, field: &ast::Name, span: Span, scope: &Scope, prev: bool, ops: &mut Vec<Op>) -> Val {
-        let Some(&(_, slot, _)) = STATE_FIELDS.iter().find(|f| f.0 == field.text) else {
+    /// `robot.FIELD` (`of` is `robot`, `fields` [`STATE_FIELDS`]) or
+    /// `team.FIELD` ([`TEAM_FIELDS`]).
+    #[allow(clippy::too_many_arguments)]
+    fn state(
+        &mut self,
+        of: &str,
+        fields: &[(&str, usize, &str)],
+        field: &ast::Name,
+        span: Span,
+        scope: &Scope,
+        prev: bool,
+        ops: &mut Vec<Op>,
+    ) -> Val {
+        let Some(&(_, slot, _)) = fields.iter().find(|f| f.0 == field.text) else {
             self.errors.push(Error::Value {
                 span: field.span.into(),
-                message: format!("the robot's state has no field `{}`", field.text),
+                message: format!("the {of}'s state has no field `{}`", field.text),
                 label: "unknown field".into(),
                 help: Some(
-                    crate::diag::did_you_mean(&field.text, STATE_FIELDS.iter().map(|f| f.0)).unwrap_or_else(
-                        || {
-                            let all: Vec<String> =
-                                STATE_FIELDS.iter().map(|f| format!("`robot.{}`", f.0)).collect();
-                            format!("the fields are {}", all.join(", "))
-                        },
-                    ),
+                    crate::diag::did_you_mean(&field.text, fields.iter().map(|f| f.0)).unwrap_or_else(|| {
+                        let all: Vec<String> = fields.iter().map(|f| format!("`{of}.{}`", f.0)).collect();
+                        format!("the fields are {}", all.join(", "))
+                    }),
                 ),
             });
             return Val::Err;
@@ -340,7 +356,7 @@ impl Lower<'_> {
             self.errors.push(Error::Value {
                 span: span.into(),
                 message: format!(
-                    "`robot.{}` is the simulator's knowledge of the robot: only a fitness reads it",
+                    "`{of}.{}` is the simulator's knowledge of the {of}: only a fitness reads it",
                     field.text
                 ),
                 label: "not a sensor".into(),
@@ -351,10 +367,7 @@ impl Lower<'_> {
         if prev {
             self.errors.push(Error::Value {
                 span: span.into(),
-                message: format!(
-                    "`prev` reads sensors only, and `robot.{}` is the robot's state",
-                    field.text
-                ),
+                message: format!("`prev` reads sensors only, and `{of}.{}` is the {of}'s state", field.text),
                 label: "no previous value".into(),
                 help: None,
             });

@@ -1068,6 +1068,7 @@ impl<'a> Lower<'a> {
         self.check_ground(&st, s, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
+        self.check_team(&st.world, decl.span);
         self.variants_decl(&mut st, decl);
         self.run(&mut st, decl, parent.is_some());
         let hw = Hw {
@@ -1156,6 +1157,7 @@ impl<'a> Lower<'a> {
         self.check_genome_size(&st, decl);
         let mut stage = assemble(&st, &sname, s, parent);
         stage.variants = self.variant_worlds(&st, &sname, decl);
+        self.check_team_clause(&stage, decl);
         (st, stage)
     }
 }

@@ -345,10 +345,56 @@ impl Lower<'_> {
             }
             bonuses.push(Bonus { event, points: b.points as f32 });
         }
-        st.fitness = Fitness { per_action, at_end, bonuses, team: st.fitness.team };
+        // `fitness adds` keeps the inherited team aggregate; a fitness that
+        // replaces the inherited one starts from `mean`.
+        let mut team = if f.adds { st.fitness.team } else { Aggregate::Mean };
+        self.repeated("fitness clause", f.team.iter().map(|(_, sp)| ("team".to_string(), *sp)));
+        if let Some((w, _)) = f.team.first() {
+            match w.text.as_str() {
+                "sum" => team = Aggregate::Sum,
+                "mean" => team = Aggregate::Mean,
+                "min" => team = Aggregate::Min,
+                other => self.errors.push(Error::Unknown {
+                    span: w.span.into(),
+                    what: "aggregation of a team",
+                    name: other.into(),
+                    help: did_you_mean(other, TEAM_AGGREGATES).or_else(|| {
+                        Some("`team sum`, `team mean` or `team min`: the sum, the mean or the lowest of the robots' fitness".into())
+                    }),
+                }),
+            }
+        }
+        st.fitness = Fitness { per_action, at_end, bonuses, team };
         st.fitness_declared = true;
     }
 }
+
+impl Lower<'_> {
+    /// A `team` clause written in a stage whose world (and every variant's)
+    /// has one robot: a warning, it has no effect.
+    pub(super) fn check_team_clause(&mut self, stage: &Stage, decl: &ast::StageDecl) {
+        let variants = stage.variants.iter().flat_map(|v| &v.list);
+        if stage.world.robots > 1 || variants.clone().any(|v| v.world.robots > 1) {
+            return;
+        }
+        for item in &decl.items {
+            if let ast::StageItem::Fitness(f) = item {
+                for (_, span) in &f.team {
+                    self.errors.push(Error::TeamOfOne {
+                        span: (*span).into(),
+                        stage: stage.name.clone(),
+                        help: Some(
+                            "`team` says how the fitness of several robots makes the team's: declare `robots N` in the stage's `world`, or remove the clause".into(),
+                        ),
+                    });
+                }
+            }
+        }
+    }
+}
+
+/// The words of `team WORD` in a fitness.
+pub(crate) const TEAM_AGGREGATES: [&str; 3] = ["sum", "mean", "min"];
 
 pub(super) fn evolve_help(n: &str) -> String {
     match n {

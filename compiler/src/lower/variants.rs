@@ -163,6 +163,7 @@ impl Lower<'_> {
             self.check_charger(&ws);
             self.check_items(&ws, d.span);
             self.check_crowded(&ws, d.span);
+            self.check_team(&ws, d.span);
             let mut world = ws.world;
             world.arena = st.world.world.arena;
             world.body = st.world.world.body.clone();

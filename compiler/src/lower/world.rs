@@ -2,10 +2,12 @@
 //! each), inner walls, cylinders, lamps and floor zones (any number), with
 //! `world adds` and `world changes` checked against the inherited world.
 
-use shaping_runtime::limits::{MAX_ACTIONS, MAX_ITEMS, MAX_OBJECTS};
+use shaping_runtime::limits::{MAX_ACTIONS, MAX_ITEMS, MAX_OBJECTS, MAX_ROBOTS};
 use shaping_runtime::program::*;
 use shaping_runtime::sim::ir;
-use shaping_runtime::world::{blocker, crowded, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE};
+use shaping_runtime::world::{
+    blocker, crowded, team_room, Blocker, Crowded, OBJECT_CLEARANCE, START_CLEARANCE,
+};
 use shaping_runtime::{bodies, catalog};
 
 use super::*;
@@ -27,6 +29,7 @@ impl Lower<'_> {
                 W::Charger { .. } => Some("charger"),
                 W::Battery(..) => Some("battery"),
                 W::Recharge(..) => Some("recharge"),
+                W::Robots(..) => Some("robots"),
                 W::Objects { .. } => Some("objects"),
                 W::Body { .. } => Some("body"),
                 W::Start { .. } => Some("start"),
@@ -151,6 +154,12 @@ impl Lower<'_> {
                                 }
                             }
                         }
+                    }
+                }
+                W::Robots(q, span) => {
+                    if let Some(n) = self.count_in(q, "the number of robots", 1, MAX_ROBOTS.into()) {
+                        ws.world.robots = n as u32;
+                        ws.spans.insert("robots", *span);
                     }
                 }
                 W::Objects { count, diameter, virtual_, span } => {
@@ -510,6 +519,43 @@ impl Lower<'_> {
         if let Some(sp) = at.first() {
             self.value_error(*sp, message, &label, Some(help));
         }
+    }
+
+    /// A team (`robots N`) larger than the start region holds
+    /// ([`team_room`]): reported in the stage (or variant, `decl` its span)
+    /// that declares the robots, the start, the arena or the body.
+    pub(super) fn check_team(&mut self, ws: &WorldSt, decl: Span) {
+        let world = &ws.world;
+        let room = team_room(world);
+        if world.robots <= room {
+            return;
+        }
+        let here = |sp: &&Span| decl.start <= sp.start && sp.end <= decl.end;
+        if !["robots", "start", "arena", "body"].iter().filter_map(|k| ws.spans.get(k)).any(|sp| here(&sp)) {
+            return;
+        }
+        let Some(&robots) = ws.spans.get("robots") else { return };
+        let spacing = 2.0 * world.body.radius + START_CLEARANCE;
+        let (region_span, region) = match (&world.items.start, ws.spans.get("start")) {
+            (Some(s), sp) if s.from == s.to => (sp.copied(), "a start point holds one robot".to_string()),
+            (Some(_), sp) => (sp.copied(), format!("the start region, which holds {room}")),
+            (None, _) => (
+                ws.spans.get("arena").copied(),
+                format!("the start region: the arena less {START_CLEARANCE} mm and a body's radius from the walls"),
+            ),
+        };
+        let help = format!(
+            "the region holds half the places of a square grid of {spacing} mm (a body's diameter and {START_CLEARANCE} mm): declare a larger `start from (X, Y) to (X, Y)` region (or none: the whole arena), or {}",
+            if room == 1 { "one robot".to_string() } else { format!("at most {room} robots") }
+        );
+        self.errors.push(Error::TeamTooLarge {
+            span: robots.into(),
+            region_span: region_span.map(Into::into),
+            robots: world.robots,
+            room,
+            region,
+            help,
+        });
     }
 
     /// The charger must fit on its wall.

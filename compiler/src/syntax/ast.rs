@@ -170,6 +170,8 @@ pub enum WorldItem {
     },
     Battery(Quantity, Span),
     Recharge(Quantity, Span),
+    /// `robots N`: a team of N clones.
+    Robots(Quantity, Span),
     Objects {
         count: Option<Quantity>,
         diameter: Option<Quantity>,
@@ -233,6 +235,7 @@ impl WorldItem {
             | WorldItem::Charger { span, .. }
             | WorldItem::Battery(_, span)
             | WorldItem::Recharge(_, span)
+            | WorldItem::Robots(_, span)
             | WorldItem::Objects { span, .. }
             | WorldItem::Body { span, .. }
             | WorldItem::Wall { span, .. }
@@ -296,6 +299,8 @@ pub struct FitnessDecl {
     /// `at end EXPR` terms.
     pub at_end: Vec<Expr>,
     pub bonuses: Vec<BonusDecl>,
+    /// `team sum|mean|min` clauses (the word, and the clause's span).
+    pub team: Vec<(Name, Span)>,
     pub span: Span,
 }
 
@@ -538,6 +543,7 @@ impl Expr {
             ExprKind::Ref(n, Some(Index { first, last: None, .. })) => format!("{}[{first}]", n.text),
             ExprKind::Ref(n, Some(Index { first, last: Some(l), .. })) => format!("{}[{first}..{l}]", n.text),
             ExprKind::State(n) => format!("robot.{}", n.text),
+            ExprKind::Team(n) => format!("team.{}", n.text),
             ExprKind::Call(n, args) => {
                 let args: Vec<String> = args.iter().map(Expr::sexpr).collect();
                 format!("({} {})", n.text, args.join(" "))
@@ -609,6 +615,8 @@ pub enum ExprKind {
     Ref(Name, Option<Index>),
     /// `robot.FIELD`: the robot's state (the name is the field).
     State(Name),
+    /// `team.FIELD`: the team's state (the name is the field).
+    Team(Name),
     Call(Name, Vec<Expr>),
     Unary(UnOp, Box<Expr>),
     Binary(BinOp, Box<Expr>, Box<Expr>),

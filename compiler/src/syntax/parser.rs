@@ -299,6 +299,8 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::charger => "`charger`",
         Rule::lamp => "`with lamp`",
         Rule::battery => "`battery`",
+        Rule::robots | Rule::k_robots => "`robots`",
+        Rule::team | Rule::k_team => "`team`",
         Rule::recharge_time | Rule::k_recharge | Rule::recharge_step => "`recharge`",
         Rule::objects => "`objects`",
         Rule::diameter => "`diameter`",
@@ -388,7 +390,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::link => "`link`",
         Rule::k_all => "`all`",
         Rule::link_kind => "`evolvable` or `fixed`",
-        Rule::expr | Rule::reference | Rule::call | Rule::state_ref => "an expression",
+        Rule::expr | Rule::reference | Rule::call | Rule::state_ref | Rule::team_ref => "an expression",
         Rule::neg | Rule::not | Rule::prev => "an expression",
         Rule::add | Rule::sub | Rule::mul | Rule::div => "an operator",
         Rule::lt | Rule::le | Rule::gt | Rule::ge | Rule::eq | Rule::ne => "an operator",
@@ -855,8 +857,14 @@ impl Builder {
 
     fn fitness(&mut self, p: Pair<Rule>) -> FitnessDecl {
         let sp = span(&p);
-        let mut f =
-            FitnessDecl { adds: false, per_action: vec![], at_end: vec![], bonuses: vec![], span: sp };
+        let mut f = FitnessDecl {
+            adds: false,
+            per_action: vec![],
+            at_end: vec![],
+            bonuses: vec![],
+            team: vec![],
+            span: sp,
+        };
         for c in p.into_inner() {
             let csp = span(&c);
             match c.as_rule() {
@@ -882,6 +890,11 @@ impl Builder {
                         ev.span = ev.span.to(span(&o));
                     }
                     f.bonuses.push(BonusDecl { points, event: ev, span: csp });
+                }
+                Rule::team => {
+                    if let Some(w) = c.into_inner().nth(1) {
+                        f.team.push((name(w), csp));
+                    }
                 }
                 _ => {}
             }
@@ -1186,6 +1199,10 @@ fn primary(pratt: &PrattParser<Rule>, p: Pair<Rule>) -> Expr {
             let field = p.into_inner().next().map(name).unwrap_or(Name { text: String::new(), span: sp });
             Expr { kind: ExprKind::State(field), span: sp }
         }
+        Rule::team_ref => {
+            let field = p.into_inner().next().map(name).unwrap_or(Name { text: String::new(), span: sp });
+            Expr { kind: ExprKind::Team(field), span: sp }
+        }
         Rule::literal => {
             let mut it = p.into_inner();
             let v = it.next().map(|n| num(&n)).unwrap_or(0.0);
@@ -1254,6 +1271,11 @@ fn world(p: Pair<Rule>) -> WorldBlock {
             Rule::recharge_time => {
                 if let Some(q) = c.into_inner().nth(1) {
                     items.push(WorldItem::Recharge(quantity(q), csp));
+                }
+            }
+            Rule::robots => {
+                if let Some(q) = c.into_inner().nth(1) {
+                    items.push(WorldItem::Robots(quantity(q), csp));
                 }
             }
             Rule::objects => {

@@ -64,10 +64,12 @@ fn kind(e: &Error) -> &'static str {
         Error::StackTooDeep { .. } => "StackTooDeep",
         Error::Conflict { .. } => "Conflict",
         Error::SimilarName { .. } => "SimilarName",
+        Error::TeamTooLarge { .. } => "TeamTooLarge",
+        Error::TeamOfOne { .. } => "TeamOfOne",
     }
 }
 
-const KINDS: [&str; 21] = [
+const KINDS: [&str; 23] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -89,6 +91,8 @@ const KINDS: [&str; 21] = [
     "StackTooDeep",
     "Conflict",
     "SimilarName",
+    "TeamTooLarge",
+    "TeamOfOne",
 ];
 
 #[test]
