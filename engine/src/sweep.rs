@@ -179,12 +179,14 @@ const FIELDS: &[(&str, Kind)] = &[
     ("train.actions", Kind::Count(Some("actions"))),
     ("variants.aggregate", Kind::Word(&["mean", "min"])),
     ("variants.draw", Kind::Count(None)),
+    ("fitness.team", Kind::Word(&["sum", "mean", "min"])),
     ("world.arena", Kind::Arena),
     ("world.charger", Kind::Real(Some("mm"))),
     ("world.lamp", Kind::Real(Some("mm"))),
     ("world.battery", Kind::Count(Some("actions"))),
     ("world.recharge", Kind::Count(Some("actions"))),
     ("world.objects", Kind::Count(None)),
+    ("world.robots", Kind::Count(None)),
     ("world.diameter", Kind::Real(Some("mm"))),
     ("world.body.radius", Kind::Real(Some("mm"))),
     ("world.body.wheel_base", Kind::Real(Some("mm"))),
@@ -395,6 +397,7 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
                 Ok(Value::Word(v.aggregate.word().to_string()))
             }
         }
+        "fitness.team" => Ok(Value::Word(s.fitness.team.word().to_string())),
         "world.arena" => Ok(Value::Pair(w.arena[0] as f64, w.arena[1] as f64)),
         "world.charger" => real(w.charger.as_ref().ok_or_else(|| missing(s, "charger"))?.length),
         "world.lamp" => {
@@ -405,6 +408,7 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
         "world.recharge" => count(w.battery.as_ref().ok_or_else(|| missing(s, "battery"))?.recharge),
         "world.objects" => count(w.objects.as_ref().ok_or_else(|| missing(s, "objects"))?.count),
         "world.diameter" => real(w.objects.as_ref().ok_or_else(|| missing(s, "objects"))?.diameter),
+        "world.robots" => count(w.robots),
         "world.body.radius" => real(w.body.radius),
         "world.body.wheel_base" => real(w.body.wheel_base),
         "world.body.v_max" => real(w.body.v_max),
@@ -475,6 +479,7 @@ fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(),
         "world.diameter" => {
             w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.diameter = r32
         }
+        "world.robots" => w.robots = whole(n)?,
         "world.body.radius" => w.body.radius = r32,
         "world.body.wheel_base" => w.body.wheel_base = r32,
         "world.body.v_max" => w.body.v_max = r32,
@@ -542,6 +547,14 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
             "draw" => v.draw = Some(whole(n)?),
             _ => return Err(format!("`{path}` is not a setting")),
         }
+        return Ok(());
+    }
+    if path == "fitness.team" {
+        s.fitness.team = match word {
+            "sum" => Aggregate::Sum,
+            "min" => Aggregate::Min,
+            _ => Aggregate::Mean,
+        };
         return Ok(());
     }
     if path.starts_with("world.") {

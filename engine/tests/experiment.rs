@@ -164,6 +164,43 @@ fn bad_set_values_are_errors_naming_them() {
     assert!(err.contains("given twice"), "{err}");
 }
 
+/// `world.robots` and `fitness.team` reach the stage and the stages that
+/// inherit them; a team too large for the start region, or above the
+/// limit, is refused with a message naming the setting.
+#[test]
+fn a_team_is_set_and_one_too_large_is_refused() {
+    use shaping_engine::sweep::apply;
+    use shaping_runtime::program::Aggregate;
+    let set = |t: &str, v: &str| vec![(t.to_string(), v.to_string())];
+    let mut p = tiny();
+    assert_eq!((p.stages[0].world.robots, p.stages[0].fitness.team), (1, Aggregate::Mean));
+    apply(&mut p, &set("first.world.robots", "4")).unwrap();
+    apply(&mut p, &set("first.fitness.team", "sum")).unwrap();
+    for s in &p.stages {
+        assert_eq!((s.world.robots, s.fitness.team), (4, Aggregate::Sum), "{}", s.name);
+    }
+    apply(&mut p, &set("second.fitness.team", "min")).unwrap();
+    assert_eq!((p.stages[0].fitness.team, p.stages[1].fitness.team), (Aggregate::Sum, Aggregate::Min));
+    // The arena of 400 x 600 mm holds 7 Kheperas without a `start`.
+    apply(&mut tiny(), &set("first.world.robots", "7")).unwrap();
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "first.world.robots",
+            "8",
+            &["`--set first.world.robots=8`", "world.robots", "8 robots do not fit", "holds 7"],
+        ),
+        ("first.world.robots", "100000", &["`--set first.world.robots=100000`", "world.robots", "10000"]),
+        ("first.world.robots", "0", &["world.robots", "0 is not between 1"]),
+        ("first.fitness.team", "median", &["`median` is not one of sum, mean, min"]),
+    ];
+    for (target, value, wanted) in cases {
+        let err = apply(&mut tiny(), &set(target, value)).unwrap_err().to_string();
+        for w in wanted {
+            assert!(err.contains(w), "--set {target}={value}: `{w}` missing from:\n{err}");
+        }
+    }
+}
+
 /// A criterion no fitness can reach (`nan`, `inf`, beyond f32) is refused
 /// before anything runs, as a word is; so are non-finite `--set` values.
 #[test]
