@@ -90,6 +90,28 @@ mod world_facts {
     }
 
     #[test]
+    fn another_robot_ahead() {
+        use shaping_runtime::sim::Team;
+        let mut w = world();
+        w.robots = 2;
+        let front = |gap: f32| {
+            let mut team = Team::new(&w, 1);
+            assert!(team.place(1, Pose { x: 40.0, y: 40.0, theta: 0.0 }));
+            assert!(team.place(0, Pose { x: 150.0, y: 300.0, theta: 0.0 }));
+            assert!(team.place(1, Pose { x: 150.0 + 2.0 * RADIUS + gap, y: 300.0, theta: 0.0 }));
+            team.begin_action();
+            team.prepare(0);
+            let mut p = [0.0; CHANNELS];
+            team.sense(0, &mut p);
+            [p[CH_IR + 2], p[CH_IR + 3]]
+        };
+        assert!(front(10.0).iter().all(|&v| v > 0.9), "{:?}", front(10.0));
+        assert!(front(18.0).iter().all(|&v| (0.1..=0.5).contains(&v)), "{:?}", front(18.0));
+        assert!(front(30.0).iter().all(|&v| v < 0.01), "{:?}", front(30.0));
+        assert!(front(40.0).iter().all(|&v| v == 0.0), "{:?}", front(40.0));
+    }
+
+    #[test]
     fn sensor_layout() {
         let w = world();
         let near = 5.0 + RADIUS;
