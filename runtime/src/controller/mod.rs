@@ -100,7 +100,7 @@ pub use fast_expr::FastExpr;
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
-pub use team::{run_team_episode, TeamResult, TeamRun};
+pub use team::{run_team_episode, TeamResult, TeamRun, TeamWatch};
 
 /// How to run one episode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

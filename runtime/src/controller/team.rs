@@ -15,19 +15,33 @@ use crate::genome::Genome;
 use crate::program::Stage;
 use crate::sim::{robot_seed, Command, Outcome, Pose, Team};
 
-/// Robot `i` of a team, as its controller sees it.
-struct Member<'t> {
-    team: &'t mut Team,
-    i: usize,
+/// What a recorder sees of a team's life ([`TeamRun::run_watched`]): each
+/// robot's sensing and commands, as they happen (the unit type sees nothing).
+pub trait TeamWatch {
+    /// Robot `i` sensed `out`, the team as it is now.
+    fn sensed(&mut self, _i: usize, _out: &[f32; CHANNELS], _team: &Team) {}
+    /// Robot `i` is about to execute `cmd`.
+    fn commanded(&mut self, _i: usize, _cmd: &Command) {}
 }
 
-impl Robot for Member<'_> {
+impl TeamWatch for () {}
+
+/// Robot `i` of a team, as its controller sees it.
+struct Member<'t, W: TeamWatch = ()> {
+    team: &'t mut Team,
+    i: usize,
+    watch: &'t mut W,
+}
+
+impl<W: TeamWatch> Robot for Member<'_, W> {
     #[inline]
     fn sense(&mut self, out: &mut [f32; CHANNELS]) {
         self.team.sense(self.i, out);
+        self.watch.sensed(self.i, out, self.team);
     }
     #[inline]
     fn step(&mut self, cmd: &Command) -> Outcome {
+        self.watch.commanded(self.i, cmd);
         self.team.step(self.i, cmd)
     }
     fn alive(&self) -> bool {
@@ -109,7 +123,21 @@ impl<'s> TeamRun<'s> {
         &mut self,
         team: &mut Team,
         opts: &EpisodeOptions,
+        traces: Option<&mut [Trace]>,
+        after: impl FnMut(&Team) -> bool,
+    ) -> TeamResult {
+        self.run_watched(team, opts, traces, &mut (), after)
+    }
+
+    /// [`TeamRun::run`], `watch` told of every robot's sensing and commands
+    /// (a recorder of the life's frames; it draws no random number, so the
+    /// life is the one [`TeamRun::run`] lives).
+    pub fn run_watched<W: TeamWatch>(
+        &mut self,
+        team: &mut Team,
+        opts: &EpisodeOptions,
         mut traces: Option<&mut [Trace]>,
+        watch: &mut W,
         mut after: impl FnMut(&Team) -> bool,
     ) -> TeamResult {
         let n = team.len();
@@ -127,7 +155,7 @@ impl<'s> TeamRun<'s> {
                 c.begin_trace(t);
             }
             team.prepare(i);
-            c.start(&mut Member { team, i });
+            c.start(&mut Member { team, i, watch: &mut *watch });
         }
         let mut actions = 0;
         for a in 0..opts.actions {
@@ -140,7 +168,7 @@ impl<'s> TeamRun<'s> {
                     continue;
                 }
                 team.prepare(i);
-                let member = &mut Member { team, i };
+                let member = &mut Member { team, i, watch: &mut *watch };
                 let rep = c.act(member);
                 tally(&mut robots[i], &mut fitness[i], &rep);
                 if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
@@ -158,7 +186,7 @@ impl<'s> TeamRun<'s> {
         }
         for (i, c) in ctls.iter().enumerate() {
             let r = std::mem::take(&mut robots[i]);
-            robots[i] = c.finish(&Member { team, i }, r, fitness[i]);
+            robots[i] = c.finish(&Member { team, i, watch: &mut *watch }, r, fitness[i]);
         }
         let mut total = EpisodeResult {
             fitness: self.stage.fitness.team.of(robots.iter().map(|r| r.fitness)),
