@@ -18,6 +18,9 @@
 //! - A life ends early (`terminated`) when the battery is empty, and is cut
 //!   (`truncated`) at the stage's length of life (its `actions`).
 //!
+//! A stage whose world has a team is refused ([`check`]): one agent
+//! drives one robot.
+//!
 //! [`Stepper`] is one robot; [`VecStepper`] is many, stepped on the
 //! threads of the caller's rayon pool in one call, each resetting itself
 //! on the step after its life ended. Both are deterministic by seed.
@@ -150,6 +153,22 @@ pub struct Step {
     pub outcome: Outcome,
 }
 
+/// Refuses a stage whose world has a team (`robots` above 1): an agent
+/// drives one robot, and the others would have no controller.
+pub fn check(stage: &Stage) -> Result<(), Error> {
+    if stage.world.robots > 1 {
+        return Err(Error::new(
+            ErrorKind::Invalid,
+            format!(
+                "error: stage `{}` has a team of {} robots, but a stepper drives one robot (one agent, one robot): \
+                 step a stage whose world has one robot, or run the team with `shaping run`",
+                stage.name, stage.world.robots
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// One robot in a stage's world, driven one action at a time.
 pub struct Stepper {
     stage: Arc<Stage>,
@@ -171,10 +190,12 @@ pub struct Stepper {
 }
 
 impl Stepper {
-    /// A robot in `stage`'s world; call [`Stepper::reset`] before the first step.
-    pub fn new(stage: Arc<Stage>) -> Stepper {
+    /// A robot in `stage`'s world; call [`Stepper::reset`] before the first
+    /// step. A team's stage is refused ([`check`]).
+    pub fn new(stage: Arc<Stage>) -> Result<Stepper, Error> {
+        check(&stage)?;
         let spaces = Arc::new(Spaces::of(&stage));
-        Stepper::with_spaces(stage, spaces)
+        Ok(Stepper::with_spaces(stage, spaces))
     }
 
     fn with_spaces(stage: Arc<Stage>, spaces: Arc<Spaces>) -> Stepper {
@@ -350,8 +371,10 @@ pub struct VecStepper {
 }
 
 impl VecStepper {
-    /// `n` robots in `stage`'s world; call [`VecStepper::reset`] first.
-    pub fn new(stage: Arc<Stage>, n: usize) -> VecStepper {
+    /// `n` robots in `stage`'s world; call [`VecStepper::reset`] first. A
+    /// team's stage is refused ([`check`]).
+    pub fn new(stage: Arc<Stage>, n: usize) -> Result<VecStepper, Error> {
+        check(&stage)?;
         let spaces = Arc::new(Spaces::of(&stage));
         let width = spaces.channels.len();
         let slots = (0..n)
@@ -362,7 +385,7 @@ impl VecStepper {
                 obs: vec![0.0; width],
             })
             .collect();
-        VecStepper { spaces, slots, started: false }
+        Ok(VecStepper { spaces, slots, started: false })
     }
 
     pub fn len(&self) -> usize {

@@ -73,7 +73,7 @@ fn a_lifes_rewards_add_up_to_the_fitness_of_its_episode() {
         let result = ctl.run(&mut robot, &opts, None);
 
         // The same commands through the stepper, in the world of that seed.
-        let mut env = Stepper::new(nav.clone());
+        let mut env = Stepper::new(nav.clone()).unwrap();
         assert_eq!(env.spaces().action, ["wheels[0]", "wheels[1]", "charge"]);
         assert_eq!(env.spaces().observation.len(), 17);
         let mut obs = vec![0.0; 17];
@@ -112,7 +112,7 @@ fn a_lifes_rewards_add_up_to_the_fitness_of_its_episode() {
 #[test]
 fn bad_actions_are_refused_naming_the_element() {
     let program = khepera();
-    let mut env = Stepper::new(stage(&program, "collect"));
+    let mut env = Stepper::new(stage(&program, "collect")).unwrap();
     assert_eq!(env.spaces().action, ["wheels[0]", "wheels[1]", "arm", "claw", "charge"]);
     let mut obs = vec![0.0; env.spaces().observation.len()];
     let err = env.step(&[0.0; 5], &mut obs).unwrap_err();
@@ -140,7 +140,7 @@ fn bad_actions_are_refused_naming_the_element() {
 fn vec_run(stage: &Arc<Stage>, n: usize, steps: usize, threads: usize) -> Vec<VecStep> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
-        let mut envs = VecStepper::new(stage.clone(), n);
+        let mut envs = VecStepper::new(stage.clone(), n).unwrap();
         let dims = envs.spaces().action.len();
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         let mut out = VecStep::default();
@@ -183,7 +183,7 @@ fn robots_stepped_together_are_deterministic_and_start_again_after_a_life() {
     // The robots do not share one world.
     assert_ne!(one[1].observations[..17], one[1].observations[17..34]);
     // A malformed row is refused, naming it, and no robot moves.
-    let mut envs = VecStepper::new(nav, 3);
+    let mut envs = VecStepper::new(nav, 3).unwrap();
     let mut out = VecStep::default();
     envs.reset(0, &mut out);
     let before = out.clone();
@@ -196,7 +196,7 @@ fn robots_stepped_together_are_deterministic_and_start_again_after_a_life() {
 #[test]
 fn a_frame_of_the_world_has_one_size_throughout_a_life() {
     let program = khepera();
-    let mut env = Stepper::new(stage(&program, "collect"));
+    let mut env = Stepper::new(stage(&program, "collect")).unwrap();
     env.keep_path(true);
     let mut obs = vec![0.0; env.spaces().observation.len()];
     env.reset(2, &mut obs);
@@ -213,4 +213,20 @@ fn a_frame_of_the_world_has_one_size_throughout_a_life() {
     let later = frame(&env);
     assert_eq!((later.width, later.height), (first.width, first.height));
     assert_ne!(later.pixels, first.pixels, "the robot moved");
+}
+
+/// One agent drives one robot: a stepper refuses a stage whose world has a team.
+#[test]
+fn a_stepper_refuses_a_team() {
+    let mut program = khepera();
+    let nav = program.stages.iter().position(|s| s.name == "navigation").unwrap();
+    program.stages[nav].world.robots = 2;
+    let team = stage(&program, "navigation");
+    let err = Stepper::new(team.clone()).err().expect("a team is refused");
+    assert_eq!(err.kind(), ErrorKind::Invalid);
+    assert!(err.message().contains("`navigation` has a team of 2 robots"), "{err}");
+    let err = VecStepper::new(team, 3).err().expect("a team is refused");
+    assert!(err.message().contains("drives one robot"), "{err}");
+    program.stages[nav].world.robots = 1;
+    assert!(Stepper::new(stage(&program, "navigation")).is_ok());
 }

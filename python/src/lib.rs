@@ -571,7 +571,8 @@ impl Stepper {
     #[new]
     #[pyo3(signature = (program, stage, keep_path=false))]
     fn new(program: &Program, stage: &str, keep_path: bool) -> PyResult<Stepper> {
-        let mut inner = shaping_engine::stepper::Stepper::new(stepped_stage(program, stage)?);
+        let mut inner = shaping_engine::stepper::Stepper::new(stepped_stage(program, stage)?)
+            .map_err(|e| Python::attach(|py| shaping_error(py, &e)))?;
         inner.keep_path(keep_path);
         let obs = vec![0.0; inner.spaces().channels.len()];
         Ok(Stepper { inner, obs })
@@ -671,7 +672,8 @@ impl VecStepper {
             .num_threads(jobs.unwrap_or(0))
             .build()
             .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
-        let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs);
+        let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs)
+            .map_err(|e| Python::attach(|py| shaping_error(py, &e)))?;
         Ok(VecStepper { inner, out: Default::default(), pool })
     }
 
