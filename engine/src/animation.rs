@@ -3,7 +3,8 @@
 //! Every frame is [`plot::trajectory_rgb`] of the world as the robot left
 //! it after an action (the objects where they were, held ones in the
 //! gripper, those thrown out gone) and of its path so far, coloured by the
-//! module that won each action; the strip above the arena shows the
+//! module that won each action (a team's other robots: their paths so far
+//! and bodies, one colour each); the strip above the arena shows the
 //! battery as a bar and the action's number (drawn with a small built-in
 //! digit font, so a frame looks the same whatever fonts the machine has).
 //! At most [`MAX_FRAMES`] frames: a longer episode is subsampled evenly,
@@ -61,9 +62,16 @@ pub fn frames(scene: &Scene, episode: &Episode) -> Result<Vec<Rgb>, Error> {
     let mut out = Vec::new();
     let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
     let mut path = Vec::with_capacity(end);
+    // A team's other robots in the first world, their paths so far.
+    let mut others = vec![Vec::with_capacity(end); episode.robots_in(0) - 1];
     let mut shown = frame_actions(end, MAX_FRAMES).into_iter().peekable();
     for a in 0..end {
         path.push([c.x[a], c.y[a], c.theta[a]]);
+        for (o, p) in c.others.iter().zip(&mut others) {
+            if let (Some(&x), Some(&y), Some(&theta)) = (o.x.get(a), o.y.get(a), o.theta.get(a)) {
+                p.push([x, y, theta]);
+            }
+        }
         while let Some(ch) = changes.next_if(|ch| ch[0] as usize <= a) {
             if let Some(o) = objects.get_mut(ch[1] as usize) {
                 (o.x, o.y, o.radius) = (ch[2], ch[3], ch[4]);
@@ -80,6 +88,7 @@ pub fn frames(scene: &Scene, episode: &Episode) -> Result<Vec<Rgb>, Error> {
             path: path.clone(),
             path_modules: Some(c.winner[..=a].to_vec()),
             module_names: episode.modules.clone(),
+            others: others.clone(),
             ..base.clone()
         };
         let mut rgb = plot::trajectory_rgb(&frame_scene).map_err(to_err)?;

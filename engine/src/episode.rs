@@ -10,6 +10,9 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use shaping_runtime::controller::{TeamResult, TeamRun, TeamWatch};
+use shaping_runtime::sim::Team;
+
 use serde::{Deserialize, Serialize};
 use shaping_runtime::catalog::{
     ActuatorKind, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, SENSOR_BEARING_DEG,
@@ -116,6 +119,32 @@ impl<'a, R: Shown> Recorder<'a, R> {
     }
 }
 
+/// The frame of what a robot sensed (`out`), its gripper, the wheel
+/// command that led there and the objects.
+fn frame_of(
+    out: &[f32; CHANNELS],
+    arm_down: bool,
+    claw_closed: bool,
+    wheels: [f32; 2],
+    objects: Vec<[f32; 4]>,
+) -> Frame {
+    let mut irv = [0.0; ir::SENSORS];
+    irv.copy_from_slice(&out[CH_IR..CH_IR + ir::SENSORS]);
+    let mut light = [0.0; ir::SENSORS];
+    light.copy_from_slice(&out[CH_LIGHT..CH_LIGHT + ir::SENSORS]);
+    Frame {
+        ir: irv,
+        light,
+        barrier: out[CH_BARRIER] > 0.5,
+        floor: out[CH_FLOOR],
+        lamp_distance: out[CH_LAMP_DISTANCE],
+        arm_down,
+        claw_closed,
+        wheels,
+        objects,
+    }
+}
+
 fn object_rows(scene: &Scene) -> Vec<[f32; 4]> {
     scene
         .objects
@@ -135,21 +164,7 @@ impl<R: Shown> Robot for Recorder<'_, R> {
     fn sense(&mut self, out: &mut [f32; CHANNELS]) {
         self.robot.sense(out);
         let scene = self.robot.scene();
-        let mut irv = [0.0; ir::SENSORS];
-        irv.copy_from_slice(&out[CH_IR..CH_IR + ir::SENSORS]);
-        let mut light = [0.0; ir::SENSORS];
-        light.copy_from_slice(&out[CH_LIGHT..CH_LIGHT + ir::SENSORS]);
-        self.frames.push(Frame {
-            ir: irv,
-            light,
-            barrier: out[CH_BARRIER] > 0.5,
-            floor: out[CH_FLOOR],
-            lamp_distance: out[CH_LAMP_DISTANCE],
-            arm_down: scene.arm_down,
-            claw_closed: scene.claw_closed,
-            wheels: self.wheels,
-            objects: object_rows(&scene),
-        });
+        self.frames.push(frame_of(out, scene.arm_down, scene.claw_closed, self.wheels, object_rows(&scene)));
     }
     fn step(&mut self, cmd: &Command) -> Outcome {
         self.wheels = cmd.wheels;
@@ -201,6 +216,18 @@ pub struct EpisodeWorld {
     pub start: [f32; 3],
     /// Objects before the first action: `[x, y, radius, state]`.
     pub objects: Vec<[f32; 4]>,
+    /// A team's other robots (1, 2, ...) in this world: their poses before
+    /// the first action, `[x, y, theta]` (absent for one robot).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<[f32; 3]>,
+}
+
+/// One robot's poses, per action.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PoseColumns {
+    pub x: Vec<f32>,
+    pub y: Vec<f32>,
+    pub theta: Vec<f32>,
 }
 
 /// Per-action columns (index = action).
@@ -236,6 +263,12 @@ pub struct EpisodeColumns {
     pub wheels: Vec<[f32; 2]>,
     /// Objects that changed at an action: `[action, index, x, y, radius, state]`.
     pub objects: Vec<[f32; 6]>,
+    /// A team's other robots (1, 2, ...): each one's poses after every
+    /// action, as long as the columns above (absent for one robot; zeros
+    /// at the actions of a world with fewer robots, see
+    /// [`EpisodeWorld::others`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<PoseColumns>,
 }
 
 impl EpisodeColumns {
@@ -362,6 +395,7 @@ pub fn episode(
             body_radius: part.scene.body_radius,
             start: [round(p.x, 2), round(p.y, 2), round(p.theta, 4)],
             objects: start.map_or_else(|| object_rows(&part.scene), |f| f.objects.clone()),
+            others: Vec::new(),
         });
         let mut prev: Vec<[f32; 4]> = start.map(|f| f.objects.clone()).unwrap_or_default();
         for (k, f) in part.frames.iter().skip(1).enumerate() {
@@ -393,8 +427,22 @@ pub fn episode(
 }
 
 /// Runs one traced and recorded episode of `genome` on `stage`, exactly as
-/// [`shaping_runtime::controller::run_episode`] does.
+/// [`shaping_runtime::controller::run_episode`] does (of a team: robot 0's
+/// trace, the episode of every robot; [`record`] gives the others' traces).
 pub fn run_recorded(
+    stage: &shaping_runtime::program::Stage,
+    genome: &shaping_runtime::genome::Genome,
+    opts: &shaping_runtime::controller::EpisodeOptions,
+) -> Result<(shaping_runtime::controller::EpisodeResult, Trace, Episode), String> {
+    if stage.world.robots > 1 {
+        let r = record(stage, genome, opts)?;
+        return Ok((r.result, r.trace, r.episode));
+    }
+    run_recorded_one(stage, genome, opts)
+}
+
+/// [`run_recorded`] of one robot.
+fn run_recorded_one(
     stage: &shaping_runtime::program::Stage,
     genome: &shaping_runtime::genome::Genome,
     opts: &shaping_runtime::controller::EpisodeOptions,
@@ -410,4 +458,198 @@ pub fn run_recorded(
     let frames = rec.frames;
     let ep = episode(stage, opts.seed, opts.learning, &trace, &[Part { stage: &stage.name, scene, frames }]);
     Ok((result, trace, ep))
+}
+
+/// Another robot of a team (robot 1, 2, ...) in one life of a recording.
+#[derive(Clone, Debug)]
+pub struct OtherRobot {
+    /// Its index in the team.
+    pub robot: usize,
+    /// The part (life) of the recording it lived in ([`Part`]).
+    pub part: usize,
+    /// Its pose before the first action.
+    pub start: Pose,
+    /// Its rows, one per action of the life, at the actions of the whole
+    /// recording (as robot 0's trace).
+    pub trace: Trace,
+    /// What it sensed after each of its rows (row `k`'s at index `k`; the
+    /// objects aside).
+    pub sensed: EpisodeColumns,
+}
+
+impl Episode {
+    /// Adds a team's other robots (`others`, of the episode's parts): their
+    /// starts in each world and their poses at every action. Nothing for
+    /// one robot: a single robot's episode is as it was.
+    pub fn add_others(&mut self, others: &[OtherRobot]) {
+        let Some(most) = others.iter().map(|o| o.robot).max() else { return };
+        let n = self.actions.x.len();
+        self.actions.others =
+            vec![PoseColumns { x: vec![0.0; n], y: vec![0.0; n], theta: vec![0.0; n] }; most];
+        for o in others {
+            if let Some(w) = self.worlds.get_mut(o.part) {
+                if w.others.len() < o.robot {
+                    w.others.resize(o.robot, [0.0; 3]);
+                }
+                let p = o.start;
+                w.others[o.robot - 1] = [round(p.x, 2), round(p.y, 2), round(p.theta, 4)];
+            }
+            let c = &mut self.actions.others[o.robot - 1];
+            for r in &o.trace.rows {
+                let a = r.action as usize;
+                if a < n {
+                    c.x[a] = round(r.pose.x, 2);
+                    c.y[a] = round(r.pose.y, 2);
+                    c.theta[a] = round(r.pose.theta, 4);
+                }
+            }
+        }
+    }
+
+    /// The robots of the team in world `w` (1 for one robot).
+    pub fn robots_in(&self, w: usize) -> usize {
+        1 + self.worlds.get(w).map_or(0, |x| x.others.len())
+    }
+}
+
+/// Records every robot's frames of a team's life ([`TeamRun::run_watched`]):
+/// robot 0's with the objects, as [`Recorder`] records the one robot's.
+struct TeamRecorder {
+    frames: Vec<Vec<Frame>>,
+    wheels: Vec<[f32; 2]>,
+}
+
+impl TeamWatch for TeamRecorder {
+    fn sensed(&mut self, i: usize, out: &[f32; CHANNELS], team: &Team) {
+        if self.frames.len() <= i {
+            self.frames.resize(i + 1, Vec::new());
+            self.wheels.resize(i + 1, [0.0; 2]);
+        }
+        let sim = team.sim(i);
+        let objects = if i == 0 { object_rows(&sim.scene()) } else { Vec::new() };
+        self.frames[i].push(frame_of(out, sim.arm_down(), sim.claw_closed(), self.wheels[i], objects));
+    }
+    fn commanded(&mut self, i: usize, cmd: &Command) {
+        if let Some(w) = self.wheels.get_mut(i) {
+            *w = cmd.wheels;
+        }
+    }
+}
+
+/// One recorded life of a team.
+pub struct TeamLife {
+    pub result: TeamResult,
+    /// Robot 0's trace and frames (the start, then one per action).
+    pub trace: Trace,
+    pub frames: Vec<Frame>,
+    /// The other robots (part 0, actions from 0).
+    pub others: Vec<OtherRobot>,
+}
+
+/// Lives one life of `run` in `team`'s world and records every robot: each
+/// one's trace has a row per action of the life and its frames a frame per
+/// action (a robot whose battery emptied stays where it stopped, an
+/// obstacle: its later rows repeat its last one with no activation, no
+/// reinforcement and no event, its frames its last with the wheels
+/// stopped). Once `stop` is set, the life ends at the next action.
+pub fn record_team_life(
+    run: &mut TeamRun<'_>,
+    team: &mut Team,
+    opts: &shaping_runtime::controller::EpisodeOptions,
+    stop: Option<&AtomicBool>,
+) -> TeamLife {
+    let n = team.len();
+    let starts: Vec<Pose> = team.sims().iter().map(|s| s.pose()).collect();
+    let mut traces = vec![Trace::default(); n];
+    let mut rec = TeamRecorder { frames: vec![Vec::new(); n], wheels: vec![[0.0; 2]; n] };
+    let result = run.run_watched(team, opts, Some(&mut traces), &mut rec, |_| {
+        !stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    });
+    let actions = result.team.actions;
+    for t in &mut traces {
+        pad_trace(t, actions);
+    }
+    for f in &mut rec.frames {
+        pad_frames(f, actions as usize + 1);
+    }
+    let mut traces = traces.into_iter();
+    let mut frames = rec.frames.into_iter();
+    let trace = traces.next().unwrap_or_default();
+    let frames0 = frames.next().unwrap_or_default();
+    let others = traces
+        .zip(frames)
+        .enumerate()
+        .map(|(k, (trace, frames))| {
+            let mut sensed = EpisodeColumns::new(0);
+            for f in frames.iter().skip(1) {
+                sensed.push_frame(f);
+            }
+            OtherRobot { robot: k + 1, part: 0, start: starts[k + 1], trace, sensed }
+        })
+        .collect();
+    TeamLife { result, trace, frames: frames0, others }
+}
+
+/// Extends a stopped robot's trace to `actions` rows (see [`record_team_life`]).
+fn pad_trace(t: &mut Trace, actions: u32) {
+    while (t.rows.len() as u32) < actions {
+        let Some(last) = t.rows.last() else { return };
+        let mut r = last.clone();
+        r.action += 1;
+        r.activations.fill(0.0);
+        r.reinforcement.fill(0.0);
+        r.recharged = false;
+        r.collided = false;
+        t.rows.push(r);
+    }
+}
+
+/// Extends a stopped robot's frames to `len` (see [`record_team_life`]).
+fn pad_frames(f: &mut Vec<Frame>, len: usize) {
+    while f.len() < len {
+        let Some(last) = f.last() else { return };
+        let mut next = last.clone();
+        next.wheels = [0.0; 2];
+        f.push(next);
+    }
+}
+
+/// A recorded episode: its result, robot 0's trace (the one robot's), the
+/// team's other robots (none for one robot), the episode, and the world
+/// before the first action.
+pub struct Recorded {
+    pub result: shaping_runtime::controller::EpisodeResult,
+    pub trace: Trace,
+    pub others: Vec<OtherRobot>,
+    pub episode: Episode,
+    pub scene: Scene,
+}
+
+/// Runs one traced and recorded episode of `genome` on `stage`, exactly as
+/// [`shaping_runtime::controller::run_episode`] does: of every robot of a
+/// team.
+pub fn record(
+    stage: &shaping_runtime::program::Stage,
+    genome: &shaping_runtime::genome::Genome,
+    opts: &shaping_runtime::controller::EpisodeOptions,
+) -> Result<Recorded, String> {
+    if stage.world.robots <= 1 {
+        let (result, trace, episode) = run_recorded_one(stage, genome, opts)?;
+        let scene = Sim::new(&stage.world, shaping_runtime::controller::episode_rngs(opts.seed).0).scene();
+        return Ok(Recorded { result, trace, others: Vec::new(), episode, scene });
+    }
+    // As `run_team_episode`.
+    let mut team = Team::new(&stage.world, opts.seed);
+    let mut run =
+        TeamRun::new(stage, genome, opts.seed).map_err(|e| format!("stage `{}`: {e}", stage.name))?;
+    let scene = team.sim(0).scene();
+    let life = record_team_life(&mut run, &mut team, opts, None);
+    let mut result = life.result.team;
+    if stage.inheritance == shaping_runtime::program::Inheritance::Lamarckian {
+        result.learned = run.controllers().first().map(|c| c.write_back(genome));
+    }
+    let parts = [Part { stage: &stage.name, scene: scene.clone(), frames: life.frames }];
+    let mut episode = episode(stage, opts.seed, opts.learning, &life.trace, &parts);
+    episode.add_others(&life.others);
+    Ok(Recorded { result, trace: life.trace, others: life.others, episode, scene })
 }

@@ -149,13 +149,17 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
                         (a.0.max(b.0), a.1.max(b.1))
                     };
                     let lives = 2 * u64::from(*lives);
-                    recording_bytes(lives.saturating_mul((*actions).into()), lives, modules, objects, items)
+                    // A team's every robot is recorded.
+                    let robots = u64::from(s.world.robots.max(parent.world.robots).max(1));
+                    let recorded = lives.saturating_mul((*actions).into()).saturating_mul(robots);
+                    recording_bytes(recorded, lives, modules, objects, items)
                 }
                 // A training life is recorded for its first actions only.
                 StageRun::Train { actions } => {
                     let (objects, items) = world_size(&s.world);
-                    let recorded = (*actions).min(RECORDED_TRAINING_ACTIONS);
-                    recording_bytes(recorded.into(), 1, modules, objects, items)
+                    let recorded = u64::from((*actions).min(RECORDED_TRAINING_ACTIONS));
+                    let robots = u64::from(s.world.robots.max(1));
+                    recording_bytes(recorded.saturating_mul(robots), 1, modules, objects, items)
                 }
             }
         })
@@ -282,8 +286,9 @@ fn check_memory_within(
 }
 
 /// Refuses, before it starts, a recorded episode of `actions` actions of
-/// `stage` (`replay`: a training stage's life may be millions of actions)
-/// that would need more memory than the machine has available.
+/// `stage` (`replay`: a training stage's life may be millions of actions;
+/// a team's every robot is recorded) that would need more memory than the
+/// machine has available.
 pub fn check_recording(stage: &shaping_runtime::program::Stage, actions: u32) -> Result<()> {
     check_recording_within(stage, actions, available_memory())
 }
@@ -294,7 +299,9 @@ fn check_recording_within(
     available: Option<u64>,
 ) -> Result<()> {
     let (objects, items) = world_size(&stage.world);
-    let need = recording_bytes(actions.into(), 1, stage.modules.len() as u64, objects, items);
+    // A team's every robot is recorded.
+    let recorded = u64::from(actions).saturating_mul(u64::from(stage.world.robots.max(1)));
+    let need = recording_bytes(recorded, 1, stage.modules.len() as u64, objects, items);
     match available {
         Some(have) if need > have => {
             let gib = |b: u64| b as f64 / (1u64 << 30) as f64;

@@ -107,6 +107,10 @@ pub struct TrajectoryScene {
     pub path_modules: Option<Vec<u16>>,
     /// Names of the modules indexed by `path_modules` (legend only).
     pub module_names: Vec<String>,
+    /// A team's other robots (1, 2, ...): each one's poses `[x, y, theta]`
+    /// after every action, drawn one colour each with the robot's number
+    /// at its start and its body at its end (empty for one robot).
+    pub others: Vec<Vec<[f32; 3]>>,
 }
 
 /// A picture could not be drawn or written.

@@ -180,8 +180,9 @@ pub fn replay(
         None => run::run_seed(&program, None),
     });
     load::check_recording(stage, actions)?;
-    let (r, trace, ep) = episode::run_recorded(stage, &genome, &EpisodeOptions { actions, learning, seed })
+    let recorded = episode::record(stage, &genome, &EpisodeOptions { actions, learning, seed })
         .map_err(|e| Error::io(format!("error: {e}")))?;
+    let episode::Recorded { result: r, trace, others, episode: ep, scene: team_scene } = recorded;
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     let mut crowding = run::Crowding::default();
     crowding.add(r.placement_failures);
@@ -189,8 +190,9 @@ pub fn replay(
         observer.event(Event::Warning(w));
     }
     create_dir(&out)?;
-    let scene = Sim::new(&stage.world, seed).scene();
-    report::episode_files(&out, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
+    // A team's world is the one its robots started in.
+    let scene = if others.is_empty() { Sim::new(&stage.world, seed).scene() } else { team_scene };
+    report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
     write_atomic(&out.join("episode.json"), rundir::compact_json(&ep)?.as_bytes())?;
     rundir::write_program(&out, &program)?;
     write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;

@@ -13,7 +13,7 @@ use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
-use crate::episode::{Episode, EpisodeColumns, Frame};
+use crate::episode::{Episode, EpisodeColumns, Frame, OtherRobot};
 use crate::error::Error;
 use crate::files::write_atomic;
 use crate::plot;
@@ -159,10 +159,33 @@ fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
 /// after the action and what each actuator was set to (from the recorded
 /// `episode`, `NaN` where it has no value).
 pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
+    team_trace_csv(trace, &[], stage, episode)
+}
+
+/// `trace.csv` of a team: [`trace_csv`]'s columns after a first column
+/// `robot` (0 for robot 0, whose rows are `trace`'s, then the `others`'),
+/// the rows in the order of the actions, each action's robots in order.
+/// Without others, the one robot's file, which has no `robot` column.
+pub fn team_trace_csv(trace: &Trace, others: &[OtherRobot], stage: &Stage, episode: &Episode) -> String {
     let declared = declared_columns(stage);
     let mut s = trace_header(&trace.modules, &declared);
-    for (k, r) in trace.rows.iter().enumerate() {
-        trace_row(&mut s, &trace.modules, &declared, r, &episode.actions, k);
+    if others.is_empty() {
+        for (k, r) in trace.rows.iter().enumerate() {
+            trace_row(&mut s, &trace.modules, &declared, r, &episode.actions, k);
+        }
+        return s;
+    }
+    s.insert_str(0, "robot,");
+    // (action, robot, row, its sensed columns, the row's index in them)
+    let mut rows: Vec<(u32, usize, &TraceRow, &EpisodeColumns, usize)> =
+        trace.rows.iter().enumerate().map(|(k, r)| (r.action, 0, r, &episode.actions, k)).collect();
+    for o in others {
+        rows.extend(o.trace.rows.iter().enumerate().map(|(k, r)| (r.action, o.robot, r, &o.sensed, k)));
+    }
+    rows.sort_by_key(|&(action, robot, ..)| (action, robot));
+    for (_, robot, r, columns, k) in rows {
+        let _ = write!(s, "{robot},");
+        trace_row(&mut s, &trace.modules, &declared, r, columns, k);
     }
     s
 }
@@ -332,12 +355,13 @@ pub fn episode_files(
     title: &str,
     stage: &Stage,
     trace: &Trace,
+    others: &[OtherRobot],
     episode: &Episode,
     scene: &Scene,
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
 ) -> Result<(), Error> {
-    episode_files_until(dir, title, stage, trace, episode, scene, marks, path, &|| false)
+    episode_files_until(dir, title, stage, trace, others, episode, scene, marks, path, &|| false)
 }
 
 /// The error [`episode_files_until`] stops with when `stop` says so.
@@ -351,20 +375,21 @@ pub fn episode_files_until(
     title: &str,
     stage: &Stage,
     trace: &Trace,
+    others: &[OtherRobot],
     episode: &Episode,
     scene: &Scene,
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
-    write_atomic(&dir.join("trace.csv"), trace_csv(trace, stage, episode).as_bytes())?;
+    write_atomic(&dir.join("trace.csv"), team_trace_csv(trace, others, stage, episode).as_bytes())?;
     if trace.rows.is_empty() {
         return Ok(());
     }
     if stop() {
         return Err(Error::io(STOPPED));
     }
-    pictures(dir, title, stage, trace, scene, marks, path, stop)
+    pictures(dir, title, stage, trace, others, scene, marks, path, stop)
 }
 
 /// The pictures of one episode whose `trace.csv` is written (see
@@ -377,7 +402,7 @@ pub fn episode_pictures(
     trace: &Trace,
     scene: &Scene,
 ) -> Result<(), Error> {
-    pictures(dir, title, stage, trace, scene, &[], None, &|| false)
+    pictures(dir, title, stage, trace, &[], scene, &[], None, &|| false)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -386,6 +411,7 @@ fn pictures(
     title: &str,
     stage: &Stage,
     trace: &Trace,
+    others: &[OtherRobot],
     scene: &Scene,
     marks: &[(u32, String)],
     path: Option<(Range<usize>, &str)>,
@@ -432,9 +458,9 @@ fn pictures(
         Some((rows, what)) => {
             let rows = trace.rows.get(rows).filter(|r| !r.is_empty()).unwrap_or(&trace.rows);
             let part = Trace { modules: trace.modules.clone(), rows: rows.to_vec() };
-            (trajectory_scene(scene, &part), format!("{title}: trajectory, {what}"))
+            (trajectory_scene(scene, &part, others), format!("{title}: trajectory, {what}"))
         }
-        None => (trajectory_scene(scene, trace), format!("{title}: trajectory")),
+        None => (trajectory_scene(scene, trace, others), format!("{title}: trajectory")),
     };
     plot::trajectory(&dir.join("trajectory"), &what, &scene).map_err(to_err)
 }
@@ -487,7 +513,23 @@ pub fn reinforcement_signals(trace: &Trace, module: usize) -> Vec<f32> {
         .collect()
 }
 
-fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
+/// The trajectory picture of robot 0's `trace` (the one robot's) and of
+/// the team's other robots at the same actions (`others`: those of a
+/// life among those actions).
+fn trajectory_scene(scene: &Scene, trace: &Trace, others: &[OtherRobot]) -> plot::TrajectoryScene {
+    let (first, last) = match (trace.rows.first(), trace.rows.last()) {
+        (Some(a), Some(b)) => (a.action, b.action),
+        _ => (1, 0),
+    };
+    let mut paths: Vec<(usize, Vec<[f32; 3]>)> = others
+        .iter()
+        .map(|o| {
+            let rows = o.trace.rows.iter().filter(|r| (first..=last).contains(&r.action));
+            (o.robot, rows.map(|r| [r.pose.x, r.pose.y, r.pose.theta]).collect::<Vec<_>>())
+        })
+        .filter(|(_, p)| !p.is_empty())
+        .collect();
+    paths.sort_by_key(|(robot, _)| *robot);
     let mut marks = Vec::new();
     let (mut grips, mut releases) = (0, 0);
     for (i, r) in trace.rows.iter().enumerate() {
@@ -505,6 +547,7 @@ fn trajectory_scene(scene: &Scene, trace: &Trace) -> plot::TrajectoryScene {
     }
     plot::TrajectoryScene {
         marks,
+        others: paths.into_iter().map(|(_, p)| p).collect(),
         path_modules: Some(trace.rows.iter().map(|r| r.winner).collect()),
         module_names: trace.modules.clone(),
         ..picture(scene, trace.rows.iter().map(|r| [r.pose.x, r.pose.y, r.pose.theta]).collect())
@@ -539,5 +582,6 @@ pub fn picture(scene: &Scene, path: Vec<[f32; 3]>) -> plot::TrajectoryScene {
         marks: Vec::new(),
         path_modules: None,
         module_names: Vec::new(),
+        others: Vec::new(),
     }
 }

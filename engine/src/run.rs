@@ -7,12 +7,12 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::Value;
 use shaping_runtime::controller::{
-    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, Trace,
+    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, TeamRun, Trace,
 };
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Param, Program, Stage, StageRun};
-use shaping_runtime::sim::{Scene, Sim};
+use shaping_runtime::sim::{Scene, Sim, Team};
 
 use crate::episode::{self, Part, Recorder, Stoppable};
 use crate::error::{Error, ErrorKind, Result};
@@ -749,6 +749,9 @@ pub struct BeforeAfter {
     pub scene: Scene,
     /// The recorded episode, every life a part (`episode.json`).
     pub episode: episode::Episode,
+    /// A team's other robots in every life, their rows at the actions of
+    /// `trace` (none for one robot).
+    pub others: Vec<episode::OtherRobot>,
 }
 
 impl BeforeAfter {
@@ -779,6 +782,10 @@ pub fn before_after(
 ) -> Result<BeforeAfter, Error> {
     if lives == 0 {
         return Err(Error::io(format!("error: test stage `{}` has no life to run", stage.name)));
+    }
+    let team = |st: &Stage| (0..st.variant_count()).any(|v| st.variant_world(v).robots > 1);
+    if team(parent) || team(stage) {
+        return team_before_after(parent, stage, genome, actions, lives, learning, seed, stop);
     }
     let (_, rng) = episode_rngs(seed);
     let mut ctl = Controller::new(stage, genome, rng)
@@ -816,7 +823,65 @@ pub fn before_after(
     let scene = parts[lives as usize].scene.clone();
     let episode = episode::episode(stage, seed, learning, &trace, &parts);
     let [before, after] = results;
-    Ok(BeforeAfter { trace, switch, before, after, scene, episode })
+    Ok(BeforeAfter { trace, switch, before, after, scene, episode, others: Vec::new() })
+}
+
+/// [`before_after`] of a team: every life the team's (one set of
+/// controllers through all lives, as one controller is for one robot),
+/// each life's result the team's; the trace robot 0's, the others' beside.
+#[allow(clippy::too_many_arguments)]
+fn team_before_after(
+    parent: &Stage,
+    stage: &Stage,
+    genome: &Genome,
+    actions: u32,
+    lives: u32,
+    learning: bool,
+    seed: u64,
+    stop: Option<&AtomicBool>,
+) -> Result<BeforeAfter, Error> {
+    let mut run = TeamRun::new(stage, genome, seed)
+        .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
+    let opts = EpisodeOptions { actions, learning, seed };
+    let mut trace = Trace::default();
+    let mut others = Vec::new();
+    let mut parts = Vec::new();
+    let mut results = [Vec::new(), Vec::new()];
+    for (half, world) in [parent, stage].into_iter().enumerate() {
+        for k in 0..lives {
+            let w = world.variant_world(k as usize % world.variant_count());
+            run.use_world(w);
+            let mut team = Team::new(w, evolve::seed::test_life_seed(seed, half == 1, k));
+            let scene = team.sim(0).scene();
+            let life = episode::record_team_life(&mut run, &mut team, &opts, stop);
+            results[half].push(life.result.team);
+            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                return Err(interrupted_test(stage, half == 1, k, lives));
+            }
+            let from = trace.rows.len() as u32;
+            let shift = |t: &mut Trace| {
+                for r in &mut t.rows {
+                    r.action += from;
+                }
+            };
+            let mut mine = life.trace;
+            shift(&mut mine);
+            trace.modules.clone_from(&mine.modules);
+            trace.rows.append(&mut mine.rows);
+            for mut o in life.others {
+                shift(&mut o.trace);
+                o.part = parts.len();
+                others.push(o);
+            }
+            parts.push(Part { stage: &world.name, scene, frames: life.frames });
+        }
+    }
+    let switch = results[0].iter().map(|r| r.actions).sum();
+    let scene = parts[lives as usize].scene.clone();
+    let mut episode = episode::episode(stage, seed, learning, &trace, &parts);
+    episode.add_others(&others);
+    let [before, after] = results;
+    Ok(BeforeAfter { trace, switch, before, after, scene, episode, others })
 }
 
 /// Ctrl-C during a test stage: the life under way stopped at its next
@@ -968,6 +1033,7 @@ fn test_files(
         &stage.name,
         stage,
         &ba.trace,
+        &ba.others,
         &ba.episode,
         &ba.scene,
         &marks,
@@ -1118,11 +1184,11 @@ impl Runner<'_> {
         // millions).
         let episode_seed = evolve::train::training_seed(seed, index);
         let opts = EpisodeOptions { actions: recorded, learning: true, seed: episode_seed };
-        let (_, trace, ep) = episode::run_recorded(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
+        let rec = episode::record(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
             .map_err(|e| Error::io(format!("error: {e}")))?;
-        let scene = Sim::new(&stage.world, episode_rngs(episode_seed).0).scene();
-        report::episode_files(dir, &stage.name, stage, &trace, &ep, &scene, &[], None)?;
-        write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())?;
+        let (trace, ep) = (&rec.trace, &rec.episode);
+        report::episode_files(dir, &stage.name, stage, trace, &rec.others, ep, &rec.scene, &[], None)?;
+        write_atomic(&dir.join("episode.json"), compact_json(ep)?.as_bytes())?;
         rundir::write_trained(dir, &trained)?;
         self.observer.event(Event::Trained { stage, trained: &trained, recorded, reused: false, dir });
         Ok(trained)

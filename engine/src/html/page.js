@@ -71,6 +71,9 @@
   // ------------------------------------------------------------------ replay
   const R = { ep: null, epIndex: 0, a: 0, playing: false, speed: 10, acc: 0, last: 0, hashTimer: 0, timer: 0 };
 
+  // The colours of a team's robots 1, 2, ... (robot 0 is drawn by its winning module).
+  const TEAM = ['#606e82', '#a6783c', '#46826e', '#965a82', '#6e6e3c', '#3c6ea0', '#a05050', '#645aa0'];
+
   function prepare(ep) {
     const c = ep.actions;
     const n = c.x.length;
@@ -179,6 +182,22 @@
       g.fillStyle = st === 1 ? '#1e8a4c' : '#8fb996'; g.fill();
       g.strokeStyle = '#2d5a36'; g.lineWidth = 1; g.stroke();
     }
+    // A team's other robots: each one's trail in this world, its body and heading, its number.
+    const others = w.others || [];
+    for (let j = 0; j < others.length && j < (c.others || []).length; j++) {
+      const o = c.others[j], col = TEAM[j % TEAM.length], r = w.body_radius;
+      g.strokeStyle = col; g.lineWidth = 1.5; g.globalAlpha = 0.5;
+      g.beginPath(); g.moveTo(X(others[j][0]), Y(others[j][1]));
+      for (let k = w.from; k <= a; k++) g.lineTo(X(o.x[k]), Y(o.y[k]));
+      g.stroke(); g.globalAlpha = 1;
+      const ox = o.x[a], oy = o.y[a], ot = o.theta[a];
+      g.beginPath(); g.arc(X(ox), Y(oy), r * s, 0, 2 * Math.PI);
+      g.fillStyle = col; g.globalAlpha = 0.25; g.fill(); g.globalAlpha = 1;
+      g.strokeStyle = col; g.lineWidth = 2; g.stroke();
+      g.beginPath(); g.moveTo(X(ox), Y(oy)); g.lineTo(X(ox + r * Math.cos(ot)), Y(oy + r * Math.sin(ot))); g.stroke();
+      g.fillStyle = '#38414d'; g.font = '10px sans-serif'; g.textAlign = 'center';
+      g.fillText(String(j + 1), X(ox), Y(oy) + 3.5); g.textAlign = 'start';
+    }
     // The robot.
     const x = c.x[a], y = c.y[a], th = c.theta[a], br = w.body_radius;
     const ir = c.ir[a];
@@ -215,7 +234,8 @@
     g.beginPath(); g.moveTo(X(x), Y(y)); g.lineTo(X(x + br * Math.cos(th)), Y(y + br * Math.sin(th))); g.stroke();
     // The stage whose world this is.
     g.fillStyle = '#5f6b7a'; g.font = '12px sans-serif';
-    g.fillText('world of ' + w.stage + ' · ' + Math.round(w.arena[0]) + ' × ' + Math.round(w.arena[1]) + ' mm · action ' + a, pad, 14);
+    const team = others.length ? ' · ' + (others.length + 1) + ' robots' : '';
+    g.fillText('world of ' + w.stage + ' · ' + Math.round(w.arena[0]) + ' × ' + Math.round(w.arena[1]) + ' mm' + team + ' · action ' + a, pad, 14);
   }
 
   // Timeline geometry: one band per module, then battery, reinforcement and performance.

@@ -1,5 +1,6 @@
 //! Top view of the arena to scale with the robot's path.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::EmptyElement;
 use plotters::prelude::*;
@@ -60,6 +61,11 @@ pub(super) fn check(s: &TrajectoryScene) -> Result<(), String> {
     if let Some(i) = s.path.iter().position(|p| !finite(p)) {
         return Err(format!("path point {i} is not finite"));
     }
+    for (k, path) in s.others.iter().enumerate() {
+        if let Some(i) = path.iter().position(|p| !finite(p)) {
+            return Err(format!("point {i} of robot {}'s path is not finite", k + 1));
+        }
+    }
     if let Some(m) = &s.path_modules {
         if m.len() != s.path.len() {
             return Err(format!(
@@ -94,7 +100,7 @@ impl<'a> Arena<'a> {
         for o in &s.objects {
             cover(f64::from(o.x), f64::from(o.y), f64::from(o.radius));
         }
-        for p in &s.path {
+        for p in s.path.iter().chain(s.others.iter().flatten()) {
             cover(f64::from(p[0]), f64::from(p[1]), f64::from(s.body_radius));
         }
         if let Some((a, b)) = s.bar {
@@ -220,6 +226,21 @@ impl Figure for Arena<'_> {
             }
         }
 
+        // A team's other robots under robot 0: each path one colour, its
+        // start numbered, its body at the end.
+        for (k, path) in s.others.iter().enumerate() {
+            let colour = team_colour(k);
+            let line: Vec<(f64, f64)> = path.iter().map(|p| (f64::from(p[0]), f64::from(p[1]))).collect();
+            let style = colour.stroke_width(2);
+            chart.draw_series(unmitered(&line).into_iter().map(|l| PathElement::new(l, style)))?;
+            if let Some(&start) = line.first() {
+                let ring = RGBColor(150, 150, 150).stroke_width(1);
+                chart.draw_series(std::iter::once(Circle::new(start, px(s.body_radius), ring)))?;
+            }
+            if let Some(last) = path.last() {
+                self.body(&mut chart, *last, colour)?;
+            }
+        }
         let pts: Vec<(f64, f64)> = s.path.iter().map(|p| (f64::from(p[0]), f64::from(p[1]))).collect();
         if let Some(&start) = pts.first() {
             let body = px(s.body_radius);
@@ -253,19 +274,63 @@ impl Figure for Arena<'_> {
             }
         }
         if let Some(last) = s.path.last() {
-            let c = (f64::from(last[0]), f64::from(last[1]));
-            let r = f64::from(s.body_radius);
-            let (dx, dy) = (r * f64::from(last[2]).cos(), r * f64::from(last[2]).sin());
-            chart.draw_series(std::iter::once(Circle::new(c, px(s.body_radius), WHITE.mix(0.6).filled())))?;
-            chart.draw_series(std::iter::once(Circle::new(c, px(s.body_radius), INK.stroke_width(2))))?;
-            chart.draw_series(std::iter::once(PathElement::new(
-                vec![c, (c.0 + dx, c.1 + dy)],
-                HEADING.stroke_width(3),
-            )))?;
+            self.body(&mut chart, *last, INK)?;
+        }
+        if text && !s.others.is_empty() {
+            // Every robot's number beside its start.
+            let style = render::label_style(13.0).pos(Pos::new(HPos::Center, VPos::Center));
+            let starts = s.path.first().into_iter().chain(s.others.iter().filter_map(|p| p.first()));
+            for (k, p) in starts.enumerate() {
+                let at = (f64::from(p[0]), f64::from(p[1]));
+                let label = EmptyElement::at(at)
+                    + Circle::new((0, 0), 8, WHITE.mix(0.85).filled())
+                    + Text::new(k.to_string(), (0, 0), style.clone());
+                chart.draw_series(std::iter::once(label))?;
+            }
         }
         if text {
             self.legend(&legend)?;
         }
+        Ok(())
+    }
+}
+
+/// The colour of a team's robot `k + 1` (robot 0's path is coloured by its
+/// modules or by time).
+pub(super) fn team_colour(k: usize) -> RGBColor {
+    const C: [RGBColor; 8] = [
+        RGBColor(96, 110, 130),
+        RGBColor(166, 120, 60),
+        RGBColor(70, 130, 110),
+        RGBColor(150, 90, 130),
+        RGBColor(110, 110, 60),
+        RGBColor(60, 110, 160),
+        RGBColor(160, 80, 80),
+        RGBColor(100, 90, 160),
+    ];
+    C[k % C.len()]
+}
+
+impl Arena<'_> {
+    /// A robot's body at `pose` `[x, y, theta]`: a pale disc outlined in
+    /// `outline`, its heading in red.
+    fn body<DB: DrawingBackend>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+        pose: [f32; 3],
+        outline: RGBColor,
+    ) -> DrawResult<DB> {
+        let s = self.s;
+        let px = ((f64::from(s.body_radius) * self.scale()).round() as i32).max(2);
+        let c = (f64::from(pose[0]), f64::from(pose[1]));
+        let r = f64::from(s.body_radius);
+        let (dx, dy) = (r * f64::from(pose[2]).cos(), r * f64::from(pose[2]).sin());
+        chart.draw_series(std::iter::once(Circle::new(c, px, WHITE.mix(0.6).filled())))?;
+        chart.draw_series(std::iter::once(Circle::new(c, px, outline.stroke_width(2))))?;
+        chart.draw_series(std::iter::once(PathElement::new(
+            vec![c, (c.0 + dx, c.1 + dy)],
+            HEADING.stroke_width(3),
+        )))?;
         Ok(())
     }
 }
@@ -372,6 +437,14 @@ impl Arena<'_> {
         area.draw(&Circle::new((gx + 14, y), 10, INK.stroke_width(2)))?;
         area.draw(&PathElement::new(vec![(gx + 14, y), (gx + 24, y)], HEADING.stroke_width(3)))?;
         entry(area, &mut y, "final pose and heading")?;
+        if !s.others.is_empty() {
+            let n = s.others.len() + 1;
+            area.draw(&PathElement::new(vec![(gx, y), (gx + 28, y)], team_colour(0).stroke_width(2)))?;
+            entry(area, &mut y, &format!("robots 1 to {}: paths", n - 1))?;
+            let style = render::label_style(13.0).pos(Pos::new(HPos::Center, VPos::Center));
+            area.draw(&(EmptyElement::at((gx + 14, y)) + Text::new("0", (0, 0), style)))?;
+            entry(area, &mut y, &format!("robot at its start (of {n})"))?;
+        }
         if !s.marks.is_empty() {
             area.draw(&Circle::new((gx + 14, y), 4, INK.filled()))?;
             entry(area, &mut y, "event")?;

@@ -479,3 +479,36 @@ fn declared_world_items_are_drawn() {
     let bad = TrajectoryScene { zones: vec![([0.0, 0.0], [1.0, 1.0], 2.0, false)], ..scene(false) };
     assert!(trajectory(&d.stem("bad"), "", &bad).is_err());
 }
+
+/// A team's other robots are drawn: their paths and bodies, each in its
+/// own colour.
+#[test]
+fn a_teams_other_robots_are_drawn_each_in_its_colour() {
+    let one = TrajectoryScene {
+        path: vec![[60.0, 60.0, 0.0], [70.0, 60.0, 0.0]],
+        marks: Vec::new(),
+        path_modules: None,
+        ..scene(true)
+    };
+    let others =
+        vec![vec![[300.0, 100.0, 1.0], [300.0, 200.0, 1.5]], vec![[100.0, 450.0, 0.0], [200.0, 450.0, 0.0]]];
+    let team = TrajectoryScene { others: others.clone(), ..one.clone() };
+    let (a, b) = (trajectory_rgb(&one).unwrap(), trajectory_rgb(&team).unwrap());
+    assert_eq!((a.width, a.height), (b.width, b.height), "the view holds both");
+    let changed: Vec<usize> = (0..a.pixels.len() / 3)
+        .filter(|&i| a.pixels[3 * i..3 * i + 3] != b.pixels[3 * i..3 * i + 3])
+        .collect();
+    assert!(changed.len() > 500, "{} pixels changed", changed.len());
+    // In each robot's own colour, which the one robot's picture has nowhere.
+    for k in 0..2 {
+        let c = super::arena::team_colour(k);
+        let rgb = [c.0, c.1, c.2];
+        let has = |f: &Rgb| f.pixels.chunks(3).filter(|p| *p == rgb).count();
+        assert_eq!(has(&a), 0, "robot {}'s colour", k + 1);
+        assert!(has(&b) > 50, "robot {}'s colour: {} pixels", k + 1, has(&b));
+    }
+    // A bad pose of another robot is refused, naming it.
+    let bad = TrajectoryScene { others: vec![vec![[f32::NAN, 0.0, 0.0]]], ..one };
+    let err = trajectory_rgb(&bad).unwrap_err().to_string();
+    assert!(err.contains("robot 1's path"), "{err}");
+}

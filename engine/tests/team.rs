@@ -1,0 +1,182 @@
+//! The outputs of a team (a world of several robots): every robot in
+//! `trace.csv`, the pictures, `episode.json` and the report; a test stage
+//! of a team; a replay.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use common::{load, options, read_text, run, tiny_bat, write_bat, Log};
+use shaping_engine::episode::{self, Episode};
+use shaping_engine::replay::{self, ReplayOptions};
+use shaping_engine::run::RunOptions;
+use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::Program;
+
+/// `program` with `robots` robots in every stage's world, an 800 mm square arena.
+fn team(mut program: Program, robots: u32) -> Program {
+    for st in &mut program.stages {
+        st.world.robots = robots;
+        st.world.arena = [800.0, 800.0];
+    }
+    program
+}
+
+fn episode_of(path: &Path) -> Episode {
+    serde_json::from_str(&read_text(path)).unwrap()
+}
+
+/// `trace.csv`'s rows per robot: `{robot: [action, ...]}` (the `robot`
+/// column first).
+fn rows_per_robot(csv: &str) -> BTreeMap<usize, Vec<u32>> {
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(&header[..2], ["robot", "action"], "{header:?}");
+    let mut out: BTreeMap<usize, Vec<u32>> = BTreeMap::new();
+    for l in lines {
+        let cells: Vec<&str> = l.split(',').collect();
+        assert_eq!(cells.len(), header.len(), "{l}");
+        out.entry(cells[0].parse().unwrap()).or_default().push(cells[1].parse().unwrap());
+    }
+    out
+}
+
+/// An evolved stage of 3 robots: its episode has the two others' poses at
+/// every action; its replay writes every robot's rows, a picture that is
+/// not the one robot's, and a report whose episode has the 3 robots.
+#[test]
+fn a_team_run_and_its_replay_record_every_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let program = team(load(&tiny_bat()), 3);
+    run(program.clone(), &RunOptions { stage: Some("first".into()), ..options(d) }).unwrap();
+
+    let ep = episode_of(&d.join("first/episode.json"));
+    let n = ep.actions.x.len();
+    assert!(n > 0);
+    assert_eq!(ep.worlds[0].others.len(), 2, "two other robots start in the world");
+    assert_eq!(ep.actions.others.len(), 2);
+    for (k, o) in ep.actions.others.iter().enumerate() {
+        assert_eq!((o.x.len(), o.y.len(), o.theta.len()), (n, n, n), "robot {}", k + 1);
+        // Each robot is somewhere else than robot 0 (bodies do not overlap).
+        assert!((0..n).all(|a| (o.x[a] - ep.actions.x[a]).hypot(o.y[a] - ep.actions.y[a]) > 50.0));
+    }
+    assert_ne!(ep.actions.others[0].x, ep.actions.others[1].x);
+
+    let out = d.join("replay");
+    let args = ReplayOptions {
+        file: tiny_bat(),
+        run: Some(d.to_path_buf()),
+        out: Some(out.clone()),
+        stage: Some("first".into()),
+        report: true,
+        ..ReplayOptions::default()
+    };
+    let replayed = replay::replay(program.clone(), &args, &Log::default()).unwrap();
+    let rows = rows_per_robot(&read_text(&out.join("trace.csv")));
+    let actions = replayed.result.actions;
+    assert!(actions > 0);
+    assert_eq!(rows.keys().copied().collect::<Vec<_>>(), [0, 1, 2]);
+    for (robot, acts) in &rows {
+        assert_eq!(*acts, (0..actions).collect::<Vec<_>>(), "robot {robot}: one row per action");
+    }
+    let ep = episode_of(&out.join("episode.json"));
+    assert_eq!(ep.actions.others.len(), 2);
+    assert_eq!(ep.actions.others[1].x.len(), actions as usize);
+    let html = read_text(&out.join("report.html"));
+    assert!(html.contains("\"others\":[{\"x\":["), "the report's episode has the other robots");
+
+    // The same replay of one robot: its trajectory is another picture.
+    let one = d.join("one");
+    let best = read_text(&d.join("first/best.genome")).trim().to_string();
+    let args1 =
+        ReplayOptions { out: Some(one.clone()), report: false, genome: Some(best), run: None, ..args };
+    replay::replay(team(load(&tiny_bat()), 1), &args1, &Log::default()).unwrap();
+    let trace1 = read_text(&one.join("trace.csv"));
+    assert!(trace1.starts_with("action,"), "one robot's trace has no robot column");
+    let png = |p: &Path| std::fs::read(p.join("trajectory.png")).unwrap();
+    assert_ne!(png(&out), png(&one));
+    let svg = read_text(&out.join("trajectory.svg"));
+    assert!(svg.contains("robots 1 to 2"), "the legend names the team");
+}
+
+/// A recorded team episode is the episode a run evaluates (the recorder
+/// draws no random number), every robot's trace one row per action.
+#[test]
+fn a_recorded_team_episode_is_the_evaluated_one() {
+    let program = team(load(&tiny_bat()), 4);
+    let stage = &program.stages[0];
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    for seed in [1, 7] {
+        let opts = EpisodeOptions { actions: 50, learning: true, seed };
+        let mut plain = Trace::default();
+        let expected = run_episode(stage, &genome, &opts, Some(&mut plain));
+        let rec = episode::record(stage, &genome, &opts).unwrap();
+        assert_eq!(rec.result, expected);
+        assert_eq!(rec.trace, plain, "robot 0's trace");
+        assert_eq!(rec.others.len(), 3);
+        for o in &rec.others {
+            assert_eq!(o.trace.rows.len() as u32, expected.actions, "robot {}", o.robot);
+            assert_eq!(o.sensed.ir.len() as u32, expected.actions, "robot {}", o.robot);
+        }
+        let csv = shaping_engine::report::team_trace_csv(&rec.trace, &rec.others, stage, &rec.episode);
+        let rows = rows_per_robot(&csv);
+        assert_eq!(rows.len(), 4);
+        // Robot 0's lines are the one robot's file's, after the robot column.
+        let one = shaping_engine::report::trace_csv(&rec.trace, stage, &rec.episode);
+        let zeros: Vec<&str> = csv.lines().skip(1).filter_map(|l| l.strip_prefix("0,")).collect();
+        assert_eq!(zeros, one.lines().skip(1).collect::<Vec<_>>());
+    }
+}
+
+/// A test stage of a team runs every life with the team: `trace.csv` has
+/// every robot's rows of every life, `episode.json` each world's others.
+#[test]
+fn a_test_stage_of_a_team_runs_every_life_with_the_team() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let stage = "\nstage third extends second {\n  test best for 2 lives of 30 actions with learning\n}\n";
+    let (_, program) = write_bat(d, "lives.bat", &(read_text(&tiny_bat()) + stage));
+    let program = team(program, 3);
+    run(program, &options(&d.join("a"))).unwrap();
+    let t = d.join("a/third");
+    let summary: serde_json::Value = serde_json::from_str(&read_text(&t.join("summary.json"))).unwrap();
+    let lives: Vec<u32> = ["before_lives", "after_lives"]
+        .iter()
+        .flat_map(|k| {
+            summary[k].as_array().unwrap().iter().map(|v| v.as_u64().unwrap() as u32).collect::<Vec<_>>()
+        })
+        .collect();
+    assert_eq!(lives.len(), 4);
+    let total: u32 = lives.iter().sum();
+    let rows = rows_per_robot(&read_text(&t.join("trace.csv")));
+    assert_eq!(rows.keys().copied().collect::<Vec<_>>(), [0, 1, 2]);
+    for acts in rows.values() {
+        assert_eq!(*acts, (0..total).collect::<Vec<_>>());
+    }
+    let ep = episode_of(&t.join("episode.json"));
+    assert_eq!(ep.worlds.len(), 4);
+    assert!(ep.worlds.iter().all(|w| w.others.len() == 2));
+    assert_eq!(ep.actions.others[0].x.len(), total as usize);
+    assert!(t.join("trajectory.png").exists());
+}
+
+/// The interruption flag stops a team's life at the next action, as it
+/// stops one robot's: a test of a life far too long to end ends at once.
+#[test]
+fn a_stopped_team_test_stops_at_the_next_action() {
+    let mut program = team(load(&tiny_bat()), 3);
+    for st in &mut program.stages {
+        // No battery: only the flag ends the life.
+        st.world.battery = None;
+    }
+    let (parent, stage) = (&program.stages[0], &program.stages[1]);
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let stop = std::sync::atomic::AtomicBool::new(true);
+    let result = shaping_engine::run::before_after(parent, stage, &genome, u32::MAX, 1, true, 1, Some(&stop));
+    let err = result.err().expect("stopped");
+    assert_eq!(err.kind(), shaping_engine::ErrorKind::Interrupted, "{err}");
+    assert!(err.message().contains("stopped in life 1 of 1"), "{err}");
+}
