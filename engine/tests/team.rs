@@ -180,3 +180,42 @@ fn a_stopped_team_test_stops_at_the_next_action() {
     assert_eq!(err.kind(), shaping_engine::ErrorKind::Interrupted, "{err}");
     assert!(err.message().contains("stopped in life 1 of 1"), "{err}");
 }
+
+/// A test whose changed world adds robots: the lives before the change
+/// are the one robot's, those after it the team's; `trace.csv` and
+/// `episode.json` say which robots lived where.
+#[test]
+fn a_test_whose_change_adds_robots_records_them_after_the_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let stage = "\nstage third extends second {\n  test best for 1 lives of 30 actions with learning\n}\n";
+    let (_, mut program) = write_bat(d, "grow.bat", &(read_text(&tiny_bat()) + stage));
+    for st in &mut program.stages {
+        st.world.arena = [800.0, 800.0];
+    }
+    let mut one = program.clone();
+    program.stages[2].world.robots = 3;
+    one.stages[2].world.robots = 1;
+    run(program, &options(&d.join("a"))).unwrap();
+    run(one, &options(&d.join("one"))).unwrap();
+    let t = d.join("a/third");
+    let summary: serde_json::Value = serde_json::from_str(&read_text(&t.join("summary.json"))).unwrap();
+    // Before the change, the team of one is the one robot of a one-robot test.
+    let alone: serde_json::Value =
+        serde_json::from_str(&read_text(&d.join("one/third/summary.json"))).unwrap();
+    assert_eq!(summary["before"], alone["before"]);
+    let switch = summary["before"]["actions"].as_u64().unwrap() as u32;
+    let total = switch + summary["after"]["actions"].as_u64().unwrap() as u32;
+    let rows = rows_per_robot(&read_text(&t.join("trace.csv")));
+    assert_eq!(rows[&0], (0..total).collect::<Vec<_>>());
+    for robot in [1, 2] {
+        assert_eq!(rows[&robot], (switch..total).collect::<Vec<_>>(), "robot {robot} lives after the change");
+    }
+    let ep = episode_of(&t.join("episode.json"));
+    assert_eq!(ep.worlds.iter().map(|w| w.others.len()).collect::<Vec<_>>(), [0, 2]);
+    assert_eq!(ep.robots_in(0), 1);
+    assert_eq!(ep.robots_in(1), 3);
+    let o = &ep.actions.others[1];
+    assert_eq!(o.x.len(), total as usize);
+    assert!(o.x[switch as usize..].iter().all(|&x| x > 0.0), "robot 2's poses after the change");
+}
