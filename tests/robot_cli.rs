@@ -432,8 +432,9 @@ fn bad_robot_arguments_are_errors() {
 
 /// `drive` binds trained weights as `replay` does (it used to refuse every
 /// stage using a training stage's weights): every stage of every example is
-/// driven for a few actions, its training stages trained on the fly, and
-/// with `--run` a run's training stage is driven through its own life.
+/// driven for a few actions, its training stages trained on the fly (a
+/// team's stages are refused), and with `--run` a run's training stage is
+/// driven through its own life.
 #[test]
 fn drive_runs_every_stage_of_every_example() {
     let dir = scratch("every-stage");
@@ -452,6 +453,8 @@ fn drive_runs_every_stage_of_every_example() {
             let name = stage["name"].as_str().unwrap();
             let bits = stage["layout"]["bits"].as_u64().unwrap() as usize;
             let physical = stage["world"]["objects"].as_object().is_some_and(|o| o["virtual_"] == false);
+            // A team (`robots N`, left out of the program while 1) is refused.
+            let team = stage["world"]["robots"].as_u64().is_some_and(|n| n > 1);
             // In an empty directory: no `runs/` of an earlier run is used.
             let out = shaping()
                 .current_dir(&dir)
@@ -466,7 +469,10 @@ fn drive_runs_every_stage_of_every_example() {
                 .output()
                 .unwrap();
             let err = text(&out.stderr);
-            if physical {
+            if team {
+                assert!(!out.status.success(), "{} {name}: a team was driven", file.display());
+                assert!(err.contains("one robot on one serial port"), "{} {name}: {err}", file.display());
+            } else if physical {
                 assert!(err.contains("the objects must be `virtual`"), "{} {name}: {err}", file.display());
             } else {
                 assert!(out.status.success(), "{} {name}: {err}", file.display());
