@@ -1,12 +1,13 @@
 //! What the experiment examples (`oracle.rs`, `grip.rs`, `discriminate.rs`,
-//! `lives.rs`) share, all through the engine library (`shaping_engine`), as
-//! `shaping run` and `shaping replay` do: loading a file's stage
-//! (`load::load_program`, its warnings printed once to stderr), binding its
-//! training stages (`run::bind_training`: a run's `trained.json` where it
-//! fits, else trained again from the seed), the best individual of an
-//! evolved stage of a run (`rundir::checked_best`: the checkpoint must fit
-//! the program, `best.genome` must be its best, and the run's seed the
-//! directory's), and turning an error into the exit status.
+//! `lives.rs`, `walkers.rs`) share, all through the engine library
+//! (`shaping_engine`), as `shaping run` and `shaping replay` do: loading a
+//! file's stage (`load::load_program`, its warnings printed once to
+//! stderr), binding its training stages (`run::bind_training`: a run's
+//! `trained.json` where it fits, else trained again from the seed), the
+//! best individual of an evolved stage of a run (`rundir::checked_best`:
+//! the checkpoint must fit the program, `best.genome` must be its best,
+//! and the run's seed the directory's), and turning an error into the exit
+//! status.
 
 #![allow(dead_code)] // each example uses part of it
 

@@ -94,6 +94,21 @@ $B experiment $R/charger.bat --seeds $SEEDS --out $R/charger --fresh > /dev/null
 # control, each best tested on 100 fresh lives in the task's two variants.
 $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/null
 
+# Teams (EXPERIMENTS.md, "Teams: aggregation and cooperative collect"):
+# aggregation.bat's 10 robots, and team-collect.bat's 4 robots with 16
+# objects against one robot with 4 objects in khepera.bat's arena (the same
+# file with three changes, each checked).
+$B experiment examples/aggregation.bat --seeds $SEEDS --out $R/aggregation --fresh > /dev/null
+$B experiment examples/team-collect.bat --seeds $SEEDS --out $R/team-collect --fresh > /dev/null
+sed -e 's#arena 800mm x 1200mm#arena 400mm x 600mm#' -e 's#charger 400mm on north wall#charger 200mm on north wall#' \
+  -e '/^    robots 4$/d' -e 's#/ 300, team sum$#/ 300#' -e 's#objects 16 diameter#objects 4 diameter#' \
+  examples/team-collect.bat > $R/team-collect-solo.bat
+grep -q 'arena 400mm x 600mm' $R/team-collect-solo.bat
+grep -q 'charger 200mm on north wall' $R/team-collect-solo.bat
+grep -q 'objects 4 diameter 10mm' $R/team-collect-solo.bat
+[ "$(grep -c '^    robots \|, team sum' $R/team-collect-solo.bat)" = 0 ]
+$B experiment $R/team-collect-solo.bat --seeds $SEEDS --out $R/team-collect-solo --fresh > /dev/null
+
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
 # to learning within the life).
@@ -101,7 +116,8 @@ $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/
 for s in $(seq 1 $SEEDS); do
   for r in 101 102 103; do
     for spec in "khepera navigation" "khepera collect" "khepera-explore navigation" "khepera-explore collect" \
-      "khepera-practice navigation" "khepera-practice collect" "pretrained navigation" "forward-only navigation" "scratch-full full"; do
+      "khepera-practice navigation" "khepera-practice collect" "pretrained navigation" "forward-only navigation" "scratch-full full" \
+      "team-collect collect" "team-collect-solo collect"; do
       set -- $spec
       file=examples/$1.bat; [ -f "$file" ] || file=$R/$1.bat
       echo "$1 $2 $s $r learning $($B replay $file --stage $2 --run $R/$1/seed-$s --seed $r --out $R/replay-$1-$2-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
@@ -123,15 +139,29 @@ done
 $B replay examples/khepera.bat --stage collect --run $R/khepera/seed-1 --actions 225 --seed 101 --out $R/figure11 --gif $D/figure11.gif > /dev/null
 $B replay examples/khepera-practice.bat --stage collect --run $R/khepera-practice/seed-1 --actions 225 --seed 101 --out $R/practice-figure11 --gif $D/practice-figure11.gif > /dev/null
 
+# The teams' bests of seed 1 in episode 101, for the pictures.
+$B replay examples/aggregation.bat --stage aggregate --run $R/aggregation/seed-1 --seed 101 --out $R/aggregation-replay > /dev/null
+$B replay examples/team-collect.bat --stage collect --run $R/team-collect/seed-1 --seed 101 --out $R/team-collect-replay > /dev/null
+
 # The F&M 1996 best of seed 1 over its 150 actions, for the picture.
 $B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed-1 --seed 101 --out $R/fm1996-replay > /dev/null
 
 for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
   figure11/activations figure11/trajectory \
   khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
-  khepera-practice/seed-1/bigger/reinforcement; do
+  khepera-practice/seed-1/bigger/reinforcement aggregation-replay/trajectory team-collect-replay/trajectory; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
+
+# The teams in 20 fresh lives per seed, the same lives for every team, and
+# 100 lives of random walkers, the first one drawn (docs/experiments/walkers.rs).
+cargo build --release --quiet --example walkers
+$T/examples/walkers examples/aggregation.bat --lives 100 --picture $D/aggregation-walkers.png > $R/walkers.txt
+$T/examples/walkers examples/aggregation.bat --lives 20 --run $R/aggregation --seeds $SEEDS > $R/aggregation-lives.txt
+$T/examples/walkers examples/team-collect.bat --stage collect --lives 20 --run $R/team-collect --seeds $SEEDS \
+  > $R/team-collect-lives.txt
+$T/examples/walkers $R/team-collect-solo.bat --stage collect --lives 20 --run $R/team-collect-solo --seeds $SEEDS \
+  > $R/team-collect-solo-lives.txt
 
 # What the world allows in the collect stage: a blind search with perfect
 # gripping, releasing and recharging, and each seed's collect best with
@@ -205,6 +235,21 @@ grep -E '^(decisions|evolved|physical) (random|even): ' $R/oracle-explore.txt
 grep '^decisions random, ' $R/oracle-explore.txt
 echo "== what the proximity sensors allow the decisions (exploring variant)"
 cat $R/discriminate.txt
+
+echo "== teams: aggregation (random walkers, then the evolved teams)"
+tail -1 $R/walkers.txt
+grep -E '^seed [0-9]+ \(' $R/aggregation-lives.txt
+grep -A5 '^over the seeds' $R/aggregation-lives.txt
+echo "== teams: cooperative collect, 4 robots and 16 objects, then 1 robot and 4 objects"
+grep -E '^seed [0-9]+ \(' $R/team-collect-lives.txt
+grep -A5 '^over the seeds' $R/team-collect-lives.txt
+grep -E '^seed [0-9]+ \(' $R/team-collect-solo-lives.txt
+grep -A5 '^over the seeds' $R/team-collect-solo-lives.txt
+echo "== the same in the replays (3 per seed): recharges and actions per life"
+for f in team-collect team-collect-solo; do
+  grep "^$f collect " $R/replays.txt | awk -v f=$f '{ n++; a += $7; for (i = 1; i < NF; i++) if ($(i+1) == "recharges,") r += $i }
+    END { printf "%s: %d recharges in %d lives, %.1f actions per life\n", f, r, n, a / n }'
+done
 
 # Speed: one seed of the whole khepera.bat (median of 3), and the benchmark.
 times=""
