@@ -305,7 +305,9 @@ enum Command {
         #[arg(short, long)]
         output: Option<PathBuf>,
     },
-    /// Measure simulator steps and controller actions per second (one JSON line).
+    /// Measure simulator steps and controller actions per second (one JSON
+    /// line); with `world.robots` N > 1, N robots acting in turn in one world
+    /// (`robot_steps_per_sec`).
     Bench {
         file: PathBuf,
         #[arg(long)]
@@ -313,6 +315,9 @@ enum Command {
         /// Timed runs; the median is reported.
         #[arg(long, default_value_t = 5, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=1000))]
         runs: usize,
+        /// Change a setting as `run --set` does (`STAGE.world.robots=100`).
+        #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
+        sets: Vec<sweep::Set>,
         #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
@@ -561,9 +566,13 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             eprintln!("wrote {} ({} kB)", path.display(), size.div_ceil(1000));
             Ok(())
         }
-        Command::Bench { file, stage, runs, error_format } => {
-            bench::bench(bench::BenchArgs { file, stage, runs, error_format })
-        }
+        Command::Bench { file, stage, runs, sets, error_format } => bench::bench(bench::BenchArgs {
+            file,
+            stage,
+            runs,
+            sets: single_values(sets, "bench")?,
+            error_format,
+        }),
         Command::Build { file, output, error_format } => {
             if load::same_entry(&file, &output) {
                 return Err(CliError::io(format!(

@@ -317,6 +317,20 @@ fn bench_prints_one_json_line() {
     // The timed robot moves: not pinned against a wall, not out of battery.
     assert!(v["sim_moving_share"].as_f64().unwrap() >= 0.9, "{v}");
     assert!(v["sim_collision_share"].as_f64().unwrap() < 0.1, "{v}");
+    // One robot: its steps are the robot-steps.
+    assert_eq!(v["robots"], 1, "{v}");
+    assert_eq!(v["robot_steps_per_sec"], v["sim_steps_per_sec"], "{v}");
+    assert!(v["file"].as_str().unwrap().ends_with("tiny.bat"), "{v}");
+    // `--set` as `run` has it: applied, or refused saying why.
+    let out =
+        run(shaping().arg("bench").arg(tiny()).args(["--runs", "1", "--set", "second.world.arena=300x300"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out =
+        run(shaping().arg("bench").arg(tiny()).args(["--runs", "1", "--set", "second.world.arena=1x1"]));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("--set second.world.arena=1x1"), "{}", text(&out.stderr));
+    let out = run(shaping().arg("bench").arg(tiny()).args(["--set", "second.world.arena=300x300,400x400"]));
+    assert!(text(&out.stderr).contains("`bench` takes one value"), "{}", text(&out.stderr));
 }
 
 /// Without the `mpi` feature, `run` under an MPI launcher would be N copies

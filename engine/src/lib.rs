@@ -8,6 +8,7 @@
 //! [`ErrorKind`] a caller can match.
 
 pub mod animation;
+pub mod bench;
 pub mod descriptors;
 pub mod diag;
 pub mod episode;
