@@ -128,13 +128,12 @@ impl Team {
     pub fn prepare(&mut self, i: usize) {
         let p = self.at[i];
         let reach2 = self.reach * self.reach;
-        let sim = &mut self.sims[i];
-        sim.others.clear();
-        let at = &self.at;
-        self.grid.near(p, |j| {
-            let q = at[j as usize];
-            if j as usize != i && (q - p).norm_squared() <= reach2 {
-                sim.others.push(q);
+        let others = &mut self.sims[i].others;
+        others.clear();
+        let me = i as u32;
+        self.grid.near(p, |j, q| {
+            if j != me && (q - p).norm_squared() <= reach2 {
+                others.push(q);
             }
         });
     }
@@ -159,6 +158,7 @@ impl Team {
             self.charger = None;
         }
         self.at[i] = sim.centre();
+        self.grid.moved(i, self.at[i]);
         if sim.held != held || out.releases_outside > 0 {
             let (before, rest) = self.sims.split_at_mut(i);
             let (me, after) = rest.split_first_mut().expect("robot i exists");
@@ -202,7 +202,9 @@ impl Team {
 }
 
 /// A uniform grid over the arena: the robots in each cell, by a counting
-/// sort of their centres (the arrays sized once).
+/// sort of their centres (the arrays sized once). Each robot's entry also
+/// holds its centre now (kept by [`Grid::moved`]), so a search reads one
+/// array in order.
 #[derive(Clone, Debug)]
 struct Grid {
     cell: f32,
@@ -210,9 +212,16 @@ struct Grid {
     rows: usize,
     /// Cell `c`'s robots are `items[start[c]..start[c + 1]]`.
     start: Vec<u32>,
-    items: Vec<u32>,
-    /// Each robot's cell.
+    items: Vec<Entry>,
+    /// Each robot's cell while sorting, then its place in `items`.
     cell_of: Vec<u32>,
+}
+
+/// A robot in the grid: its index and its centre now.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    robot: u32,
+    at: Point2<f32>,
 }
 
 impl Grid {
@@ -227,15 +236,18 @@ impl Grid {
             cols,
             rows,
             start: vec![0; cols * rows + 1],
-            items: vec![0; robots],
+            items: vec![Entry { robot: 0, at: Point2::origin() }; robots],
             cell_of: vec![0; robots],
         }
     }
 
     fn coords(&self, p: Point2<f32>) -> (usize, usize) {
+        // The cell's index: the floor of a finite quotient, 0 below the
+        // first (a cast truncates, which is the floor for what is positive,
+        // and makes anything negative 0).
         let c = |v: f32, n: usize| {
-            let k = (v / self.cell).floor();
-            if k.is_finite() && k > 0.0 {
+            let k = v / self.cell;
+            if k.is_finite() {
                 (k as usize).min(n - 1)
             } else {
                 0
@@ -258,9 +270,11 @@ impl Grid {
         }
         // Each robot at its cell's cursor (robots in increasing order within
         // a cell); the cursors end at their cells' ends, one place on.
-        for i in 0..at.len() {
+        for (i, p) in at.iter().enumerate() {
             let c = self.cell_of[i] as usize;
-            self.items[self.start[c] as usize] = i as u32;
+            let k = self.start[c];
+            self.items[k as usize] = Entry { robot: i as u32, at: *p };
+            self.cell_of[i] = k;
             self.start[c] += 1;
         }
         for c in (0..cells).rev() {
@@ -269,14 +283,24 @@ impl Grid {
         self.start[0] = 0;
     }
 
-    /// Calls `f` with every robot in the 3 x 3 cells around `p`.
-    fn near(&self, p: Point2<f32>, mut f: impl FnMut(u32)) {
+    /// Robot `i` is now at `p` (it stays in the cell it was sorted into).
+    #[inline]
+    fn moved(&mut self, i: usize, p: Point2<f32>) {
+        self.items[self.cell_of[i] as usize].at = p;
+    }
+
+    /// Calls `f` with every robot in the 3 x 3 cells around `p` and its
+    /// centre now: row by row, cell by cell, each cell's in increasing order.
+    #[inline]
+    fn near(&self, p: Point2<f32>, mut f: impl FnMut(u32, Point2<f32>)) {
         let (x, y) = self.coords(p);
+        let (x0, x1) = (x.saturating_sub(1), (x + 1).min(self.cols - 1));
         for cy in y.saturating_sub(1)..=(y + 1).min(self.rows - 1) {
             let row = cy * self.cols;
-            let (a, b) = (row + x.saturating_sub(1), row + (x + 1).min(self.cols - 1));
-            for &j in &self.items[self.start[a] as usize..self.start[b + 1] as usize] {
-                f(j);
+            // A row's three cells are one run of `items`.
+            let (a, b) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
+            for e in &self.items[a..b] {
+                f(e.robot, e.at);
             }
         }
     }
@@ -314,6 +338,8 @@ mod tests {
                 assert_eq!(found, brute, "robot {i}, round {round}");
                 let turn = if (i + round) % 3 == 0 { 0.2 } else { 1.0 };
                 team.step(i, &Command { wheels: [1.0, turn], ..Command::default() });
+                // The grid's centres are the robots' own.
+                assert!(team.grid.items.iter().all(|e| e.at == team.at[e.robot as usize]), "round {round}");
             }
         }
         assert!(team.sims.iter().map(|s| s.others.len()).sum::<usize>() > 0, "some robots are near others");
