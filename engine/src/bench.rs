@@ -209,7 +209,10 @@ fn time_sim(world: &World, runs: usize) -> SimTimes {
 /// A team: every action, each living robot in turn is given the others
 /// within reach, senses and moves; a new team (the next seed) once half
 /// the robots' batteries are empty (until then a dead robot's turn is no
-/// step).
+/// step), and after [`EPISODE_ACTIONS`] actions, as evolution's lives are
+/// (with time, a robot of this rule can wedge itself in a corner, its back
+/// against one wall while a front sensor sees the other: a long-lived
+/// team would time ever more robots that do not move).
 fn time_team(world: &World, runs: usize) -> SimTimes {
     let n = world.robots.max(1) as usize;
     let actions = (SIM_ROBOT_STEPS / n as u64).max(1);
@@ -227,14 +230,16 @@ fn time_team(world: &World, runs: usize) -> SimTimes {
         let mut seed = run as u64 * 1_000_000;
         let mut team = Team::new(world, seed);
         let mut alive = living(&team);
-        let mut done = 0u64;
+        let (mut done, mut age) = (0u64, 0);
         let t = Instant::now();
         for _ in 0..actions {
-            if 2 * alive <= n {
+            if 2 * alive <= n || age == EPISODE_ACTIONS {
                 seed += 1;
                 team = Team::new(world, seed);
                 alive = living(&team);
+                age = 0;
             }
+            age += 1;
             team.begin_action();
             for i in 0..n {
                 if !team.sim(i).alive() {
