@@ -131,10 +131,17 @@ impl Team {
         let others = &mut self.sims[i].others;
         others.clear();
         let me = i as u32;
-        self.grid.near(p, |j, q| {
-            if j != me && (q - p).norm_squared() <= reach2 {
-                others.push(q);
+        // Without a branch per robot (which a predictor cannot learn):
+        // every candidate written in order, the list's end moved on past
+        // those within reach only.
+        self.grid.near(p, |run| {
+            let mut end = others.len();
+            others.resize(end + run.len(), p);
+            for e in run {
+                others[end] = e.at;
+                end += usize::from((e.robot != me) & ((e.at - p).norm_squared() <= reach2));
             }
+            others.truncate(end);
         });
     }
 
@@ -289,19 +296,17 @@ impl Grid {
         self.items[self.cell_of[i] as usize].at = p;
     }
 
-    /// Calls `f` with every robot in the 3 x 3 cells around `p` and its
-    /// centre now: row by row, cell by cell, each cell's in increasing order.
+    /// Calls `f` with the robots in the 3 x 3 cells around `p`, a row of
+    /// cells at a time (a row's three cells are one run of `items`): row by
+    /// row, cell by cell, each cell's in increasing order.
     #[inline]
-    fn near(&self, p: Point2<f32>, mut f: impl FnMut(u32, Point2<f32>)) {
+    fn near(&self, p: Point2<f32>, mut f: impl FnMut(&[Entry])) {
         let (x, y) = self.coords(p);
         let (x0, x1) = (x.saturating_sub(1), (x + 1).min(self.cols - 1));
         for cy in y.saturating_sub(1)..=(y + 1).min(self.rows - 1) {
             let row = cy * self.cols;
-            // A row's three cells are one run of `items`.
             let (a, b) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
-            for e in &self.items[a..b] {
-                f(e.robot, e.at);
-            }
+            f(&self.items[a..b]);
         }
     }
 }
