@@ -106,3 +106,35 @@ fn an_episode_allocates_the_same_whatever_its_length() {
         );
     }
 }
+
+/// The densest team there is, bodies packed side by side: finding each
+/// robot's neighbours, sensing and moving allocate nothing.
+#[test]
+fn a_packed_team_never_allocates() {
+    use shaping_runtime::sim::{Pose, Team};
+    let mut world = testkit::navigation().world;
+    world.battery = None;
+    world.arena = [4000.0, 4000.0];
+    world.robots = 144;
+    world.items.start = Some(Start { from: [2000.0, 100.0], to: [3900.0, 3900.0], heading: None });
+    let mut team = Team::new(&world, 1);
+    // Moved from their start (the east half) to a square block in the west
+    // half, 56 mm apart (bodies 55 mm wide).
+    for i in 0..144 {
+        let pose = Pose { x: 300.0 + (i % 12) as f32 * 56.0, y: 1000.0 + (i / 12) as f32 * 56.0, theta: 0.0 };
+        assert!(team.place(i, pose), "robot {i}");
+    }
+    let mut p = [0.0f32; CHANNELS];
+    let info = measure(|| {
+        for a in 0..50u32 {
+            team.begin_action();
+            for i in 0..144 {
+                team.prepare(i);
+                team.sense(i, &mut p);
+                let turn = if (i as u32 + a).is_multiple_of(5) { 1.0 } else { 0.0 };
+                team.step(i, &Command { wheels: [1.0 - turn, 1.0], ..Command::default() });
+            }
+        }
+    });
+    assert_eq!(info.count_total, 0, "a packed team allocated");
+}

@@ -79,11 +79,18 @@ impl Team {
         let travel = s.travel * (1.0 + s.wheel_noise);
         let reach = 2.0 * s.radius + super::ir::RANGE + 2.0 * travel + 1.0;
         let grid = Grid::new(s.width, s.depth, reach + 2.0 * travel, n);
-        // Room for every body that fits within reach (discs of the body
-        // radius whose centres are within `reach` cover at most the disc of
-        // radius `reach + radius`), so `prepare` never allocates.
-        let fit = ((reach + s.radius) / s.radius).powi(2).ceil();
-        let room = if fit.is_finite() { (fit as usize).min(n - 1) } else { n - 1 };
+        // Room for every body that fits within reach, and for a row of
+        // three cells more (`prepare` writes a row's candidates before it
+        // keeps those within reach), so `prepare` never allocates. Bodies
+        // that do not overlap cover at most the area around their centres
+        // grown by a radius: `area / (pi r^2)` bounds their number.
+        let r = s.radius;
+        let bodies = |area: f32| (area / (std::f32::consts::PI * r * r)).ceil();
+        let c = grid.cell;
+        let bound = bodies(std::f32::consts::PI * (reach + r).powi(2))
+            + bodies((3.0 * c + 2.0 * r) * (c + 2.0 * r))
+            + 1.0;
+        let room = if bound.is_finite() { (bound as usize).min(n) } else { n };
         for sim in &mut sims {
             sim.others.reserve_exact(room);
         }
