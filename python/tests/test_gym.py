@@ -176,3 +176,9 @@ def test_the_vector_environment_is_deterministic_and_resets_each_robot():
         envs.step(np.zeros((2, 3), np.float32))
     with pytest.raises(ValueError, match="num_envs"):
         shaping.gym.make_vec(KHEPERA, "navigation", num_envs=0)
+
+
+def test_a_team_is_refused():
+    # One agent drives one robot: a stage with a team of 10 is refused.
+    with pytest.raises(shaping.ShapingError, match="team of 10 robots"):
+        shaping.gym.make(ROOT / "examples" / "aggregation.bat", "aggregate")

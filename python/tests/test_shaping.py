@@ -169,6 +169,24 @@ def test_evaluate_is_deterministic_and_complete(navigation):
     assert not np.array_equal(ev2.evaluate(genomes)["fitness"], a["fitness"])
 
 
+def test_evaluate_a_team():
+    # examples/aggregation.bat: 10 clones of each genome in one world, the
+    # fitness 1 - team.spread / 400 (the robots' mean distance to their
+    # centre, mm), as `shaping run` evaluates it.
+    program = shaping.compile(ROOT / "examples" / "aggregation.bat")
+    ev = program.evaluator("aggregate", seed=5, jobs=2)
+    genomes = random_genomes(6, ev.bits, seed=2)
+    a = ev.evaluate(genomes)
+    np.testing.assert_array_equal(a["fitness"], ev.evaluate(genomes)["fitness"])
+    # A spread is at most the arena's half diagonal (600 x 600 mm), and
+    # positive: ten bodies cannot all stand at one point.
+    assert np.all((a["fitness"] > 1 - 425 / 400) & (a["fitness"] < 1)), a["fitness"]
+    # The genomes behave differently, so the teams end differently.
+    assert len(set(a["fitness"].tolist())) > 1
+    # Robot 0's descriptors: inside the arena.
+    assert np.all((a["x"] >= 0) & (a["x"] <= 600) & (a["y"] >= 0) & (a["y"] <= 600))
+
+
 def test_evaluate_rejects_bad_arrays(navigation):
     _, ev = navigation
     g = random_genomes(4, ev.bits)
