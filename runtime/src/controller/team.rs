@@ -148,9 +148,10 @@ impl<'s> TeamRun<'s> {
         let ctls = &mut self.ctls[..n];
         let mut robots = vec![EpisodeResult::default(); n];
         let mut fitness = vec![0.0f64; n];
+        let spread = team.spread();
         for (i, c) in ctls.iter_mut().enumerate() {
             c.set_learning(opts.learning);
-            c.set_spread(team.spread());
+            c.set_spread(spread);
             if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
                 c.begin_trace(t);
             }

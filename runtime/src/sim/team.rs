@@ -12,7 +12,7 @@
 //! What the team keeps in step:
 //! - **the other bodies**: before robot `i` acts, [`Team::prepare`] writes
 //!   into its `Sim` the centres of the robots within reach
-//!   ([`Team::reach`]: the IR range and two moves), found in a uniform grid
+//!   (the IR range and two moves), found in a uniform grid
 //!   rebuilt at the start of each action ([`Team::begin_action`]), so the
 //!   cost per robot does not grow with the team;
 //! - **the objects**: a robot whose action gripped or released one passes
@@ -119,11 +119,6 @@ impl Team {
         &self.sims
     }
 
-    /// The centre distance within which another robot matters, mm.
-    pub fn reach(&self) -> f32 {
-        self.reach
-    }
-
     /// Starts an action: the grid of the robots' centres now.
     pub fn begin_action(&mut self) {
         self.grid.build(&self.at);
@@ -173,7 +168,9 @@ impl Team {
         }
         self.at[i] = sim.centre();
         self.grid.moved(i, self.at[i]);
-        if sim.held != held || out.releases_outside > 0 {
+        // Objects change only by a grip or a release, which changes `held`
+        // (a release outside too, whether the object leaves or comes back).
+        if sim.held != held {
             let (before, rest) = self.sims.split_at_mut(i);
             let (me, after) = rest.split_first_mut().expect("robot i exists");
             for other in before.iter_mut().chain(after) {
