@@ -646,7 +646,7 @@ pub fn record(
     let life = record_team_life(&mut run, &mut team, opts, None);
     let mut result = life.result.team;
     if stage.inheritance == shaping_runtime::program::Inheritance::Lamarckian {
-        result.learned = run.controllers().first().map(|c| c.write_back(genome));
+        result.learned = Some(run.write_back(genome));
     }
     let parts = [Part { stage: &stage.name, scene: scene.clone(), frames: life.frames }];
     let mut episode = episode(stage, opts.seed, opts.learning, &life.trace, &parts);

@@ -53,6 +53,23 @@ pub struct Stage {
     /// by kind and name in the world of each episode (a variant's included).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub targets: Vec<Target>,
+    /// The roles of a heterogeneous team, in order (empty: every robot runs
+    /// all of `modules`). Role `r` owns the next `roles[r].modules` modules
+    /// of `modules` (role 0's first), their links and their genes; its
+    /// `robots` robots follow the previous roles' (robot 0 is role 0's).
+    /// The counts add up to `world.robots`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub roles: Vec<Role>,
+}
+
+/// A role of a heterogeneous team ([`Stage::roles`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Role {
+    pub name: String,
+    /// How many of the team's robots play it.
+    pub robots: u32,
+    /// How many modules of [`Stage::modules`] are its own.
+    pub modules: u16,
 }
 
 /// The conditions an individual is evaluated in: named variants of the
@@ -152,6 +169,30 @@ impl Stage {
             }
         }
         st
+    }
+
+    /// The role robot `i` of the team plays: its index in `roles` (0 without
+    /// roles, and for a robot past the roles' count).
+    pub fn role_of(&self, i: usize) -> usize {
+        let mut end = 0usize;
+        for (r, role) in self.roles.iter().enumerate() {
+            end += role.robots as usize;
+            if i < end {
+                return r;
+            }
+        }
+        self.roles.len().saturating_sub(1)
+    }
+
+    /// The modules of role `r`: a range of indices into `modules` (all of
+    /// them without roles).
+    pub fn role_modules(&self, r: usize) -> std::ops::Range<usize> {
+        if self.roles.is_empty() {
+            return 0..self.modules.len();
+        }
+        let start: usize = self.roles.iter().take(r).map(|x| x.modules as usize).sum();
+        let len = self.roles.get(r).map_or(0, |x| x.modules as usize);
+        start.min(self.modules.len())..(start + len).min(self.modules.len())
     }
 
     /// The world of variant `v` (the stage's own without variants).

@@ -262,6 +262,7 @@ pub fn bare_stage(name: &str, world: World) -> Stage {
         inheritance: Inheritance::Darwinian,
         variants: None,
         targets: Vec::new(),
+        roles: Vec::new(),
     }
 }
 

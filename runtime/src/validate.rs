@@ -280,6 +280,7 @@ pub fn stage(s: &Stage) -> R {
     layout(&at.field("layout"), s)?;
     modules(&at, s)?;
     links(&at, s)?;
+    roles(&at, s)?;
     fitness(&at.field("fitness"), &s.fitness)?;
     run(&at.field("run"), s)?;
     variants(&at, s)?;
@@ -339,6 +340,12 @@ fn extension(p: &Program, i: usize) -> R {
             let n = parent.genes.len();
             at.field("layout.genes").ensure(genes.len() >= n && s.layout.bits >= parent.bits, || {
                 format!("{} genes, fewer than the {n} of the stage it extends", genes.len())
+            })?;
+            let (pr, pm) = (&p.stages[j].roles, p.stages[j].modules.len());
+            let same_roles = s.roles.len() == pr.len()
+                && s.roles.iter().zip(pr).all(|(a, b)| a.name == b.name && a.modules == b.modules);
+            at.field("roles").ensure(same_roles && (pr.is_empty() || s.modules.len() == pm), || {
+                "a stage with roles extends no stage, and a stage that extends it has its roles and modules (and adds none)".into()
             })?;
             for (k, (c, q)) in genes.iter().zip(&parent.genes).enumerate() {
                 at.field("layout.genes").index(k).ensure(
@@ -600,7 +607,9 @@ fn modules(at: &At, s: &Stage) -> R {
     for (i, m) in s.modules.iter().enumerate() {
         let at = at.field("modules").index(i);
         at.field("name").name(&m.name)?;
-        if let Some(j) = s.modules[..i].iter().position(|n| n.name == m.name) {
+        // Names are the role's own: two roles may each have an `avoid`.
+        let mine = s.role_modules(role_of_module(s, i));
+        if let Some(j) = (mine.start..i).find(|&j| s.modules[j].name == m.name) {
             return at.field("name").err(format!("`{}` is also the name of module {j}", m.name));
         }
         at.field("inputs").inputs(&m.inputs)?;
@@ -751,6 +760,57 @@ fn links(at: &At, s: &Stage) -> R {
         at.field("from").ensure((l.from as usize) < n, || format!("module {} does not exist", l.from))?;
         at.field("to").ensure((l.to as usize) < n, || format!("module {} does not exist", l.to))?;
         param(&at.field("weight"), s, &l.weight)?;
+    }
+    Ok(())
+}
+
+/// The role module `i` of `s` belongs to (0 without roles).
+fn role_of_module(s: &Stage, i: usize) -> usize {
+    (0..s.roles.len()).find(|&r| s.role_modules(r).contains(&i)).unwrap_or(0)
+}
+
+/// The roles of a heterogeneous team: named once each, each with robots and
+/// modules, together every module and every robot (of every variant's
+/// world); a link joins two modules of one role; in an evolved stage every
+/// role has genes of its own.
+fn roles(at: &At, s: &Stage) -> R {
+    if s.roles.is_empty() {
+        return Ok(());
+    }
+    let at_roles = at.field("roles");
+    at_roles.count(s.roles.len() as u32, 1, MAX_MODULES as u32)?;
+    for (r, role) in s.roles.iter().enumerate() {
+        let at = at_roles.index(r);
+        at.field("name").name(&role.name)?;
+        at.field("name").ensure(!s.roles[..r].iter().any(|x| x.name == role.name), || {
+            format!("`{}` names two roles", role.name)
+        })?;
+        at.field("robots").count(role.robots, 1, MAX_ROBOTS)?;
+        at.field("modules").count(u32::from(role.modules), 1, MAX_MODULES as u32)?;
+        let evolved = matches!(s.run, StageRun::Evolve(_));
+        let mine = s.role_modules(r);
+        at.ensure(!evolved || s.layout.genes.iter().any(|g| mine.contains(&(g.module as usize))), || {
+            format!("role `{}` has no genes: evolution would not change it", role.name)
+        })?;
+    }
+    let modules: usize = s.roles.iter().map(|x| x.modules as usize).sum();
+    at_roles.ensure(modules == s.modules.len(), || {
+        format!("the roles have {modules} modules, the stage {}", s.modules.len())
+    })?;
+    let robots: u64 = s.roles.iter().map(|x| u64::from(x.robots)).sum();
+    let worlds = std::iter::once(("world", &s.world))
+        .chain(s.variants.iter().flat_map(|v| v.list.iter().map(|x| ("variants", &x.world))));
+    for (field, w) in worlds {
+        at.field(field).ensure(u64::from(w.robots) == robots, || {
+            format!("{} robots, but the roles have {robots}", w.robots)
+        })?;
+    }
+    for (i, l) in s.links.iter().enumerate() {
+        at.field("links")
+            .index(i)
+            .ensure(role_of_module(s, l.from as usize) == role_of_module(s, l.to as usize), || {
+                format!("module {} and module {} are of different roles", l.from, l.to)
+            })?;
     }
     Ok(())
 }

@@ -68,6 +68,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, run: StageRun)
         inheritance: Inheritance::Darwinian,
         variants: None,
         targets: Vec::new(),
+        roles: Vec::new(),
     }
 }
 

@@ -84,6 +84,7 @@ fn stage(name: &str, parent: Option<usize>, layout: GenomeLayout, evo: Evolution
         inheritance: Inheritance::Darwinian,
         variants: None,
         targets: Vec::new(),
+        roles: Vec::new(),
     }
 }
 

@@ -1283,6 +1283,7 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
         inheritance: st.inheritance,
         variants: None,
         targets: st.targets.clone(),
+        roles: Vec::new(),
     }
 }
 

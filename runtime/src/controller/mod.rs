@@ -327,6 +327,8 @@ pub struct ActionReport {
 #[derive(Clone, Debug)]
 pub struct Controller<'s> {
     stage: &'s Stage,
+    /// The modules it runs: the stage's, or its role's ([`Controller::for_role`]).
+    modules: &'s [crate::program::Module],
     mods: Vec<Mod<'s>>,
     /// The activation networks evaluated together, when they all fit
     /// ([`block::Block::new`]); else one by one.
@@ -376,9 +378,23 @@ impl<'s> Controller<'s> {
     pub fn new(
         stage: &'s Stage,
         genome: &Genome,
+        rng: ChaCha8Rng,
+    ) -> Result<Controller<'s>, ControllerError> {
+        Controller::for_role(stage, 0, genome, rng)
+    }
+
+    /// [`Controller::new`] for a robot of role `role` of a heterogeneous
+    /// team: the role's modules and links only (all of them without roles;
+    /// winners and traces number the role's modules from 0).
+    pub fn for_role(
+        stage: &'s Stage,
+        role: usize,
+        genome: &Genome,
         mut rng: ChaCha8Rng,
     ) -> Result<Controller<'s>, ControllerError> {
         check_genome(stage, genome)?;
+        let own = stage.role_modules(role);
+        let modules = &stage.modules[own.clone()];
         crate::validate::bound(stage)?;
         let genes = genome.decode_all(&stage.layout);
         let mut value = |p: &Param| match *p {
@@ -393,8 +409,8 @@ impl<'s> Controller<'s> {
             }
             Param::Trained { .. } => unreachable!("`validate::bound` refused unbound trained weights"),
         };
-        let mut mods = Vec::with_capacity(stage.modules.len());
-        for m in &stage.modules {
+        let mut mods = Vec::with_capacity(modules.len());
+        for m in modules {
             let a = &m.activation;
             let activation = Net::with_context(
                 m.inputs.clone(),
@@ -433,13 +449,14 @@ impl<'s> Controller<'s> {
                 perf: Rolling::new(window),
             });
         }
-        for l in &stage.links {
+        for l in stage.links.iter().filter(|l| own.contains(&(l.to as usize))) {
             let w = value(&l.weight);
-            mods[l.to as usize].links.push((l.from as usize, w));
+            mods[l.to as usize - own.start].links.push((l.from as usize - own.start, w));
         }
         let n = mods.len();
         Ok(Controller {
             stage,
+            modules,
             block: block::Block::new(mods.iter().map(|m| &m.activation)),
             mods,
             act: vec![0.0; n],
@@ -862,7 +879,7 @@ impl<'s> Controller<'s> {
 
     /// Starts `trace` for a life of this controller's.
     fn begin_trace(&self, trace: &mut Trace) {
-        trace.modules = self.stage.modules.iter().map(|m| m.name.clone()).collect();
+        trace.modules = self.modules.iter().map(|m| m.name.clone()).collect();
         trace.rows.clear();
     }
 
@@ -915,7 +932,7 @@ impl<'s> Controller<'s> {
                 }
             }
         };
-        for (m, module) in self.stage.modules.iter().enumerate() {
+        for (m, module) in self.modules.iter().enumerate() {
             put(&module.activation.params, &self.mods[m].activation.w);
             // Evolvable weights of a neural behavior generator learn too.
             if let (Behavior::Neural(nb), Gen::Neural { net, .. }) = (&module.behavior, &self.mods[m].gen) {

@@ -7,7 +7,9 @@
 //! life ends when every robot's has or after the stage's actions. Each
 //! robot's fitness is a single robot's (its terms, its events' bonuses);
 //! the team's is their `sum`, `mean` or `min` (`Fitness::team`).
-//! `team.spread` is given to every controller after each action.
+//! `team.spread` is given to every controller after each action. In a
+//! heterogeneous team each robot runs its role's modules
+//! ([`Controller::for_role`]), all decoded from the one genome.
 
 use super::{episode_rngs, tally, Controller, ControllerError, EpisodeOptions, EpisodeResult, Robot, Trace};
 use crate::catalog::CHANNELS;
@@ -99,7 +101,8 @@ impl<'s> TeamRun<'s> {
         while self.ctls.len() < n {
             let i = self.ctls.len();
             let (_, rng) = episode_rngs(robot_seed(self.seed, i));
-            self.ctls.push(Controller::new(self.stage, &self.genome, rng)?);
+            let role = self.stage.role_of(i);
+            self.ctls.push(Controller::for_role(self.stage, role, &self.genome, rng)?);
         }
         Ok(())
     }
@@ -208,7 +211,7 @@ impl<'s> TeamRun<'s> {
 
 /// A team's episode of `genome` on `stage` (`stage.world.robots` robots),
 /// as [`super::run_episode`] runs one robot's; Lamarckian stages write back
-/// robot 0's learned weights.
+/// what the first robot of each role learned (robot 0's without roles).
 pub fn run_team_episode(
     stage: &Stage,
     genome: &Genome,
@@ -219,7 +222,23 @@ pub fn run_team_episode(
     let mut run = TeamRun::new(stage, genome, opts.seed)?;
     let mut res = run.run(&mut team, opts, traces, |_| true);
     if stage.inheritance == crate::program::Inheritance::Lamarckian {
-        res.team.learned = Some(run.ctls[0].write_back(genome));
+        res.team.learned = Some(run.write_back(genome));
     }
     Ok(res)
+}
+
+impl TeamRun<'_> {
+    /// `genome` with the learned weights of the first robot of each role
+    /// written back (robot 0's without roles): each role's genes are its own.
+    pub fn write_back(&self, genome: &Genome) -> Genome {
+        let mut g = genome.clone();
+        let mut first = 0;
+        for r in 0..self.stage.roles.len().max(1) {
+            if let Some(c) = self.ctls.get(first) {
+                g = c.write_back(&g);
+            }
+            first += self.stage.roles.get(r).map_or(0, |x| x.robots as usize);
+        }
+        g
+    }
 }

@@ -85,6 +85,7 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
         inheritance,
         variants,
         targets,
+        roles,
     } = stage;
     let parent = parent.and_then(|p| program.stages.get(p)).map(|p| p.name.as_str());
     let (settings, generations) = match run {
@@ -100,7 +101,8 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
         hash(&parent),
         hash(&(sensors, actuators)),
         hash(world),
-        hash(modules),
+        // The roles only where there are some (as the targets).
+        if roles.is_empty() { hash(modules) } else { hash(&(modules, roles)) },
         hash(links),
         hash(layout),
         // The targets only where there are some, so the prints of stages
