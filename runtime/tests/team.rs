@@ -222,3 +222,131 @@ fn the_robot_link_refuses_a_team() {
     let why = shaping_runtime::robot::unfit_for_robot(&stage).unwrap();
     assert!(why.contains("a team of 3 robots") && why.contains("one serial port"), "{why}");
 }
+
+/// A heterogeneous team: role `movers` (robots 0 and 1) has two modules,
+/// one spinning left, one right; role `sitters` (robot 2) one that stops.
+/// Each module's activation is evolvable: every role has its genes.
+fn two_roles() -> Stage {
+    two_roles_with(|_| ())
+}
+
+/// [`two_roles`], `edit` applied before the genes are laid out.
+fn two_roles_with(edit: impl Fn(&mut Stage)) -> Stage {
+    let world = quiet(World { robots: 3, battery: None, charger: None, ..testkit::arena_world() });
+    let mut st = testkit::bare_stage("roles", world);
+    let ir = testkit::chans(CH_IR, 8);
+    let wheels = |left, right| testkit::script(Action::Wheels { left, right });
+    st.modules = vec![
+        testkit::module("go", 0, ir.clone(), wheels(-1.0, 1.0)),
+        testkit::module("turn", 0, ir.clone(), wheels(1.0, -1.0)),
+        // The same name in another role: each role names its own modules.
+        testkit::module("go", 0, ir, wheels(0.0, 0.0)),
+    ];
+    st.links = vec![Link { from: 0, to: 1, weight: testkit::EVOLVABLE }];
+    st.roles = vec![
+        Role { name: "movers".into(), robots: 2, modules: 2 },
+        Role { name: "sitters".into(), robots: 1, modules: 1 },
+    ];
+    edit(&mut st);
+    testkit::lay_out(&mut st, 0, testkit::GeneSpec::default());
+    st
+}
+
+#[test]
+fn each_robot_runs_its_roles_modules() {
+    let stage = two_roles();
+    shaping_runtime::validate::stage(&stage).expect("a valid two-role stage");
+    assert_eq!((0..4).map(|i| stage.role_of(i)).collect::<Vec<_>>(), [0, 0, 1, 1]);
+    for seed in 1..4 {
+        let g = genome_of(&stage, seed);
+        let opts = EpisodeOptions { actions: 60, learning: true, seed };
+        let mut traces = vec![Trace::default(); 3];
+        let res = run_team_episode(&stage, &g, &opts, Some(&mut traces)).unwrap();
+        assert_eq!(res.robots.len(), 3);
+        assert_eq!(traces[0].modules, ["go", "turn"]);
+        assert_eq!(traces[2].modules, ["go"]);
+        // How much the robot moved and turned, action by action.
+        let travel = |t: &Trace| -> f32 {
+            t.rows
+                .windows(2)
+                .map(|w| {
+                    (w[1].pose.x - w[0].pose.x).hypot(w[1].pose.y - w[0].pose.y)
+                        + (w[1].pose.theta - w[0].pose.theta).abs()
+                })
+                .sum()
+        };
+        for t in &traces[..2] {
+            assert!(t.rows.iter().all(|r| r.winner < 2 && r.activations.len() == 2));
+            assert!(travel(t) > 1.0, "a mover moves or turns (seed {seed})");
+        }
+        assert!(traces[2].rows.iter().all(|r| r.winner == 0 && r.activations.len() == 1));
+        assert_eq!(travel(&traces[2]), 0.0, "the sitter stays where it starts (seed {seed})");
+    }
+}
+
+#[test]
+fn a_roles_genes_are_its_own() {
+    let stage = two_roles();
+    let opts = EpisodeOptions { actions: 60, learning: true, seed: 3 };
+    let g = genome_of(&stage, 5);
+    let base = run_team_episode(&stage, &g, &opts, None).unwrap();
+    // Flip every bit of the sitters' gene (the third module's activation).
+    let mut other = g.clone();
+    for gene in stage.layout.genes.iter().filter(|x| x.module == 2) {
+        for b in gene.offset..gene.offset + gene.bits as u32 {
+            other.bits[b as usize] ^= 1;
+        }
+    }
+    let changed = run_team_episode(&stage, &other, &opts, None).unwrap();
+    // The sitter has one module: what its activation is does not change
+    // what it does, nor the movers' lives.
+    assert_eq!(changed.robots, base.robots);
+    // The movers' genes do change the movers.
+    let mut movers = g.clone();
+    for gene in stage.layout.genes.iter().filter(|x| x.module < 2) {
+        for b in gene.offset..gene.offset + gene.bits as u32 {
+            movers.bits[b as usize] ^= 1;
+        }
+    }
+    let moved = run_team_episode(&stage, &movers, &opts, None).unwrap();
+    assert_ne!(moved.robots[..2], base.robots[..2]);
+    assert_eq!(moved.robots[2], base.robots[2]);
+}
+
+#[test]
+fn lamarckian_roles_write_back_every_roles_learning() {
+    let mut stage = two_roles();
+    stage.inheritance = Inheritance::Lamarckian;
+    for m in &mut stage.modules {
+        m.learning = Some(testkit::crbp(LearnTarget::Activation, 0.5, 0.5, 10));
+        // Every action rewarded: whatever a module does, it learns.
+        m.reinforce = Some(testkit::expr(vec![shaping_runtime::expr::Op::Const(1.0)]));
+    }
+    shaping_runtime::validate::stage(&stage).unwrap();
+    let g = genome_of(&stage, 7);
+    let opts = EpisodeOptions { actions: 300, learning: true, seed: 2 };
+    let learned = run_team_episode(&stage, &g, &opts, None).unwrap().team.learned.unwrap();
+    let differs = |module: u16| {
+        stage.layout.genes.iter().filter(|x| x.module == module).any(|x| {
+            let r = x.offset as usize..(x.offset + x.bits as u32) as usize;
+            learned.bits[r.clone()] != g.bits[r]
+        })
+    };
+    assert!(differs(0) || differs(1), "the movers' learning is written back");
+    assert!(differs(2), "the sitters' learning is written back");
+}
+
+#[test]
+fn bad_roles_are_refused() {
+    let check = |edit: &dyn Fn(&mut Stage), expect: &str| {
+        let s = two_roles_with(edit);
+        let e = shaping_runtime::validate::stage(&s).expect_err(expect).to_string();
+        assert!(e.contains(expect), "{e}");
+    };
+    check(&|s| s.world.robots = 4, "4 robots, but the roles have 3");
+    check(&|s| s.links.push(Link { from: 0, to: 2, weight: Param::Fixed(1.0) }), "different roles");
+    check(&|s| s.roles[1].name = "movers".into(), "`movers` names two roles");
+    check(&|s| s.roles[1].modules = 2, "the roles have 4 modules, the stage 3");
+    check(&|s| s.modules[2].activation.params = vec![Param::Fixed(0.0); 9], "role `sitters` has no genes");
+    check(&|s| s.modules[1].name = "go".into(), "`go` is also the name of module 0");
+}
