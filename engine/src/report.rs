@@ -168,13 +168,21 @@ pub fn trace_csv(trace: &Trace, stage: &Stage, episode: &Episode) -> String {
 /// Without others, the one robot's file, which has no `robot` column.
 pub fn team_trace_csv(trace: &Trace, others: &[OtherRobot], stage: &Stage, episode: &Episode) -> String {
     let declared = declared_columns(stage);
-    let mut s = trace_header(&trace.modules, &declared);
     if others.is_empty() {
+        let mut s = trace_header(&trace.modules, &declared);
         for (k, r) in trace.rows.iter().enumerate() {
             trace_row(&mut s, &trace.modules, &declared, r, &episode.actions, k);
         }
         return s;
     }
+    // With roles, a column per module of every role (`ROLE.MODULE`), empty
+    // in the rows of the other roles' robots.
+    let modules: Vec<String> = if stage.roles.is_empty() {
+        trace.modules.clone()
+    } else {
+        (0..stage.modules.len()).map(|i| stage.module_label(i)).collect()
+    };
+    let mut s = trace_header(&modules, &declared);
     s.insert_str(0, "robot,");
     // (action, robot, row, its sensed columns, the row's index in them)
     let mut rows: Vec<(u32, usize, &TraceRow, &EpisodeColumns, usize)> =
@@ -185,9 +193,33 @@ pub fn team_trace_csv(trace: &Trace, others: &[OtherRobot], stage: &Stage, episo
     rows.sort_by_key(|&(action, robot, ..)| (action, robot));
     for (_, robot, r, columns, k) in rows {
         let _ = write!(s, "{robot},");
-        trace_row(&mut s, &trace.modules, &declared, r, columns, k);
+        if stage.roles.is_empty() {
+            trace_row(&mut s, &modules, &declared, r, columns, k);
+        } else {
+            trace_row(&mut s, &modules, &declared, &in_all_modules(stage, robot, r), columns, k);
+        }
     }
     s
+}
+
+/// Row `r` of `robot`'s role, its winner and per-module values placed
+/// among all the stage's modules (`NaN`, written empty, for the others').
+fn in_all_modules(stage: &Stage, robot: usize, r: &TraceRow) -> TraceRow {
+    let own = stage.role_modules(stage.role_of(robot));
+    let widen = |v: &[f32]| {
+        let mut all = vec![f32::NAN; stage.modules.len()];
+        for (k, x) in v.iter().enumerate().take(own.len()) {
+            all[own.start + k] = *x;
+        }
+        all
+    };
+    TraceRow {
+        winner: r.winner + own.start as u16,
+        activations: widen(&r.activations),
+        reinforcement: widen(&r.reinforcement),
+        performance: widen(&r.performance),
+        ..r.clone()
+    }
 }
 
 /// The first line of `trace.csv`.
@@ -237,7 +269,11 @@ fn trace_row(
         r.pose.theta
     );
     for v in r.activations.iter().chain(&r.reinforcement).chain(&r.performance) {
-        let _ = write!(s, ",{v:.4}");
+        if v.is_nan() {
+            s.push(',');
+        } else {
+            let _ = write!(s, ",{v:.4}");
+        }
     }
     for (_, source) in declared {
         let _ = write!(s, ",{:.4}", source.at(columns, k));

@@ -210,7 +210,10 @@ fn kind(path: &str) -> Option<Kind> {
     if let Some(&(_, k)) = FIELDS.iter().find(|(p, _)| *p == path) {
         return Some(k);
     }
-    let (_, field) = path.split_once('.')?;
+    let (_, field) = path.rsplit_once('.')?;
+    if field == "robots" {
+        return Some(Kind::Count(None));
+    }
     MODULE_FIELDS.iter().find(|(p, _)| *p == field).map(|&(_, k)| k)
 }
 
@@ -218,23 +221,26 @@ fn kind(path: &str) -> Option<Kind> {
 /// [`get`]): else an error naming the closest one.
 fn check_path(program: &Program, i: usize, path: &str) -> Result<(), String> {
     let stage = &program.stages[i];
-    let module = |name: &str| stage.modules.iter().any(|m| m.name == name);
+    let module = |name: &str| (0..stage.modules.len()).any(|i| stage.module_label(i) == name);
+    let role = |name: &str| stage.roles.iter().any(|r| r.name == name);
     if path == "evolve.seed" {
         return Err(
             "`evolve.seed` only gives the run seed when none is given: use `--seed` (`run`) or `--seeds` and `--first-seed` (`experiment`)"
                 .into(),
         );
     }
-    let known = match path.split_once('.') {
+    let known = match path.rsplit_once('.') {
+        Some((r, "robots")) if role(r) => true,
         Some((m, f)) if module(m) => MODULE_FIELDS.iter().any(|(p, _)| *p == f),
         _ => FIELDS.iter().any(|(p, _)| *p == path),
     };
     if known {
         return Ok(());
     }
-    if let Some((m, f)) = path.split_once('.') {
+    if let Some((m, f)) = path.rsplit_once('.') {
         if MODULE_FIELDS.iter().any(|(p, _)| *p == f) {
-            let names: Vec<&str> = stage.modules.iter().map(|m| m.name.as_str()).collect();
+            let labels: Vec<String> = (0..stage.modules.len()).map(|i| stage.module_label(i)).collect();
+            let names: Vec<&str> = labels.iter().map(String::as_str).collect();
             let hint = did_you_mean(m, names.iter().copied()).map(|h| format!("; {h}")).unwrap_or_default();
             return Err(format!(
                 "stage `{}` has no module `{m}`{hint} (its modules: {})",
@@ -244,9 +250,10 @@ fn check_path(program: &Program, i: usize, path: &str) -> Result<(), String> {
         }
     }
     let mut all: Vec<String> = FIELDS.iter().map(|(p, _)| p.to_string()).collect();
-    for m in &stage.modules {
-        all.extend(MODULE_FIELDS.iter().map(|(f, _)| format!("{}.{f}", m.name)));
+    for i in 0..stage.modules.len() {
+        all.extend(MODULE_FIELDS.iter().map(|(f, _)| format!("{}.{f}", stage.module_label(i))));
     }
+    all.extend(stage.roles.iter().map(|r| format!("{}.robots", r.name)));
     let hint = did_you_mean(path, all.iter().map(String::as_str))
         .map_or_else(|| "; `shaping experiment --help` lists the settings".to_string(), |h| format!("; {h}"));
     Err(format!("stage `{}` has no setting `{path}`{hint}", stage.name))
@@ -299,7 +306,7 @@ fn set(program: &mut Program, i: usize, path: &str, value: &Value) -> Result<(),
     let old = get(&program.stages[i], path)?;
     // A module's activation genes are set in the stage that introduced them:
     // later stages hold them frozen, with the same range.
-    if let Some((name, "range")) = path.split_once('.') {
+    if let Some((name, "range")) = path.rsplit_once('.') {
         let (_, m) = module(&program.stages[i], name)?;
         let owner = &program.stages[m.stage as usize].name;
         if m.stage as usize != i {
@@ -329,11 +336,12 @@ fn evolution(s: &Stage) -> Result<&Evolution, String> {
     }
 }
 
+/// The module `name` (`ROLE.MODULE` in a stage with roles) of `s`.
 fn module<'a>(s: &'a Stage, name: &str) -> Result<(usize, &'a Module), String> {
     s.modules
         .iter()
         .enumerate()
-        .find(|(_, m)| m.name == name)
+        .find(|&(i, _)| s.module_label(i) == name)
         .ok_or_else(|| format!("stage `{}` has no module `{name}`", s.name))
 }
 
@@ -416,7 +424,10 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
         "world.body.wheel_noise" => real(w.body.wheel_noise),
         "world.body.sensor_noise" => real(w.body.sensor_noise),
         _ => {
-            let (name, field) = path.split_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
+            let (name, field) = path.rsplit_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
+            if let (Some(role), "robots") = (s.roles.iter().find(|r| r.name == name), field) {
+                return count(role.robots);
+            }
             let (mi, m) = module(s, name)?;
             let learning = || {
                 m.learning
@@ -557,6 +568,13 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
         };
         return Ok(());
     }
+    if path == "world.robots" && !s.roles.is_empty() {
+        let roles: Vec<String> = s.roles.iter().map(|r| format!("`{name}.{}.robots`", r.name)).collect();
+        return Err(format!(
+            "stage `{name}` has roles: its robots are its roles' (set {})",
+            roles.join(", ")
+        ));
+    }
     if path.starts_with("world.") {
         // The variants' worlds have the stage's arena, body, charger ...
         // (a variant changes items): the setting changes them too.
@@ -578,7 +596,17 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
         },
         _ => {
             let (module_name, field) =
-                path.split_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
+                path.rsplit_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
+            if let (Some(r), "robots") = (s.roles.iter().position(|r| r.name == module_name), field) {
+                s.roles[r].robots = whole(n)?;
+                // The team is its roles' robots, in every world.
+                let robots = s.roles.iter().map(|r| r.robots).sum();
+                s.world.robots = robots;
+                for x in s.variants.iter_mut().flat_map(|v| v.list.iter_mut()) {
+                    x.world.robots = robots;
+                }
+                return Ok(());
+            }
             let mi = module(s, module_name)?.0;
             if field == "range" {
                 let Value::Pair(lo, hi) = value else { return Err(format!("`{path}` takes LO..HI")) };

@@ -201,6 +201,45 @@ fn a_team_is_set_and_one_too_large_is_refused() {
     }
 }
 
+/// In a stage with roles, `ROLE.robots` sets a role's robots (and the
+/// team's), `world.robots` is refused with the roles' settings named, and a
+/// module's settings are `ROLE.MODULE.FIELD`.
+#[test]
+fn a_roles_robots_and_modules_are_set_by_role() {
+    use shaping_engine::sweep::apply;
+    use shaping_runtime::program::{Program, FORMAT_VERSION};
+    let set = |t: &str, v: &str| vec![(t.to_string(), v.to_string())];
+    let roles = || Program {
+        format: FORMAT_VERSION,
+        name: "roles".into(),
+        stages: vec![shaping_runtime::testkit::two_roles(|_| ())],
+    };
+    let mut p = roles();
+    apply(&mut p, &set("roles.sitters.robots", "3")).unwrap();
+    assert_eq!((p.stages[0].roles[1].robots, p.stages[0].world.robots), (3, 5));
+    apply(&mut p, &set("roles.movers.go.range", "-2..2")).unwrap();
+    let ranges: Vec<(u16, f32)> = p.stages[0].layout.genes.iter().map(|g| (g.module, g.hi)).collect();
+    assert!(
+        ranges.iter().all(|&(m, hi)| (m == 0) == (hi == 2.0)),
+        "only the movers' `go` changes: {ranges:?}"
+    );
+    let cases: [(&str, &str, &[&str]); 3] = [
+        (
+            "roles.world.robots",
+            "4",
+            &["stage `roles` has roles", "`roles.movers.robots`, `roles.sitters.robots`"],
+        ),
+        ("roles.go.range", "-1..1", &["no module `go`", "its modules: movers.go, movers.turn, sitters.go"]),
+        ("roles.sitters.robots", "0", &["roles[1].robots", "0 is not between 1"]),
+    ];
+    for (target, value, wanted) in cases {
+        let err = apply(&mut roles(), &set(target, value)).unwrap_err().to_string();
+        for w in wanted {
+            assert!(err.contains(w), "--set {target}={value}: `{w}` missing from:\n{err}");
+        }
+    }
+}
+
 /// A criterion no fitness can reach (`nan`, `inf`, beyond f32) is refused
 /// before anything runs, as a word is; so are non-finite `--set` values.
 #[test]

@@ -219,3 +219,45 @@ fn a_test_whose_change_adds_robots_records_them_after_the_change() {
     assert_eq!(o.x.len(), total as usize);
     assert!(o.x[switch as usize..].iter().all(|&x| x > 0.0), "robot 2's poses after the change");
 }
+
+/// A team with roles: `trace.csv` has a column per module of every role
+/// (`ROLE.MODULE`), each robot's row filling its role's and naming its
+/// role's winner; the report's modules are named by role.
+#[test]
+fn a_team_with_roles_writes_every_roles_modules() {
+    use shaping_runtime::program::{StageRun, FORMAT_VERSION};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut stage = shaping_runtime::testkit::two_roles(|_| ());
+    if let StageRun::Evolve(e) = &mut stage.run {
+        (e.population, e.generations, e.actions) = (8, 2, 40);
+        e.selection = shaping_runtime::program::Selection::Truncation { keep: 2 };
+    }
+    let program = Program { format: FORMAT_VERSION, name: "roles".into(), stages: vec![stage] };
+    run(program.clone(), &RunOptions { no_report: false, ..options(d) }).unwrap();
+    let out = d.join("replay");
+    let args = ReplayOptions {
+        run: Some(d.to_path_buf()),
+        out: Some(out.clone()),
+        stage: Some("roles".into()),
+        ..ReplayOptions::default()
+    };
+    replay::replay(program, &args, &Log::default()).unwrap();
+    let csv = read_text(&out.join("trace.csv"));
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let acts: Vec<&str> = header.iter().copied().filter(|h| h.starts_with("act_")).collect();
+    assert_eq!(acts, ["act_movers.go", "act_movers.turn", "act_sitters.go"]);
+    let at = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows = rows_per_robot(&csv);
+    assert_eq!(rows.keys().copied().collect::<Vec<_>>(), [0, 1, 2]);
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let sitter = cells[0] == "2";
+        assert_eq!(cells[at("act_sitters.go")].is_empty(), !sitter, "{line}");
+        assert_eq!(cells[at("act_movers.go")].is_empty(), sitter, "{line}");
+        let winner = cells[at("winner")];
+        assert!(if sitter { winner == "sitters.go" } else { winner.starts_with("movers.") }, "{line}");
+    }
+    let report = read_text(&d.join("report.html"));
+    assert!(report.contains("sitters.go") && report.contains("movers.turn"));
+}

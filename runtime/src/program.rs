@@ -195,6 +195,21 @@ impl Stage {
         start.min(self.modules.len())..(start + len).min(self.modules.len())
     }
 
+    /// Module `i`'s name as outputs and settings write it: `ROLE.MODULE` in
+    /// a stage with roles (two roles may name a module alike), else its name.
+    pub fn module_label(&self, i: usize) -> String {
+        let name = self.modules.get(i).map_or("", |m| m.name.as_str());
+        match self.roles.get(self.role_of_module(i)) {
+            Some(role) => format!("{}.{name}", role.name),
+            None => name.to_string(),
+        }
+    }
+
+    /// The role module `i` belongs to (0 without roles).
+    pub fn role_of_module(&self, i: usize) -> usize {
+        (0..self.roles.len()).find(|&r| self.role_modules(r).contains(&i)).unwrap_or(0)
+    }
+
     /// The world of variant `v` (the stage's own without variants).
     pub fn variant_world(&self, v: usize) -> &World {
         self.variants.as_ref().and_then(|x| x.list.get(v)).map_or(&self.world, |x| &x.world)

@@ -414,6 +414,34 @@ pub fn collect_with(spec: GeneSpec) -> Stage {
     s
 }
 
+/// A heterogeneous team of 3 robots, without noise, battery or charger:
+/// role `movers` (robots 0 and 1) has two modules, one spinning left, one
+/// right; role `sitters` (robot 2) one that stops. Each module's activation
+/// is evolvable, so every role has its genes; `edit` is applied before the
+/// genes are laid out.
+pub fn two_roles(edit: impl Fn(&mut Stage)) -> Stage {
+    let mut world = World { robots: 3, battery: None, charger: None, ..arena_world() };
+    world.body.wheel_noise = 0.0;
+    world.body.sensor_noise = 0.0;
+    let mut st = bare_stage("roles", world);
+    let ir = chans(CH_IR, 8);
+    let wheels = |left, right| script(Action::Wheels { left, right });
+    st.modules = vec![
+        module("go", 0, ir.clone(), wheels(-1.0, 1.0)),
+        module("turn", 0, ir.clone(), wheels(1.0, -1.0)),
+        // The same name in another role: each role names its own modules.
+        module("go", 0, ir, wheels(0.0, 0.0)),
+    ];
+    st.links = vec![Link { from: 0, to: 1, weight: EVOLVABLE }];
+    st.roles = vec![
+        Role { name: "movers".into(), robots: 2, modules: 2 },
+        Role { name: "sitters".into(), robots: 1, modules: 1 },
+    ];
+    edit(&mut st);
+    lay_out(&mut st, 0, GeneSpec::default());
+    st
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

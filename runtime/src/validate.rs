@@ -608,7 +608,7 @@ fn modules(at: &At, s: &Stage) -> R {
         let at = at.field("modules").index(i);
         at.field("name").name(&m.name)?;
         // Names are the role's own: two roles may each have an `avoid`.
-        let mine = s.role_modules(role_of_module(s, i));
+        let mine = s.role_modules(s.role_of_module(i));
         if let Some(j) = (mine.start..i).find(|&j| s.modules[j].name == m.name) {
             return at.field("name").err(format!("`{}` is also the name of module {j}", m.name));
         }
@@ -764,11 +764,6 @@ fn links(at: &At, s: &Stage) -> R {
     Ok(())
 }
 
-/// The role module `i` of `s` belongs to (0 without roles).
-fn role_of_module(s: &Stage, i: usize) -> usize {
-    (0..s.roles.len()).find(|&r| s.role_modules(r).contains(&i)).unwrap_or(0)
-}
-
 /// The roles of a heterogeneous team: named once each, each with robots and
 /// modules, together every module and every robot (of every variant's
 /// world); a link joins two modules of one role; in an evolved stage every
@@ -808,7 +803,7 @@ fn roles(at: &At, s: &Stage) -> R {
     for (i, l) in s.links.iter().enumerate() {
         at.field("links")
             .index(i)
-            .ensure(role_of_module(s, l.from as usize) == role_of_module(s, l.to as usize), || {
+            .ensure(s.role_of_module(l.from as usize) == s.role_of_module(l.to as usize), || {
                 format!("module {} and module {} are of different roles", l.from, l.to)
             })?;
     }

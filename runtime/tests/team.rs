@@ -223,33 +223,12 @@ fn the_robot_link_refuses_a_team() {
     assert!(why.contains("a team of 3 robots") && why.contains("one serial port"), "{why}");
 }
 
-/// A heterogeneous team: role `movers` (robots 0 and 1) has two modules,
-/// one spinning left, one right; role `sitters` (robot 2) one that stops.
-/// Each module's activation is evolvable: every role has its genes.
 fn two_roles() -> Stage {
-    two_roles_with(|_| ())
+    testkit::two_roles(|_| ())
 }
 
-/// [`two_roles`], `edit` applied before the genes are laid out.
 fn two_roles_with(edit: impl Fn(&mut Stage)) -> Stage {
-    let world = quiet(World { robots: 3, battery: None, charger: None, ..testkit::arena_world() });
-    let mut st = testkit::bare_stage("roles", world);
-    let ir = testkit::chans(CH_IR, 8);
-    let wheels = |left, right| testkit::script(Action::Wheels { left, right });
-    st.modules = vec![
-        testkit::module("go", 0, ir.clone(), wheels(-1.0, 1.0)),
-        testkit::module("turn", 0, ir.clone(), wheels(1.0, -1.0)),
-        // The same name in another role: each role names its own modules.
-        testkit::module("go", 0, ir, wheels(0.0, 0.0)),
-    ];
-    st.links = vec![Link { from: 0, to: 1, weight: testkit::EVOLVABLE }];
-    st.roles = vec![
-        Role { name: "movers".into(), robots: 2, modules: 2 },
-        Role { name: "sitters".into(), robots: 1, modules: 1 },
-    ];
-    edit(&mut st);
-    testkit::lay_out(&mut st, 0, testkit::GeneSpec::default());
-    st
+    testkit::two_roles(edit)
 }
 
 #[test]

@@ -463,7 +463,9 @@ fn added(program: &Program, index: usize) -> Vec<String> {
     let sensors: Vec<&str> = st.sensors.iter().filter(|s| s.stage == i).map(|s| s.name.as_str()).collect();
     let actuators: Vec<&str> =
         st.actuators.iter().filter(|a| a.stage == i).map(|a| a.name.as_str()).collect();
-    let modules: Vec<&str> = st.modules.iter().filter(|m| m.stage == i).map(|m| m.name.as_str()).collect();
+    let labels: Vec<String> =
+        (0..st.modules.len()).filter(|&m| st.modules[m].stage == i).map(|m| st.module_label(m)).collect();
+    let modules: Vec<&str> = labels.iter().map(String::as_str).collect();
     let Some(parent) = st.parent.map(|p| &program.stages[p]) else {
         out.push(format!("modules {}", names(modules)));
         return out;
@@ -500,7 +502,10 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
     let st = &program.stages[index];
     let stage_name =
         |i: u16| program.stages.get(i as usize).map_or_else(|| format!("#{i}"), |s| s.name.clone());
-    let module_name = |i: u16| st.modules.get(i as usize).map_or_else(|| format!("#{i}"), |m| m.name.clone());
+    let module_name = |i: u16| match st.modules.get(i as usize) {
+        Some(_) => st.module_label(i as usize),
+        None => format!("#{i}"),
+    };
     let g = genome.as_ref().map(|(g, _)| *g);
     let genes = st
         .layout
@@ -575,8 +580,9 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
         modules: st
             .modules
             .iter()
-            .map(|m| ModuleView {
-                name: m.name.clone(),
+            .enumerate()
+            .map(|(k, m)| ModuleView {
+                name: st.module_label(k),
                 stage: stage_name(m.stage),
                 new: m.stage as usize == index,
                 sensors: sensor_list(st, &m.inputs),
