@@ -45,6 +45,7 @@ use shaping_runtime::controller::{EpisodeOptions, TeamRun};
 use shaping_runtime::evolve::seed::mix;
 use shaping_runtime::program::{Stage, StageRun};
 use shaping_runtime::sim::{Command, Team};
+use shaping_runtime::state::NEIGHBOUR_GAP;
 
 struct Args {
     file: String,
@@ -139,44 +140,8 @@ impl Walker {
     }
 }
 
-/// Gap between two bodies within which two robots count as together, mm:
-/// about the range of the Khepera's proximity sensors.
-const TOUCH: f32 = 20.0;
-
-/// How grouped a team is: the share of its robots with another's body
-/// within [`TOUCH`] of their own, and the share in the largest group of
-/// robots linked by such gaps.
-fn groups(team: &Team, radius: f32) -> (f32, f32) {
-    let at: Vec<[f32; 2]> = team.sims().iter().map(|s| s.position()).collect();
-    let n = at.len();
-    let near = 2.0 * radius + TOUCH;
-    let close = |i: usize, j: usize| (at[i][0] - at[j][0]).hypot(at[i][1] - at[j][1]) <= near;
-    let with = (0..n).filter(|&i| (0..n).any(|j| j != i && close(i, j))).count();
-    let mut seen = vec![false; n];
-    let mut largest = 0;
-    for first in 0..n {
-        if seen[first] {
-            continue;
-        }
-        seen[first] = true;
-        let mut stack = vec![first];
-        let mut size = 0;
-        while let Some(i) = stack.pop() {
-            size += 1;
-            for (j, s) in seen.iter_mut().enumerate() {
-                if !*s && close(i, j) {
-                    *s = true;
-                    stack.push(j);
-                }
-            }
-        }
-        largest = largest.max(size);
-    }
-    (with as f32 / n as f32, largest as f32 / n as f32)
-}
-
 /// One life of a team: spread, share with a neighbour and share in the
-/// largest group ([`groups`]) at action 0 and at the end; objects released
+/// largest group ([`Team::groups`], bodies within [`NEIGHBOUR_GAP`]) at action 0 and at the end; objects released
 /// outside by each robot.
 struct Life {
     spread: [f32; 2],
@@ -213,9 +178,8 @@ fn live(
     mut paths: Option<&mut Vec<Vec<[f32; 2]>>>,
 ) -> Life {
     let seed = life_seed(k);
-    let radius = stage.world.body.radius;
     let mut team = Team::new(&stage.world, seed);
-    let (spread0, (near0, group0)) = (team.spread(), groups(&team, radius));
+    let (spread0, (near0, group0)) = (team.spread(), team.groups(NEIGHBOUR_GAP));
     let mut record = |team: &Team| {
         if let Some(paths) = paths.as_deref_mut() {
             paths.resize(team.len(), Vec::new());
@@ -252,7 +216,7 @@ fn live(
             out
         }
     };
-    let (near1, group1) = groups(&team, radius);
+    let (near1, group1) = team.groups(NEIGHBOUR_GAP);
     Life { spread: [spread0, team.spread()], near: [near0, near1], group: [group0, group1], out }
 }
 

@@ -10,13 +10,23 @@ use crate::expr::{Expr, Op};
 use crate::program::{Action, Behavior, Stage, StepEnd};
 
 /// Number of state slots an expression can read (`robot.x` ...,
-/// `distance_to(NAME)`, `team.spread`).
-pub const STATE_SLOTS: usize = ST_SPREAD + 1;
+/// `distance_to(NAME)`, `team.spread`, `team.grouped`, `team.largest`).
+pub const STATE_SLOTS: usize = ST_LARGEST + 1;
 /// The team's spread (`team.spread`): the mean distance of its robots'
 /// centres to the team's centre (their mean), mm, after the last action
 /// all of them did (0 for one robot). After the targets, so the slots
 /// before it keep their numbers.
 pub const ST_SPREAD: usize = ST_TARGETS + MAX_TARGETS;
+/// The share of the team's robots whose body is within [`NEIGHBOUR_GAP`]
+/// of another robot's (`team.grouped`; 0 for one robot).
+pub const ST_GROUPED: usize = ST_SPREAD + 1;
+/// The share of the team's robots in its largest group (`team.largest`):
+/// robots joined by bodies within [`NEIGHBOUR_GAP`] of each other, and
+/// the robots joined to those (1 for one robot).
+pub const ST_LARGEST: usize = ST_SPREAD + 2;
+/// The gap between two bodies within which robots are neighbours, mm: a
+/// Khepera's proximity sensors see another body about this far.
+pub const NEIGHBOUR_GAP: f32 = 20.0;
 /// The first slot of the distances to the stage's targets
 /// (`Stage::targets`): slot `ST_TARGETS + i` is target `i`'s.
 pub const ST_TARGETS: usize = 6;
@@ -147,6 +157,17 @@ impl Odometer {
 
 /// Some expression of `stage` reads the robot's state (`robot.x` ...).
 pub fn reads_state(stage: &Stage) -> bool {
+    reads(stage, |_| true)
+}
+
+/// Some expression of `stage` reads one of the team's groups
+/// (`team.grouped`, `team.largest`): what the team then measures each action.
+pub fn reads_groups(stage: &Stage) -> bool {
+    reads(stage, |slot| slot == ST_GROUPED || slot == ST_LARGEST)
+}
+
+/// Some expression of `stage` reads a state slot that `slot` accepts.
+fn reads(stage: &Stage, slot: impl Fn(usize) -> bool) -> bool {
     let mut exprs: Vec<&Expr> = Vec::new();
     exprs.extend(&stage.fitness.per_action);
     exprs.extend(&stage.fitness.at_end);
@@ -164,7 +185,7 @@ pub fn reads_state(stage: &Stage) -> bool {
             }
         }
     }
-    exprs.iter().any(|e| e.ops.iter().any(|op| matches!(op, Op::State(_))))
+    exprs.iter().any(|e| e.ops.iter().any(|op| matches!(*op, Op::State(v) if slot(v as usize))))
 }
 
 #[cfg(test)]

@@ -214,6 +214,99 @@ fn team_spread_is_read_at_the_end() {
     }
 }
 
+/// The team's groups, found in the grid, are those of a search over every
+/// pair: robots placed at random, some touching, in teams of 1 to 60.
+#[test]
+fn team_groups_are_every_pairs() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    for (n, side) in [(1u32, 400.0f32), (2, 300.0), (7, 500.0), (25, 900.0), (60, 1500.0)] {
+        let world = quiet(World {
+            robots: n,
+            battery: None,
+            charger: None,
+            arena: [side, side],
+            ..testkit::arena_world()
+        });
+        let mut team = Team::new(&world, u64::from(n));
+        let r = world.body.radius;
+        // Each robot placed near the last one placed, or anywhere.
+        for i in 1..n as usize {
+            for _ in 0..50 {
+                let prev = team.sim(rng.random_range(0..i)).position();
+                let (x, y) = if rng.random_bool(0.6) {
+                    let a: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+                    let d = 2.0 * r + rng.random_range(0.0..30.0);
+                    (prev[0] + d * a.cos(), prev[1] + d * a.sin())
+                } else {
+                    (rng.random_range(30.0..side - 30.0), rng.random_range(30.0..side - 30.0))
+                };
+                if team.place(i, Pose { x, y, theta: 0.0 }) {
+                    break;
+                }
+            }
+        }
+        team.begin_action();
+        let at: Vec<[f32; 2]> = team.sims().iter().map(|s| s.position()).collect();
+        let near = |i: usize, j: usize| (at[i][0] - at[j][0]).hypot(at[i][1] - at[j][1]) <= 2.0 * r + 20.0;
+        let k = at.len();
+        let with = (0..k).filter(|&i| (0..k).any(|j| j != i && near(i, j))).count();
+        // The largest group by repeated spreading from each robot.
+        let mut largest = 0;
+        for first in 0..k {
+            let mut seen = vec![false; k];
+            seen[first] = true;
+            let mut stack = vec![first];
+            while let Some(i) = stack.pop() {
+                for (j, s) in seen.iter_mut().enumerate() {
+                    if !*s && near(i, j) {
+                        *s = true;
+                        stack.push(j);
+                    }
+                }
+            }
+            largest = largest.max(seen.iter().filter(|&&s| s).count());
+        }
+        let (grouped, big) = team.groups(shaping_runtime::state::NEIGHBOUR_GAP);
+        assert_eq!(grouped, with as f32 / k as f32, "{n} robots");
+        assert_eq!(big, largest as f32 / k as f32, "{n} robots");
+        if n == 60 {
+            assert!(
+                with > 10 && largest > 2 && largest < k,
+                "a mixed team: {with} grouped, largest {largest}"
+            );
+        }
+    }
+}
+
+/// `team.grouped` and `team.largest` reach the fitness, measured where the
+/// robots end.
+#[test]
+fn team_groups_are_read_at_the_end() {
+    use shaping_runtime::expr::Op;
+    use shaping_runtime::state::{ST_GROUPED, ST_LARGEST};
+    let mut stage = testkit::bare_stage(
+        "groups",
+        quiet(World { robots: 6, battery: None, charger: None, ..testkit::arena_world() }),
+    );
+    // 10 x team.grouped + team.largest: both in one number.
+    stage.fitness.at_end = Some(testkit::expr(vec![
+        Op::State(ST_GROUPED as u16),
+        Op::Const(10.0),
+        Op::Mul,
+        Op::State(ST_LARGEST as u16),
+        Op::Add,
+    ]));
+    let opts = EpisodeOptions { actions: 5, learning: false, seed: 4 };
+    let res = run_team_episode(&stage, &Genome { bits: vec![] }, &opts, None).unwrap();
+    // No module: the robots stand where they start.
+    let (grouped, largest) = Team::new(&stage.world, 4).groups(shaping_runtime::state::NEIGHBOUR_GAP);
+    assert!(largest > 0.0);
+    for r in &res.robots {
+        assert_eq!(r.fitness, 10.0 * grouped + largest);
+    }
+}
+
 #[test]
 fn the_robot_link_refuses_a_team() {
     let mut stage = testkit::collect();

@@ -192,7 +192,7 @@ const LIST: &[Word] = &[
     w("battery", C, WORLD, "`battery N actions`: how long a full battery lasts", WORLD_S),
     w("objects", C, WORLD, "`objects N diameter D physical|virtual`: objects to collect", WORLD_S),
     w("robots", C, WORLD, "`robots N`: a team of N clones of the evaluated individual, all starting in the start region", TEAMS),
-    w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm", TEAMS),
+    w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm; `team.grouped`, `team.largest`: the shares of the robots with a neighbour and in the largest group", TEAMS),
     w("body", C, WORLD, "`body [khepera | e-puck] { v_max 80 ... }`: the robot's body, from a preset, with single values changed", WORLD_S),
     w("khepera", C, CLAUSE, "`body khepera`: the Khepera's body and sensors (the default)", BODIES),
     w("e-puck", C, CLAUSE, "`body e-puck`: the e-puck's body, its IR sensors' places and bearings and 3 ground sensors", BODIES),

@@ -41,11 +41,23 @@ pub const STATE_FIELDS: [(&str, usize, &str); 6] = [
 ];
 
 /// The fields of `team.FIELD` and their state slots.
-pub const TEAM_FIELDS: [(&str, usize, &str); 1] = [(
-    "spread",
-    ST_SPREAD,
-    "the mean distance of the team's robots' centres to the team's centre, mm (0 for one robot)",
-)];
+pub const TEAM_FIELDS: [(&str, usize, &str); 3] = [
+    (
+        "spread",
+        ST_SPREAD,
+        "the mean distance of the team's robots' centres to the team's centre, mm (0 for one robot)",
+    ),
+    (
+        "grouped",
+        shaping_runtime::state::ST_GROUPED,
+        "the share of the team's robots whose body is within 20 mm of another robot's, 0..1",
+    ),
+    (
+        "largest",
+        shaping_runtime::state::ST_LARGEST,
+        "the share of the team's robots in its largest group (bodies within 20 mm of each other), 0..1",
+    ),
+];
 
 enum Val {
     /// Emitted onto the code.

@@ -71,3 +71,13 @@ fn the_documented_team_is_one() {
     };
     assert!(reads(&p.stages[0].fitness.at_end) || reads(&p.stages[0].fitness.per_action));
 }
+
+/// `team.grouped` and `team.largest` read their state slots.
+#[test]
+fn the_teams_groups_are_fields() {
+    use shaping_runtime::state::{ST_GROUPED, ST_LARGEST};
+    let src = SRC.replace("at end -team.spread / 100", "at end team.largest - team.grouped");
+    let p = compile_ok(&src, "teams.bat");
+    let at_end = p.stages[1].fitness.at_end.as_ref().expect("an at-end term");
+    assert_eq!(at_end.ops[..2], [Op::State(ST_LARGEST as u16), Op::State(ST_GROUPED as u16)]);
+}

@@ -360,8 +360,9 @@ pub struct Controller<'s> {
     odo: Odometer,
     /// The state the expressions read (`robot.x` ...), filled only when one does.
     state: [f32; STATE_SLOTS],
-    /// `team.spread`, as the team last gave it ([`Controller::set_spread`]).
-    spread: f32,
+    /// `team.spread`, `team.grouped`, `team.largest`, as the team last
+    /// gave them ([`Controller::set_team`]).
+    team: [f32; 3],
     reads_state: bool,
     /// Where the stage's targets (`distance_to(NAME)`) are in the world of
     /// the life (`None`: not in it; its distance reads [`FAR`]).
@@ -476,7 +477,7 @@ impl<'s> Controller<'s> {
             at_end: stage.fitness.at_end.as_ref().map(FastExpr::new),
             odo: Odometer::default(),
             state: [0.0; STATE_SLOTS],
-            spread: 0.0,
+            team: [0.0, 0.0, 1.0],
             reads_state: crate::state::reads_state(stage),
             targets: stage.targets.iter().map(|t| crate::world::Place::of(&stage.world, t)).collect(),
         })
@@ -528,15 +529,17 @@ impl<'s> Controller<'s> {
             for (slot, place) in self.state[crate::state::ST_TARGETS..].iter_mut().zip(&self.targets) {
                 *slot = place.map_or(FAR, |p| p.distance(at));
             }
-            self.state[crate::state::ST_SPREAD] = self.spread;
+            self.state[crate::state::ST_SPREAD..=crate::state::ST_LARGEST].copy_from_slice(&self.team);
         }
     }
 
-    /// Gives the team's spread (`team.spread`) the expressions read from now on.
-    pub fn set_spread(&mut self, spread: f32) {
-        self.spread = spread;
+    /// Gives the team's state the expressions read from now on: its
+    /// spread, the share of its robots grouped and in its largest group
+    /// (`team.spread`, `team.grouped`, `team.largest`).
+    pub fn set_team(&mut self, team: [f32; 3]) {
+        self.team = team;
         if self.reads_state {
-            self.state[crate::state::ST_SPREAD] = spread;
+            self.state[crate::state::ST_SPREAD..=crate::state::ST_LARGEST].copy_from_slice(&team);
         }
     }
 

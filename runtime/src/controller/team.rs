@@ -7,7 +7,8 @@
 //! life ends when every robot's has or after the stage's actions. Each
 //! robot's fitness is a single robot's (its terms, its events' bonuses);
 //! the team's is their `sum`, `mean` or `min` (`Fitness::team`).
-//! `team.spread` is given to every controller after each action. In a
+//! The team's state (`team.spread`, and `team.grouped` and `team.largest`
+//! when the stage reads them) is given to every controller after each action. In a
 //! heterogeneous team each robot runs its role's modules
 //! ([`Controller::for_role`]), all decoded from the one genome.
 
@@ -151,10 +152,11 @@ impl<'s> TeamRun<'s> {
         let ctls = &mut self.ctls[..n];
         let mut robots = vec![EpisodeResult::default(); n];
         let mut fitness = vec![0.0f64; n];
-        let spread = team.spread();
+        let groups = crate::state::reads_groups(self.stage);
+        let state = team.state(groups);
         for (i, c) in ctls.iter_mut().enumerate() {
             c.set_learning(opts.learning);
-            c.set_spread(spread);
+            c.set_team(state);
             if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
                 c.begin_trace(t);
             }
@@ -180,9 +182,9 @@ impl<'s> TeamRun<'s> {
                 }
             }
             actions += 1;
-            let spread = team.spread();
+            let state = team.state(groups);
             for c in ctls.iter_mut() {
-                c.set_spread(spread);
+                c.set_team(state);
             }
             if !after(team) {
                 break;

@@ -52,6 +52,10 @@ pub struct Team {
     reach: f32,
     /// The robot the charger serves.
     charger: Option<usize>,
+    /// [`Team::groups`]' scratch, sized once: each robot's group (a union-find
+    /// parent) and each group's size.
+    group: Vec<u32>,
+    size: Vec<u32>,
 }
 
 impl Team {
@@ -94,7 +98,7 @@ impl Team {
         for sim in &mut sims {
             sim.others.reserve_exact(room);
         }
-        let mut team = Team { sims, at, grid, reach, charger: None };
+        let mut team = Team { sims, at, grid, reach, charger: None, group: vec![0; n], size: vec![0; n] };
         team.begin_action();
         team
     }
@@ -199,6 +203,62 @@ impl Team {
     /// The robot the charger serves now, if any.
     pub fn charger_holder(&self) -> Option<usize> {
         self.charger
+    }
+
+    /// The team's state as expressions read it: `[team.spread, team.grouped,
+    /// team.largest]`, the groups measured only when `groups` ([0, 1] for
+    /// them otherwise: nothing reads them).
+    pub fn state(&mut self, groups: bool) -> [f32; 3] {
+        let (grouped, largest) = if groups { self.groups(crate::state::NEIGHBOUR_GAP) } else { (0.0, 1.0) };
+        [self.spread(), grouped, largest]
+    }
+
+    /// The share of the robots whose body is within `gap` mm of another's,
+    /// and the share in the largest group (robots joined by such pairs,
+    /// and the robots joined to those): `(0, 1)` for one robot. Found in
+    /// the grid (`gap` is at most the IR range), without allocating.
+    pub fn groups(&mut self, gap: f32) -> (f32, f32) {
+        let n = self.at.len();
+        let near = 2.0 * self.sims[0].radius + gap.clamp(0.0, super::ir::RANGE);
+        let near2 = near * near;
+        for (i, g) in self.group.iter_mut().enumerate() {
+            *g = i as u32;
+        }
+        self.size.fill(0);
+        let mut with = 0;
+        // The root of robot `i`'s group, halving the path on the way.
+        fn root(group: &mut [u32], mut i: u32) -> u32 {
+            while group[i as usize] != i {
+                let up = group[group[i as usize] as usize];
+                group[i as usize] = up;
+                i = up;
+            }
+            i
+        }
+        for i in 0..n {
+            let p = self.at[i];
+            let mut found = false;
+            let group = &mut self.group;
+            self.grid.near(p, |run| {
+                for e in run {
+                    if e.robot as usize != i && (e.at - p).norm_squared() <= near2 {
+                        found = true;
+                        let (a, b) = (root(group, i as u32), root(group, e.robot));
+                        if a != b {
+                            group[a.max(b) as usize] = a.min(b);
+                        }
+                    }
+                }
+            });
+            with += usize::from(found);
+        }
+        let mut largest = 0;
+        for i in 0..n {
+            let r = root(&mut self.group, i as u32) as usize;
+            self.size[r] += 1;
+            largest = largest.max(self.size[r]);
+        }
+        (with as f32 / n as f32, largest as f32 / n as f32)
     }
 
     /// The mean distance of the robots' centres to their mean, mm (0 for one).
