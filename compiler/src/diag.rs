@@ -262,6 +262,68 @@ pub enum Error {
         #[help]
         help: Option<String>,
     },
+
+    #[error("role `{role}` has no genes: evolution would not change it")]
+    #[diagnostic(code(S0024))]
+    RoleWithoutGenes {
+        #[label("{label}")]
+        span: SourceSpan,
+        role: String,
+        label: String,
+        #[help]
+        help: String,
+    },
+
+    #[error("stage `{stage}` has roles, but declares {what} outside them")]
+    #[diagnostic(code(S0025))]
+    OutsideRole {
+        #[label("outside every role")]
+        span: SourceSpan,
+        #[label("the stage's first role")]
+        role: SourceSpan,
+        stage: String,
+        what: String,
+        #[help]
+        help: String,
+    },
+
+    #[error("role `{role}` has no module")]
+    #[diagnostic(code(S0026))]
+    EmptyRole {
+        #[label("no module")]
+        span: SourceSpan,
+        role: String,
+        #[help]
+        help: String,
+    },
+
+    #[error("{where_} has {robots} robots, but the roles have {roles}")]
+    #[diagnostic(code(S0027))]
+    RoleRobots {
+        #[label(primary, "{robots} robots")]
+        span: SourceSpan,
+        #[label("the roles start here")]
+        first_role: Option<SourceSpan>,
+        where_: String,
+        robots: u32,
+        roles: u64,
+        #[help]
+        help: String,
+    },
+
+    #[error("{message}")]
+    #[diagnostic(code(S0028))]
+    RolesNotHere {
+        #[label(primary, "{label}")]
+        span: SourceSpan,
+        #[label("{other_label}")]
+        other: Option<SourceSpan>,
+        message: String,
+        label: String,
+        other_label: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

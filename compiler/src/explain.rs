@@ -196,6 +196,41 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
     },
+    Explanation {
+        code: "S0024",
+        title: "a role without genes",
+        text: "Each role of a heterogeneous team (`role NAME robots N { ... }`) owns its modules' genes; in an evolved stage, a role whose modules have no gene (fixed or random weights, scripts, fixed links) would be the same in every individual: evolution would not change it. Make one of its weights evolvable (`activation evolvable`, the default of a module's activation network, or `weights evolvable` in a `behavior neural`), or link its modules with evolvable links.",
+        wrong: concat!(robot!(), stage!("role scout robots 2 { module m { sense ir  behavior forward } }", "role idle robots 1 { module m { sense ir  activation fixed 0  behavior forward } }")),
+        right: concat!(robot!(), stage!("role scout robots 2 { module m { sense ir  behavior forward } }", "role idle robots 1 { module m { sense ir  activation evolvable  behavior forward } }")),
+    },
+    Explanation {
+        code: "S0025",
+        title: "a module or link outside the roles",
+        text: "In a stage with roles, each robot runs its role's modules and links only: a module or a link declared directly in the stage would belong to no robot. Move it into a role (two roles may each have a module of one name).",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward }", "role a robots 2 { module n { sense ir  behavior back } }")),
+        right: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward }  module n { sense ir  behavior back } }")),
+    },
+    Explanation {
+        code: "S0026",
+        title: "a role without modules",
+        text: "A role's robots run the role's modules: a role declares at least one `module NAME { ... }` inside its braces.",
+        wrong: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }", "role b robots 1 { }")),
+        right: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }", "role b robots 1 { module m { sense ir  behavior back } }")),
+    },
+    Explanation {
+        code: "S0027",
+        title: "`robots N` that disagrees with the roles",
+        text: "With roles, the team is the roles' robots: role 0's robots first, then role 1's, and so on. A `robots N` in the stage's world, in a variant or in a later `world changes` must be their sum (it may be left out).",
+        wrong: concat!(robot!(), stage!("world { robots 4 }", "role a robots 2 { module m { sense ir  behavior forward } }", "role b robots 1 { module m { sense ir  behavior back } }")),
+        right: concat!(robot!(), stage!("world { robots 3 }", "role a robots 2 { module m { sense ir  behavior forward } }", "role b robots 1 { module m { sense ir  behavior back } }")),
+    },
+    Explanation {
+        code: "S0028",
+        title: "roles where a stage cannot have them",
+        text: "Roles are declared by a stage that extends no stage and evolves its team. A training stage trains the modules of one robot, so it has no roles. A stage that extends a stage with roles keeps its roles, their modules and links (their genes frozen) and declares none of its own: it changes the world, the fitness or the evolution (a `test` stage, or an evolved stage in a new world).",
+        wrong: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }"), "stage t extends s {\n  module n { sense ir  behavior back }\n}\n"),
+        right: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }"), "stage t extends s {\n  world changes { arena 500mm x 500mm }\n}\n"),
+    },
 ];
 
 /// The explanation of a code (`S0006`, any case).

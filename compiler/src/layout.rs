@@ -14,6 +14,20 @@ fn channel_name(stage: &Stage, c: u16) -> String {
     }
 }
 
+/// The name of module `i` of a stage as the layout shows it: `avoid`, or
+/// `role.avoid` in a stage with roles (two roles may each have an `avoid`).
+pub fn module_label(stage: &Stage, i: usize) -> String {
+    let Some(m) = stage.modules.get(i) else { return format!("#{i}") };
+    if stage.roles.is_empty() {
+        return m.name.clone();
+    }
+    let r = (0..stage.roles.len()).find(|&r| stage.role_modules(r).contains(&i));
+    match r.and_then(|r| stage.roles.get(r)) {
+        Some(role) => format!("{}.{}", role.name, m.name),
+        None => m.name.clone(),
+    }
+}
+
 /// What gene `gene` of a stage's layout encodes, as the layout table shows it:
 /// `bias`, `weight ir[3]`, `link avoid -> wander`, `behavior out1 weight ir[0]`.
 pub fn role_text(stage: &Stage, gene: u32) -> String {
@@ -88,7 +102,10 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
                 g.offset.to_string(),
                 g.bits.to_string(),
                 program.stages.get(g.stage as usize).map(|s| s.name.clone()).unwrap_or_default(),
-                st.modules.get(g.module as usize).map(|m| m.name.clone()).unwrap_or_default(),
+                st.modules
+                    .get(g.module as usize)
+                    .map(|_| module_label(st, g.module as usize))
+                    .unwrap_or_default(),
                 role_text(st, i as u32),
                 format!("{:.2}..{:.2}", g.lo, g.hi),
                 if g.frozen { "frozen" } else { "evolvable" }.to_string(),
@@ -129,8 +146,21 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         n - frozen.len(),
         st.layout.bits - fbits
     );
+    // The roles of a heterogeneous team: who plays them, which modules and
+    // genes are theirs.
+    let mut robot = 0u64;
+    for (r, role) in st.roles.iter().enumerate() {
+        let mods = st.role_modules(r);
+        let genes = st.layout.genes.iter().filter(|g| mods.contains(&(g.module as usize))).count();
+        let last = robot + u64::from(role.robots) - 1;
+        let robots =
+            if role.robots == 1 { format!("robot {robot}") } else { format!("robots {robot}..{last}") };
+        let names: Vec<&str> = st.modules[mods].iter().map(|m| m.name.as_str()).collect();
+        let _ = writeln!(out, "role `{}`: {robots}, modules {}, {genes} genes", role.name, names.join(", "));
+        robot = last + 1;
+    }
     // Parameters that are not genes: what training stages learned.
-    for m in &st.modules {
+    for (i, m) in st.modules.iter().enumerate() {
         for (part, name) in [(Part::Activation, "activation network"), (Part::Behavior, "behavior")] {
             let mut params = m.network_params().filter(|(p, _)| *p == part).map(|(_, q)| q);
             let Some(Param::Trained { stage: t, .. }) = params.next() else { continue };
@@ -142,7 +172,7 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
             let _ = writeln!(
                 out,
                 "trained: `{}` {name}, {} weights, learned by stage `{by}`{actions} (not genes)",
-                m.name,
+                module_label(st, i),
                 params.count() + 1
             );
         }
@@ -258,7 +288,7 @@ pub fn render_graph(program: &Program, stage: usize) -> String {
         let _ = writeln!(
             out,
             "  \"m:{i}\" [shape=ellipse, label=\"{}\\n({kind})\"{style}];",
-            dot_escape(&m.name)
+            dot_escape(&module_label(st, i))
         );
         let mut seen: Vec<&str> = Vec::new();
         for &c in &m.inputs {

@@ -665,6 +665,11 @@ impl F<'_> {
                     .collect();
                 self.item(v.span, self.block(head, v.span, items))
             }
+            StageItem::Role(r) => {
+                let head = format!("role {} robots {}", r.name.text, self.qty(&r.robots));
+                let items = r.items.iter().map(|x| self.stage_item(x)).collect();
+                self.item(r.span, self.block(head, r.span, items))
+            }
             StageItem::Link(l) => self.item(
                 l.span,
                 Doc::Text(format!(

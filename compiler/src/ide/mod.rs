@@ -69,6 +69,11 @@ pub fn declarations(file: &ast::File) -> Vec<Declaration> {
                 ast::StageItem::RobotAdds(hws, _) => {
                     out.extend(hws.iter().map(|h| hw(h, Some(s.name.text.clone()))))
                 }
+                ast::StageItem::Role(r) => out.extend(r.modules().map(|m| Declaration {
+                    name: m.name.clone(),
+                    kind: Kind::Module,
+                    stage: Some(s.name.text.clone()),
+                })),
                 _ => {}
             }
         }
@@ -152,9 +157,9 @@ enum Context {
 /// The kind of the innermost block open among `tokens` (the keyword
 /// before its `{`), `None` at the top level.
 fn block_at<'t>(text: &'t str, tokens: &[Token]) -> Option<&'t str> {
-    const HEADS: [&str; 11] = [
+    const HEADS: [&str; 12] = [
         "stage", "module", "world", "robot", "genome", "evolve", "body", "neural", "script", "behavior",
-        "commit",
+        "commit", "role",
     ];
     let mut stack: Vec<Option<&str>> = Vec::new();
     for (i, t) in tokens.iter().enumerate() {
@@ -208,7 +213,9 @@ fn context(text: &str, offset: usize) -> Context {
         }
         ("outputs", _) => return Context::Only(&["sign", "linear"]),
         ("learn", _) => return Context::Only(&["crbp"]),
-        ("links", _) if block == Some("stage") => return Context::Only(&["all"]),
+        ("links", _) if matches!(block, Some("stage" | "role")) => return Context::Only(&["all"]),
+        ("role", _) => return Context::Nothing,
+        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots"]),
         ("all", "links") => return Context::Only(&["evolvable", "fixed"]),
         ("test", _) => return Context::Only(&["best"]),
         ("best", _) | ("train", _) => return Context::Only(&["for"]),
@@ -286,6 +293,7 @@ fn context(text: &str, offset: usize) -> Context {
         None => Context::Words(words::TOP),
         Some("robot") => Context::Words(words::ROBOT),
         Some("stage") => Context::Words(words::STAGE),
+        Some("role") => Context::Words(words::ROLE),
         Some("module") => Context::Words(words::MODULE),
         Some("world") => Context::Words(words::WORLD),
         Some("evolve") => Context::Words(words::EVOLVE),
@@ -363,15 +371,17 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
             })
             .collect()
     };
+    // The role the cursor is in: its modules are the ones a link names.
+    let role = here.and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end));
     let modules = |stages: &[&ast::StageDecl]| -> Vec<String> {
         let mut names: Vec<String> = Vec::new();
-        for s in stages.iter().rev() {
-            for i in &s.items {
-                if let ast::StageItem::Module(m) = i {
-                    if !names.contains(&m.name.text) {
-                        names.push(m.name.text.clone());
-                    }
-                }
+        let declared: Vec<&ast::ModuleDecl> = match role {
+            Some(r) => r.modules().collect(),
+            None => stages.iter().rev().flat_map(|s| s.all_modules()).collect(),
+        };
+        for m in declared {
+            if !names.contains(&m.name.text) {
+                names.push(m.name.text.clone());
             }
         }
         names
@@ -386,7 +396,8 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
         Context::Modules => modules(&stages).iter().map(|n| item(n, K::Module, "module")).collect(),
         Context::InheritedModules => {
             let parents: Vec<&ast::StageDecl> = stages.iter().skip(1).copied().collect();
-            let parents = if here.is_some() { parents } else { Vec::new() };
+            // A role's modules are new: a stage with roles extends none.
+            let parents = if here.is_some() && role.is_none() { parents } else { Vec::new() };
             modules(&parents).iter().map(|n| item(n, K::Module, "inherited module: changes it")).collect()
         }
         Context::Stages | Context::TrainingStages => file
@@ -567,13 +578,22 @@ pub fn hover(text: &str, offset: usize) -> Option<(Span, String)> {
                         .rev()
                         .find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
                 };
-                let m = st.modules.iter().find(|m| m.name == word)?;
+                // In a stage with roles, the module of the role at the
+                // cursor (two roles may each have a module of this name).
+                let role_at =
+                    here.and_then(|s| s.roles().position(|r| r.span.start <= offset && offset <= r.span.end));
+                let in_role = role_at
+                    .filter(|_| !st.roles.is_empty())
+                    .and_then(|r| st.role_modules(r).find(|&k| st.modules[k].name == word));
+                let mi = in_role.or_else(|| st.modules.iter().position(|m| m.name == word))?;
+                let m = &st.modules[mi];
+                let label = crate::module_label(st, mi);
                 let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
                 let table = render_layout(p, i);
                 let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
-                rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(word)));
+                rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(label.as_str())));
                 // Weights that are not genes: what a training stage learned.
-                let trained = format!("trained: `{word}` ");
+                let trained = format!("trained: `{label}` ");
                 let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
                 let genes = if rows.len() > 1 {
                     format!("```text\n{}\n```", rows.join("\n"))
@@ -582,8 +602,12 @@ pub fn hover(text: &str, offset: usize) -> Option<(Span, String)> {
                 };
                 let extra =
                     if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
+                let role = match label.split_once('.') {
+                    Some((r, _)) if !st.roles.is_empty() => format!(", role `{r}`"),
+                    _ => String::new(),
+                };
                 format!(
-                    "**module `{word}`** in stage `{}`\n\nsenses: {}\n\n{genes}{extra}",
+                    "**module `{word}`** in stage `{}`{role}\n\nsenses: {}\n\n{genes}{extra}",
                     st.name,
                     if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
                 )

@@ -45,6 +45,8 @@ pub const EVENT: Places = 1 << 15;
 /// on behavior always`): words hover explains, completion offers only
 /// where a rule of [`super::complete`] says so.
 pub const CLAUSE: Places = 1 << 16;
+/// In a `role NAME robots N { }` block.
+pub const ROLE: Places = 1 << 17;
 
 /// What kind of word it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,6 +95,7 @@ const ITEMS: &str = "walls-cylinders-lamps-floor-zones-and-the-start";
 const BODIES: &str = "bodies-and-sensor-layouts";
 const VARIANTS: &str = "variants-conditions-per-evaluation";
 const TEAMS: &str = "teams";
+const ROLES: &str = "roles-heterogeneous-teams";
 const EVOLUTION: &str = "7-evolution";
 const FITNESS: &str = "8-fitness";
 const MODULES: &str = "9-modules";
@@ -112,14 +115,14 @@ const LIST: &[Word] = &[
     w("genome", K, TOP | STAGE, "`genome { bits 4 range -1..1 }`: how genes are encoded (top level: every stage's default)", GENOME_S),
     w("stage", K, TOP, "`stage NAME [extends PARENT] { ... }`: one step of incremental shaping", STAGES),
     w("extends", K, CLAUSE, "`stage B extends A`: B starts from A's modules, links and frozen genes", STAGES),
-    w("module", K, STAGE, "`module NAME { sense ... behavior ... }`: a behavior module (naming an inherited one changes it)", MODULES),
+    w("module", K, STAGE | ROLE, "`module NAME { sense ... behavior ... }`: a behavior module (naming an inherited one changes it)", MODULES),
     w("sense", K, MODULE | NEURAL, "`sense ir[0..5], battery`: the module's inputs, in order", MODULES),
     w("activation", K, MODULE, "the module's activation network: `evolvable`, `fixed V`, `random LO..HI` or `trained STAGE`, `hidden N`, `range`", MODULES),
     w("behavior", K, MODULE, "what the module does when it wins: a step, a `script { }` or a `neural { }` behavior", MODULES),
     w("learn", K, MODULE, "`learn crbp(R, P) on behavior always`: local learning of the behavior or activation weights", LEARNING),
     w("reinforce", K, MODULE | STEP, "`reinforce EXPR`: the module's reinforcement program (in a script: deliver it now)", LEARNING),
-    w("links", K, STAGE | GENOME, "`links all evolvable`: a link between every pair of modules (in `genome`: the link genes)", LINKS),
-    w("link", K, STAGE, "`link A -> B evolvable`: A's activation inhibits or excites B's", LINKS),
+    w("links", K, STAGE | ROLE | GENOME, "`links all evolvable`: a link between every pair of modules (in `genome`: the link genes)", LINKS),
+    w("link", K, STAGE | ROLE, "`link A -> B evolvable`: A's activation inhibits or excites B's", LINKS),
     w("world", K, STAGE, "`world [adds | changes] { ... }`: the arena and what is in it", WORLD_S),
     w("evolve", K, STAGE, "`evolve { population 100 generations 40 ... }`: the genetic algorithm of the stage", EVOLUTION),
     w("test", K, STAGE, "`test best for N actions`: no evolution, the best of the parent re-adapts", STAGES),
@@ -191,7 +194,8 @@ const LIST: &[Word] = &[
     w("charger", C, WORLD | CLAUSE, "`charger L on north wall [with lamp]`: a charging bar on a wall", WORLD_S),
     w("battery", C, WORLD, "`battery N actions`: how long a full battery lasts", WORLD_S),
     w("objects", C, WORLD, "`objects N diameter D physical|virtual`: objects to collect", WORLD_S),
-    w("robots", C, WORLD, "`robots N`: a team of N clones of the evaluated individual, all starting in the start region", TEAMS),
+    w("robots", C, WORLD | CLAUSE, "`robots N`: a team of N clones of the evaluated individual, all starting in the start region (`role NAME robots N`: the robots that play a role)", TEAMS),
+    w("role", C, STAGE, "`role NAME robots N { MODULES LINKS }`: a role of a heterogeneous team, whose N robots run its own modules, links and genes", ROLES),
     w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm; `team.grouped`, `team.largest`: the shares of the robots with a neighbour and in the largest group", TEAMS),
     w("body", C, WORLD, "`body [khepera | e-puck] { v_max 80 ... }`: the robot's body, from a preset, with single values changed", WORLD_S),
     w("khepera", C, CLAUSE, "`body khepera`: the Khepera's body and sensors (the default)", BODIES),

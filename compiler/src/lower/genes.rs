@@ -12,18 +12,39 @@ use crate::syntax::Span;
 
 impl Lower<'_> {
     pub(super) fn links(&mut self, st: &mut StageSt, decl: &ast::StageDecl, s: u16) {
+        let (modules, links) = (&st.modules, &mut st.links);
+        self.links_of(modules, links, &decl.name.text, &decl.items, s, &[]);
+    }
+
+    /// The links of `items` (a stage's, or a role's) between `modules`,
+    /// into `links`. `others` are the modules of the stage's other roles,
+    /// with their role's name: a link to one of them is named so.
+    pub(super) fn links_of(
+        &mut self,
+        modules: &[ModuleSt],
+        links: &mut Vec<LinkSt>,
+        stage: &str,
+        items: &[ast::StageItem],
+        s: u16,
+        others: &[(String, String)],
+    ) {
         use ast::StageItem as I;
-        let names: Vec<String> = st.modules.iter().map(|m| m.name.clone()).collect();
+        let names: Vec<String> = modules.iter().map(|m| m.name.clone()).collect();
         let lookup = |lw: &mut Lower, n: &ast::Name| -> Option<u16> {
             if let Some(i) = names.iter().position(|m| *m == n.text) {
                 return Some(i as u16);
             }
-            let help = match lw.module_origin.get(&n.text) {
-                Some(origin) => Some(format!(
+            let other = others.iter().find(|(m, _)| *m == n.text);
+            let help = match (other, lw.module_origin.get(&n.text)) {
+                (Some((_, role)), _) => Some(format!(
+                    "`{}` is a module of role `{role}`: a link joins two modules of one role",
+                    n.text
+                )),
+                (None, Some(origin)) => Some(format!(
                     "`{}` is declared by stage `{origin}`, which does not come before this one",
                     n.text
                 )),
-                None => did_you_mean(&n.text, names.iter().map(String::as_str)),
+                (None, None) => did_you_mean(&n.text, names.iter().map(String::as_str)),
             };
             lw.errors.push(Error::Unknown {
                 span: n.span.into(),
@@ -34,8 +55,8 @@ impl Lower<'_> {
             None
         };
         let mut link_index: HashMap<(u16, u16), usize> =
-            st.links.iter().enumerate().map(|(k, x)| ((x.from, x.to), k)).collect();
-        for item in &decl.items {
+            links.iter().enumerate().map(|(k, x)| ((x.from, x.to), k)).collect();
+        for item in items {
             let I::Link(l) = item else { continue };
             let (from, to) = (lookup(self, &l.from), lookup(self, &l.to));
             let (Some(from), Some(to)) = (from, to) else { continue };
@@ -43,7 +64,7 @@ impl Lower<'_> {
                 ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
                 ast::LinkKind::Fixed(w) => Err(*w as f32),
             };
-            if let Some(old) = link_index.get(&(from, to)).map(|&k| &st.links[k]) {
+            if let Some(old) = link_index.get(&(from, to)).map(|&k| &links[k]) {
                 if old.stage == s {
                     self.errors.push(Error::Duplicate {
                         span: l.span.into(),
@@ -55,18 +76,18 @@ impl Lower<'_> {
                     self.errors.push(Error::Frozen {
                         span: l.span.into(),
                         frozen: old.span.into(),
-                        stage: decl.name.text.clone(),
+                        stage: stage.to_string(),
                         by: self.stage_names[old.stage as usize].clone(),
                         what: format!("the link `{} -> {}`", l.from.text, l.to.text),
                     });
                 }
                 continue;
             }
-            link_index.insert((from, to), st.links.len());
-            st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: l.span });
+            link_index.insert((from, to), links.len());
+            links.push(LinkSt { from, to, kind, param: None, stage: s, span: l.span });
         }
         let mut all_span: Option<Span> = None;
-        for item in &decl.items {
+        for item in items {
             let I::LinksAll(kind, span) = item else { continue };
             if let Some(first) = all_span {
                 self.errors.push(Error::Duplicate {
@@ -82,11 +103,11 @@ impl Lower<'_> {
                 ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
                 ast::LinkKind::Fixed(w) => Err(*w as f32),
             };
-            let n = st.modules.len() as u16;
+            let n = modules.len() as u16;
             for to in 0..n {
                 for from in 0..n {
                     if from != to && !link_index.contains_key(&(from, to)) {
-                        st.links.push(LinkSt { from, to, kind, param: None, stage: s, span: *span });
+                        links.push(LinkSt { from, to, kind, param: None, stage: s, span: *span });
                     }
                 }
             }

@@ -10,6 +10,7 @@
 pub(crate) mod expr;
 mod genes;
 pub(crate) mod module;
+mod roles;
 pub(crate) mod training;
 pub(crate) mod variants;
 pub(crate) mod world;
@@ -178,6 +179,10 @@ struct StageSt {
     /// The items the fitness measures the distance to (`distance_to`).
     targets: Vec<Target>,
     variants: Option<variants::VariantsSt>,
+    /// The roles of a heterogeneous team (declared here or inherited), and
+    /// where their heads (`role NAME robots N`) are written.
+    roles: Vec<Role>,
+    role_heads: Vec<Span>,
 }
 
 pub(crate) struct Lower<'a> {
@@ -619,17 +624,14 @@ impl<'a> Lower<'a> {
                 by_name.insert(&s.name.text, i);
             }
             for item in &s.items {
-                match item {
-                    ast::StageItem::RobotAdds(hw, _) => {
-                        for h in hw {
-                            self.hw_origin.entry(h.name.text.clone()).or_insert_with(|| s.name.text.clone());
-                        }
+                if let ast::StageItem::RobotAdds(hw, _) = item {
+                    for h in hw {
+                        self.hw_origin.entry(h.name.text.clone()).or_insert_with(|| s.name.text.clone());
                     }
-                    ast::StageItem::Module(m) => {
-                        self.module_origin.entry(m.name.text.clone()).or_insert_with(|| s.name.text.clone());
-                    }
-                    _ => {}
                 }
+            }
+            for m in s.all_modules() {
+                self.module_origin.entry(m.name.text.clone()).or_insert_with(|| s.name.text.clone());
             }
         }
         // Parents.
@@ -856,6 +858,8 @@ impl<'a> Lower<'a> {
             bits: 0,
             targets: Vec::new(),
             variants: None,
+            roles: Vec::new(),
+            role_heads: Vec::new(),
         };
         let file = self.file;
         if let Some(r) = file.robots.first() {
@@ -1063,6 +1067,10 @@ impl<'a> Lower<'a> {
                 self.world(&mut st.world, w, &sname);
             }
         }
+        let inherited_roles = !st.roles.is_empty();
+        self.role_heads(&mut st, decl);
+        let (roles, heads) = (st.roles.clone(), st.role_heads.clone());
+        self.role_robots(&mut st.world, &roles, &heads, decl.span, format!("the world of stage `{sname}`"));
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span, decl.span);
         self.check_ground(&st, s, decl.span);
@@ -1078,9 +1086,18 @@ impl<'a> Lower<'a> {
             has_charger: st.world.world.charger.is_some()
                 || st.world.world.items.zones.iter().any(|z| z.charger),
         };
-        // Modules.
+        self.check_role_training(&st, decl);
+        // Modules: a stage's, or its roles'.
+        let role_stage = !st.roles.is_empty();
+        let own_roles = self.check_role_items(&st, decl, inherited_roles);
+        if own_roles {
+            self.role_modules(&hw, &mut st, decl, s);
+        }
         let mut declared_here: HashMap<String, Span> = HashMap::new();
         for item in &decl.items {
+            if role_stage {
+                break;
+            }
             if let I::Module(m) = item {
                 if let Some(first) = declared_here.get(&m.name.text) {
                     self.errors.push(Error::Duplicate {
@@ -1110,7 +1127,7 @@ impl<'a> Lower<'a> {
                 self.check_module(m);
             }
         }
-        if st.modules.is_empty() {
+        if st.modules.is_empty() && decl.roles().next().is_none() {
             self.value_error(
                 decl.name.span,
                 format!("stage `{sname}` has no modules"),
@@ -1118,7 +1135,9 @@ impl<'a> Lower<'a> {
                 Some("declare at least one `module NAME { ... }`".into()),
             );
         }
-        self.links(&mut st, decl, s);
+        if !role_stage {
+            self.links(&mut st, decl, s);
+        }
         // Fitness.
         // A `fitness` without `adds` replaces the fitness: after another
         // `fitness` of the same stage, it would silently drop that one.
@@ -1154,6 +1173,7 @@ impl<'a> Lower<'a> {
         }
         st.targets = std::mem::take(&mut self.targets);
         self.allocate(&mut st, s);
+        self.check_role_genes(&st, decl);
         self.check_genome_size(&st, decl);
         let mut stage = assemble(&st, &sname, s, parent);
         stage.variants = self.variant_worlds(&st, &sname, decl);
@@ -1283,30 +1303,26 @@ fn assemble(st: &StageSt, name: &str, s: u16, parent: Option<usize>) -> Stage {
         inheritance: st.inheritance,
         variants: None,
         targets: st.targets.clone(),
-        roles: Vec::new(),
+        roles: st.roles.clone(),
     }
 }
 
 /// The stages named by the `weights trained STAGE` and `activation trained
 /// STAGE` of a stage's modules.
 fn trained_uses(s: &ast::StageDecl) -> impl Iterator<Item = &ast::Name> {
-    s.items
-        .iter()
-        .filter_map(|item| match item {
-            ast::StageItem::Module(m) => Some(m.items.iter().filter_map(|mi| match mi {
-                ast::ModuleItem::Behavior(ast::BehaviorDecl::Neural(n)) => match &n.weights {
-                    Some(ast::WeightSource::Trained(by, _)) => Some(by),
-                    _ => None,
-                },
-                ast::ModuleItem::Activation(a) => match &a.source {
-                    Some(ast::WeightSource::Trained(by, _)) => Some(by),
-                    _ => None,
-                },
+    s.all_modules().flat_map(|m| {
+        m.items.iter().filter_map(|mi| match mi {
+            ast::ModuleItem::Behavior(ast::BehaviorDecl::Neural(n)) => match &n.weights {
+                Some(ast::WeightSource::Trained(by, _)) => Some(by),
                 _ => None,
-            })),
+            },
+            ast::ModuleItem::Activation(a) => match &a.source {
+                Some(ast::WeightSource::Trained(by, _)) => Some(by),
+                _ => None,
+            },
             _ => None,
         })
-        .flatten()
+    })
 }
 
 fn unit_desc(u: Unit) -> String {

@@ -120,6 +120,53 @@ pub enum StageItem {
     LinksAll(LinkKind, Span),
     Link(LinkDecl),
     Variants(VariantsDecl),
+    /// `role NAME robots N { ... }`: a role of a heterogeneous team.
+    Role(RoleDecl),
+}
+
+/// `role NAME robots N { MODULES LINKS }`: a role of a heterogeneous team.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoleDecl {
+    pub name: Name,
+    /// How many robots play it.
+    pub robots: Quantity,
+    /// Its modules and links (`StageItem::Module`, `LinksAll` and `Link`).
+    pub items: Vec<StageItem>,
+    pub span: Span,
+}
+
+impl RoleDecl {
+    /// The head `role NAME robots N`, up to its count.
+    pub fn head(&self) -> Span {
+        Span { start: self.span.start, end: self.robots.span.end.max(self.span.start) }
+    }
+
+    /// The modules the role declares.
+    pub fn modules(&self) -> impl Iterator<Item = &ModuleDecl> {
+        self.items.iter().filter_map(|i| match i {
+            StageItem::Module(m) => Some(m),
+            _ => None,
+        })
+    }
+}
+
+impl StageDecl {
+    /// The roles the stage declares.
+    pub fn roles(&self) -> impl Iterator<Item = &RoleDecl> {
+        self.items.iter().filter_map(|i| match i {
+            StageItem::Role(r) => Some(r),
+            _ => None,
+        })
+    }
+
+    /// Every module the stage declares: its own, then each role's.
+    pub fn all_modules(&self) -> impl Iterator<Item = &ModuleDecl> {
+        let own = self.items.iter().filter_map(|i| match i {
+            StageItem::Module(m) => Some(m),
+            _ => None,
+        });
+        own.chain(self.roles().flat_map(RoleDecl::modules))
+    }
 }
 
 /// `variants mean [draw N] { NAME { ITEMS } ... }`.

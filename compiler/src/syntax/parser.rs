@@ -386,6 +386,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::learn_error => "`difference` or `squared`",
         Rule::learn_when | Rule::k_always => "`always` or `when`",
         Rule::window => "`over`",
+        Rule::role | Rule::k_role => "`role`",
         Rule::links_all => "`links`",
         Rule::link => "`link`",
         Rule::k_all => "`all`",
@@ -566,7 +567,11 @@ fn misspelt_keyword(word: &str, expected: &str) -> Option<String> {
     }
     let words = expected.split('`').skip(1).step_by(2).filter(|w| w.chars().all(|c| c.is_ascii_alphabetic()));
     let units = if expected.contains("a unit") { &["actions", "action"][..] } else { &[] };
-    crate::diag::did_you_mean(word, words.chain(units.iter().copied()).filter(|w| *w != word))
+    // Of candidates as far from the word, a swap of neighbours (`wrold`) is
+    // the likelier slip: the closest by that count first.
+    let mut candidates: Vec<&str> = words.chain(units.iter().copied()).filter(|w| *w != word).collect();
+    candidates.sort_by_key(|w| strsim::osa_distance(word, w));
+    crate::diag::did_you_mean(word, candidates)
 }
 
 /// A decoding table's entry that is no wheel motion (`sign(2) -> forward |
@@ -833,26 +838,48 @@ impl Builder {
                     let fit = self.fitness(c);
                     items.push(StageItem::Fitness(fit));
                 }
-                Rule::module => {
-                    let m = self.module(c);
-                    items.push(StageItem::Module(m));
-                }
-                Rule::links_all => {
-                    let kind = c.into_inner().nth(1).map(link_kind).unwrap_or(LinkKind::Evolvable(None));
-                    items.push(StageItem::LinksAll(kind, csp));
-                }
-                Rule::link => {
-                    let mut li = c.into_inner();
+                Rule::role => {
+                    let mut ri = c
+                        .into_inner()
+                        .filter(|p| p.as_rule() != Rule::k_role && p.as_rule() != Rule::k_robots);
                     let blank = Name { text: String::new(), span: csp };
-                    let from = li.next().map(name).unwrap_or(blank.clone());
-                    let to = li.next().map(name).unwrap_or(blank);
-                    let kind = li.next().map(link_kind).unwrap_or(LinkKind::Evolvable(None));
-                    items.push(StageItem::Link(LinkDecl { from, to, kind, span: csp }));
+                    let role_name = ri.next().map(name).unwrap_or(blank);
+                    let robots =
+                        ri.next().map(quantity).unwrap_or(Quantity { value: 1.0, unit: None, span: csp });
+                    let role_items = ri.filter_map(|p| self.role_item(p)).collect();
+                    items.push(StageItem::Role(RoleDecl {
+                        name: role_name,
+                        robots,
+                        items: role_items,
+                        span: csp,
+                    }));
                 }
+                Rule::module | Rule::links_all | Rule::link => items.extend(self.role_item(c)),
                 _ => {}
             }
         }
         StageDecl { name: n, extends, items, span: sp }
+    }
+
+    /// A module, `links all` or `link` (of a stage or of a role).
+    fn role_item(&mut self, c: Pair<Rule>) -> Option<StageItem> {
+        let csp = span(&c);
+        match c.as_rule() {
+            Rule::module => Some(StageItem::Module(self.module(c))),
+            Rule::links_all => {
+                let kind = c.into_inner().nth(1).map(link_kind).unwrap_or(LinkKind::Evolvable(None));
+                Some(StageItem::LinksAll(kind, csp))
+            }
+            Rule::link => {
+                let mut li = c.into_inner();
+                let blank = Name { text: String::new(), span: csp };
+                let from = li.next().map(name).unwrap_or(blank.clone());
+                let to = li.next().map(name).unwrap_or(blank);
+                let kind = li.next().map(link_kind).unwrap_or(LinkKind::Evolvable(None));
+                Some(StageItem::Link(LinkDecl { from, to, kind, span: csp }))
+            }
+            _ => None,
+        }
     }
 
     fn fitness(&mut self, p: Pair<Rule>) -> FitnessDecl {

@@ -13,6 +13,7 @@ mod limits;
 mod parse;
 mod props;
 mod recover;
+mod roles;
 mod teams;
 mod ui;
 mod words;

@@ -66,10 +66,15 @@ fn kind(e: &Error) -> &'static str {
         Error::SimilarName { .. } => "SimilarName",
         Error::TeamTooLarge { .. } => "TeamTooLarge",
         Error::TeamOfOne { .. } => "TeamOfOne",
+        Error::RoleWithoutGenes { .. } => "RoleWithoutGenes",
+        Error::OutsideRole { .. } => "OutsideRole",
+        Error::EmptyRole { .. } => "EmptyRole",
+        Error::RoleRobots { .. } => "RoleRobots",
+        Error::RolesNotHere { .. } => "RolesNotHere",
     }
 }
 
-const KINDS: [&str; 23] = [
+const KINDS: [&str; 28] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -93,6 +98,11 @@ const KINDS: [&str; 23] = [
     "SimilarName",
     "TeamTooLarge",
     "TeamOfOne",
+    "RoleWithoutGenes",
+    "OutsideRole",
+    "EmptyRole",
+    "RoleRobots",
+    "RolesNotHere",
 ];
 
 #[test]

@@ -1,0 +1,77 @@
+//! Roles of a heterogeneous team (`role NAME robots N { ... }`): what the
+//! compiler writes into the program, and what a later stage inherits.
+
+use shaping_runtime::program::{Param, Role, StageRun};
+
+use crate::compile_ok;
+
+fn roles_src() -> String {
+    std::fs::read_to_string(crate::root().join("tests/lower/roles.bat")).unwrap()
+}
+
+fn role(name: &str, robots: u32, modules: u16) -> Role {
+    Role { name: name.into(), robots, modules }
+}
+
+#[test]
+fn two_roles_make_the_program_s_roles() {
+    let p = compile_ok(&roles_src(), "roles.bat");
+    let s = &p.stages[0];
+    assert_eq!(s.roles, [role("seeker", 3, 1), role("anchor", 2, 2)]);
+    assert_eq!(s.world.robots, 5);
+    let names: Vec<&str> = s.modules.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["brain", "brain", "avoid"]);
+    // `links all` of role `anchor` joins its two modules, numbered in the stage.
+    let links: Vec<(u16, u16)> = s.links.iter().map(|l| (l.from, l.to)).collect();
+    assert_eq!(links, [(2, 1), (1, 2)]);
+    // Role `seeker`'s genes are its brain's behavior (an activation fixed 0);
+    // `anchor`'s the activation networks of its modules and its links.
+    let of = |m: u16| s.layout.genes.iter().filter(|g| g.module == m).count();
+    assert_eq!((of(0), of(1), of(2)), (7, 3, 3), "genes per module");
+    assert!(s.layout.genes.windows(2).all(|w| w[0].module <= w[1].module), "role by role");
+    for l in &s.links {
+        let Param::Gene(g) = l.weight else { panic!("an evolvable link") };
+        assert_eq!(s.layout.genes[g as usize].module, l.to);
+    }
+    assert_eq!(s.role_of(2), 0);
+    assert_eq!(s.role_of(3), 1);
+}
+
+#[test]
+fn a_stage_extending_a_role_stage_keeps_its_roles() {
+    let p = compile_ok(&roles_src(), "roles.bat");
+    let (gather, check, wider) = (&p.stages[0], &p.stages[1], &p.stages[2]);
+    assert!(matches!(check.run, StageRun::Test { lives: 2, .. }));
+    for s in [check, wider] {
+        assert_eq!(s.roles, gather.roles, "{}", s.name);
+        assert_eq!(s.modules, gather.modules, "{}", s.name);
+        assert_eq!(s.links, gather.links, "{}", s.name);
+        assert_eq!(s.world.robots, 5);
+        assert_eq!(s.layout.genes.len(), gather.layout.genes.len());
+        assert!(s.layout.genes.iter().all(|g| g.frozen), "{}: inherited genes are frozen", s.name);
+    }
+    assert_eq!(wider.world.arena, [800.0, 800.0]);
+}
+
+#[test]
+fn the_runtime_accepts_every_stage() {
+    let p = compile_ok(&roles_src(), "roles.bat");
+    shaping_runtime::validate::program(&p).expect("a valid program");
+}
+
+#[test]
+fn a_program_without_roles_writes_none() {
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s { world { robots 3 }  fitness per action wheels[0]  module m { sense ir  behavior forward } }";
+    let p = compile_ok(src, "clones.bat");
+    assert!(p.stages[0].roles.is_empty());
+    let json = serde_json::to_string(&p).unwrap();
+    assert!(!json.contains("roles"), "{json}");
+}
+
+#[test]
+fn a_robots_count_equal_to_the_roles_is_accepted() {
+    let src = roles_src().replace("arena 600mm x 600mm }", "arena 600mm x 600mm  robots 5 }");
+    let p = compile_ok(&src, "roles.bat");
+    assert_eq!(p.stages[0].world.robots, 5);
+}
