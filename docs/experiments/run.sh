@@ -99,6 +99,7 @@ $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/
 # objects against one robot with 4 objects in khepera.bat's arena (the same
 # file with three changes, each checked).
 $B experiment examples/aggregation.bat --seeds $SEEDS --out $R/aggregation --fresh > /dev/null
+$B experiment examples/aggregation-roles.bat --seeds $SEEDS --out $R/aggregation-roles --fresh > /dev/null
 $B experiment examples/team-collect.bat --seeds $SEEDS --out $R/team-collect --fresh > /dev/null
 sed -e 's#arena 800mm x 1200mm#arena 400mm x 600mm#' -e 's#charger 400mm on north wall#charger 200mm on north wall#' \
   -e '/^    robots 4$/d' -e 's#/ 300, team sum$#/ 300#' -e 's#objects 16 diameter#objects 4 diameter#' \
@@ -108,6 +109,11 @@ grep -q 'charger 200mm on north wall' $R/team-collect-solo.bat
 grep -q 'objects 4 diameter 10mm' $R/team-collect-solo.bat
 [ "$(grep -c '^    robots \|, team sum' $R/team-collect-solo.bat)" = 0 ]
 $B experiment $R/team-collect-solo.bat --seeds $SEEDS --out $R/team-collect-solo --fresh > /dev/null
+# One robot in the team's world (its arena, charger and 16 objects): what
+# the arena does, without the other robots.
+sed -e '/^    robots 4$/d' -e 's#/ 300, team sum$#/ 300#' examples/team-collect.bat > $R/team-collect-one.bat
+[ "$(grep -c '^    robots \|, team sum' $R/team-collect-one.bat)" = 0 ]
+$B experiment $R/team-collect-one.bat --seeds $SEEDS --out $R/team-collect-one --fresh > /dev/null
 
 # The chosen bests at work: three fresh episodes each (seeds 101..103),
 # with learning and, for collect, without it (how much grip decisions owe
@@ -117,7 +123,7 @@ for s in $(seq 1 $SEEDS); do
   for r in 101 102 103; do
     for spec in "khepera navigation" "khepera collect" "khepera-explore navigation" "khepera-explore collect" \
       "khepera-practice navigation" "khepera-practice collect" "pretrained navigation" "forward-only navigation" "scratch-full full" \
-      "team-collect collect" "team-collect-solo collect"; do
+      "team-collect collect" "team-collect-solo collect" "team-collect-one collect"; do
       set -- $spec
       file=examples/$1.bat; [ -f "$file" ] || file=$R/$1.bat
       echo "$1 $2 $s $r learning $($B replay $file --stage $2 --run $R/$1/seed-$s --seed $r --out $R/replay-$1-$2-$s-$r | sed 's/ -> .*//')" >> $R/replays.txt
@@ -158,10 +164,14 @@ done
 cargo build --release --quiet --example walkers
 $T/examples/walkers examples/aggregation.bat --lives 100 --picture $D/aggregation-walkers.png > $R/walkers.txt
 $T/examples/walkers examples/aggregation.bat --lives 20 --run $R/aggregation --seeds $SEEDS > $R/aggregation-lives.txt
+$T/examples/walkers examples/aggregation-roles.bat --lives 20 --run $R/aggregation-roles --seeds $SEEDS \
+  > $R/aggregation-roles-lives.txt
 $T/examples/walkers examples/team-collect.bat --stage collect --lives 20 --run $R/team-collect --seeds $SEEDS \
   > $R/team-collect-lives.txt
 $T/examples/walkers $R/team-collect-solo.bat --stage collect --lives 20 --run $R/team-collect-solo --seeds $SEEDS \
   > $R/team-collect-solo-lives.txt
+$T/examples/walkers $R/team-collect-one.bat --stage collect --lives 20 --run $R/team-collect-one --seeds $SEEDS \
+  > $R/team-collect-one-lives.txt
 
 # What the world allows in the collect stage: a blind search with perfect
 # gripping, releasing and recharging, and each seed's collect best with
@@ -240,13 +250,19 @@ echo "== teams: aggregation (random walkers, then the evolved teams)"
 tail -1 $R/walkers.txt
 grep -E '^seed [0-9]+ \(' $R/aggregation-lives.txt
 grep -A5 '^over the seeds' $R/aggregation-lives.txt
+echo "== teams: aggregation by two roles of 5 robots"
+grep -E '^seed [0-9]+ \(' $R/aggregation-roles-lives.txt
+grep -A5 '^over the seeds' $R/aggregation-roles-lives.txt
 echo "== teams: cooperative collect, 4 robots and 16 objects, then 1 robot and 4 objects"
 grep -E '^seed [0-9]+ \(' $R/team-collect-lives.txt
 grep -A5 '^over the seeds' $R/team-collect-lives.txt
 grep -E '^seed [0-9]+ \(' $R/team-collect-solo-lives.txt
 grep -A5 '^over the seeds' $R/team-collect-solo-lives.txt
+echo "== teams: cooperative collect, 1 robot in the team's world (800 x 1200 mm, 16 objects)"
+grep -E '^seed [0-9]+ \(' $R/team-collect-one-lives.txt
+grep -A5 '^over the seeds' $R/team-collect-one-lives.txt
 echo "== the same in the replays (3 per seed): recharges and actions per life"
-for f in team-collect team-collect-solo; do
+for f in team-collect team-collect-solo team-collect-one; do
   grep "^$f collect " $R/replays.txt | awk -v f=$f '{ n++; a += $7; for (i = 1; i < NF; i++) if ($(i+1) == "recharges,") r += $i }
     END { printf "%s: %d recharges in %d lives, %.1f actions per life\n", f, r, n, a / n }'
 done

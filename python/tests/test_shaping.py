@@ -187,6 +187,24 @@ def test_evaluate_a_team():
     assert np.all((a["x"] >= 0) & (a["x"] <= 600) & (a["y"] >= 0) & (a["y"] <= 600))
 
 
+def test_evaluate_a_team_with_roles():
+    # examples/aggregation-roles.bat: two roles of 5 robots, each with its
+    # own network: the genome is both roles' genes (twice aggregation.bat's),
+    # and each role's genes change the team's life.
+    clones = shaping.compile(ROOT / "examples" / "aggregation.bat").evaluator("aggregate", seed=5)
+    ev = shaping.compile(ROOT / "examples" / "aggregation-roles.bat").evaluator("aggregate", seed=5, jobs=2)
+    assert ev.bits == 2 * clones.bits
+    g = random_genomes(4, ev.bits, seed=3)
+    base = ev.evaluate(g)["fitness"]
+    np.testing.assert_array_equal(base, ev.evaluate(g)["fitness"])
+    assert np.all((base > 1 - 425 / 400) & (base < 1)), base
+    half = ev.bits // 2
+    for part in (slice(0, half), slice(half, ev.bits)):
+        changed = g.copy()
+        changed[:, part] = 1 - changed[:, part]
+        assert np.all(ev.evaluate(changed)["fitness"] != base), part
+
+
 def test_evaluate_rejects_bad_arrays(navigation):
     _, ev = navigation
     g = random_genomes(4, ev.bits)
