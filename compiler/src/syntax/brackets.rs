@@ -286,6 +286,9 @@ fn block_name(src: &str, tokens: &[Token], i: usize) -> Option<String> {
         let name = if w(2) == Some("stage") { w(1) } else { w(3) };
         return name.map(|n| format!("stage `{n}`"));
     }
+    if w(4) == Some("role") && w(2) == Some("robots") {
+        return w(3).map(|n| format!("role `{n}`"));
+    }
     match (w(2), w(1)?) {
         (Some(kw @ ("robot" | "world")), m @ ("adds" | "changes")) => Some(format!("the `{kw} {m}` block")),
         (Some(kw @ ("module" | "robot")), name) => Some(format!("{kw} `{name}`")),

@@ -161,6 +161,8 @@ pub(super) fn starts_item(src: &str, tokens: &[Token], i: usize) -> bool {
         Some("links") => next == Some("all"),
         Some("robot") => next == Some("adds"),
         Some("train") => next == Some("for"),
+        // `role NAME robots N {`: a role (its modules are its own items).
+        Some("role") => next.is_some_and(|n| !super::RESERVED.contains(&n)),
         _ => false,
     }
 }
@@ -220,8 +222,14 @@ fn stage_items(
     let mut start = body;
     let mut depth = 0i64;
     let mut close = None;
+    // Inside a role's braces, its modules and links belong to the role's item.
+    let mut in_role = false;
     for (j, t) in toks.iter().enumerate().skip(i + 1) {
-        let starts = starts_item(src, toks, j) || (depth == 0 && misspelt_item(src, toks, j));
+        let inner = in_role && depth > 0;
+        let starts = !inner && (starts_item(src, toks, j) || (depth == 0 && misspelt_item(src, toks, j)));
+        if starts {
+            in_role = word(src, Some(t)) == Some("role");
+        }
         if starts && t.span.start > start {
             items.push((start, t.span.start));
             start = t.span.start;

@@ -83,6 +83,8 @@ const TOKENS: &[&str] = &[
     "sign",
     "|",
     "script",
+    "role",
+    "robots",
     "// c\n",
 ];
 

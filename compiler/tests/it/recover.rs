@@ -170,3 +170,23 @@ fn recovery_keeps_the_call_budget_on_huge_files() {
         assert!(first == "robot `q` is not closed" || first.contains("too complex"), "{first}");
     }
 }
+
+/// A syntax error in one role's module loses that role only: the stage's
+/// other roles and items, and the next stage, are in the AST.
+#[test]
+fn an_error_in_a_role_keeps_the_other_roles() {
+    let src = format!(
+        "{ROBOT}stage s {{\n  fitness per action wheels[0]\n  role a robots 2 {{\n    module m {{ sense ir  behavior forward( }}\n  }}\n\
+         role b robots 1 {{ module n {{ sense ir  behavior back }} }}\n}}\nstage t extends s {{ fitness per action 1 }}\n"
+    );
+    let (file, errors) = parse_recovering(&src);
+    let file = file.expect("an AST");
+    assert_eq!(lines(&src, &errors), [5]);
+    assert_eq!(stage_names(&file), ["s", "t"]);
+    let roles: Vec<(&str, Vec<&str>)> = file.stages[0]
+        .roles()
+        .map(|r| (r.name.text.as_str(), r.modules().map(|m| m.name.text.as_str()).collect()))
+        .collect();
+    assert_eq!(roles, [("b", vec!["n"])]);
+    assert!(file.stages[0].items.iter().any(|i| matches!(i, ast::StageItem::Fitness(_))));
+}

@@ -75,3 +75,64 @@ fn a_robots_count_equal_to_the_roles_is_accepted() {
     let p = compile_ok(&src, "roles.bat");
     assert_eq!(p.stages[0].world.robots, 5);
 }
+
+/// Files with roles, right and wrong in every way the runtime checks
+/// roles: each either compiles to a program the runtime accepts, or gives
+/// a diagnostic. None reaches the runtime's validation with an error.
+#[test]
+fn no_file_with_roles_reaches_the_runtime_s_refusals() {
+    let robots = ["0", "1", "3"];
+    let activations = ["", "activation fixed 0", "activation random -1..1"];
+    let links =
+        ["", "links all evolvable", "links all fixed 1", "link p -> q evolvable", "link q -> p fixed 1"];
+    let worlds = ["", "world { robots 4 }", "world { robots 5 }"];
+    let later = [
+        "",
+        "stage t extends s { test best for 50 actions }",
+        "stage t extends s { world changes { robots 2 } fitness per action 1 }",
+        "stage t extends s { module z { sense ir  behavior stop } }",
+        "stage t extends s { role z robots 1 { module z { sense ir  behavior stop } } }",
+        "stage t { train for 10 actions  role z robots 1 { module z { sense ir  activation fixed 0  behavior stop } } }",
+    ];
+    let (mut compiled, mut refused) = (0, 0);
+    for r in robots {
+        for a in activations {
+            for l in links {
+                for w in worlds {
+                    for (k, t) in later.iter().enumerate() {
+                        // The second role's name: its own, or the first's.
+                        let second = if k % 2 == 0 { "b" } else { "a" };
+                        let src = format!(
+                            "robot x {{ sensor ir[8] proximity  actuator wheels[2] speed }}
+stage s {{
+  {w}
+  fitness per action wheels[0]
+  role a robots 2 {{ module p {{ sense ir  behavior forward }} }}
+  role {second} robots {r} {{
+    module p {{ sense ir  {a}  behavior back }}
+    module q {{ sense ir[0]  activation fixed 0  behavior stop }}
+    {l}
+  }}
+}}
+{t}
+"
+                        );
+                        match shaping_compiler::compile(&src, "roles.bat") {
+                            Ok(p) => {
+                                compiled += 1;
+                                if let Err(e) = shaping_runtime::validate::program(&p) {
+                                    panic!("compiles to a program the runtime refuses ({e}):\n{src}");
+                                }
+                            }
+                            Err(d) => {
+                                refused += 1;
+                                assert!(d.error_count() > 0, "{src}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(compiled > 20 && refused > 20, "{compiled} compiled, {refused} refused");
+}
