@@ -7,6 +7,8 @@
 //! - [`keyword_at`]: the word of the language under the cursor (hover);
 //! - [`declarations`], [`prepare_rename`], [`rename`]: the names a file
 //!   declares, and renaming a module or a stage;
+//! - [`outline`], [`definition`]: the document's symbols (roles holding
+//!   their modules), and where a name used at an offset is declared;
 //! - [`fixes`]: the edits a diagnostic's help proposes (quick fixes).
 
 pub mod words;
@@ -79,6 +81,80 @@ pub fn declarations(file: &ast::File) -> Vec<Declaration> {
         }
     }
     out
+}
+
+/// What a symbol of the outline is.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum SymbolKind {
+    Robot,
+    Hardware,
+    Stage,
+    Role,
+    Module,
+}
+
+/// A symbol of the document outline: its name, what it is, the span of
+/// its whole declaration, and the symbols it holds.
+#[derive(Clone, Debug)]
+pub struct Symbol {
+    pub name: ast::Name,
+    pub kind: SymbolKind,
+    pub span: Span,
+    pub children: Vec<Symbol>,
+}
+
+/// The document outline, in source order: each robot with its hardware,
+/// each stage with its modules and roles, each role with its modules.
+pub fn outline(file: &ast::File) -> Vec<Symbol> {
+    let leaf = |name: &ast::Name, kind, span| Symbol { name: name.clone(), kind, span, children: Vec::new() };
+    let modules = |items: &[ast::StageItem]| -> Vec<Symbol> {
+        items
+            .iter()
+            .filter_map(|i| match i {
+                ast::StageItem::Module(m) => Some(leaf(&m.name, SymbolKind::Module, m.span)),
+                ast::StageItem::Role(r) => Some(Symbol {
+                    name: r.name.clone(),
+                    kind: SymbolKind::Role,
+                    span: r.span,
+                    children: r.modules().map(|m| leaf(&m.name, SymbolKind::Module, m.span)).collect(),
+                }),
+                _ => None,
+            })
+            .collect()
+    };
+    let mut out: Vec<Symbol> = file
+        .robots
+        .iter()
+        .map(|r| Symbol {
+            name: r.name.clone(),
+            kind: SymbolKind::Robot,
+            span: r.span,
+            children: r.hardware.iter().map(|h| leaf(&h.name, SymbolKind::Hardware, h.span)).collect(),
+        })
+        .collect();
+    out.extend(file.stages.iter().map(|s| Symbol {
+        name: s.name.clone(),
+        kind: SymbolKind::Stage,
+        span: s.span,
+        children: modules(&s.items),
+    }));
+    out.sort_by_key(|s| s.span.start);
+    out
+}
+
+/// Where the name at `offset` is declared: a module named inside a role is
+/// that role's (two roles may each have a `brain`); any other name, its
+/// first declaration.
+pub fn definition(text: &str, offset: usize) -> Option<Span> {
+    let span = word_at(text, offset)?;
+    let word = &text[span.start..span.end];
+    let file = parse_recovering(text).0?;
+    let role =
+        file.stages.iter().flat_map(|s| s.roles()).find(|r| r.span.start <= offset && offset <= r.span.end);
+    if let Some(m) = role.and_then(|r| r.modules().find(|m| m.name.text == word)) {
+        return Some(m.name.span);
+    }
+    declarations(&file).into_iter().find(|d| d.name.text == word).map(|d| d.name.span)
 }
 
 /// The word token at an offset (its end included).

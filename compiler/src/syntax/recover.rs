@@ -263,9 +263,19 @@ fn stage_items(
             // After the item's last token: its trailing blanks may take a missing `}`.
             Ok(_) => last_kept = tokens[first_token(tokens, e) - 1].span.end,
             Err(err) => {
-                let pos = position(&err).saturating_sub(ITEM_HEAD.len()).min(text.len());
-                errors.push(at(src, err, s + pos));
-                blank(masked, s, e);
+                // A role: its modules and links that parse are kept.
+                let is_role = word(src, tokens.get(first_token(tokens, s))) == Some("role");
+                match is_role.then(|| role_items(src, tokens, (s, e), masked)).flatten() {
+                    Some(inner) => {
+                        errors.extend(inner);
+                        last_kept = tokens[first_token(tokens, e) - 1].span.end;
+                    }
+                    None => {
+                        let pos = position(&err).saturating_sub(ITEM_HEAD.len()).min(text.len());
+                        errors.push(at(src, err, s + pos));
+                        blank(masked, s, e);
+                    }
+                }
             }
         }
     }
@@ -290,6 +300,61 @@ fn stage_items(
         }
     }
     Some(errors)
+}
+
+/// What the wrapper of a lone item of a role adds before it.
+const ROLE_ITEM_HEAD: &str = "stage _ { role _ robots 1 {";
+
+/// Recovers the items of the role in `s..e` (`role NAME robots N { ... }`),
+/// which does not parse: blanks its modules and links that do not parse and
+/// returns their errors, when the role then parses (else `None`, and the
+/// caller blanks the role whole).
+fn role_items(src: &str, tokens: &[Token], (s, e): (usize, usize), masked: &mut [u8]) -> Option<Vec<Error>> {
+    let toks = &tokens[first_token(tokens, s)..first_token(tokens, e)];
+    // `role NAME robots N {`
+    if toks.get(4).and_then(|t| punct(src, t)) != Some(b'{') {
+        return None;
+    }
+    let body = toks[4].span.end;
+    let mut pieces: Vec<(usize, usize)> = Vec::new();
+    let mut start = body;
+    let mut depth = 0i64;
+    let mut close = None;
+    for (j, t) in toks.iter().enumerate().skip(5) {
+        if starts_item(src, toks, j) {
+            if t.span.start > start {
+                pieces.push((start, t.span.start));
+            }
+            start = t.span.start;
+            depth = 0;
+        }
+        match punct(src, t) {
+            Some(b'{') => depth += 1,
+            Some(b'}') if depth == 0 => {
+                close = Some(t.span.start);
+                break;
+            }
+            Some(b'}') => depth -= 1,
+            _ => {}
+        }
+    }
+    let close = close?;
+    pieces.push((start, close));
+    let mut errors = Vec::new();
+    for (a, b) in pieces {
+        let text = &src[a..b];
+        if text.trim().is_empty() {
+            continue;
+        }
+        if let Err(err) = BatParser::parse(Rule::file, &format!("{ROLE_ITEM_HEAD}{text}\n}} }}")) {
+            let pos = position(&err).saturating_sub(ROLE_ITEM_HEAD.len()).min(text.len());
+            errors.push(at(src, err, a + pos));
+            blank(masked, a, b);
+        }
+    }
+    let role = String::from_utf8_lossy(&masked[s..e]).into_owned();
+    let parses = BatParser::parse(Rule::file, &format!("{ITEM_HEAD}{role}\n}}")).is_ok();
+    (parses && !errors.is_empty()).then_some(errors)
 }
 
 /// The byte position of a pest error.

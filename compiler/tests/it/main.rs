@@ -8,6 +8,7 @@ mod docs;
 mod examples;
 mod fixes;
 mod fmt;
+mod ide;
 mod layout;
 mod limits;
 mod parse;

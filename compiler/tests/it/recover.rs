@@ -171,12 +171,13 @@ fn recovery_keeps_the_call_budget_on_huge_files() {
     }
 }
 
-/// A syntax error in one role's module loses that role only: the stage's
-/// other roles and items, and the next stage, are in the AST.
+/// A syntax error in one role's module loses that module only: the role's
+/// other modules, the stage's other roles and items, and the next stage,
+/// are in the AST.
 #[test]
 fn an_error_in_a_role_keeps_the_other_roles() {
     let src = format!(
-        "{ROBOT}stage s {{\n  fitness per action wheels[0]\n  role a robots 2 {{\n    module m {{ sense ir  behavior forward( }}\n  }}\n\
+        "{ROBOT}stage s {{\n  fitness per action wheels[0]\n  role a robots 2 {{\n    module m {{ sense ir  behavior forward( }}\n    module k {{ sense ir  behavior stop }}\n  }}\n\
          role b robots 1 {{ module n {{ sense ir  behavior back }} }}\n}}\nstage t extends s {{ fitness per action 1 }}\n"
     );
     let (file, errors) = parse_recovering(&src);
@@ -187,6 +188,6 @@ fn an_error_in_a_role_keeps_the_other_roles() {
         .roles()
         .map(|r| (r.name.text.as_str(), r.modules().map(|m| m.name.text.as_str()).collect()))
         .collect();
-    assert_eq!(roles, [("b", vec!["n"])]);
+    assert_eq!(roles, [("a", vec!["k"]), ("b", vec!["n"])]);
     assert!(file.stages[0].items.iter().any(|i| matches!(i, ast::StageItem::Fitness(_))));
 }
