@@ -136,3 +136,43 @@ stage s {{
     }
     assert!(compiled > 20 && refused > 20, "{compiled} compiled, {refused} refused");
 }
+
+/// A small two-role program and a test stage that extends it: each stage's
+/// layout, the roles' robots and modules, and the GA's mask (a frozen bit
+/// `#`, an evolvable one `.`) split by role.
+#[test]
+fn two_roles_layout_and_masks() {
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage pair {
+  genome { bits 2 }
+  fitness per action wheels[0], team sum
+  role lead robots 1 { module go { sense ir[0]  behavior forward } }
+  role follow robots 2 {
+    module go { sense ir[1]  activation fixed 0  behavior neural { outputs linear  weights evolvable } }
+    module stay { sense ir[2]  behavior stop }
+    link stay -> go evolvable
+  }
+}
+stage check extends pair { test best for 100 actions }
+";
+    let p = compile_ok(src, "pair.bat");
+    let mut out = String::new();
+    for (i, s) in p.stages.iter().enumerate() {
+        out += &shaping_compiler::render_layout(&p, i);
+        let mask = shaping_runtime::evolve::ga::frozen_mask(&s.layout);
+        for r in 0..s.roles.len() {
+            let mods = s.role_modules(r);
+            let bits: String = s
+                .layout
+                .genes
+                .iter()
+                .filter(|g| mods.contains(&(g.module as usize)))
+                .flat_map(|g| &mask[g.offset as usize..(g.offset + u32::from(g.bits)) as usize])
+                .map(|&frozen| if frozen { '#' } else { '.' })
+                .collect();
+            out += &format!("mask of role `{}`: {bits}\n", s.roles[r].name);
+        }
+        out += "\n";
+    }
+    insta::assert_snapshot!(out);
+}
