@@ -306,6 +306,15 @@ pub fn render_graph(program: &Program, stage: usize) -> String {
             }
         }
     }
+    // A heterogeneous team: each role's modules in a box of their own.
+    for (r, role) in st.roles.iter().enumerate() {
+        let _ = writeln!(out, "  subgraph \"cluster_{r}\" {{");
+        let _ = writeln!(out, "    label=\"role {} ({} robots)\";", dot_escape(&role.name), role.robots);
+        for i in st.role_modules(r) {
+            let _ = writeln!(out, "    \"m:{i}\";");
+        }
+        let _ = writeln!(out, "  }}");
+    }
     for l in &st.links {
         let label = match l.weight {
             Param::Gene(g) => format!("gene {g}"),

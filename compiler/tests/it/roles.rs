@@ -176,3 +176,17 @@ stage check extends pair { test best for 100 actions }
     }
     insta::assert_snapshot!(out);
 }
+
+/// The graph of a stage with roles boxes each role's modules, named
+/// `role.module`.
+#[test]
+fn the_graph_boxes_each_role() {
+    let p = compile_ok(&roles_src(), "roles.bat");
+    let g = shaping_compiler::render_graph(&p, 0);
+    assert!(
+        g.contains("subgraph \"cluster_0\" {\n    label=\"role seeker (3 robots)\";\n    \"m:0\";\n  }"),
+        "{g}"
+    );
+    assert!(g.contains("label=\"role anchor (2 robots)\";\n    \"m:1\";\n    \"m:2\";"), "{g}");
+    assert!(g.contains("label=\"anchor.avoid\\n(script)\""), "{g}");
+}
