@@ -300,6 +300,36 @@ fn hover_definition_references_completion_symbols_and_formatting() {
     c.stop();
 }
 
+/// Roles in the editor: the outline holds a stage's roles and each role its
+/// modules; the definition of a module named in a role's link is that
+/// role's module, though another role has one of the same name.
+#[test]
+fn roles_in_the_outline_and_definitions() {
+    let mut c = Client::start();
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n\
+               stage s {\n  world { arena 600mm x 600mm }\n  fitness per action wheels[0]\n\
+               role a robots 2 {\n    module go { sense ir  behavior forward }\n    module turn { sense ir  behavior turn left }\n    links all evolvable\n  }\n\
+               role b robots 1 {\n    module go { sense ir  behavior back }\n    module stay { sense ir  behavior stop }\n    link go -> stay evolvable\n  }\n}\n";
+    c.open(URI, src);
+    let s = c.request("textDocument/documentSymbol", json!({ "textDocument": { "uri": URI } }));
+    let stage = &s["result"][1];
+    assert_eq!(stage["name"], json!("s"), "{s}");
+    let roles: Vec<(&str, Vec<&str>)> = stage["children"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            let kids = r["children"].as_array().unwrap().iter().filter_map(|m| m["name"].as_str()).collect();
+            (r["name"].as_str().unwrap(), kids)
+        })
+        .collect();
+    assert_eq!(roles, [("a", vec!["go", "turn"]), ("b", vec!["go", "stay"])]);
+    let d = c.at("textDocument/definition", URI, src, "link go -> stay", 5);
+    let line = src[..src.find("module go { sense ir  behavior back").unwrap()].matches('\n').count();
+    assert_eq!(d["result"][0]["range"]["start"]["line"], json!(line), "role b's `go`: {d}");
+    c.stop();
+}
+
 /// A thousand random edits of an example, mended every 20: every one gets
 /// diagnostics and a response to a request, hover answers on the modules of
 /// the stages the edits left alone, and the server survives.

@@ -246,8 +246,9 @@ fn locations(uri: &Uri, text: &str, offset: usize, refs: bool) -> Value {
     let spans: Vec<(usize, usize)> = if refs {
         ide::uses(text, word).into_iter().map(|s| (s.start, s.end)).collect()
     } else {
-        // The first declaration: a module redeclared by a later stage is defined where it first appears.
-        decls.iter().take(1).map(|d| (d.2.span.start, d.2.span.end)).collect()
+        // The first declaration (a module redeclared by a later stage is
+        // defined where it first appears), or, inside a role, the role's.
+        ide::definition(text, offset).into_iter().map(|s| (s.start, s.end)).collect()
     };
     let lines = Lines::new(text);
     let locs: Vec<lt::Location> =
@@ -309,28 +310,26 @@ fn symbol(
 }
 
 fn symbols(text: &str) -> Value {
+    use ide::SymbolKind as S;
+    fn convert(lines: &Lines, s: &ide::Symbol) -> lt::DocumentSymbol {
+        let kind = match s.kind {
+            S::Robot => lt::SymbolKind::STRUCT,
+            S::Hardware => lt::SymbolKind::FIELD,
+            S::Stage => lt::SymbolKind::CLASS,
+            S::Role => lt::SymbolKind::NAMESPACE,
+            S::Module => lt::SymbolKind::MODULE,
+        };
+        let children = s.children.iter().map(|c| convert(lines, c)).collect();
+        let mut sym = symbol(lines, &s.name, kind, children);
+        // A stage's and a role's range is their whole declaration.
+        if matches!(s.kind, S::Stage | S::Role) {
+            sym.range = lines.range(s.span.start, s.span.end);
+        }
+        sym
+    }
     let Some(file) = parse_recovering(text).0 else { return Value::Null };
     let lines = Lines::new(text);
-    let mut out = Vec::new();
-    for r in &file.robots {
-        let hw = r.hardware.iter().map(|h| symbol(&lines, &h.name, lt::SymbolKind::FIELD, vec![])).collect();
-        out.push((r.span.start, symbol(&lines, &r.name, lt::SymbolKind::STRUCT, hw)));
-    }
-    for s in &file.stages {
-        let modules = s
-            .items
-            .iter()
-            .filter_map(|i| match i {
-                ast::StageItem::Module(m) => Some(symbol(&lines, &m.name, lt::SymbolKind::MODULE, vec![])),
-                _ => None,
-            })
-            .collect();
-        let mut sym = symbol(&lines, &s.name, lt::SymbolKind::CLASS, modules);
-        sym.range = lines.range(s.span.start, s.span.end);
-        out.push((s.span.start, sym));
-    }
-    out.sort_by_key(|s| s.0);
-    let out: Vec<lt::DocumentSymbol> = out.into_iter().map(|s| s.1).collect();
+    let out: Vec<lt::DocumentSymbol> = ide::outline(&file).iter().map(|s| convert(&lines, s)).collect();
     serde_json::to_value(out).unwrap_or(Value::Null)
 }
 
