@@ -111,6 +111,9 @@ pub struct TrajectoryScene {
     /// after every action, drawn one colour each with the robot's number
     /// at its start and its body at its end (empty for one robot).
     pub others: Vec<Vec<[f32; 3]>>,
+    /// A heterogeneous team's roles, in order, and how many robots play
+    /// each (robot 0 plays the first; legend only; empty without roles).
+    pub roles: Vec<(String, u32)>,
 }
 
 /// A picture could not be drawn or written.

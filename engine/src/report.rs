@@ -490,7 +490,7 @@ fn pictures(
         check()?;
     }
 
-    let (scene, what) = match path {
+    let (mut scene, what) = match path {
         Some((rows, what)) => {
             let rows = trace.rows.get(rows).filter(|r| !r.is_empty()).unwrap_or(&trace.rows);
             let part = Trace { modules: trace.modules.clone(), rows: rows.to_vec() };
@@ -498,6 +498,7 @@ fn pictures(
         }
         None => (trajectory_scene(scene, trace, others), format!("{title}: trajectory")),
     };
+    scene.roles = stage.roles.iter().map(|r| (r.name.clone(), r.robots)).collect();
     plot::trajectory(&dir.join("trajectory"), &what, &scene).map_err(to_err)
 }
 
@@ -619,5 +620,6 @@ pub fn picture(scene: &Scene, path: Vec<[f32; 3]>) -> plot::TrajectoryScene {
         path_modules: None,
         module_names: Vec::new(),
         others: Vec::new(),
+        roles: Vec::new(),
     }
 }

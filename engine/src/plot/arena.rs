@@ -444,6 +444,14 @@ impl Arena<'_> {
             let style = render::label_style(13.0).pos(Pos::new(HPos::Center, VPos::Center));
             area.draw(&(EmptyElement::at((gx + 14, y)) + Text::new("0", (0, 0), style)))?;
             entry(area, &mut y, &format!("robot at its start (of {n})"))?;
+            let mut first = 0;
+            for (name, robots) in &s.roles {
+                let last = first + robots.saturating_sub(1);
+                let who =
+                    if *robots == 1 { format!("robot {first}") } else { format!("robots {first} to {last}") };
+                entry(area, &mut y, &format!("role {name}: {who}"))?;
+                first = last + 1;
+            }
         }
         if !s.marks.is_empty() {
             area.draw(&Circle::new((gx + 14, y), 4, INK.filled()))?;
