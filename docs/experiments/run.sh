@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates every number and picture of EXPERIMENTS.md (about 15 minutes on
-# two cores). Results go to runs/experiments/; the pictures EXPERIMENTS.md
+# Regenerates every number and picture of EXPERIMENTS.md (about 12 minutes on
+# two idle cores). Results go to runs/experiments/; the pictures EXPERIMENTS.md
 # shows are copied next to this script; the numbers are printed.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -100,6 +100,13 @@ $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/
 # file with three changes, each checked).
 $B experiment examples/aggregation.bat --seeds $SEEDS --out $R/aggregation --fresh > /dev/null
 $B experiment examples/aggregation-roles.bat --seeds $SEEDS --out $R/aggregation-roles --fresh > /dev/null
+# Twice the generations for the clones and the roles: does the roles'
+# longer genome catch up?
+for f in aggregation aggregation-roles; do
+  sed 's/generations 60 /generations 120 /' examples/$f.bat > $R/$f-120.bat
+  grep -q 'generations 120 ' $R/$f-120.bat
+  $B experiment $R/$f-120.bat --seeds $SEEDS --out $R/$f-120 --fresh > /dev/null
+done
 $B experiment examples/team-collect.bat --seeds $SEEDS --out $R/team-collect --fresh > /dev/null
 sed -e 's#arena 800mm x 1200mm#arena 400mm x 600mm#' -e 's#charger 400mm on north wall#charger 200mm on north wall#' \
   -e '/^    robots 4$/d' -e 's#/ 300, team sum$#/ 300#' -e 's#objects 16 diameter#objects 4 diameter#' \
@@ -166,6 +173,9 @@ $T/examples/walkers examples/aggregation.bat --lives 100 --picture $D/aggregatio
 $T/examples/walkers examples/aggregation.bat --lives 20 --run $R/aggregation --seeds $SEEDS > $R/aggregation-lives.txt
 $T/examples/walkers examples/aggregation-roles.bat --lives 20 --run $R/aggregation-roles --seeds $SEEDS \
   > $R/aggregation-roles-lives.txt
+for f in aggregation aggregation-roles; do
+  $T/examples/walkers $R/$f-120.bat --lives 20 --run $R/$f-120 --seeds $SEEDS > $R/$f-120-lives.txt
+done
 $T/examples/walkers examples/team-collect.bat --stage collect --lives 20 --run $R/team-collect --seeds $SEEDS \
   > $R/team-collect-lives.txt
 $T/examples/walkers $R/team-collect-solo.bat --stage collect --lives 20 --run $R/team-collect-solo --seeds $SEEDS \
@@ -253,6 +263,9 @@ grep -A5 '^over the seeds' $R/aggregation-lives.txt
 echo "== teams: aggregation by two roles of 5 robots"
 grep -E '^seed [0-9]+ \(' $R/aggregation-roles-lives.txt
 grep -A5 '^over the seeds' $R/aggregation-roles-lives.txt
+echo "== teams: aggregation with 120 generations, the clones then the roles"
+grep -A1 '^over the seeds' $R/aggregation-120-lives.txt
+grep -A1 '^over the seeds' $R/aggregation-roles-120-lives.txt
 echo "== teams: cooperative collect, 4 robots and 16 objects, then 1 robot and 4 objects"
 grep -E '^seed [0-9]+ \(' $R/team-collect-lives.txt
 grep -A5 '^over the seeds' $R/team-collect-lives.txt
