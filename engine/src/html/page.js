@@ -366,7 +366,9 @@
     $('r-world').textContent = w.stage + (lives > 1 ? ' (life ' + life + ' of ' + lives + ')' : ep.worlds.length > 1 ? ' (part ' + (ep._.world[a] + 1) + ' of ' + ep.worlds.length + ')' : '') +
       ' · seed ' + ep.seed + ', learning ' + (ep.learning ? 'on' : 'off');
     const win = c.winner[a];
-    $('r-winner').textContent = ep.modules[win] || '–';
+    // A team's robot 0 whose battery is empty stands still while the others go on.
+    const stopped = (c.others || []).length > 0 && c.battery[a] <= 0;
+    $('r-winner').textContent = stopped ? 'none: robot 0 stopped, its battery empty' : ep.modules[win] || '–';
     $('r-winner-chip').style.background = color(win);
     $('r-x').textContent = fmt(c.x[a], 2);
     $('r-y').textContent = fmt(c.y[a], 2);
@@ -389,9 +391,9 @@
     body.textContent = '';
     ep.modules.forEach((name, m) => {
       const r = c.reinforcement[m][a];
-      const tr = el('tr', { cls: m === win ? 'win' : '' },
+      const tr = el('tr', { cls: m === win && !stopped ? 'win' : '' },
         el('td', {}, el('span', { cls: 'chip', style: 'background:' + color(m) }), name),
-        el('td', { cls: 'num', text: fmt(c.activation[m][a], 3) }),
+        el('td', { cls: 'num', text: stopped ? '' : fmt(c.activation[m][a], 3) }),
         el('td', { cls: 'num', text: r === 0 ? '' : signed(r, 0) }),
         el('td', { cls: 'num', text: ep._.perfSeen[m][a] ? fmt(c.performance[m][a], 2) : '' }));
       body.append(tr);
