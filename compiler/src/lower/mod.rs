@@ -1099,13 +1099,7 @@ impl<'a> Lower<'a> {
                 break;
             }
             if let I::Module(m) = item {
-                if let Some(first) = declared_here.get(&m.name.text) {
-                    self.errors.push(Error::Duplicate {
-                        span: m.name.span.into(),
-                        first: (*first).into(),
-                        what: "module",
-                        name: m.name.text.clone(),
-                    });
+                if !self.declare_module(&mut declared_here, &m.name) {
                     continue;
                 }
                 if st.modules.len() >= MAX_MODULES && !st.modules.iter().any(|x| x.name == m.name.text) {
@@ -1117,7 +1111,6 @@ impl<'a> Lower<'a> {
                     );
                     break;
                 }
-                declared_here.insert(m.name.text.clone(), m.name.span);
                 self.similar_module(&st.modules, m, s);
                 self.module(&hw, &mut st.modules, m, s);
             }
@@ -1183,6 +1176,23 @@ impl<'a> Lower<'a> {
 }
 
 impl Lower<'_> {
+    /// Records module `name` as declared in `declared` (one stage's, or
+    /// one role's): a second declaration is the error `Duplicate`, and
+    /// false (the module is skipped).
+    fn declare_module(&mut self, declared: &mut HashMap<String, Span>, name: &ast::Name) -> bool {
+        if let Some(first) = declared.get(&name.text) {
+            self.errors.push(Error::Duplicate {
+                span: name.span.into(),
+                first: (*first).into(),
+                what: "module",
+                name: name.text.clone(),
+            });
+            return false;
+        }
+        declared.insert(name.text.clone(), name.span);
+        true
+    }
+
     /// Warns about a new module whose name is one edit (or one swap of
     /// neighbours) from an inherited module's: most likely a typo that
     /// declares a module instead of changing the inherited one. Names under

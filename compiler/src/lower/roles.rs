@@ -184,13 +184,7 @@ impl Lower<'_> {
             let mut modules: Vec<ModuleSt> = Vec::new();
             let mut declared_here: HashMap<String, Span> = HashMap::new();
             for m in role.modules() {
-                if let Some(first) = declared_here.get(&m.name.text) {
-                    self.errors.push(Error::Duplicate {
-                        span: m.name.span.into(),
-                        first: (*first).into(),
-                        what: "module",
-                        name: m.name.text.clone(),
-                    });
+                if !self.declare_module(&mut declared_here, &m.name) {
                     continue;
                 }
                 if st.modules.len() + modules.len() >= MAX_MODULES {
@@ -202,7 +196,6 @@ impl Lower<'_> {
                     );
                     break;
                 }
-                declared_here.insert(m.name.text.clone(), m.name.span);
                 self.module(hw, &mut modules, m, s);
             }
             for m in &modules {
