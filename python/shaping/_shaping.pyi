@@ -65,6 +65,8 @@ class Program:
         """"evolve", "train" or "test"."""
     def layout(self, stage: str) -> list[dict[str, Any]]:
         """The genes of ``stage``: the rows of ``shaping layout --format json``."""
+    def roles(self, stage: str) -> list[dict[str, Any]]:
+        """The roles of ``stage``'s heterogeneous team: ``name``, ``robots`` and ``modules`` (module indices; [] without roles)."""
     def layout_text(self, stage: str) -> str:
         """The table ``shaping layout`` prints."""
     def evaluator(

@@ -259,6 +259,24 @@ impl Program {
         json_to_py(py, &genes)
     }
 
+    /// The roles of `stage`'s heterogeneous team, in order, one dict per
+    /// role: `name`, `robots` (robot 0 plays the first role) and `modules`,
+    /// the indices of its modules (a gene of `layout` whose `module` is one
+    /// of them is the role's). Empty for a team of clones or one robot.
+    fn roles<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyAny>> {
+        let st = &self.program.stages[stage_index(&self.program, stage)?];
+        let roles: Vec<serde_json::Value> = st
+            .roles
+            .iter()
+            .enumerate()
+            .map(|(r, role)| {
+                let modules: Vec<usize> = st.role_modules(r).collect();
+                serde_json::json!({ "name": role.name, "robots": role.robots, "modules": modules })
+            })
+            .collect();
+        json_to_py(py, &serde_json::Value::Array(roles))
+    }
+
     /// The text `shaping layout` prints for `stage`.
     fn layout_text(&self, stage: &str) -> PyResult<String> {
         Ok(shaping_compiler::render_layout(&self.program, stage_index(&self.program, stage)?))

@@ -198,7 +198,14 @@ def test_evaluate_a_team_with_roles():
     base = ev.evaluate(g)["fitness"]
     np.testing.assert_array_equal(base, ev.evaluate(g)["fitness"])
     assert np.all((base > 1 - 425 / 400) & (base < 1)), base
+    program = shaping.compile(ROOT / "examples" / "aggregation-roles.bat")
+    roles = program.roles("aggregate")
+    assert [(r["name"], r["robots"], r["modules"]) for r in roles] == [("first", 5, [0]), ("second", 5, [1])]
+    assert shaping.compile(ROOT / "examples" / "aggregation.bat").roles("aggregate") == []
+    # Each role's genes are one half of the genome, the first role's first.
+    genes = program.layout("aggregate")
     half = ev.bits // 2
+    assert all((g["offset"] < half) == (g["module"] == 0) for g in genes)
     for part in (slice(0, half), slice(half, ev.bits)):
         changed = g.copy()
         changed[:, part] = 1 - changed[:, part]
