@@ -10,6 +10,7 @@ mod out;
 mod replay;
 mod robot;
 mod run;
+mod signals;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -307,7 +308,10 @@ enum Command {
     },
     /// Measure simulator steps and controller actions per second (one JSON
     /// line); with `world.robots` N > 1, N robots acting in turn in one world
-    /// (`robot_steps_per_sec`).
+    /// (`robot_steps_per_sec`). The bench picks its own life lengths, printed
+    /// in the line: controller lives of `controller_episode_actions` (300,
+    /// fewer for a large team; the stage's own is `stage_actions`), and
+    /// simulated worlds that live at most `sim_episode_actions`.
     Bench {
         file: PathBuf,
         #[arg(long)]
@@ -354,6 +358,16 @@ fn main() -> ExitCode {
         eprintln!("{e}");
         return ExitCode::from(exit_code(&e) as u8);
     }
+    if let Command::Lsp = cli.command {
+        // The protocol's status: 1 when `exit` came without `shutdown`.
+        return match lsp::stdio() {
+            Ok(ending) => ExitCode::from(ending.status()),
+            Err(e) => {
+                eprintln!("error: language server: {e}");
+                ExitCode::from(2)
+            }
+        };
+    }
     match dispatch(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -370,7 +384,8 @@ fn dispatch(command: Command) -> Result<(), CliError> {
     match command {
         Command::Check { files, error_format } => check(&files, error_format),
         Command::Fmt { files, check, error_format } => fmt::fmt(&files, check, error_format),
-        Command::Lsp => lsp::stdio().map_err(|e| CliError::io(format!("error: language server: {e}"))),
+        // Served by `main`, for the protocol's exit status.
+        Command::Lsp => Ok(()),
         Command::Explain { code } => match shaping_compiler::explain::explain(&code) {
             Some(e) => out!("{}", shaping_compiler::explain::render(e)),
             None => Err(CliError::new(

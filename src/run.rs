@@ -200,20 +200,16 @@ fn progress_bar(hidden: bool, stage: &str, generations: u32, done: u32) -> Progr
     bar
 }
 
-/// Ctrl-C, SIGTERM or SIGHUP during a run in one process: the generation
-/// under way finishes and is saved, then the run stops saying where; a
-/// second signal ends it at once. (On a robot the robot's own handler stops
-/// the motors first, so there the second one does not end the process.)
+/// Ctrl-C, SIGTERM, SIGHUP or any other signal that would end the process
+/// (`crate::signals`) during a run in one process: the generation under way
+/// finishes and is saved, then the run stops saying where; a second signal
+/// ends it at once. (On a robot the robot's own handler stops the motors
+/// first, so there the second one does not end the process.)
 pub fn interrupt_flag(exit_on_second: bool) -> Option<Arc<AtomicBool>> {
     static FLAG: OnceLock<Option<Arc<AtomicBool>>> = OnceLock::new();
     FLAG.get_or_init(|| {
         let flag = Arc::new(AtomicBool::new(false));
-        for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM, signal_hook::consts::SIGHUP] {
-            if exit_on_second {
-                signal_hook::flag::register_conditional_shutdown(sig, 2, Arc::clone(&flag)).ok()?;
-            }
-            signal_hook::flag::register(sig, Arc::clone(&flag)).ok()?;
-        }
+        crate::signals::register(&flag, exit_on_second).ok()?;
         Some(flag)
     })
     .clone()

@@ -293,7 +293,7 @@ fn spawn_drive(dir: &std::path::Path, emu: &Emulator, out: fn() -> Stdio) -> std
         .unwrap()
 }
 
-/// `drive` sent `signal` (`INT`, `TERM`, `HUP`) once it drives: what it
+/// `drive` sent `signal` (`INT`, `TERM`, `HUP`, ...) once it drives: what it
 /// printed after, and the speed the robot was left with.
 fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
     let dir = scratch(&format!("signal-{signal}"));
@@ -315,15 +315,46 @@ fn interrupted_drive(signal: &str) -> (String, Option<(i32, i32)>) {
     (rest, emu.last_speed())
 }
 
-/// Ctrl-C, SIGTERM and SIGHUP (a closed terminal or ssh session) stop the
-/// motors and keep the trace, each named.
+/// Every signal that would end the process and can be caught stops the
+/// motors and keeps the trace, each named: Ctrl-C, SIGTERM, SIGHUP (a
+/// closed terminal or ssh session), SIGQUIT, the limits' SIGXCPU and
+/// SIGXFSZ, the user's and the timers' signals, the real-time ones (the
+/// list is `src/signals.rs`; its unit test checks it against every signal).
 #[test]
-fn ctrl_c_sigterm_and_sighup_stop_the_motors() {
-    for (signal, words) in [("INT", "Ctrl-C"), ("TERM", "SIGTERM"), ("HUP", "SIGHUP")] {
-        let (rest, speed) = interrupted_drive(signal);
-        assert!(rest.contains("interrupted") && rest.contains("the motors were stopped"), "{rest}");
-        assert!(rest.contains(words), "{signal}: {rest}");
-        assert_eq!(speed, Some((0, 0)), "{signal}");
+fn every_signal_that_would_end_drive_stops_the_motors() {
+    let signals = [
+        ("INT", "Ctrl-C"),
+        ("TERM", "SIGTERM"),
+        ("HUP", "SIGHUP"),
+        ("QUIT", "SIGQUIT"),
+        ("USR1", "SIGUSR1"),
+        ("USR2", "SIGUSR2"),
+        ("ALRM", "SIGALRM"),
+        ("VTALRM", "SIGVTALRM"),
+        ("PROF", "SIGPROF"),
+        ("XCPU", "SIGXCPU"),
+        ("XFSZ", "SIGXFSZ"),
+        ("IO", "SIGIO"),
+        ("PWR", "SIGPWR"),
+        ("STKFLT", "SIGSTKFLT"),
+        ("RTMIN", "SIGRTMIN"),
+        ("RTMIN+3", "SIGRTMIN+3"),
+    ];
+    // Four drives at a time, each on its own emulator.
+    for group in signals.chunks(4) {
+        std::thread::scope(|s| {
+            for &(signal, words) in group {
+                s.spawn(move || {
+                    let (rest, speed) = interrupted_drive(signal);
+                    assert!(
+                        rest.contains("interrupted") && rest.contains("the motors were stopped"),
+                        "{rest}"
+                    );
+                    assert!(rest.contains(words), "{signal}: {rest}");
+                    assert_eq!(speed, Some((0, 0)), "{signal}");
+                });
+            }
+        });
     }
 }
 

@@ -16,31 +16,15 @@ use shaping_runtime::robot::{Link, LinkError};
 
 use crate::CliError;
 
-/// The last of the signals below that arrived (0: none).
-static SIGNAL: std::sync::OnceLock<Arc<std::sync::atomic::AtomicUsize>> = std::sync::OnceLock::new();
-
-/// Sets up the flag that Ctrl-C, SIGTERM and SIGHUP (a closed terminal or
-/// ssh session) set: the robot is stopped and the trace kept on each.
+/// Sets up the flag that every signal that would end the process sets
+/// (Ctrl-C, SIGTERM, SIGHUP from a closed terminal or ssh session, SIGQUIT,
+/// SIGXCPU, ...: `crate::signals`): the robot is stopped and the trace kept
+/// on each.
 pub fn interrupt_flag() -> Result<Arc<AtomicBool>, CliError> {
-    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     let flag = Arc::new(AtomicBool::new(false));
-    let which = SIGNAL.get_or_init(|| Arc::new(std::sync::atomic::AtomicUsize::new(0)));
-    for sig in [SIGINT, SIGTERM, SIGHUP] {
-        signal_hook::flag::register(sig, Arc::clone(&flag))
-            .and_then(|_| signal_hook::flag::register_usize(sig, Arc::clone(which), sig as usize))
-            .map_err(|e| CliError::io(format!("error: cannot catch Ctrl-C: {e}")))?;
-    }
+    crate::signals::register(&flag, false)
+        .map_err(|e| CliError::io(format!("error: cannot catch Ctrl-C and the other signals: {e}")))?;
     Ok(flag)
-}
-
-/// The words for the signal that interrupted the robot.
-pub fn signal_name() -> &'static str {
-    use signal_hook::consts::{SIGHUP, SIGTERM};
-    match SIGNAL.get().map_or(0, |s| s.load(Ordering::Relaxed)) {
-        s if s == SIGTERM as usize => "SIGTERM",
-        s if s == SIGHUP as usize => "SIGHUP: the terminal closed",
-        _ => "Ctrl-C",
-    }
 }
 
 /// A robot's serial port.
@@ -177,7 +161,7 @@ impl Link for SerialPort {
             std::thread::sleep((until - Instant::now()).min(Duration::from_millis(20)));
         }
         if self.interrupted.load(Ordering::Relaxed) {
-            return Err(LinkError(format!("interrupted ({})", signal_name())));
+            return Err(LinkError(format!("interrupted ({})", crate::signals::last_name())));
         }
         // The next period starts now (a late action does not shorten it).
         self.next_tick = Some(Instant::now());
