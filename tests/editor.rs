@@ -940,6 +940,20 @@ fn requests_before_initialize_and_after_shutdown_are_refused() {
     assert!(c.child.wait().unwrap().success());
 }
 
+/// `exit` without `shutdown` before it ends the server with status 1, as
+/// the protocol says (after `shutdown`, 0: the test above).
+#[test]
+fn exit_without_shutdown_is_status_1() {
+    let mut child = shaping().arg("lsp").stdin(Stdio::piped()).stdout(Stdio::piped()).spawn().unwrap();
+    let stdin = child.stdin.take().unwrap();
+    let stdout = BufReader::new(child.stdout.take().unwrap());
+    let mut c = Client { child, stdin, stdout, next_id: 1 };
+    let r = c.request("initialize", json!({ "capabilities": {} }));
+    assert!(r["result"]["capabilities"].is_object(), "{r}");
+    c.notify("exit", Value::Null);
+    assert_eq!(c.child.wait().unwrap().code(), Some(1));
+}
+
 /// The input ends in the middle of a frame: every answer before it is
 /// written whole, and the server exits cleanly.
 #[test]

@@ -35,22 +35,34 @@ use serde_json::Value;
 use rpc::{Frame, Incoming, RpcError};
 
 /// Runs the server on stdin and stdout until the client says `exit` or
-/// closes its end.
-pub fn stdio() -> Result<(), String> {
+/// closes its end; how it ended.
+pub fn stdio() -> Result<Ending, String> {
     let stdin = io::stdin().lock();
     let stdout = io::BufWriter::new(io::stdout().lock());
-    serve(stdin, stdout).map(|_| ())
+    serve(stdin, stdout)
 }
 
 /// How [`serve`] ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Ending {
-    /// The `exit` notification (after `shutdown`, or not).
+    /// The `exit` notification (after `shutdown`, or not: the protocol's
+    /// exit status is then 1, [`Ending::status`]).
     Exit { shut_down: bool },
     /// The end of the input between frames.
     End,
     /// The end of the input inside a body.
     EndInBody,
+}
+
+impl Ending {
+    /// The process's exit status after this ending: 1 for an `exit`
+    /// without `shutdown` before it, as the protocol says, 0 otherwise.
+    pub fn status(self) -> u8 {
+        match self {
+            Ending::Exit { shut_down: false } => 1,
+            _ => 0,
+        }
+    }
 }
 
 /// Serves the messages of `input` on `output` until `exit` or the end of

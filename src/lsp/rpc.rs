@@ -91,6 +91,9 @@ fn content_length_at(line: &[u8]) -> Option<usize> {
 pub fn read_frame(input: &mut impl BufRead) -> Result<Frame, Fatal> {
     let io = |e: io::Error| Fatal(format!("cannot read the input: {e}"));
     let mut size: Option<usize> = None;
+    // Two `Content-Length`s that disagree: the frame is read with the
+    // smaller and skipped, so that a longer one cannot swallow the next.
+    let mut disagree: Option<(usize, usize)> = None;
     let mut headers = 0;
     let mut wrong: Option<String> = None;
     loop {
@@ -120,7 +123,12 @@ pub fn read_frame(input: &mut impl BufRead) -> Result<Frame, Fatal> {
             };
             let mut body = vec![0; size];
             return match input.read_exact(&mut body) {
-                Ok(()) => Ok(Frame::Body(body)),
+                Ok(()) => Ok(match disagree {
+                    Some((a, b)) => {
+                        Frame::Skipped(format!("a message with two Content-Length headers, {a} and {b}"))
+                    }
+                    None => Frame::Body(body),
+                }),
                 Err(e) if e.kind() == io::ErrorKind::UnexpectedEof => Ok(Frame::EndInBody),
                 Err(e) => Err(io(e)),
             };
@@ -129,6 +137,7 @@ pub fn read_frame(input: &mut impl BufRead) -> Result<Frame, Fatal> {
             Some(at) if at > 0 => {
                 // Garbage before the header: a new frame starts here.
                 size = None;
+                disagree = None;
                 headers = 0;
                 wrong = None;
                 &line[at..]
@@ -154,7 +163,13 @@ pub fn read_frame(input: &mut impl BufRead) -> Result<Frame, Fatal> {
                     MAX_MESSAGE_BYTES >> 20
                 )))
                 }
-                Ok(n) => size = Some(n as usize),
+                Ok(n) => {
+                    let n = n as usize;
+                    if let Some(before) = size.filter(|&b| b != n) {
+                        disagree = Some((before, n));
+                    }
+                    size = Some(size.map_or(n, |b| b.min(n)));
+                }
                 Err(e) => {
                     wrong.get_or_insert(format!("a bad Content-Length {value:?}: {e}"));
                 }
@@ -363,6 +378,17 @@ mod tests {
         // a body longer than its length: the rest is skipped up to the next frame
         assert_eq!(frames("Content-Length: 1\r\n\r\n{}Content-Length: 2\r\n\r\n{}"), ["{", "{}"]);
         assert_eq!(frames("Content-Length: 9\r\n\r\n{}"), ["end in body"]);
+        // A second Content-Length, larger or smaller, does not swallow the
+        // next message; the same one twice is no error.
+        assert_eq!(
+            frames("Content-Length: 2\r\nContent-Length: 40\r\n\r\n{}Content-Length: 2\r\n\r\n[]"),
+            ["skipped: a message with two Content-Length headers, 2 and 40", "[]"]
+        );
+        assert_eq!(
+            frames("Content-Length: 40\r\nContent-Length: 2\r\n\r\n{}Content-Length: 2\r\n\r\n[]"),
+            ["skipped: a message with two Content-Length headers, 40 and 2", "[]"]
+        );
+        assert_eq!(frames("Content-Length: 2\r\nContent-Length: 2\r\n\r\n{}"), ["{}"]);
         let long = format!("{}\r\nContent-Length: 2\r\n\r\n{{}}", "x".repeat(5000));
         assert_eq!(frames(&long).len(), 2);
         assert!(read_frame(&mut io::Cursor::new(b"Content-Length: 99999999999\r\n\r\n".to_vec())).is_err());
