@@ -258,9 +258,15 @@ fn a_population_beyond_the_limit_is_a_diagnostic() {
     assert!(text(&out.stderr).contains("`population` must be at most 100000"), "{}", text(&out.stderr));
 }
 
+/// Whether `program` is on the PATH.
+fn which(program: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
+}
+
 /// `replay --gif` writes the episode as an animated GIF: the collect stage
-/// of `khepera.bat` as run, more than 10 frames, at most 300; `--mp4`
-/// without `ffmpeg` on the PATH is refused naming it, before anything runs.
+/// of `khepera.bat` as run, more than 10 frames, at most 300; `--mp4` the
+/// same frames as an H.264 video; `--mp4` without `ffmpeg` on the PATH is
+/// refused naming it, before anything runs.
 #[test]
 fn replay_writes_an_animated_gif_and_mp4_needs_ffmpeg() {
     let dir = scratch("replay-gif");
@@ -288,9 +294,36 @@ fn replay_writes_an_animated_gif_and_mp4_needs_ffmpeg() {
     }
     assert!((11..=300).contains(&frames), "{frames} frames");
 
+    // With `ffmpeg` (and its `ffprobe`), `--mp4` writes the same frames as
+    // a video that decodes; CI installs it, so there its absence fails.
+    let mp4 = dir.join("out.mp4");
+    if which("ffmpeg") && which("ffprobe") {
+        let out = run(shaping()
+            .arg("replay")
+            .arg(&khepera)
+            .args(["--stage", "collect", "--run"])
+            .arg(&dir)
+            .arg("--mp4")
+            .arg(&mp4));
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let probe = run(Command::new("ffprobe")
+            .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
+            .args(["-show_entries", "stream=nb_read_frames,codec_name", "-of", "default=noprint_wrappers=1"])
+            .arg(&mp4));
+        assert!(probe.status.success(), "{}", text(&probe.stderr));
+        let said = text(&probe.stdout);
+        assert!(said.contains("codec_name=h264"), "{said}");
+        assert!(said.contains(&format!("nb_read_frames={frames}")), "{frames} frames in the GIF: {said}");
+        std::fs::remove_file(&mp4).unwrap();
+    } else {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "CI has `ffmpeg` and `ffprobe` (.ci/run installs them)"
+        );
+    }
+
     let empty = dir.join("no-programs");
     std::fs::create_dir_all(&empty).unwrap();
-    let mp4 = dir.join("out.mp4");
     let out = run(shaping()
         .env("PATH", &empty)
         .arg("replay")
@@ -321,6 +354,11 @@ fn bench_prints_one_json_line() {
     assert_eq!(v["robots"], 1, "{v}");
     assert_eq!(v["robot_steps_per_sec"], v["sim_steps_per_sec"], "{v}");
     assert!(v["file"].as_str().unwrap().ends_with("tiny.bat"), "{v}");
+    // The bench's own life lengths are in the line, beside the stage's.
+    assert_eq!(v["controller_episode_actions"], 300, "{v}");
+    assert_eq!(v["controller_episodes_per_run"], 200, "{v}");
+    assert!(v["stage_actions"].as_u64().unwrap() > 0, "{v}");
+    assert!(v["sim_episode_actions"].as_u64().unwrap() > 0, "{v}");
     // `--set` as `run` has it: applied, or refused saying why.
     let out =
         run(shaping().arg("bench").arg(tiny()).args(["--runs", "1", "--set", "second.world.arena=300x300"]));

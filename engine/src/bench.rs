@@ -48,6 +48,19 @@ pub struct Bench {
     pub controller_episodes_per_sec: f64,
     /// The mean length of a life in actions.
     pub controller_actions_per_episode: f64,
+    /// The bench's own life length for the controller runs (a life ends
+    /// there or when its battery is empty): [`EPISODE_ACTIONS`], shorter
+    /// for a large team, whatever the stage declares.
+    pub controller_episode_actions: u32,
+    /// The life length the stage declares (`evolve { actions N }`), which
+    /// the controller runs do not use.
+    pub stage_actions: u32,
+    /// Episodes in each timed controller run ([`EPISODES`], fewer for a team).
+    pub controller_episodes_per_run: u64,
+    /// The longest a simulated world lives in the timed simulator runs
+    /// before a new one is made, in actions (a new one is made sooner when
+    /// one robot's battery, or half a team's, is empty).
+    pub sim_episode_actions: u32,
     /// How far robot 0 went per action of its lives, mm.
     pub controller_mm_per_action: f64,
     pub modules: usize,
@@ -141,6 +154,14 @@ pub fn bench(mut program: Program, index: usize, runs: usize) -> Result<Bench> {
         controller_actions_per_sec: median(ctl_rates).round(),
         controller_episodes_per_sec: median(episode_rates).round(),
         controller_actions_per_episode: (lives as f64 / (episodes * runs as u64) as f64).round(),
+        controller_episode_actions: actions,
+        stage_actions: shaping_runtime::evolve::EvalOptions::of(stage).actions,
+        controller_episodes_per_run: episodes,
+        sim_episode_actions: match (robots, &stage.world.battery) {
+            (1, Some(b)) => b.capacity,
+            (1, None) => SIM_ROBOT_STEPS as u32,
+            _ => EPISODE_ACTIONS,
+        },
         controller_mm_per_action: (path / first.max(1) as f64 * 10.0).round() / 10.0,
         modules: stage.modules.len(),
         genome_bits: stage.layout.bits,
