@@ -24,11 +24,11 @@ robot khepera {
 }
 
 // Every evolved value is a 4-bit gene (paper, fig. 2), normalised to 0..1
-// and decoded into -4..4 (spec section 7: W_max = 4). With -1..1 a link,
-// whose source activation is at most 1, adds at most 1 to a net input that
-// six saturated proximity sensors can push to 6: the follow -> recharge
-// link, the only way the recharge module can tell the charger from any
-// other wall, could never matter, and recharging did not evolve.
+// and decoded into -4..4 (ours: docs/language.md, section 18). With -1..1
+// a link, whose source activation is at most 1, adds at most 1 to a net
+// input that six saturated proximity sensors can push to 6: the follow ->
+// recharge link, the only way the recharge module can tell the charger
+// from any other wall, could never matter, and recharging did not evolve.
 genome { bits 4  range -4..4 }
 
 // The avoidance module learns by CRBP from random weights, with the paper's

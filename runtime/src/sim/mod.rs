@@ -116,8 +116,9 @@ pub const CATCH_NEAR: f32 = 5.0;
 pub const CATCH_FAR: f32 = 30.0;
 /// ... and at most this far to either side of the heading, mm: half the open
 /// claw's gap (about 27-29 mm on the K-Team gripper), which also covers the
-/// +-20 degree dead band of `toward(...)` at catch distance (the spec's +-8
-/// mm made a `toward(ir); arm down; back until barrier` sequence miss).
+/// +-20 degree dead band of `toward(...)` at catch distance (a first +-8 mm
+/// made a `toward(ir); arm down; back until barrier` sequence miss; the
+/// gripper's numbers and their sources: `docs/language.md`, section 18).
 pub const CATCH_HALF_WIDTH: f32 = 15.0;
 /// Opening the claw throws the object out when the body surface is this
 /// close to a wall, mm ...
@@ -1165,11 +1166,13 @@ impl Sim {
         }
         let start = self.centre();
         let heading = self.pose.rotation;
-        // The exact arc (spec 1.3) in chord form: the centre moves by
-        // `d * sinc(phi / 2)` along the heading turned by `phi / 2`, and
-        // halfway by `d / 2 * sinc(phi / 4)` along it turned by `phi / 4`.
-        // One `sin_cos` of `phi / 4` gives the turns by `phi / 2` and `phi`
-        // as products of rotations.
+        // The exact arc of a differential drive whose wheels keep their
+        // speed for the whole action (the Khepera's motion, as Nolfi's
+        // evorobotpy2 moves it: `docs/language.md`, section 18), in chord
+        // form: the centre moves by `d * sinc(phi / 2)` along the heading
+        // turned by `phi / 2`, and halfway by `d / 2 * sinc(phi / 4)` along
+        // it turned by `phi / 4`. One `sin_cos` of `phi / 4` gives the turns
+        // by `phi / 2` and `phi` as products of rotations.
         let d = (dl + dr) / 2.0;
         let phi = (dr - dl) / (2.0 * self.half_axle);
         let q = phi / 4.0;
