@@ -80,6 +80,7 @@
 
 mod block;
 mod fast_expr;
+mod life;
 mod net;
 mod perf;
 pub mod script;
@@ -92,15 +93,16 @@ use serde::{Deserialize, Serialize};
 use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
 use crate::expr::Env;
 use crate::genome::Genome;
-use crate::program::{Behavior, Decode, Event, Inheritance, LearnTarget, LearnWhen, Learning, Param, Stage};
+use crate::program::{Behavior, Decode, Event, LearnTarget, LearnWhen, Learning, Param, Stage};
 use crate::sim::{Command, Outcome, Pose, Sim};
 use crate::state::{Descriptors, Odometer, STATE_SLOTS};
 
 pub use fast_expr::FastExpr;
+pub use life::{live, team_result, Bodies, Hooks, Solo};
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
-pub use team::{run_team_episode, TeamResult, TeamRun, TeamWatch};
+pub use team::{run_team_episode, TeamBodies, TeamResult, TeamRun, TeamWatch};
 
 /// How to run one episode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -852,32 +854,20 @@ impl<'s> Controller<'s> {
         &mut self,
         sim: &mut R,
         opts: &EpisodeOptions,
-        mut trace: Option<&mut Trace>,
-        mut before: impl FnMut(&mut Self, &R),
-        mut after: impl FnMut(&TraceRow, &R),
+        trace: Option<&mut Trace>,
+        before: impl FnMut(&mut Self, &R),
+        after: impl FnMut(&TraceRow, &R),
     ) -> EpisodeResult {
-        self.set_learning(opts.learning);
-        if let Some(t) = trace.as_deref_mut() {
-            self.begin_trace(t);
-        }
-        self.start(sim);
-        let mut res = EpisodeResult::default();
-        let mut fitness = 0.0f64;
-        for a in 0..opts.actions {
-            if !sim.alive() {
-                break;
-            }
-            before(self, sim);
-            let rep = self.act(sim);
-            tally(&mut res, &mut fitness, &rep);
-            if let Some(t) = trace.as_deref_mut() {
-                t.rows.push(self.trace_row(a, &rep, &res, sim));
-                if let Some(row) = t.rows.last() {
-                    after(row, sim);
-                }
-            }
-        }
-        self.finish(sim, res, fitness)
+        let stage = self.stage;
+        let (robots, _) = life::live(
+            stage,
+            std::slice::from_mut(self),
+            &mut life::Solo(sim),
+            opts,
+            trace.map(std::slice::from_mut),
+            &mut SoloHooks { before, after },
+        );
+        robots.into_iter().next().unwrap_or_default()
     }
 
     /// Starts `trace` for a life of this controller's.
@@ -943,6 +933,24 @@ impl<'s> Controller<'s> {
             }
         }
         g
+    }
+}
+
+/// [`Controller::run_with`]'s and [`Controller::run_traced`]'s closures
+/// as the life's hooks.
+struct SoloHooks<F, G> {
+    before: F,
+    after: G,
+}
+
+impl<'s, R: Robot, F: FnMut(&mut Controller<'s>, &R), G: FnMut(&TraceRow, &R)>
+    life::Hooks<'s, life::Solo<'_, R>> for SoloHooks<F, G>
+{
+    fn before(&mut self, ctl: &mut Controller<'s>, robot: &&mut R) {
+        (self.before)(ctl, robot)
+    }
+    fn row(&mut self, row: &TraceRow, robot: &&mut R) {
+        (self.after)(row, robot)
     }
 }
 
@@ -1071,19 +1079,8 @@ fn episode_on<R: Robot>(
     trace: Option<&mut Trace>,
     robot: impl FnOnce(Sim) -> R,
 ) -> Result<EpisodeResult, ControllerError> {
-    if stage.world.robots > 1 {
-        // A team (the robot wrapper, a watch or a stop, is for one robot;
-        // its trace is robot 0's).
-        return Ok(run_team_episode(stage, genome, opts, trace.map(std::slice::from_mut))?.team);
-    }
-    let (sim_seed, rng) = episode_rngs(opts.seed);
-    let mut ctl = Controller::new(stage, genome, rng)?;
-    let mut sim = robot(Sim::new(&stage.world, sim_seed));
-    let mut res = ctl.run(&mut sim, opts, trace);
-    if stage.inheritance == Inheritance::Lamarckian {
-        res.learned = Some(ctl.write_back(genome));
-    }
-    Ok(res)
+    // Of a team: the team's result, robot 0's trace.
+    Ok(team::episode_in(stage, genome, opts, trace.map(std::slice::from_mut), robot)?.team)
 }
 
 /// Checks that the controller can run `stage` with `genome`: the stage passes

@@ -1,5 +1,6 @@
 //! A team's lives: one [`Controller`] per robot of a [`Team`], all of the
-//! same genome, acting in turn.
+//! same genome, acting in turn (the loop is [`super::live`], the one of a
+//! single robot too).
 //!
 //! Each action, robot 0, then 1, ... senses (what its last action left),
 //! decides and moves, seeing the others where they are at that moment.
@@ -12,11 +13,14 @@
 //! heterogeneous team each robot runs its role's modules
 //! ([`Controller::for_role`]), all decoded from the one genome.
 
-use super::{episode_rngs, tally, Controller, ControllerError, EpisodeOptions, EpisodeResult, Robot, Trace};
+use super::{
+    episode_rngs, Bodies, Controller, ControllerError, EpisodeOptions, EpisodeResult, Hooks, Robot, Solo,
+    Trace,
+};
 use crate::catalog::CHANNELS;
 use crate::genome::Genome;
 use crate::program::Stage;
-use crate::sim::{robot_seed, Command, Outcome, Pose, Team};
+use crate::sim::{robot_seed, Command, Outcome, Pose, Sim, Team};
 
 /// What a recorder sees of a team's life ([`TeamRun::run_watched`]): each
 /// robot's sensing and commands, as they happen (the unit type sees nothing).
@@ -30,7 +34,7 @@ pub trait TeamWatch {
 impl TeamWatch for () {}
 
 /// Robot `i` of a team, as its controller sees it.
-struct Member<'t, W: TeamWatch = ()> {
+pub struct Member<'t, W: TeamWatch = ()> {
     team: &'t mut Team,
     i: usize,
     watch: &'t mut W,
@@ -140,89 +144,103 @@ impl<'s> TeamRun<'s> {
         &mut self,
         team: &mut Team,
         opts: &EpisodeOptions,
-        mut traces: Option<&mut [Trace]>,
+        traces: Option<&mut [Trace]>,
         watch: &mut W,
-        mut after: impl FnMut(&Team) -> bool,
+        after: impl FnMut(&Team) -> bool,
     ) -> TeamResult {
-        let n = team.len();
-        if self.grow(n).is_err() {
+        self.run_in(&mut TeamBodies { team, watch }, opts, traces, &mut AfterAction(after))
+    }
+
+    /// Lives one life in `bodies` (fresh: one robot's or a team's), robot
+    /// `i`'s trace in `traces[i]` when given, `hooks` called as it goes.
+    pub fn run_in<B: Bodies>(
+        &mut self,
+        bodies: &mut B,
+        opts: &EpisodeOptions,
+        traces: Option<&mut [Trace]>,
+        hooks: &mut impl Hooks<'s, B>,
+    ) -> TeamResult {
+        if self.grow(bodies.robots()).is_err() {
             // The same stage and genome made robot 0's: never fails here.
             return TeamResult::default();
         }
-        let ctls = &mut self.ctls[..n];
-        let mut robots = vec![EpisodeResult::default(); n];
-        let mut fitness = vec![0.0f64; n];
-        let groups = crate::state::reads_groups(self.stage);
-        let state = team.state(groups);
-        for (i, c) in ctls.iter_mut().enumerate() {
-            c.set_learning(opts.learning);
-            c.set_team(state);
-            if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
-                c.begin_trace(t);
-            }
-            team.prepare(i);
-            c.start(&mut Member { team, i, watch: &mut *watch });
-        }
-        let mut actions = 0;
-        for a in 0..opts.actions {
-            if !team.sims().iter().any(|s| s.alive()) {
-                break;
-            }
-            team.begin_action();
-            for (i, c) in ctls.iter_mut().enumerate() {
-                if !team.sim(i).alive() {
-                    continue;
-                }
-                team.prepare(i);
-                let member = &mut Member { team, i, watch: &mut *watch };
-                let rep = c.act(member);
-                tally(&mut robots[i], &mut fitness[i], &rep);
-                if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
-                    t.rows.push(c.trace_row(a, &rep, &robots[i], member));
-                }
-            }
-            actions += 1;
-            let state = team.state(groups);
-            for c in ctls.iter_mut() {
-                c.set_team(state);
-            }
-            if !after(team) {
-                break;
-            }
-        }
-        for (i, c) in ctls.iter().enumerate() {
-            let r = std::mem::take(&mut robots[i]);
-            robots[i] = c.finish(&Member { team, i, watch: &mut *watch }, r, fitness[i]);
-        }
-        let mut total = EpisodeResult {
-            fitness: self.stage.fitness.team.of(robots.iter().map(|r| r.fitness)),
-            actions,
-            ..EpisodeResult::default()
-        };
-        for r in &robots {
-            total.grips += r.grips;
-            total.releases_outside += r.releases_outside;
-            total.recharges += r.recharges;
-            total.collisions += r.collisions;
-            total.placement_failures = total.placement_failures.saturating_add(r.placement_failures);
-        }
-        total.descriptors = robots[0].descriptors;
-        TeamResult { team: total, robots }
+        let (robots, actions) = super::live(self.stage, &mut self.ctls, bodies, opts, traces, hooks);
+        TeamResult { team: super::team_result(self.stage, &robots, actions), robots }
     }
 }
 
-/// A team's episode of `genome` on `stage` (`stage.world.robots` robots),
-/// as [`super::run_episode`] runs one robot's; Lamarckian stages write back
-/// what the first robot of each role learned (robot 0's without roles).
+/// A team's robots as the bodies of a life ([`super::live`]), `watch` told
+/// of every robot's sensing and commands.
+pub struct TeamBodies<'t, W: TeamWatch = ()> {
+    pub team: &'t mut Team,
+    pub watch: &'t mut W,
+}
+
+impl<W: TeamWatch> super::Bodies for TeamBodies<'_, W> {
+    type Member<'a>
+        = Member<'a, W>
+    where
+        Self: 'a;
+    fn robots(&self) -> usize {
+        self.team.len()
+    }
+    fn alive(&self, i: usize) -> bool {
+        self.team.sim(i).alive()
+    }
+    fn begin_action(&mut self) {
+        self.team.begin_action();
+    }
+    fn prepare(&mut self, i: usize) {
+        self.team.prepare(i);
+    }
+    fn member(&mut self, i: usize) -> Member<'_, W> {
+        Member { team: &mut *self.team, i, watch: &mut *self.watch }
+    }
+    fn state(&mut self, groups: bool) -> Option<[f32; 3]> {
+        Some(self.team.state(groups))
+    }
+}
+
+/// [`TeamRun::run`]'s `after`, called with the team after every action.
+struct AfterAction<F>(F);
+
+impl<'s, W: TeamWatch, F: FnMut(&Team) -> bool> super::Hooks<'s, TeamBodies<'_, W>> for AfterAction<F> {
+    fn after_action(&mut self, bodies: &TeamBodies<'_, W>) -> bool {
+        (self.0)(bodies.team)
+    }
+}
+
+/// An episode of `genome` on `stage`, of one robot or of a team
+/// (`stage.world.robots` robots), every robot's result; Lamarckian stages
+/// write back what the first robot of each role learned (robot 0's without
+/// roles).
 pub fn run_team_episode(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
     traces: Option<&mut [Trace]>,
 ) -> Result<TeamResult, ControllerError> {
-    let mut team = Team::new(&stage.world, opts.seed);
+    episode_in(stage, genome, opts, traces, |sim| sim)
+}
+
+/// [`run_team_episode`], one robot's simulator wrapped by `robot` (a watch
+/// or a stop; a team's robots are not wrapped). The one place that decides
+/// the bodies of an episode: one robot is a team of one, whose body needs
+/// no neighbours and no team state.
+pub(crate) fn episode_in<R: Robot>(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    traces: Option<&mut [Trace]>,
+    robot: impl FnOnce(Sim) -> R,
+) -> Result<TeamResult, ControllerError> {
     let mut run = TeamRun::new(stage, genome, opts.seed)?;
-    let mut res = run.run(&mut team, opts, traces, |_| true);
+    let mut res = if stage.world.robots > 1 {
+        run.run(&mut Team::new(&stage.world, opts.seed), opts, traces, |_| true)
+    } else {
+        let mut sim = robot(Sim::new(&stage.world, opts.seed));
+        run.run_in(&mut Solo(&mut sim), opts, traces, &mut ())
+    };
     if stage.inheritance == crate::program::Inheritance::Lamarckian {
         res.team.learned = Some(run.write_back(genome));
     }
