@@ -13,6 +13,8 @@
 //! in f64), the events are summed, and the learned genome is the last
 //! episode's.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult};
 use shaping_runtime::evolve::{seed, Evaluation, Events};
 use shaping_runtime::genome::Genome;
@@ -76,6 +78,19 @@ pub fn actions(stage: &Stage) -> u32 {
 /// per variant, aggregated as the stage declares); the final pose is the last episode's, the
 /// path length and the squares visited the means over the episodes.
 pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
+    evaluate_unless(stage, genome, seeds, &AtomicBool::new(false)).unwrap_or_default()
+}
+
+/// [`evaluate`], stopped between two episodes once `stop` is set (Python's
+/// Ctrl-C): `None` if it stopped, and then nothing of the individual is
+/// kept. An episode is at most the stage's `actions`, so a caller that sets
+/// the flag waits for one episode at most.
+pub fn evaluate_unless(
+    stage: &Stage,
+    genome: &Genome,
+    seeds: &[u64],
+    stop: &AtomicBool,
+) -> Option<Described> {
     let actions = actions(stage);
     let mut sum = 0.0f64;
     let mut events = Events::default();
@@ -87,6 +102,9 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
     // With variants: each variant's fitness sum and episodes.
     let mut per = vec![(0.0f64, 0u32); stage.variants.as_ref().map_or(0, |v| v.list.len())];
     for &s in seeds {
+        if stop.load(Ordering::Relaxed) {
+            return None;
+        }
         let (r, d) = episode(worlds.stage(s), genome, &EpisodeOptions { actions, learning: true, seed: s });
         sum += f64::from(r.fitness);
         if let Some(p) = per.get_mut(seed::seed_variant(s)) {
@@ -109,7 +127,7 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
         None => (sum / n) as f32,
         Some(v) => v.aggregate.of(per.iter().filter(|p| p.1 > 0).map(|p| (p.0 / f64::from(p.1)) as f32)),
     };
-    Described {
+    Some(Described {
         evaluation: Evaluation { fitness, learned, events, placement_failures },
         collisions,
         descriptors: Descriptors {
@@ -117,7 +135,7 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
             squares_visited: (squares / n) as f32,
             ..last
         },
-    }
+    })
 }
 
 #[cfg(test)]
@@ -169,6 +187,19 @@ mod tests {
             // Deterministic.
             assert_eq!(evaluate(stage, &genome, &[s]), d);
         }
+    }
+
+    /// A set stop flag stops the evaluation before its next episode and
+    /// keeps nothing; an unset one changes nothing.
+    #[test]
+    fn a_stop_flag_stops_between_episodes() {
+        let program = khepera();
+        let stage = &program.stages[1];
+        let genome = random_genome(stage.layout.bits, 3);
+        let s = seeds(stage, 1, 5, 0, 2);
+        let go = AtomicBool::new(false);
+        assert_eq!(evaluate_unless(stage, &genome, &s, &go), Some(evaluate(stage, &genome, &s)));
+        assert_eq!(evaluate_unless(stage, &genome, &s, &AtomicBool::new(true)), None);
     }
 
     /// Several evaluations: the fitness is the one a run's first generation

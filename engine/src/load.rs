@@ -215,7 +215,7 @@ pub fn recording_bytes(actions: u64, lives: u64, modules: u64, objects: u64, ite
 /// `MemAvailable` of `/proc/meminfo`), or the limit of its control group
 /// (`memory.max` less `memory.current`, cgroup v2, as in a Slurm job) where
 /// that is lower; `None` where neither can be read.
-fn available_memory() -> Option<u64> {
+pub fn available_memory() -> Option<u64> {
     let machine = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
         let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
         let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;

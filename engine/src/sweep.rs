@@ -15,7 +15,7 @@ use shaping_runtime::program::{
     Aggregate, Evolution, Inheritance, LearnWhen, Module, Program, Selection, Stage, StageRun, World,
 };
 
-use crate::error::Error;
+use crate::error::{Error, ErrorKind};
 
 /// One `--set TARGET=V1,V2,...`, as written: `TARGET` is `STAGE.PATH`.
 #[derive(Clone, Debug, PartialEq)]
@@ -95,11 +95,17 @@ pub fn point_dir_name(point: &[Assignment], sets: &[Set]) -> String {
 pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
     for (i, s) in sets.iter().enumerate() {
         if sets[..i].iter().any(|t| t.target == s.target) {
-            return Err(Error::io(format!("error: `--set {}` is given twice", s.target)));
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!("error: `--set {}` is given twice", s.target),
+            ));
         }
         if let Some(v) = s.values.iter().enumerate().find_map(|(k, v)| s.values[..k].contains(v).then_some(v))
         {
-            return Err(Error::io(format!("error: `--set {}`: the value `{v}` is given twice", s.target)));
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!("error: `--set {}`: the value `{v}` is given twice", s.target),
+            ));
         }
     }
     Ok(())
@@ -108,7 +114,7 @@ pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
 /// Applies a point's settings to `program` and validates the result.
 pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
     for (target, text) in point {
-        let fail = |m: String| Error::io(format!("error: `--set {target}={text}`: {m}"));
+        let fail = |m: String| Error::new(ErrorKind::Invalid, format!("error: `--set {target}={text}`: {m}"));
         let (stage, path) = target.split_once('.').ok_or_else(|| fail("no stage in the target".into()))?;
         let indices: Vec<usize> = if stage == "*" {
             let having: Vec<usize> =
@@ -137,7 +143,9 @@ pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
             set(program, i, path, &value).map_err(fail)?;
         }
     }
-    program.validate().map_err(|e| Error::io(format!("error: `--set {}`: {e}", point_name(point))))
+    program
+        .validate()
+        .map_err(|e| Error::new(ErrorKind::Invalid, format!("error: `--set {}`: {e}", point_name(point))))
 }
 
 /// The value kinds of the settings.

@@ -183,7 +183,9 @@ fn a_team_is_set_and_one_too_large_is_refused() {
     assert_eq!((p.stages[0].fitness.team, p.stages[1].fitness.team), (Aggregate::Sum, Aggregate::Min));
     // The arena of 400 x 600 mm holds 7 Kheperas without a `start`.
     apply(&mut tiny(), &set("first.world.robots", "7")).unwrap();
-    let cases: [(&str, &str, &[&str]); 4] = [
+    let cases: [(&str, &str, &[&str]); 6] = [
+        ("first.evolve.nothing", "2", &["`--set first.evolve.nothing=2`"]),
+        ("nope.evolve.generations", "2", &["there is no stage `nope`"]),
         (
             "first.world.robots",
             "8",
@@ -194,7 +196,10 @@ fn a_team_is_set_and_one_too_large_is_refused() {
         ("first.fitness.team", "median", &["`median` is not one of sum, mean, min"]),
     ];
     for (target, value, wanted) in cases {
-        let err = apply(&mut tiny(), &set(target, value)).unwrap_err().to_string();
+        let err = apply(&mut tiny(), &set(target, value)).unwrap_err();
+        // A setting that cannot be used: `Invalid` (Python's ValueError), not a file's failure.
+        assert_eq!(err.kind(), ErrorKind::Invalid, "--set {target}={value}");
+        let err = err.to_string();
         for w in wanted {
             assert!(err.contains(w), "--set {target}={value}: `{w}` missing from:\n{err}");
         }
