@@ -2,7 +2,9 @@
 # The Python package's CI (called by .ci/run): builds and installs it with
 # pip in a fresh virtual environment, then runs its pytest tests, which
 # compare it with the `shaping` command line (built here if SHAPING_BIN is
-# not set). Exits non-zero if the build, the install or a test fails.
+# not set); checks the type stubs with mypy's stubtest and runs bench.py
+# once. Exits non-zero if the build, the install, stubtest, a test or the
+# bench fails.
 #
 #   bash python/ci.sh
 set -euo pipefail
@@ -30,6 +32,18 @@ if [ -z "${SHAPING_BIN:-}" ]; then
   export SHAPING_BIN="$target/debug/shaping"
 fi
 
+root="$(pwd)"
+
+# The type stubs against the installed module (mypy's stubtest).
+"$venv/pip" install --quiet --disable-pip-version-check mypy
+(cd "$work" && "$venv/python" -m mypy.stubtest shaping)
+
 # Run from outside the source tree, so `import shaping` is the installed package.
 cd "$work"
-CI="${CI:-}" "$venv/python" -m pytest "$OLDPWD/python/tests" -q -p no:cacheprovider
+CI="${CI:-}" "$venv/python" -m pytest "$root/python/tests" -q -p no:cacheprovider
+
+# The bench as its documentation runs it, from the repository's root (where
+# python/ holds no package source to shadow the installed package): one
+# round, to see that it runs; its ratios are not checked.
+cd "$root"
+"$venv/python" python/bench.py --rounds 1

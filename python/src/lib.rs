@@ -1,5 +1,5 @@
 //! The `shaping._shaping` extension module: shaping's compiler, engine and
-//! simulator for Python. The `shaping` package (`python/shaping/`) re-exports
+//! simulator for Python. The `shaping` package (`python/python/shaping/`) re-exports
 //! it; its docstrings and type stubs are there.
 //!
 //! Everything goes through the engine (`shaping_engine`): `load` to read a
@@ -9,11 +9,12 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 use miette::Diagnostic as _;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyValueError};
+use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
@@ -53,8 +54,153 @@ fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
     err
 }
 
+/// The error a run, an experiment or a setting raises: `ValueError` for a
+/// setting or an argument that cannot be used (`ErrorKind::Invalid`: an
+/// unknown `set` key, a bad value, `seeds=0`), else `ShapingError`.
+fn engine_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
+    match e.kind() {
+        ErrorKind::Invalid => value_error(e.message()),
+        _ => shaping_error(py, e),
+    }
+}
+
 fn value_error(message: impl Into<String>) -> PyErr {
     PyValueError::new_err(message.into())
+}
+
+/// An integer argument `name` from 0 to `max`, or a ValueError naming it
+/// (a negative, a too large or a non-integer value, e.g. `1.5`).
+fn count_arg(value: &Bound<'_, PyAny>, name: &str, max: u64) -> PyResult<u64> {
+    let bad = || {
+        let shown = value.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into());
+        value_error(format!("error: {name} must be an integer from 0 to {max}, not {shown}"))
+    };
+    if value.is_instance_of::<pyo3::types::PyBool>() {
+        return Err(bad());
+    }
+    match value.extract::<u64>() {
+        Ok(v) if v <= max => Ok(v),
+        _ => Err(bad()),
+    }
+}
+
+/// The most worker threads a call takes (the command line's `--jobs` limit).
+const MAX_JOBS: usize = 1024;
+
+/// `jobs`: None (one thread per core) or 1 to [`MAX_JOBS`].
+fn jobs_arg(jobs: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(jobs) = jobs.filter(|j| !j.is_none()) else { return Ok(None) };
+    match count_arg(jobs, "jobs", MAX_JOBS as u64) {
+        Ok(0) | Err(_) => Err(value_error(format!(
+            "error: jobs must be an integer from 1 to {MAX_JOBS} (None: one thread per core), not {}",
+            jobs.repr().map(|r| r.to_string()).unwrap_or_else(|_| "?".into())
+        ))),
+        Ok(n) => Ok(Some(n as usize)),
+    }
+}
+
+/// A rayon pool of `jobs` threads (None: one per core), rebuilt in a
+/// process forked from the one that built it: a pool's threads are not in
+/// a forked child (`multiprocessing`'s default start on Linux), where the
+/// pool would wait for them forever.
+struct Pool {
+    jobs: Option<usize>,
+    built: Mutex<Option<(u32, Arc<rayon::ThreadPool>)>>,
+}
+
+impl Pool {
+    fn new(jobs: Option<usize>) -> PyResult<Pool> {
+        let pool = Pool { jobs, built: Mutex::new(None) };
+        pool.get()?;
+        Ok(pool)
+    }
+
+    /// The pool of this process.
+    fn get(&self) -> PyResult<Arc<rayon::ThreadPool>> {
+        let pid = std::process::id();
+        let mut built = self.built.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((owner, pool)) = built.as_ref() {
+            if *owner == pid {
+                return Ok(pool.clone());
+            }
+        }
+        // Forked: the parent's pool has no threads here; it is left alone
+        // (dropping it would signal threads that do not exist).
+        if let Some(parent) = built.take() {
+            std::mem::forget(parent);
+        }
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.jobs.unwrap_or(0))
+            .build()
+            .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
+        let pool = Arc::new(pool);
+        *built = Some((pid, pool.clone()));
+        Ok(pool)
+    }
+}
+
+/// Refuses, before allocating, a call that would need `need` bytes where
+/// fewer are available (the machine's or the control group's, as `run`
+/// checks): a MemoryError with the estimate and what to do.
+fn check_room(need: u64, what: &str, instead: &str) -> PyResult<()> {
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    match load::available_memory() {
+        Some(have) if need > have => Err(PyMemoryError::new_err(format!(
+            "error: {what} needs about {:.1} GiB of memory, but only {:.1} GiB are available; {instead}",
+            gib(need),
+            gib(have)
+        ))),
+        // Where nothing can be read: what no machine has (1 TiB).
+        None if need > 1 << 40 => Err(PyMemoryError::new_err(format!(
+            "error: {what} needs about {:.1} GiB of memory; {instead}",
+            gib(need)
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Runs `work` on another thread with the GIL released, checking Python's
+/// signals every 50 ms meanwhile: on Ctrl-C (or any signal whose handler
+/// raises) it sets the flag `work` is given, waits for `work` to return
+/// (it checks the flag between episodes) and raises the handler's
+/// exception (KeyboardInterrupt), keeping nothing of the work.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> T + Send) -> PyResult<T> {
+    let stop = AtomicBool::new(false);
+    let done = AtomicBool::new(false);
+    /// Says the work is over, even if it panicked.
+    struct Done<'a>(&'a AtomicBool, std::thread::Thread);
+    impl Drop for Done<'_> {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Release);
+            self.1.unpark();
+        }
+    }
+    let me = std::thread::current();
+    std::thread::scope(|scope| {
+        let (stop, done) = (&stop, &done);
+        let worker = scope.spawn(move || {
+            let _done = Done(done, me);
+            work(stop)
+        });
+        let panicked =
+            || PyRuntimeError::new_err("error: the evaluation failed (a bug of shaping: please report it)");
+        while !done.load(Ordering::Acquire) {
+            py.detach(|| {
+                if !done.load(Ordering::Acquire) {
+                    std::thread::park_timeout(Duration::from_millis(50));
+                }
+            });
+            if done.load(Ordering::Acquire) {
+                break;
+            }
+            if let Err(e) = py.check_signals() {
+                stop.store(true, Ordering::Relaxed);
+                let _ = py.detach(|| worker.join());
+                return Err(e);
+            }
+        }
+        py.detach(|| worker.join()).map_err(|_| panicked())
+    })
 }
 
 fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
@@ -287,18 +433,23 @@ impl Program {
     /// `run`: a `Run` or a run directory whose training stages' weights
     /// (`trained.json`) are used; without it, training stages are trained
     /// afresh with the program's run seed, and a warning says so. `seed`:
-    /// the seed the episodes derive from. `jobs`: worker threads (None: one
-    /// per core). A stage that does not exist or is not evolved raises
-    /// ValueError.
-    #[pyo3(signature = (stage, run=None, seed=0, jobs=None))]
+    /// the seed the episodes derive from (0 to 2**64 - 1). `jobs`: worker
+    /// threads (1 to 1024; None: one per core). A stage that does not exist
+    /// or is not evolved, or a bad `seed` or `jobs`, raises ValueError.
+    #[pyo3(signature = (stage, run=None, seed=None, jobs=None))]
     fn evaluator(
         &self,
         py: Python<'_>,
         stage: &str,
         run: Option<&Bound<'_, PyAny>>,
-        seed: u64,
-        jobs: Option<usize>,
+        seed: Option<&Bound<'_, PyAny>>,
+        jobs: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Evaluator> {
+        let seed = match seed {
+            Some(s) if !s.is_none() => count_arg(s, "seed", u64::MAX)?,
+            _ => 0,
+        };
+        let jobs = jobs_arg(jobs)?;
         let index = stage_index(&self.program, stage)?;
         if !matches!(self.program.stages[index].run, StageRun::Evolve(_)) {
             return Err(value_error(format!(
@@ -306,22 +457,7 @@ impl Program {
                 if matches!(self.program.stages[index].run, StageRun::Train { .. }) { "training" } else { "test" }
             )));
         }
-        check_jobs(jobs)?;
-        let run_dir: Option<PathBuf> = match run {
-            None => None,
-            Some(r) => Some(match r.getattr("out") {
-                Ok(out) => out.extract()?,
-                Err(_) => r.extract()?,
-            }),
-        };
-        if let Some(d) = &run_dir {
-            if !d.is_dir() {
-                return Err(value_error(format!(
-                    "error: the run directory `{}` does not exist",
-                    d.display()
-                )));
-            }
-        }
+        let run_dir = run_dir_arg(run)?;
         let mut program = (*self.program).clone();
         let uses_training = engine_run::chain(&program, index)
             .iter()
@@ -346,11 +482,17 @@ impl Program {
         let st = &program.stages[index];
         shaping_runtime::controller::validate(st, &Genome::zeros(st.layout.bits as usize))
             .map_err(|e| ShapingError::new_err(format!("error: stage `{}` cannot run: {e}", st.name)))?;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.unwrap_or(0))
-            .build()
-            .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
-        Ok(Evaluator { program: Arc::new(program), index, seed, pool })
+        Ok(Evaluator { program: Arc::new(program), index, seed, jobs, pool: Pool::new(jobs)? })
+    }
+
+    /// Pickled as its program (the compiled `Program`, as `shaping build`
+    /// writes it) and its path: unpickling does not read the file again.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String, PathBuf))> {
+        let py = slf.py();
+        let this = slf.get();
+        let json = serde_json::to_string(&*this.program)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot serialise the program: {e}")))?;
+        Ok((py.import("shaping._shaping")?.getattr("_program_from_json")?, (json, this.path.clone())))
     }
 
     fn __repr__(&self) -> String {
@@ -368,6 +510,50 @@ impl Program {
 fn compile(py: Python<'_>, path: PathBuf) -> PyResult<Program> {
     let program = load(py, &path)?;
     Ok(Program { program: Arc::new(program), path })
+}
+
+/// A program pickled by `Program.__reduce__` (the JSON of `shaping build`).
+#[pyfunction]
+fn _program_from_json(py: Python<'_>, json: &str, path: PathBuf) -> PyResult<Program> {
+    let program =
+        load::parse_built(json.as_bytes(), &path.display().to_string()).map_err(|e| shaping_error(py, &e))?;
+    Ok(Program { program: Arc::new(program), path })
+}
+
+/// An evaluator pickled by `Evaluator.__reduce__`: its program with the
+/// training stages' weights bound, so nothing is trained again.
+#[pyfunction]
+#[pyo3(signature = (json, index, seed, jobs=None))]
+fn _evaluator_from_json(
+    py: Python<'_>,
+    json: &str,
+    index: usize,
+    seed: u64,
+    jobs: Option<usize>,
+) -> PyResult<Evaluator> {
+    let program =
+        load::parse_built(json.as_bytes(), "the pickled evaluator").map_err(|e| shaping_error(py, &e))?;
+    if !matches!(program.stages.get(index).map(|s| &s.run), Some(StageRun::Evolve(_))) {
+        return Err(value_error(format!(
+            "error: the pickled evaluator's stage {index} is not an evolved stage"
+        )));
+    }
+    Ok(Evaluator { program: Arc::new(program), index, seed, jobs, pool: Pool::new(jobs)? })
+}
+
+/// `run`: a `Run` (its `out`) or a run directory that exists.
+fn run_dir_arg(run: Option<&Bound<'_, PyAny>>) -> PyResult<Option<PathBuf>> {
+    let Some(r) = run.filter(|r| !r.is_none()) else { return Ok(None) };
+    let dir: PathBuf = match r.getattr("out") {
+        Ok(out) => out.extract()?,
+        Err(_) => r
+            .extract()
+            .map_err(|_| value_error("error: run must be a `Run` or the path of a run directory"))?,
+    };
+    if !dir.is_dir() {
+        return Err(value_error(format!("error: the run directory `{}` does not exist", dir.display())));
+    }
+    Ok(Some(dir))
 }
 
 /// An observer that keeps the warnings.
@@ -394,11 +580,20 @@ struct Evaluator {
     program: Arc<Compiled>,
     index: usize,
     seed: u64,
-    pool: rayon::ThreadPool,
+    jobs: Option<usize>,
+    pool: Pool,
 }
 
-/// The rows of a 2-D array of 0/1 of `bits` columns, or a ValueError.
-fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize) -> PyResult<Vec<Genome>> {
+/// The memory an evaluation takes per genome of `bits` bits besides its
+/// bits: the genome's `Vec`, its individual's index, its result and the
+/// result's row in the arrays returned.
+const EVALUATED_BYTES: u64 =
+    (std::mem::size_of::<Genome>() + 8 + std::mem::size_of::<Described>() + 11 * 4) as u64;
+
+/// The rows of a 2-D array of 0/1 of `bits` columns, or a ValueError; a
+/// MemoryError, before anything is allocated, for more rows than the
+/// memory available holds.
+fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize, what: &str) -> PyResult<Vec<Genome>> {
     let py = genomes.py();
     let array = if genomes.is_instance_of::<numpy::PyUntypedArray>() {
         genomes.clone()
@@ -417,6 +612,8 @@ fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize) -> PyResult<Vec<Genome>> 
             }
         )));
     }
+    let need = (shape[0] as u64).saturating_mul(bits as u64 + EVALUATED_BYTES);
+    check_room(need, &format!("{what} {} genomes", shape[0]), "pass them in smaller batches")?;
     macro_rules! rows {
         ($($t:ty),*) => {
             $(
@@ -454,6 +651,63 @@ fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize) -> PyResult<Vec<Genome>> 
     Err(value_error(format!(
         "genomes must be an array of integers or booleans (0 and 1), not of dtype {dtype}; e.g. `genomes.astype(numpy.uint8)` after rounding"
     )))
+}
+
+/// What an `Evaluator` is pickled as: its program's JSON (the training
+/// stages' weights bound), its stage's index, its seed and its jobs.
+type EvaluatorState = (String, usize, u64, Option<usize>);
+
+/// The largest individual index `individuals` may hold.
+const MAX_INDIVIDUAL: u64 = u32::MAX as u64;
+
+/// `individuals`: one integer index per row (default: the rows' order).
+fn individuals_of(individuals: Option<&Bound<'_, PyAny>>, rows: usize) -> PyResult<Vec<u64>> {
+    let Some(individuals) = individuals.filter(|x| !x.is_none()) else {
+        return Ok((0..rows as u64).collect());
+    };
+    let py = individuals.py();
+    let np = py.import("numpy")?;
+    let array = np.call_method1("asarray", (individuals,))?;
+    let shape: Vec<usize> = array.getattr("shape")?.extract()?;
+    if shape != [rows] {
+        return Err(value_error(format!(
+            "error: individuals must be an array of shape ({rows},) (one index per row of genomes), not {}",
+            array.getattr("shape")?.repr()?
+        )));
+    }
+    if rows == 0 {
+        return Ok(Vec::new());
+    }
+    let kind: String = array.getattr("dtype")?.getattr("kind")?.extract()?;
+    let values: Vec<i128> = match kind.as_str() {
+        "i" => {
+            let a = array.call_method1("astype", ("int64",))?;
+            let a = a.extract::<numpy::PyReadonlyArray1<'_, i64>>()?;
+            a.as_array().iter().map(|&v| i128::from(v)).collect()
+        }
+        "u" => {
+            let a = array.call_method1("astype", ("uint64",))?;
+            let a = a.extract::<numpy::PyReadonlyArray1<'_, u64>>()?;
+            a.as_array().iter().map(|&v| i128::from(v)).collect()
+        }
+        _ => {
+            return Err(value_error(format!(
+                "error: individuals must be integers (each row's index in its generation), not of dtype {}",
+                array.getattr("dtype")?.str()?
+            )))
+        }
+    };
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| {
+            u64::try_from(v).ok().filter(|&v| v <= MAX_INDIVIDUAL).ok_or_else(|| {
+                value_error(format!(
+                    "error: individuals must be indices from 0 to {MAX_INDIVIDUAL} (an individual's index in its generation): row {i} holds {v}"
+                ))
+            })
+        })
+        .collect()
 }
 
 #[pymethods]
@@ -499,36 +753,44 @@ impl Evaluator {
     /// over the episodes.
     ///
     /// Row i is evaluated on the episodes a run with run seed `seed` gives
-    /// individual i of generation `generation` of the stage (an optimizer
-    /// passes its generation's number for fresh episodes each generation,
-    /// as a run's are), so the same array, seed and generation give the
-    /// same results whatever the threads. A wrong shape, dtype or value
-    /// raises ValueError.
-    #[pyo3(signature = (genomes, generation=0))]
+    /// individual `individuals[i]` (default: i) of generation `generation`
+    /// of the stage (an optimizer passes its generation's number for fresh
+    /// episodes each generation, as a run's are), so the same genome,
+    /// individual, seed and generation give the same results whatever the
+    /// threads and however a batch is split. A wrong shape, dtype or value
+    /// raises ValueError naming the argument; a batch larger than the
+    /// memory available, MemoryError. Ctrl-C stops it within about a
+    /// second (KeyboardInterrupt; nothing is returned).
+    #[pyo3(signature = (genomes, generation=None, individuals=None))]
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
-        generation: u32,
+        generation: Option<&Bound<'py, PyAny>>,
+        individuals: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let generation = match generation {
+            Some(g) if !g.is_none() => count_arg(g, "generation", u64::from(u32::MAX))? as u32,
+            _ => 0,
+        };
         let stage = &self.program.stages[self.index];
-        let genomes = genomes_of(genomes, stage.layout.bits as usize)?;
+        let genomes = genomes_of(genomes, stage.layout.bits as usize, "evaluating")?;
+        let individuals = individuals_of(individuals, genomes.len())?;
         let (index, seed) = (self.index, self.seed);
-        let results: Vec<Described> = py.detach(|| {
-            self.pool.install(|| {
+        let pool = self.pool.get()?;
+        let results = interruptible(py, |stop| {
+            pool.install(|| {
                 genomes
                     .par_iter()
-                    .enumerate()
-                    .map(|(i, g)| {
-                        descriptors::evaluate(
-                            stage,
-                            g,
-                            &descriptors::seeds(stage, index, seed, generation, i),
-                        )
+                    .zip(individuals.par_iter())
+                    .map(|(g, &i)| {
+                        let seeds = descriptors::seeds(stage, index, seed, generation, i as usize);
+                        descriptors::evaluate_unless(stage, g, &seeds, stop)
                     })
-                    .collect()
+                    .collect::<Option<Vec<Described>>>()
             })
-        });
+        })?
+        .ok_or_else(|| PyKeyboardInterrupt::new_err("interrupted: the evaluation was stopped"))?;
         let out = PyDict::new(py);
         let f32s = |f: &dyn Fn(&Described) -> f32| results.iter().map(f).collect::<Vec<f32>>();
         let u32s = |f: &dyn Fn(&Described) -> u32| results.iter().map(f).collect::<Vec<u32>>();
@@ -552,6 +814,20 @@ impl Evaluator {
         Ok(out)
     }
 
+    /// Pickled as its program with the training stages' weights bound, its
+    /// stage, seed and jobs: the unpickled evaluator gives the same results
+    /// and trains nothing.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, EvaluatorState)> {
+        let py = slf.py();
+        let this = slf.get();
+        let json = serde_json::to_string(&*this.program)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot serialise the program: {e}")))?;
+        Ok((
+            py.import("shaping._shaping")?.getattr("_evaluator_from_json")?,
+            (json, this.index, this.seed, this.jobs),
+        ))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "<Evaluator of stage `{}` ({} bits, {} episodes each, seed {})>",
@@ -561,6 +837,155 @@ impl Evaluator {
             self.seed
         )
     }
+}
+
+// ------------------------------------------------------------------ genes
+
+/// The genome whose frozen genes `genes.encode` copies: `base`'s, or those
+/// of the best genome of the run `run` of the stage's nearest evolved
+/// ancestor (the genome the run's later stage extends); all zeros for a
+/// stage without frozen genes. Neither for a stage with frozen genes, or
+/// both, is a ValueError.
+fn frozen_template(
+    program: &Compiled,
+    index: usize,
+    base: Option<&Bound<'_, PyAny>>,
+    run: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Genome> {
+    let st = &program.stages[index];
+    let bits = st.layout.bits as usize;
+    let frozen = st.layout.genes.iter().filter(|g| g.frozen).count();
+    let base = base.filter(|b| !b.is_none());
+    let run_dir = run_dir_arg(run)?;
+    match (base, run_dir) {
+        (Some(_), Some(_)) => Err(value_error(
+            "error: pass run= (the frozen genes of its best genome) or base= (a genome), not both",
+        )),
+        (Some(b), None) => {
+            let py = b.py();
+            let array = py.import("numpy")?.call_method1("atleast_2d", (b,))?;
+            let rows = genomes_of(&array, bits, "reading").map_err(|e| {
+                value_error(format!("error: base must be one genome of stage `{}` ({bits} bits of 0 and 1): {}", st.name, e.value(py)))
+            })?;
+            match <[Genome; 1]>::try_from(rows) {
+                Ok([g]) => Ok(g),
+                Err(rows) => Err(value_error(format!(
+                    "error: base must be one genome of stage `{}` ({bits} bits), not {} rows",
+                    st.name,
+                    rows.len()
+                ))),
+            }
+        }
+        (None, Some(dir)) => {
+            let mut genome = Genome::zeros(bits);
+            let Some(parent) = st.parent.and_then(|p| engine_run::evolved_ancestor(program, p)) else {
+                return Ok(genome);
+            };
+            let pst = &program.stages[parent];
+            let py = run.expect("a run directory comes from run=").py();
+            let ran = load::load_built(&rundir::program_path(&dir)).map_err(|e| shaping_error(py, &e))?;
+            if ran.stage(&pst.name).map(|(_, s)| &s.layout) != Some(&pst.layout) {
+                return Err(value_error(format!(
+                    "error: the run `{}` has no stage `{}` with this program's genes: run= must be a run of this program",
+                    dir.display(),
+                    pst.name
+                )));
+            }
+            let best = rundir::read_best(&rundir::stage_dir(&dir, &pst.name)).map_err(|e| shaping_error(py, &e))?;
+            let kept = pst.layout.bits as usize;
+            if best.bits.len() != kept {
+                return Err(ShapingError::new_err(format!(
+                    "error: the best genome of `{}` in `{}` has {} bits, its layout {kept}",
+                    pst.name,
+                    dir.display(),
+                    best.bits.len()
+                )));
+            }
+            genome.bits[..kept].copy_from_slice(&best.bits);
+            Ok(genome)
+        }
+        (None, None) if frozen > 0 => Err(value_error(format!(
+            "error: stage `{}` has {frozen} frozen genes (of the stages it extends): pass run= a run of them \
+             (the frozen genes are its best genome's, as a run's stage starts from) or base= a genome of the stage",
+            st.name
+        ))),
+        (None, None) => Ok(Genome::zeros(bits)),
+    }
+}
+
+/// `genes.encode`: genomes of `stage` whose evolvable genes are the levels
+/// nearest to `values` (the runtime's codec, `Genome::encode`, as a run's
+/// write-back encodes) and whose frozen genes come from `base` or `run`.
+#[pyfunction]
+#[pyo3(signature = (program, stage, values, base=None, run=None))]
+fn _encode_genes<'py>(
+    py: Python<'py>,
+    program: &Program,
+    stage: &str,
+    values: &Bound<'py, PyAny>,
+    base: Option<&Bound<'py, PyAny>>,
+    run: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, numpy::PyArray2<u8>>> {
+    let index = stage_index(&program.program, stage)?;
+    let st = &program.program.stages[index];
+    let genes: Vec<&shaping_runtime::program::Gene> = st.layout.genes.iter().filter(|g| !g.frozen).collect();
+    let np = py.import("numpy")?;
+    let x = np
+        .call_method1("atleast_2d", (np.call_method1("asarray", (values,))?,))?
+        .call_method1("astype", ("float64",))
+        .map_err(|_| value_error("error: values must be an array of numbers"))?;
+    let x = x.extract::<PyReadonlyArray2<'_, f64>>().map_err(|_| {
+        value_error(format!(
+            "error: values must be an array of shape (n, {}) (the evolvable genes of `{stage}`)",
+            genes.len()
+        ))
+    })?;
+    let shape = x.shape().to_vec();
+    if shape[1] != genes.len() {
+        return Err(value_error(format!(
+            "error: values must have {} columns (the evolvable genes of `{stage}`), not {}",
+            genes.len(),
+            shape[1]
+        )));
+    }
+    let bits = st.layout.bits as usize;
+    let need = (shape[0] as u64).saturating_mul(bits as u64 + 8 * genes.len() as u64);
+    check_room(need, &format!("encoding {} genomes", shape[0]), "pass them in smaller batches")?;
+    let x = x.as_array();
+    if let Some(((i, j), _)) = x.indexed_iter().find(|(_, v)| v.is_nan()) {
+        return Err(value_error(format!(
+            "error: values must be numbers: row {i}, column {j} (gene at bit {}) is NaN",
+            genes[j].offset
+        )));
+    }
+    let template = frozen_template(&program.program, index, base, run)?;
+    let mut out = Vec::with_capacity(shape[0] * bits);
+    for row in x.rows() {
+        let mut genome = template.clone();
+        for (g, &v) in genes.iter().zip(row.iter()) {
+            genome.encode(g, v as f32);
+        }
+        out.extend_from_slice(&genome.bits);
+    }
+    PyArray1::from_vec(py, out).reshape([shape[0], bits])
+}
+
+/// `genes.decode`: the values of the evolvable genes of `genomes` (the
+/// runtime's codec, `Genome::decode`, the values a controller uses).
+#[pyfunction]
+fn _decode_genes<'py>(
+    py: Python<'py>,
+    program: &Program,
+    stage: &str,
+    genomes: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let index = stage_index(&program.program, stage)?;
+    let st = &program.program.stages[index];
+    let array = py.import("numpy")?.call_method1("atleast_2d", (genomes,))?;
+    let rows = genomes_of(&array, st.layout.bits as usize, "decoding")?;
+    let genes: Vec<&shaping_runtime::program::Gene> = st.layout.genes.iter().filter(|g| !g.frozen).collect();
+    let out: Vec<f64> = rows.iter().flat_map(|r| genes.iter().map(move |g| f64::from(r.decode(g)))).collect();
+    PyArray1::from_vec(py, out).reshape([rows.len(), genes.len()])
 }
 
 // ------------------------------------------------------------------ step
@@ -672,24 +1097,46 @@ impl Stepper {
 struct VecStepper {
     inner: shaping_engine::stepper::VecStepper,
     out: shaping_engine::stepper::VecStep,
-    pool: rayon::ThreadPool,
+    pool: Pool,
 }
+
+/// The memory one robot of a `VecStepper` takes, besides its observation
+/// and action rows: its stepper, its simulator after the first reset and
+/// its rows of the results (measured: 6.2 to 6.6 KB a Khepera after a
+/// reset in `examples/khepera.bat`'s `navigation` and `collect`, the
+/// resident size of 100,000 robots; rounded up).
+const VEC_ROBOT_BYTES: u64 = 8192;
+
+/// The most robots of one `VecStepper` (far beyond what a step's latency allows).
+const MAX_NUM_ENVS: u64 = 1 << 32;
 
 #[pymethods]
 impl VecStepper {
     /// `num_envs` robots of stage `stage` of `program`, stepped on `jobs`
     /// threads (None: one per core).
+    /// A `num_envs` that is not a positive integer, or a bad `jobs`, raises
+    /// ValueError; more robots than the memory available holds, MemoryError.
     #[new]
     #[pyo3(signature = (program, stage, num_envs, jobs=None))]
-    fn new(program: &Program, stage: &str, num_envs: usize, jobs: Option<usize>) -> PyResult<VecStepper> {
-        if num_envs == 0 {
-            return Err(value_error("error: num_envs must be at least 1"));
-        }
-        check_jobs(jobs)?;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(jobs.unwrap_or(0))
-            .build()
-            .map_err(|e| ShapingError::new_err(format!("error: cannot start worker threads: {e}")))?;
+    fn new(
+        program: &Program,
+        stage: &str,
+        num_envs: &Bound<'_, PyAny>,
+        jobs: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<VecStepper> {
+        let num_envs = match count_arg(num_envs, "num_envs", MAX_NUM_ENVS) {
+            Ok(0) => Err(value_error("error: num_envs must be at least 1")),
+            other => other,
+        }? as usize;
+        let jobs = jobs_arg(jobs)?;
+        let index = stage_index(&program.program, stage)?;
+        let width = {
+            let st = &program.program.stages[index];
+            shaping_engine::stepper::Spaces::of(st).channels.len() as u64 + 8
+        };
+        let need = (num_envs as u64).saturating_mul(VEC_ROBOT_BYTES + 8 * width);
+        check_room(need, &format!("stepping {num_envs} robots"), "pass a smaller num_envs")?;
+        let pool = Pool::new(jobs)?;
         let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs)
             .map_err(|e| Python::attach(|py| shaping_error(py, &e)))?;
         Ok(VecStepper { inner, out: Default::default(), pool })
@@ -730,7 +1177,8 @@ impl VecStepper {
             )));
         }
         let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
-        let (inner, out, pool) = (&mut self.inner, &mut self.out, &self.pool);
+        let pool = self.pool.get()?;
+        let (inner, out) = (&mut self.inner, &mut self.out);
         py.detach(|| pool.install(|| inner.step(flat, out))).map_err(|e| invalid(&e))?;
         Ok((
             self.observations(py)?,
@@ -813,7 +1261,10 @@ impl Run {
         Ok(dir)
     }
 
-    /// The columns of `generations.csv` of evolved stage `stage`, each a numpy array.
+    /// The columns of `generations.csv` of evolved stage `stage`, each a
+    /// numpy array: `stage` strings, `best`, `mean`, `worst` and (a stage
+    /// with variants) `best_variant_NAME` floats (NaN where the generation
+    /// did not draw the variant), the others integers.
     fn generations<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyDict>> {
         let path = self.stage_dir(stage)?.join("generations.csv");
         let text = std::fs::read_to_string(&path)
@@ -833,6 +1284,16 @@ impl Run {
                 "best" | "mean" | "worst" => {
                     let v: Vec<f64> =
                         cells.iter().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad())?;
+                    out.set_item(name, PyArray1::from_vec(py, v))?;
+                }
+                // The best's fitness in each variant: empty (NaN) where its
+                // generation did not draw the variant.
+                _ if name.starts_with("best_variant_") => {
+                    let v: Vec<f64> = cells
+                        .iter()
+                        .map(|s| if s.is_empty() { Ok(f64::NAN) } else { s.parse() })
+                        .collect::<Result<_, _>>()
+                        .map_err(|_| bad())?;
                     out.set_item(name, PyArray1::from_vec(py, v))?;
                 }
                 _ => {
@@ -968,14 +1429,6 @@ fn assignments(set: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<sweep::Assignmen
         .collect()
 }
 
-/// `jobs`: None (one thread per core) or at least 1.
-fn check_jobs(jobs: Option<usize>) -> PyResult<()> {
-    if jobs == Some(0) {
-        return Err(value_error("error: jobs must be at least 1 (None: one thread per core)"));
-    }
-    Ok(())
-}
-
 /// Runs the file `path` like `shaping run` into `out` (default
 /// `runs/<file stem>`), resuming what is saved there, and returns its `Run`.
 ///
@@ -1000,12 +1453,12 @@ fn run(
     seed: Option<u64>,
     stage: Option<String>,
     set: Option<&Bound<'_, PyDict>>,
-    jobs: Option<usize>,
+    jobs: Option<&Bound<'_, PyAny>>,
     callback: Option<Py<PyAny>>,
     fresh: bool,
     report: bool,
 ) -> PyResult<Run> {
-    check_jobs(jobs)?;
+    let jobs = jobs_arg(jobs)?;
     check_callback(py, &callback)?;
     let sets = assignments(set)?;
     let program = load(py, &path)?;
@@ -1066,7 +1519,7 @@ fn observed<T: Send>(
             let _ = py.check_signals();
             Err(PyKeyboardInterrupt::new_err(e.message().to_string()))
         }
-        Err(e) => Err(shaping_error(py, &e)),
+        Err(e) => Err(engine_error(py, &e)),
     }
 }
 
@@ -1184,12 +1637,12 @@ fn experiment(
     stage: Option<String>,
     set: Option<&Bound<'_, PyDict>>,
     criterion: Option<&Bound<'_, PyDict>>,
-    jobs: Option<usize>,
+    jobs: Option<&Bound<'_, PyAny>>,
     callback: Option<Py<PyAny>>,
     fresh: bool,
     report: bool,
 ) -> PyResult<Experiment> {
-    check_jobs(jobs)?;
+    let jobs = jobs_arg(jobs)?;
     check_callback(py, &callback)?;
     let sets = sweep_sets(set)?;
     let mut criteria = Vec::new();
@@ -1215,7 +1668,7 @@ fn experiment(
         fresh,
         no_report: !report,
     };
-    let plan = shaping_engine::experiment::Plan::new(program, options).map_err(|e| shaping_error(py, &e))?;
+    let plan = shaping_engine::experiment::Plan::new(program, options).map_err(|e| engine_error(py, &e))?;
     let (outcomes, finished) = observed(py, callback, |observer, stop| {
         let _lock = plan.lock()?;
         let runner = Runner { observer, evaluator: None, interrupt: Some(stop) };
@@ -1258,5 +1711,9 @@ fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(experiment, m)?)?;
+    m.add_function(wrap_pyfunction!(_program_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(_evaluator_from_json, m)?)?;
+    m.add_function(wrap_pyfunction!(_encode_genes, m)?)?;
+    m.add_function(wrap_pyfunction!(_decode_genes, m)?)?;
     Ok(())
 }

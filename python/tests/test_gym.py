@@ -182,3 +182,68 @@ def test_a_team_is_refused():
     # One agent drives one robot: a stage with a team of 10 is refused.
     with pytest.raises(shaping.ShapingError, match="team of 10 robots"):
         shaping.gym.make(ROOT / "examples" / "aggregation.bat", "aggregate")
+
+
+def test_bad_num_envs_and_jobs_raise():
+    for n in (1.5, 0, -3, "4", True):
+        with pytest.raises(ValueError, match="num_envs must be"):
+            shaping.gym.make_vec(KHEPERA, "navigation", num_envs=n)
+    assert shaping.gym.make_vec(KHEPERA, "navigation", num_envs=np.int64(3)).num_envs == 3
+    with pytest.raises(ValueError, match="jobs must be an integer from 1 to 1024"):
+        shaping.gym.make_vec(KHEPERA, "navigation", num_envs=2, jobs=100000)
+
+
+def test_too_many_robots_for_the_memory_are_refused():
+    with pytest.raises(MemoryError, match=r"stepping 1000000000 robots needs about [\d.]+ GiB"):
+        shaping.gym.make_vec(KHEPERA, "navigation", num_envs=10**9)
+
+
+def _step_in_child(envs, actions):
+    envs.reset(seed=4)
+    return envs.step(actions)[0]
+
+
+def test_a_vector_environment_made_before_fork_works_in_the_child():
+    import multiprocessing
+
+    envs = shaping.gym.make_vec(KHEPERA, "navigation", num_envs=64, jobs=2)
+    actions = np.full(envs.action_space.shape, 0.5, np.float32)
+    expected = _step_in_child(envs, actions)  # the pool's threads run in the parent
+    global _ENVS
+    _ENVS = (envs, actions)
+    with multiprocessing.get_context("fork").Pool(1) as pool:
+        got = pool.apply_async(_inherited_step, ()).get(timeout=60)
+    np.testing.assert_array_equal(got, expected)
+
+
+_ENVS = None
+
+
+def _inherited_step():
+    return _step_in_child(*_ENVS)
+
+
+def test_shaping_gym_loads_on_first_use_and_says_how_to_install_gymnasium(tmp_path):
+    import subprocess
+    import sys
+
+    code = (
+        "import shaping\n"
+        f"env = shaping.gym.make({str(KHEPERA)!r}, 'navigation')\n"
+        "print(type(env).__name__)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0 and out.stdout.strip() == "ShapingEnv", out.stderr
+    # Without gymnasium: `import shaping` works, `shaping.gym` says what to install.
+    code = (
+        "import sys\n"
+        "sys.modules['gymnasium'] = None\n"
+        "import shaping\n"
+        "try:\n"
+        "    shaping.gym\n"
+        "except ImportError as e:\n"
+        "    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert 'pip install "shaping[gym]"' in out.stdout, out.stdout

@@ -304,17 +304,21 @@ def test_run_set_and_bad_arguments(tmp_path):
     assert len(run.generations("first")["best"]) == 2
     with pytest.raises(ValueError, match="no stage `nope`"):
         shaping.run(TINY, out=tmp_path / "b", stage="nope")
-    with pytest.raises(shaping.ShapingError) as e:
-        shaping.run(TINY, out=tmp_path / "c", set={"first.evolve.nothing": 2})
-    res = shaping_cli("run", TINY, "--out", tmp_path / "d", "--set", "first.evolve.nothing=2")
-    assert res.returncode != 0
-    assert str(e.value).strip() == res.stderr.strip()
+    # An unknown setting or a bad value: ValueError with the CLI's message.
+    for key, value in [("first.evolve.nothing", 2), ("first.evolve.mutation", "lots"), ("nope.evolve.mutation", 0.1)]:
+        with pytest.raises(ValueError) as e:
+            shaping.run(TINY, out=tmp_path / "c", set={key: value})
+        res = shaping_cli("run", TINY, "--out", tmp_path / "d", "--set", f"{key}={value}")
+        assert res.returncode == 2
+        assert str(e.value).strip() == res.stderr.strip()
+        assert not isinstance(e.value, shaping.ShapingError)
     with pytest.raises(ValueError, match="one value"):
         shaping.run(TINY, out=tmp_path / "e", set={"first.evolve.generations": [1, 2]})
     with pytest.raises(ValueError, match="STAGE.SECTION.FIELD"):
         shaping.run(TINY, out=tmp_path / "f", set={"generations": 2})
-    with pytest.raises(ValueError, match="jobs"):
-        shaping.run(TINY, out=tmp_path / "g", jobs=0)
+    for jobs in (0, -1, 1.5, 100000, "2"):
+        with pytest.raises(ValueError, match="jobs must be an integer from 1 to 1024"):
+            shaping.run(TINY, out=tmp_path / "g", jobs=jobs)
     with pytest.raises(ValueError, match="no stage"):
         run.best_genome("second")
 
@@ -499,9 +503,9 @@ def test_experiment_sweeps_a_list_of_values(tmp_path):
         {"first.evolve.generations": "1"},
         {"first.evolve.generations": "2"},
     ]
-    with pytest.raises(shaping.ShapingError, match="seeds"):
+    with pytest.raises(ValueError, match="seeds"):
         shaping.experiment(TINY, seeds=0, out=tmp_path / "none")
-    with pytest.raises(shaping.ShapingError, match="no stage `nope`"):
+    with pytest.raises(ValueError, match="no stage `nope`"):
         shaping.experiment(TINY, seeds=1, out=tmp_path / "crit", criterion={"nope": 0.5})
     assert not (tmp_path / "none").exists()
 
@@ -515,11 +519,12 @@ def test_genes_encode_to_the_nearest_level_and_decode_back():
     levels = lo + (hi - lo) * (np.arange(48) % 16) / 15
     g = genes.encode(program, "navigation", levels + 0.1)
     assert g.shape == (1, program.genome_bits("navigation")) and g.dtype == np.uint8
-    np.testing.assert_allclose(genes.decode(program, "navigation", g)[0], levels)
+    # The runtime decodes in f32: the values its controllers use.
+    np.testing.assert_allclose(genes.decode(program, "navigation", g)[0], levels, rtol=1e-6)
     # Gene 5 is level 5: bits 0101, most significant first.
     assert list(g[0, 20:24]) == [0, 1, 0, 1]
     # The frozen genes of a later stage are the base genome's.
-    base = random_genomes(1, program.genome_bits("collect"))[0]
+    base = random_genomes(1, program.genome_bits("collect"), seed=5)[0]
     frozen = [x for x in program.layout("collect") if x["frozen"]]
     values = np.zeros((2, len(genes.evolvable(program, "collect"))))
     out = genes.encode(program, "collect", values, base=base)
@@ -527,3 +532,243 @@ def test_genes_encode_to_the_nearest_level_and_decode_back():
         np.testing.assert_array_equal(out[:, x["offset"] : x["offset"] + x["bits"]], [base[x["offset"] : x["offset"] + x["bits"]]] * 2)
     with pytest.raises(ValueError, match="48 columns"):
         genes.encode(program, "navigation", np.zeros((1, 3)))
+
+
+def test_genes_encode_refuses_a_stage_with_frozen_genes_without_their_source():
+    from shaping import genes
+
+    program = shaping.compile(KHEPERA)
+    values = np.zeros((2, len(genes.evolvable(program, "collect"))))
+    with pytest.raises(ValueError, match=r"stage `collect` has \d+ frozen genes.*run=.*base="):
+        genes.encode(program, "collect", values)
+    with pytest.raises(ValueError, match="not both"):
+        genes.encode(program, "collect", values, base=np.zeros(344, np.uint8), run=ROOT)
+    with pytest.raises(ValueError, match="base must be one genome"):
+        genes.encode(program, "collect", values, base=np.zeros(343, np.uint8))
+    with pytest.raises(ValueError, match="base must be one genome"):
+        genes.encode(program, "collect", values, base=np.full(344, 2))
+
+
+def test_genes_encode_takes_the_frozen_genes_from_a_run(tmp_path):
+    from shaping import genes
+
+    run = shaping.run(TINY, out=tmp_path / "run", set={"first.evolve.generations": 1}, report=False, stage="second")
+    program = shaping.compile(TINY)
+    frozen = [x for x in program.layout("second") if x["frozen"]]
+    assert frozen
+    values = np.zeros((3, len(genes.evolvable(program, "second"))))
+    best = run.best_genome("first")
+    for source in (run, run.out, str(run.out)):
+        g = genes.encode(program, "second", values, run=source)
+        assert g.shape == (3, program.genome_bits("second"))
+        np.testing.assert_array_equal(g[:, : len(best)], [best] * 3)
+    # First stage: no frozen genes, the run changes nothing.
+    np.testing.assert_array_equal(
+        genes.encode(program, "first", np.zeros((1, len(genes.evolvable(program, "first")))), run=run),
+        genes.encode(program, "first", np.zeros((1, len(genes.evolvable(program, "first"))))),
+    )
+    # A run of another program is refused.
+    other = shaping.compile(KHEPERA)
+    with pytest.raises(ValueError, match="run= must be a run of this program"):
+        genes.encode(other, "collect", np.zeros((1, len(genes.evolvable(other, "collect")))), run=run)
+    with pytest.raises(ValueError, match="does not exist"):
+        genes.encode(program, "second", values, run=tmp_path / "nothing")
+
+
+def test_genes_encode_refuses_nan_and_rounds_halves_as_the_runtime():
+    from shaping import genes
+
+    program = shaping.compile(KHEPERA)
+    n = len(genes.evolvable(program, "navigation"))
+    x = np.zeros((2, n))
+    x[1, 7] = np.nan
+    with pytest.raises(ValueError, match="row 1, column 7 .* NaN"):
+        genes.encode(program, "navigation", x)
+    # Exact halves between two levels (in the f32 arithmetic of the
+    # runtime's `Genome::encode`) take the upper level, as a run's
+    # write-back does; np.rint would take the even one.
+    lo, hi = np.float32(-4), np.float32(4)
+    halves = []
+    for k in range(15):
+        v = np.float32(lo + (hi - lo) * np.float32((k + 0.5) / 15))
+        if np.float32(np.float32(v - lo) / np.float32(hi - lo)) * np.float32(15) == np.float32(k + 0.5):
+            halves.append((k, float(v)))
+    assert len(halves) >= 3, halves
+    for k, v in halves:
+        g = genes.encode(program, "navigation", np.full((1, n), v))
+        level = int("".join(map(str, g[0, :4])), 2)
+        assert level == k + 1, (k, v, level)
+    # Decoding is the runtime's too: every level's value, in f32.
+    levels = lo + (hi - lo) * ((np.arange(n) % 16).astype(np.float32) / np.float32(15))
+    np.testing.assert_array_equal(
+        genes.decode(program, "navigation", genes.encode(program, "navigation", levels[None, :]))[0],
+        levels.astype(np.float32),
+    )
+
+
+# ------------------------------------------------------------------ issue 46, 47
+
+
+def test_generations_of_a_stage_with_variants(tmp_path):
+    """examples/t-maze.bat's `recurrent` has four variants: their columns
+    are floats; with `draw 2`, a generation leaves two out (NaN)."""
+    tmaze = ROOT / "examples" / "t-maze.bat"
+    run = shaping.run(tmaze, out=tmp_path / "all", stage="recurrent", set={"recurrent.evolve.generations": 2},
+                      report=False)
+    g = run.generations("recurrent")
+    assert len(g["best"]) == 2
+    names = ["left", "right", "left_seen", "right_seen"]
+    for v in names:
+        column = g[f"best_variant_{v}"]
+        assert column.dtype == np.float64 and column.shape == (2,) and np.all(np.isfinite(column)), v
+    assert g["best_index"].dtype == np.int64
+    source = tmaze.read_text()
+    assert source.count("variants mean {") >= 1
+    drawn = tmp_path / "drawn.bat"
+    drawn.write_text(source.replace("variants mean {", "variants mean draw 2 {", 1))
+    run = shaping.run(drawn, out=tmp_path / "drawn", stage="recurrent",
+                      set={"recurrent.evolve.generations": 3}, report=False)
+    g = run.generations("recurrent")
+    columns = np.array([g[f"best_variant_{v}"] for v in names])
+    assert columns.shape == (4, 3)
+    # Each generation draws two of the four: two numbers and two NaN.
+    assert np.all(np.isnan(columns).sum(axis=0) == 2), columns
+
+
+def test_a_row_s_result_does_not_depend_on_its_place_in_the_batch(navigation):
+    """`individuals`: each row's index in its generation. Split three ways
+    or reversed, every genome gets the numbers it got in one batch."""
+    _, ev = navigation
+    genomes = random_genomes(30, ev.bits, seed=11)
+    whole = ev.evaluate(genomes, generation=2)
+    ids = np.arange(30)
+    parts = [ev.evaluate(genomes[a:b], generation=2, individuals=ids[a:b]) for a, b in [(0, 7), (7, 19), (19, 30)]]
+    back = ev.evaluate(genomes[::-1], generation=2, individuals=ids[::-1].tolist())
+    for k in whole:
+        np.testing.assert_array_equal(np.concatenate([p[k] for p in parts]), whole[k], err_msg=k)
+        np.testing.assert_array_equal(back[k][::-1], whole[k], err_msg=k)
+    # The default is the rows' order; an index is any row's.
+    np.testing.assert_array_equal(ev.evaluate(genomes, generation=2, individuals=ids)["fitness"], whole["fitness"])
+    same = ev.evaluate(genomes[:2], generation=2, individuals=np.array([5, 5], dtype=np.uint16))
+    assert same["fitness"][0] == ev.evaluate(genomes[:1], generation=2, individuals=[5])["fitness"][0]
+
+
+def test_bad_individuals_generation_and_seed_name_the_argument(navigation):
+    program, ev = navigation
+    genomes = random_genomes(3, ev.bits)
+    for bad, match in [
+        ([0, 1], r"individuals must be an array of shape \(3,\)"),
+        ([[0, 1, 2]], r"individuals must be an array of shape \(3,\)"),
+        ([0, -1, 2], "individuals must be indices from 0 to 4294967295.*row 1 holds -1"),
+        ([0, 1, 2**40], "individuals must be indices from 0 to 4294967295.*row 2 holds 1099511627776"),
+        ([0.0, 1.0, 2.0], "individuals must be integers"),
+    ]:
+        with pytest.raises(ValueError, match=match):
+            ev.evaluate(genomes, individuals=bad)
+    for g in (-1, 2**32, 1.5, True):
+        with pytest.raises(ValueError, match="generation must be an integer from 0 to 4294967295"):
+            ev.evaluate(genomes, generation=g)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for seed in (-1, 2**64, 0.5):
+            with pytest.raises(ValueError, match="seed must be an integer from 0 to 18446744073709551615"):
+                program.evaluator("navigation", seed=seed)
+        for jobs in (0, -1, 100000, 2.0):
+            with pytest.raises(ValueError, match="jobs must be an integer from 1 to 1024"):
+                program.evaluator("navigation", jobs=jobs)
+        assert program.evaluator("navigation", seed=2**64 - 1, jobs=1024).seed == 2**64 - 1
+
+
+def test_a_batch_too_large_for_the_memory_is_refused(navigation):
+    _, ev = navigation
+    huge = np.broadcast_to(np.zeros(ev.bits, np.uint8), (2**40, ev.bits))
+    with pytest.raises(MemoryError, match=r"evaluating 1099511627776 genomes needs about [\d.]+ GiB"):
+        ev.evaluate(huge)
+
+
+def _evaluate_in_child(ev, genomes):
+    return ev.evaluate(genomes)["fitness"]
+
+
+def test_an_evaluator_made_before_fork_works_in_the_child(navigation):
+    import multiprocessing
+
+    _, ev = navigation
+    genomes = random_genomes(6, ev.bits, seed=12)
+    expected = ev.evaluate(genomes)["fitness"]  # the pool's threads run in the parent
+    ctx = multiprocessing.get_context("fork")
+    with ctx.Pool(2) as pool:
+        got = pool.starmap(_evaluate_in_child, [(ev, genomes)] * 2, chunksize=1)
+    for g in got:
+        np.testing.assert_array_equal(g, expected)
+    # jobs=1 too, and the evaluator inherited (not pickled) by the child.
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        one = navigation[0].evaluator("navigation", seed=3, jobs=1)
+    one.evaluate(genomes)
+    global _INHERITED
+    _INHERITED = one
+    with ctx.Pool(1) as pool:
+        got = pool.apply_async(_evaluate_inherited, (genomes,)).get(timeout=120)
+    np.testing.assert_array_equal(got, expected)
+
+
+_INHERITED = None
+
+
+def _evaluate_inherited(genomes):
+    return _INHERITED.evaluate(genomes)["fitness"]
+
+
+def test_a_program_and_an_evaluator_pickle(navigation, tmp_path):
+    import pickle
+
+    program, ev = navigation
+    again = pickle.loads(pickle.dumps(program))
+    assert again.stages == program.stages and again.path == program.path and again.name == program.name
+    assert again.layout("collect") == program.layout("collect")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing is trained again
+        copy = pickle.loads(pickle.dumps(ev))
+    assert (copy.stage, copy.bits, copy.seed, copy.episodes) == (ev.stage, ev.bits, ev.seed, ev.episodes)
+    genomes = random_genomes(5, ev.bits, seed=13)
+    for k, v in ev.evaluate(genomes, generation=1).items():
+        np.testing.assert_array_equal(copy.evaluate(genomes, generation=1)[k], v, err_msg=k)
+    with pytest.raises(TypeError):
+        pickle.dumps(shaping._shaping.Stepper(program, "navigation"))
+
+
+def test_ctrl_c_stops_evaluate_within_a_second(tmp_path):
+    """SIGINT to a process in a long `evaluate` (minutes): KeyboardInterrupt
+    within about a second."""
+    import signal
+    import sys
+    import time
+
+    script = tmp_path / "long.py"
+    script.write_text(
+        "import sys, time, warnings\n"
+        "import numpy as np\n"
+        "import shaping\n"
+        "warnings.simplefilter('ignore')\n"
+        f"ev = shaping.compile({str(KHEPERA)!r}).evaluator('navigation', seed=1, jobs=1)\n"
+        "g = np.random.default_rng(0).integers(0, 2, size=(200000, ev.bits), dtype=np.uint8)\n"
+        "print('start', flush=True)\n"
+        "try:\n"
+        "    ev.evaluate(g)\n"
+        "    print('finished', flush=True)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted', time.monotonic(), flush=True)\n"
+    )
+    child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        assert child.stdout.readline().strip() == "start"
+        time.sleep(1.0)
+        sent = time.monotonic()
+        child.send_signal(signal.SIGINT)
+        out, _ = child.communicate(timeout=30)
+    finally:
+        child.kill()
+    assert out.startswith("interrupted"), out
+    took = float(out.split()[1]) - sent
+    assert took < 1.5, took

@@ -24,7 +24,9 @@ The robot is driven by the agent alone: the stage's modules, their
 learning and the genome are not used. ``make_vec`` steps all its robots in
 Rust in one call.
 
-Needs ``gymnasium`` (``pip install ./python[gym]``).
+Needs ``gymnasium`` (``pip install "shaping[gym]"``, from this repository
+``pip install "./python[gym]"``); without it, ``shaping.gym`` raises
+ImportError saying so.
 """
 
 from __future__ import annotations
@@ -32,10 +34,16 @@ from __future__ import annotations
 import os
 from typing import Any
 
-import gymnasium
+import importlib.util
+
 import numpy as np
-from gymnasium import spaces
-from gymnasium.vector import AutoresetMode, VectorEnv
+
+if importlib.util.find_spec("gymnasium") is None:
+    raise ImportError('shaping.gym needs gymnasium, which is not installed: pip install "shaping[gym]"')
+
+import gymnasium  # noqa: E402
+from gymnasium import spaces  # noqa: E402
+from gymnasium.vector import AutoresetMode, VectorEnv  # noqa: E402
 
 from . import Program, compile
 from ._shaping import Stepper, VecStepper
@@ -57,7 +65,7 @@ def _spaces(names_obs: list[str], bounds: tuple[list[float], list[float]]):
     return observation, spaces.Box(low, high, dtype=np.float32)
 
 
-def _action(action: Any, shape: tuple[int, ...]) -> np.ndarray:
+def _action(action: Any, shape: tuple[int, ...] | None) -> np.ndarray:
     a = np.ascontiguousarray(action, dtype=np.float32)
     if a.shape != shape:
         raise ValueError(f"error: the action must be an array of shape {shape}, not {a.shape}")
@@ -134,9 +142,9 @@ class ShapingVecEnv(VectorEnv):
     ) -> None:
         self.program = _program(path)
         self.stage = stage
-        self._robots = VecStepper(self.program, stage, int(num_envs), jobs)
+        self._robots = VecStepper(self.program, stage, num_envs, jobs)
         probe = Stepper(self.program, stage)
-        self.num_envs = int(num_envs)
+        self.num_envs = self._robots.num_envs
         self.observation_names: list[str] = probe.observation_names
         self.action_names: list[str] = probe.action_names
         self.single_observation_space, self.single_action_space = _spaces(

@@ -1,12 +1,32 @@
 """Type stubs of the Rust extension ``shaping._shaping`` (re-exported by ``shaping``)."""
 
 import os
-from typing import Any, Callable, Mapping, Optional, Union
+from typing import Any, Callable, Mapping, Optional, Union, final
 
 import numpy as np
 import numpy.typing as npt
 
-PathLike = Union[str, os.PathLike[str]]
+__all__ = [
+    "ShapingError",
+    "SQUARE_MM",
+    "Diagnostic",
+    "Program",
+    "Evaluator",
+    "Run",
+    "Experiment",
+    "Stepper",
+    "VecStepper",
+    "check",
+    "compile",
+    "run",
+    "experiment",
+    "_program_from_json",
+    "_evaluator_from_json",
+    "_encode_genes",
+    "_decode_genes",
+]
+
+_PathLike = Union[str, os.PathLike[str]]
 
 SQUARE_MM: float
 """The side (mm) of the squares counted by ``squares_visited``."""
@@ -22,6 +42,7 @@ class ShapingError(Exception):
     kind: str
     diagnostics: list[Diagnostic]
 
+@final
 class Diagnostic:
     """One diagnostic of a file, as ``shaping check`` reports it."""
 
@@ -36,19 +57,20 @@ class Diagnostic:
     help: Optional[str]
     file: str
 
-def check(path: PathLike) -> list[Diagnostic]:
+def check(path: _PathLike) -> list[Diagnostic]:
     """Every diagnostic (errors and warnings) of a ``.bat`` file; [] for a good file.
 
     A file that cannot be read raises :class:`ShapingError`.
     """
 
-def compile(path: PathLike) -> Program:
+def compile(path: _PathLike) -> Program:
     """Compiles a ``.bat`` file (or loads a ``shaping build`` JSON).
 
     A file with errors raises :class:`ShapingError` whose text holds the
     diagnostics; warnings of a file that compiles are Python warnings.
     """
 
+@final
 class Program:
     """A compiled architecture file."""
 
@@ -72,18 +94,22 @@ class Program:
     def evaluator(
         self,
         stage: str,
-        run: Optional[Union[Run, PathLike]] = None,
-        seed: int = 0,
+        run: Optional[Union[Run, _PathLike]] = None,
+        seed: Optional[int] = None,
         jobs: Optional[int] = None,
     ) -> Evaluator:
         """An evaluator of the genomes of evolved stage ``stage``.
 
         The weights of training stages come from ``run`` (a :class:`Run` or
         a run directory); without it they are trained afresh, with the
-        program's run seed (a warning says so). ``jobs``: worker threads
-        (None: one per core).
+        program's run seed (a warning says so). ``seed``: 0 to 2**64 - 1
+        (None: 0). ``jobs``: worker threads, 1 to 1024 (None: one per
+        core). Other values raise ValueError naming the argument.
         """
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as the compiled program and its path (no file is read again)."""
 
+@final
 class Evaluator:
     """Evaluates genomes of one evolved stage as a run evaluates them."""
 
@@ -96,7 +122,12 @@ class Evaluator:
         """The episodes per individual (the stage's ``evaluations``)."""
     @property
     def seed(self) -> int: ...
-    def evaluate(self, genomes: npt.ArrayLike, generation: int = 0) -> dict[str, np.ndarray]:
+    def evaluate(
+        self,
+        genomes: npt.ArrayLike,
+        generation: Optional[int] = None,
+        individuals: Optional[npt.ArrayLike] = None,
+    ) -> dict[str, np.ndarray]:
         """Evaluates each row of ``genomes`` (shape ``(n, bits)``, 0 and 1, integer or bool dtype).
 
         Returns arrays of shape ``(n,)``: ``fitness`` (float32, the mean
@@ -106,18 +137,24 @@ class Evaluator:
         (float32, the final pose of its last episode, mm and radians),
         ``path_length`` (mm) and ``squares_visited`` (float32, means over
         its episodes). Row ``i`` is evaluated on the episodes a run with
-        run seed ``seed`` gives individual ``i`` of generation
-        ``generation`` of the stage (pass an optimizer's generation for
-        fresh episodes each generation, as a run's are), so the same
-        array, seed and generation give the same results. The
-        GIL is released while it runs. A wrong shape, dtype or value raises
-        ValueError.
+        run seed ``seed`` gives individual ``individuals[i]`` (default
+        ``i``) of generation ``generation`` (None: 0) of the stage (pass an
+        optimizer's generation for fresh episodes each generation, as a
+        run's are), so the same genome, individual, seed and generation
+        give the same results however a batch is split. The GIL is
+        released while it runs; Ctrl-C stops it within about a second
+        (KeyboardInterrupt). A wrong shape, dtype or value raises
+        ValueError naming the argument; a batch larger than the memory
+        available, MemoryError.
         """
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled as its program with the training stages' weights bound: nothing is trained again."""
 
+@final
 class Run:
     """A run directory: the stages it holds and their files."""
 
-    def __init__(self, out: PathLike) -> None:
+    def __new__(cls, out: _PathLike) -> Run:
         """Opens a run directory written by ``shaping run`` or :func:`run`."""
     @property
     def out(self) -> str: ...
@@ -130,15 +167,17 @@ class Run:
         """The path of ``report.html`` (None if not written)."""
     def stage_dir(self, stage: str) -> str: ...
     def generations(self, stage: str) -> dict[str, np.ndarray]:
-        """The columns of the stage's ``generations.csv``."""
+        """The columns of the stage's ``generations.csv``: ``best``, ``mean``,
+        ``worst`` and ``best_variant_NAME`` floats (NaN where a generation
+        did not draw the variant), ``stage`` strings, the others integers."""
     def best_genome(self, stage: str) -> npt.NDArray[np.uint8]:
         """The stage's chosen best genome (``best.genome``), 0 and 1."""
     def population(self, stage: str) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.float32]]:
         """The last evaluated generation (the checkpoint): genomes ``(population, bits)`` and their fitness."""
 
 def run(
-    path: PathLike,
-    out: Optional[PathLike] = None,
+    path: _PathLike,
+    out: Optional[_PathLike] = None,
     seed: Optional[int] = None,
     stage: Optional[str] = None,
     set: Optional[Mapping[str, Any]] = None,
@@ -157,6 +196,7 @@ def run(
     KeyboardInterrupt.
     """
 
+@final
 class Experiment:
     """An experiment's directory: its runs and its summaries."""
 
@@ -177,10 +217,10 @@ class Experiment:
     def reports(self) -> list[str]: ...
 
 def experiment(
-    path: PathLike,
+    path: _PathLike,
     seeds: int = 5,
     first_seed: int = 1,
-    out: Optional[PathLike] = None,
+    out: Optional[_PathLike] = None,
     stage: Optional[str] = None,
     set: Optional[Mapping[str, Any]] = None,
     criterion: Optional[Mapping[str, float]] = None,
@@ -198,10 +238,11 @@ def experiment(
     The rest as :func:`run`.
     """
 
+@final
 class Stepper:
     """One robot of a stage driven one action at a time (see ``shaping.gym``)."""
 
-    def __init__(self, program: Program, stage: str, keep_path: bool = False) -> None: ...
+    def __new__(cls, program: Program, stage: str, keep_path: bool = False) -> Stepper: ...
     @property
     def observation_names(self) -> list[str]: ...
     @property
@@ -216,10 +257,13 @@ class Stepper:
     ) -> tuple[npt.NDArray[np.float32], float, bool, bool, dict[str, Any]]: ...
     def render(self) -> npt.NDArray[np.uint8]: ...
 
+@final
 class VecStepper:
     """Many robots of a stage stepped together in Rust (see ``shaping.gym.make_vec``)."""
 
-    def __init__(self, program: Program, stage: str, num_envs: int, jobs: Optional[int] = None) -> None: ...
+    def __new__(cls, program: Program, stage: str, num_envs: int, jobs: Optional[int] = None) -> VecStepper:
+        """``num_envs``: a positive integer (else ValueError; more robots
+        than the memory available holds: MemoryError); ``jobs``: 1 to 1024."""
     @property
     def num_envs(self) -> int: ...
     def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
@@ -228,3 +272,14 @@ class VecStepper:
     ) -> tuple[
         npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.bool_], npt.NDArray[np.bool_]
     ]: ...
+
+def _program_from_json(json: str, path: _PathLike) -> Program: ...
+def _evaluator_from_json(json: str, index: int, seed: int, jobs: Optional[int] = None) -> Evaluator: ...
+def _encode_genes(
+    program: Program,
+    stage: str,
+    values: npt.ArrayLike,
+    base: Optional[npt.ArrayLike] = None,
+    run: Optional[Union[Run, _PathLike]] = None,
+) -> npt.NDArray[np.uint8]: ...
+def _decode_genes(program: Program, stage: str, genomes: npt.ArrayLike) -> npt.NDArray[np.float64]: ...

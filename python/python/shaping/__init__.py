@@ -35,10 +35,32 @@ from ._shaping import (
     run,
 )
 
+from typing import TYPE_CHECKING
+
 from . import genes
+
+if TYPE_CHECKING:
+    from . import gym as gym
+
+
+def __getattr__(name: str):
+    # `shaping.gym` is loaded on first use (as SciPy loads its submodules),
+    # so `import shaping` needs no gymnasium and `shaping.gym.make` works
+    # without `import shaping.gym`.
+    if name == "gym":
+        import importlib
+
+        return importlib.import_module(".gym", __name__)
+    raise AttributeError(f"module 'shaping' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), "gym"])
+
 
 __all__ = [
     "genes",
+    "gym",
     "SQUARE_MM",
     "Diagnostic",
     "Evaluator",
