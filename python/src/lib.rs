@@ -159,13 +159,27 @@ fn check_room(need: u64, what: &str, instead: &str) -> PyResult<()> {
     }
 }
 
+/// The most robot-actions [`interruptible`] runs on the caller's thread
+/// (about 30 ms of `examples/khepera.bat`'s navigation on one core).
+const INLINE_ACTIONS: u64 = 100_000;
+
 /// Runs `work` on another thread with the GIL released, checking Python's
 /// signals every 50 ms meanwhile: on Ctrl-C (or any signal whose handler
 /// raises) it sets the flag `work` is given, waits for `work` to return
 /// (it checks the flag between episodes) and raises the handler's
-/// exception (KeyboardInterrupt), keeping nothing of the work.
-fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> T + Send) -> PyResult<T> {
+/// exception (KeyboardInterrupt), keeping nothing of the work. Work of at
+/// most [`INLINE_ACTIONS`] robot-actions (`actions`) runs on the caller's
+/// thread instead: a thread costs more than such work, which ends within
+/// a few tens of milliseconds anyway.
+fn interruptible<T: Send>(
+    py: Python<'_>,
+    actions: u64,
+    work: impl FnOnce(&AtomicBool) -> T + Send,
+) -> PyResult<T> {
     let stop = AtomicBool::new(false);
+    if actions <= INLINE_ACTIONS {
+        return Ok(py.detach(|| work(&stop)));
+    }
     let done = AtomicBool::new(false);
     /// Says the work is over, even if it panicked.
     struct Done<'a>(&'a AtomicBool, std::thread::Thread);
@@ -778,7 +792,11 @@ impl Evaluator {
         let individuals = individuals_of(individuals, genomes.len())?;
         let (index, seed) = (self.index, self.seed);
         let pool = self.pool.get()?;
-        let results = interruptible(py, |stop| {
+        let actions = (genomes.len() as u64)
+            .saturating_mul(descriptors::seeds(stage, index, seed, generation, 0).len() as u64)
+            .saturating_mul(u64::from(descriptors::actions(stage)))
+            .saturating_mul(u64::from(stage.world.robots.max(1)));
+        let results = interruptible(py, actions, |stop| {
             pool.install(|| {
                 genomes
                     .par_iter()
@@ -1450,7 +1468,7 @@ fn run(
     py: Python<'_>,
     path: PathBuf,
     out: Option<PathBuf>,
-    seed: Option<u64>,
+    seed: Option<&Bound<'_, PyAny>>,
     stage: Option<String>,
     set: Option<&Bound<'_, PyDict>>,
     jobs: Option<&Bound<'_, PyAny>>,
@@ -1458,6 +1476,7 @@ fn run(
     fresh: bool,
     report: bool,
 ) -> PyResult<Run> {
+    let seed = seed.filter(|s| !s.is_none()).map(|s| count_arg(s, "seed", u64::MAX)).transpose()?;
     let jobs = jobs_arg(jobs)?;
     check_callback(py, &callback)?;
     let sets = assignments(set)?;

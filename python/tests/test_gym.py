@@ -193,9 +193,22 @@ def test_bad_num_envs_and_jobs_raise():
         shaping.gym.make_vec(KHEPERA, "navigation", num_envs=2, jobs=100000)
 
 
-def test_too_many_robots_for_the_memory_are_refused():
-    with pytest.raises(MemoryError, match=r"stepping 1000000000 robots needs about [\d.]+ GiB"):
-        shaping.gym.make_vec(KHEPERA, "navigation", num_envs=10**9)
+def test_too_many_robots_for_the_memory_are_refused(tmp_path):
+    """In a child process: before the fix, the allocation aborted the interpreter."""
+    import re
+    import subprocess
+    import sys
+
+    code = (
+        "import shaping\n"
+        "try:\n"
+        f"    shaping.gym.make_vec({str(KHEPERA)!r}, 'navigation', num_envs=10**9)\n"
+        "except MemoryError as e:\n"
+        "    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert re.search(r"stepping 1000000000 robots needs about [\d.]+ GiB", out.stdout), out.stdout
 
 
 def _step_in_child(envs, actions):

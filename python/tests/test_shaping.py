@@ -4,6 +4,7 @@ else `shaping` on PATH; skipped without it, failing under CI=true)."""
 
 import json
 import os
+import re
 import shutil
 import subprocess
 import warnings
@@ -319,6 +320,8 @@ def test_run_set_and_bad_arguments(tmp_path):
     for jobs in (0, -1, 1.5, 100000, "2"):
         with pytest.raises(ValueError, match="jobs must be an integer from 1 to 1024"):
             shaping.run(TINY, out=tmp_path / "g", jobs=jobs)
+    with pytest.raises(ValueError, match="seed must be an integer from 0 to 18446744073709551615"):
+        shaping.run(TINY, out=tmp_path / "g", seed=-1)
     with pytest.raises(ValueError, match="no stage"):
         run.best_genome("second")
 
@@ -679,11 +682,25 @@ def test_bad_individuals_generation_and_seed_name_the_argument(navigation):
         assert program.evaluator("navigation", seed=2**64 - 1, jobs=1024).seed == 2**64 - 1
 
 
-def test_a_batch_too_large_for_the_memory_is_refused(navigation):
-    _, ev = navigation
-    huge = np.broadcast_to(np.zeros(ev.bits, np.uint8), (2**40, ev.bits))
-    with pytest.raises(MemoryError, match=r"evaluating 1099511627776 genomes needs about [\d.]+ GiB"):
-        ev.evaluate(huge)
+def test_a_batch_too_large_for_the_memory_is_refused(tmp_path):
+    """In a child process: before the fix, the allocation aborted the interpreter."""
+    import sys
+
+    code = (
+        "import warnings\n"
+        "import numpy as np\n"
+        "import shaping\n"
+        "warnings.simplefilter('ignore')\n"
+        f"ev = shaping.compile({str(KHEPERA)!r}).evaluator('navigation', jobs=1)\n"
+        "huge = np.broadcast_to(np.zeros(ev.bits, np.uint8), (2**40, ev.bits))\n"
+        "try:\n"
+        "    ev.evaluate(huge)\n"
+        "except MemoryError as e:\n"
+        "    print(e)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert re.search(r"evaluating 1099511627776 genomes needs about [\d.]+ GiB", out.stdout), out.stdout
 
 
 def _evaluate_in_child(ev, genomes):
@@ -698,7 +715,8 @@ def test_an_evaluator_made_before_fork_works_in_the_child(navigation):
     expected = ev.evaluate(genomes)["fitness"]  # the pool's threads run in the parent
     ctx = multiprocessing.get_context("fork")
     with ctx.Pool(2) as pool:
-        got = pool.starmap(_evaluate_in_child, [(ev, genomes)] * 2, chunksize=1)
+        # (Before the fix the children waited forever for the pool's threads.)
+        got = pool.starmap_async(_evaluate_in_child, [(ev, genomes)] * 2, chunksize=1).get(timeout=120)
     for g in got:
         np.testing.assert_array_equal(g, expected)
     # jobs=1 too, and the evaluator inherited (not pickled) by the child.
