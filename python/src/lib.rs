@@ -861,7 +861,7 @@ impl Evaluator {
 
 /// The genome whose frozen genes `genes.encode` copies: `base`'s, or those
 /// of the best genome of the run `run` of the stage's nearest evolved
-/// ancestor (the genome the run's later stage extends); all zeros for a
+/// ancestor (its `best.genome`, the run's chosen best); all zeros for a
 /// stage without frozen genes. Neither for a stage with frozen genes, or
 /// both, is a ValueError.
 fn frozen_template(
@@ -924,7 +924,7 @@ fn frozen_template(
         }
         (None, None) if frozen > 0 => Err(value_error(format!(
             "error: stage `{}` has {frozen} frozen genes (of the stages it extends): pass run= a run of them \
-             (the frozen genes are its best genome's, as a run's stage starts from) or base= a genome of the stage",
+             (the frozen genes are those of its best genome of the stage extended) or base= a genome of the stage",
             st.name
         ))),
         (None, None) => Ok(Genome::zeros(bits)),
@@ -1119,11 +1119,16 @@ struct VecStepper {
 }
 
 /// The memory one robot of a `VecStepper` takes, besides its observation
-/// and action rows: its stepper, its simulator after the first reset and
-/// its rows of the results (measured: 6.2 to 6.6 KB a Khepera after a
-/// reset in `examples/khepera.bat`'s `navigation` and `collect`, the
-/// resident size of 100,000 robots; rounded up).
+/// and action rows and its world's items: its stepper, its simulator after
+/// the first reset and its rows of the results (measured as the resident
+/// size of 20,000 to 100,000 robots after a reset: 3.4 KB a Khepera in
+/// `examples/t-maze.bat`, 6.2 to 6.6 KB in `examples/khepera.bat`'s
+/// `navigation` and `collect`; rounded up).
 const VEC_ROBOT_BYTES: u64 = 8192;
+/// The memory each wall, cylinder, lamp, zone or object of its world adds
+/// to a robot (measured: about 12 bytes a wall, t-maze with 400 more; an
+/// upper bound).
+const VEC_ITEM_BYTES: u64 = 64;
 
 /// The most robots of one `VecStepper` (far beyond what a step's latency allows).
 const MAX_NUM_ENVS: u64 = 1 << 32;
@@ -1148,11 +1153,16 @@ impl VecStepper {
         }? as usize;
         let jobs = jobs_arg(jobs)?;
         let index = stage_index(&program.program, stage)?;
-        let width = {
+        let per_robot = {
             let st = &program.program.stages[index];
-            shaping_engine::stepper::Spaces::of(st).channels.len() as u64 + 8
+            let width = shaping_engine::stepper::Spaces::of(st).channels.len() + 8;
+            let w = &st.world;
+            let items =
+                w.items.walls.len() + w.items.cylinders.len() + w.items.lamps.len() + w.items.zones.len();
+            let objects = w.objects.as_ref().map_or(0, |o| u64::from(o.count));
+            VEC_ROBOT_BYTES + 8 * width as u64 + VEC_ITEM_BYTES * (items as u64 + objects)
         };
-        let need = (num_envs as u64).saturating_mul(VEC_ROBOT_BYTES + 8 * width);
+        let need = (num_envs as u64).saturating_mul(per_robot);
         check_room(need, &format!("stepping {num_envs} robots"), "pass a smaller num_envs")?;
         let pool = Pool::new(jobs)?;
         let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs)

@@ -45,8 +45,8 @@ def encode(
 
     A stage that extends evolved stages has frozen genes: they come from
     ``run`` (a :class:`shaping.Run` or a run directory of this program: the
-    best genome of the nearest evolved stage it extends, the genome a run's
-    stage starts from) or from ``base`` (one genome of the stage). Without
+    chosen best genome, ``best.genome``, of the nearest evolved stage it
+    extends) or from ``base`` (one genome of the stage). Without
     either, such a stage raises ValueError, as do NaN values and values of
     the wrong shape."""
     return _encode_genes(program, stage, values, base=base, run=run)
