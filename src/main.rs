@@ -24,7 +24,7 @@ pub use shaping_engine::Error as CliError;
 use shaping_engine::{html, sweep};
 
 /// Most worker threads `--jobs` accepts.
-const MAX_JOBS: u64 = 1024;
+const MAX_JOBS: u64 = shaping_engine::run::MAX_JOBS as u64;
 /// Most seeds an experiment runs.
 use shaping_engine::experiment::MAX_SEEDS;
 

@@ -122,14 +122,23 @@ pub trait Evaluate {
     }
 }
 
+/// Most worker threads a caller may ask for (`--jobs`, Python's `jobs=`).
+pub const MAX_JOBS: usize = 1024;
+
 /// Evaluation on this process's threads (a rayon pool of `jobs` threads).
 pub struct Local {
     pool: rayon::ThreadPool,
 }
 
 impl Local {
-    /// A pool of `jobs` threads (one per core: `None`).
+    /// A pool of `jobs` threads (one per core: `None`; 1 to [`MAX_JOBS`]).
     pub fn new(jobs: Option<usize>) -> Result<Local> {
+        if let Some(j) = jobs.filter(|j| !(1..=MAX_JOBS).contains(j)) {
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!("error: jobs must be from 1 to {MAX_JOBS} worker threads, not {j}"),
+            ));
+        }
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(jobs.unwrap_or(0))
             .build()

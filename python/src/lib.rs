@@ -84,8 +84,8 @@ fn count_arg(value: &Bound<'_, PyAny>, name: &str, max: u64) -> PyResult<u64> {
     }
 }
 
-/// The most worker threads a call takes (the command line's `--jobs` limit).
-const MAX_JOBS: usize = 1024;
+// The most worker threads a call takes (the command line's `--jobs` limit).
+use shaping_engine::run::MAX_JOBS;
 
 /// `jobs`: None (one thread per core) or 1 to [`MAX_JOBS`].
 fn jobs_arg(jobs: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
