@@ -3,15 +3,20 @@
 //! action, the world as the robot left it (objects, gripper, what the
 //! proximity sensors read).
 //!
-//! The world is recorded by [`Recorder`], a [`Robot`] that forwards every
-//! call to the simulator and takes a snapshot each time the controller
-//! senses. It draws no random number of its own, so a recorded episode is
-//! the same episode as an unrecorded one with the same seed.
+//! A simulated life, of one robot or of a team, is recorded by
+//! [`record_life`]: the life's hooks take a snapshot each time a
+//! controller has sensed (once at the start, then after every action). A
+//! real robot's life (`drive`) is recorded by [`Recorder`], a [`Robot`]
+//! that forwards every call to the robot and takes the same snapshot. Both
+//! draw no random number of their own, so a recorded episode is the same
+//! episode as an unrecorded one with the same seed.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use shaping_runtime::controller::{TeamResult, TeamRun, TeamWatch};
-use shaping_runtime::sim::Team;
+use shaping_runtime::controller::{
+    episode_with, ActionReport, Controller, Hooks, Solo, TeamBodies, TeamMember, TeamResult, TeamRun,
+};
+use shaping_runtime::program::World;
 
 use serde::{Deserialize, Serialize};
 use shaping_runtime::catalog::{
@@ -58,50 +63,6 @@ impl Shown for Sim {
 impl<L: Link> Shown for SerialRobot<L> {
     fn scene(&self) -> Scene {
         self.host().scene()
-    }
-}
-
-/// A robot that stops acting, as an empty battery makes it, once `stop` is
-/// set (Ctrl-C during a long life of a test stage: the life ends at the
-/// next action). Until then it is the robot it wraps, call for call.
-pub struct Stoppable<'a, R> {
-    pub robot: R,
-    stop: Option<&'a AtomicBool>,
-}
-
-impl<'a, R> Stoppable<'a, R> {
-    pub fn new(robot: R, stop: Option<&'a AtomicBool>) -> Stoppable<'a, R> {
-        Stoppable { robot, stop }
-    }
-}
-
-impl<R: Robot> Robot for Stoppable<'_, R> {
-    fn sense(&mut self, out: &mut [f32; CHANNELS]) {
-        self.robot.sense(out);
-    }
-    fn step(&mut self, cmd: &Command) -> Outcome {
-        self.robot.step(cmd)
-    }
-    fn alive(&self) -> bool {
-        !self.stop.is_some_and(|s| s.load(Ordering::Relaxed)) && self.robot.alive()
-    }
-    fn battery(&self) -> f32 {
-        self.robot.battery()
-    }
-    fn pose(&self) -> Pose {
-        self.robot.pose()
-    }
-    fn holding(&self) -> Option<bool> {
-        self.robot.holding()
-    }
-    fn placement_failures(&self) -> u32 {
-        self.robot.placement_failures()
-    }
-}
-
-impl<R: Shown> Shown for Stoppable<'_, R> {
-    fn scene(&self) -> Scene {
-        self.robot.scene()
     }
 }
 
@@ -434,30 +395,8 @@ pub fn run_recorded(
     genome: &shaping_runtime::genome::Genome,
     opts: &shaping_runtime::controller::EpisodeOptions,
 ) -> Result<(shaping_runtime::controller::EpisodeResult, Trace, Episode), String> {
-    if stage.world.robots > 1 {
-        let r = record(stage, genome, opts)?;
-        return Ok((r.result, r.trace, r.episode));
-    }
-    run_recorded_one(stage, genome, opts)
-}
-
-/// [`run_recorded`] of one robot.
-fn run_recorded_one(
-    stage: &shaping_runtime::program::Stage,
-    genome: &shaping_runtime::genome::Genome,
-    opts: &shaping_runtime::controller::EpisodeOptions,
-) -> Result<(shaping_runtime::controller::EpisodeResult, Trace, Episode), String> {
-    use shaping_runtime::controller::{episode_rngs, Controller};
-    let (sim_seed, rng) = episode_rngs(opts.seed);
-    let mut ctl = Controller::new(stage, genome, rng).map_err(|e| format!("stage `{}`: {e}", stage.name))?;
-    let mut sim = Sim::new(&stage.world, sim_seed);
-    let scene = sim.scene();
-    let mut trace = Trace::default();
-    let mut rec = Recorder::new(&mut sim);
-    let result = ctl.run(&mut rec, opts, Some(&mut trace));
-    let frames = rec.frames;
-    let ep = episode(stage, opts.seed, opts.learning, &trace, &[Part { stage: &stage.name, scene, frames }]);
-    Ok((result, trace, ep))
+    let r = record(stage, genome, opts)?;
+    Ok((r.result, r.trace, r.episode))
 }
 
 /// Another robot of a team (robot 1, 2, ...) in one life of a recording.
@@ -512,59 +451,134 @@ impl Episode {
     }
 }
 
-/// Records every robot's frames of a team's life ([`TeamRun::run_watched`]):
-/// robot 0's with the objects, as [`Recorder`] records the one robot's.
-struct TeamRecorder {
+/// Records a life ([`Hooks`]): every robot's frames (a frame each time
+/// it has sensed: at the start, then after each of its actions; robot 0's
+/// with the objects), every robot's start, and robot 0's world before the
+/// first action; once `stop` is set, the life ends at the next action.
+struct LifeRecorder<'a> {
     frames: Vec<Vec<Frame>>,
-    wheels: Vec<[f32; 2]>,
+    starts: Vec<Pose>,
+    scene: Option<Scene>,
+    stop: Option<&'a AtomicBool>,
 }
 
-impl TeamWatch for TeamRecorder {
-    fn sensed(&mut self, i: usize, out: &[f32; CHANNELS], team: &Team) {
+impl LifeRecorder<'_> {
+    /// Robot `i` sensed `percept` after the command `wheels` (zero at the
+    /// start), its gripper as given, in `world` (whose objects robot 0's
+    /// frames keep).
+    fn sensed(
+        &mut self,
+        i: usize,
+        percept: &[f32; CHANNELS],
+        gripper: [bool; 2],
+        wheels: [f32; 2],
+        world: Option<&Scene>,
+    ) {
         if self.frames.len() <= i {
             self.frames.resize(i + 1, Vec::new());
-            self.wheels.resize(i + 1, [0.0; 2]);
         }
-        let sim = team.sim(i);
-        let objects = if i == 0 { object_rows(&sim.scene()) } else { Vec::new() };
-        self.frames[i].push(frame_of(out, sim.arm_down(), sim.claw_closed(), self.wheels[i], objects));
+        let objects = world.filter(|_| i == 0).map(object_rows).unwrap_or_default();
+        self.frames[i].push(frame_of(percept, gripper[0], gripper[1], wheels, objects));
     }
-    fn commanded(&mut self, i: usize, cmd: &Command) {
-        if let Some(w) = self.wheels.get_mut(i) {
-            *w = cmd.wheels;
+
+    fn started(&mut self, i: usize, pose: Pose, scene: impl FnOnce() -> Scene) {
+        if self.starts.len() <= i {
+            self.starts.resize(i + 1, Pose::default());
         }
+        self.starts[i] = pose;
+        if i == 0 {
+            self.scene = Some(scene());
+        }
+    }
+
+    fn go_on(&self) -> bool {
+        !self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
     }
 }
 
-/// One recorded life of a team.
+impl<'s, R: Shown> Hooks<'s, Solo<'_, R>> for LifeRecorder<'_> {
+    fn started(&mut self, i: usize, ctl: &Controller<'s>, robot: &&mut R) {
+        let scene = robot.scene();
+        self.sensed(i, ctl.percept(), [scene.arm_down, scene.claw_closed], [0.0; 2], Some(&scene));
+        LifeRecorder::started(self, i, robot.pose(), || scene);
+    }
+    fn acted(
+        &mut self,
+        i: usize,
+        ctl: &Controller<'s>,
+        rep: &ActionReport,
+        _: Option<&TraceRow>,
+        robot: &&mut R,
+    ) {
+        let scene = robot.scene();
+        self.sensed(i, ctl.percept(), [scene.arm_down, scene.claw_closed], rep.command.wheels, Some(&scene));
+    }
+    fn after_action(&mut self, _: &Solo<'_, R>) -> bool {
+        self.go_on()
+    }
+}
+
+impl<'s> Hooks<'s, TeamBodies<'_>> for LifeRecorder<'_> {
+    fn started(&mut self, i: usize, ctl: &Controller<'s>, robot: &TeamMember<'_>) {
+        self.team_sensed(i, ctl, [0.0; 2], robot);
+        LifeRecorder::started(self, i, robot.sim().pose(), || robot.sim().scene());
+    }
+    fn acted(
+        &mut self,
+        i: usize,
+        ctl: &Controller<'s>,
+        rep: &ActionReport,
+        _: Option<&TraceRow>,
+        robot: &TeamMember<'_>,
+    ) {
+        self.team_sensed(i, ctl, rep.command.wheels, robot);
+    }
+    fn after_action(&mut self, _: &TeamBodies<'_>) -> bool {
+        self.go_on()
+    }
+}
+
+impl LifeRecorder<'_> {
+    /// A team's robot `i` sensed (its world's objects drawn for robot 0 only).
+    fn team_sensed(&mut self, i: usize, ctl: &Controller<'_>, wheels: [f32; 2], robot: &TeamMember<'_>) {
+        let sim = robot.sim();
+        let gripper = [sim.arm_down(), sim.claw_closed()];
+        let scene = (i == 0).then(|| sim.scene());
+        self.sensed(i, ctl.percept(), gripper, wheels, scene.as_ref());
+    }
+}
+
+/// One recorded life, of one robot or of a team.
 pub struct TeamLife {
     pub result: TeamResult,
     /// Robot 0's trace and frames (the start, then one per action).
     pub trace: Trace,
     pub frames: Vec<Frame>,
-    /// The other robots (part 0, actions from 0).
+    /// The other robots (part 0, actions from 0): none for one robot.
     pub others: Vec<OtherRobot>,
+    /// Robot 0's world before the first action.
+    pub scene: Scene,
 }
 
-/// Lives one life of `run` in `team`'s world and records every robot: each
-/// one's trace has a row per action of the life and its frames a frame per
+/// Lives one life of `run` in a fresh `world` of seed `seed` (one robot's
+/// or a team's: [`episode_with`]) and records every robot: each one's
+/// trace has a row per action of the life and its frames a frame per
 /// action (a robot whose battery emptied stays where it stopped, an
 /// obstacle: its later rows repeat its last one with no activation, no
 /// reinforcement and no event, its frames its last with the wheels
 /// stopped). Once `stop` is set, the life ends at the next action.
-pub fn record_team_life(
+pub fn record_life(
     run: &mut TeamRun<'_>,
-    team: &mut Team,
+    world: &World,
+    seed: u64,
     opts: &shaping_runtime::controller::EpisodeOptions,
     stop: Option<&AtomicBool>,
 ) -> TeamLife {
-    let n = team.len();
-    let starts: Vec<Pose> = team.sims().iter().map(|s| s.pose()).collect();
+    let n = world.robots.max(1) as usize;
     let mut traces = vec![Trace::default(); n];
-    let mut rec = TeamRecorder { frames: vec![Vec::new(); n], wheels: vec![[0.0; 2]; n] };
-    let result = run.run_watched(team, opts, Some(&mut traces), &mut rec, |_| {
-        !stop.is_some_and(|s| s.load(Ordering::Relaxed))
-    });
+    let mut rec =
+        LifeRecorder { frames: vec![Vec::new(); n], starts: vec![Pose::default(); n], scene: None, stop };
+    let result = episode_with(run, world, seed, opts, Some(&mut traces), |sim| sim, &mut rec);
     let actions = result.team.actions;
     for t in &mut traces {
         pad_trace(t, actions);
@@ -576,6 +590,7 @@ pub fn record_team_life(
     let mut frames = rec.frames.into_iter();
     let trace = traces.next().unwrap_or_default();
     let frames0 = frames.next().unwrap_or_default();
+    let starts = rec.starts;
     let others = traces
         .zip(frames)
         .enumerate()
@@ -587,10 +602,12 @@ pub fn record_team_life(
             OtherRobot { robot: k + 1, part: 0, start: starts[k + 1], trace, sensed }
         })
         .collect();
-    TeamLife { result, trace, frames: frames0, others }
+    // Robot 0 always starts; the world before it did, should it not.
+    let scene = rec.scene.unwrap_or_else(|| Sim::new(world, seed).scene());
+    TeamLife { result, trace, frames: frames0, others, scene }
 }
 
-/// Extends a stopped robot's trace to `actions` rows (see [`record_team_life`]).
+/// Extends a stopped robot's trace to `actions` rows (see [`record_life`]).
 fn pad_trace(t: &mut Trace, actions: u32) {
     while (t.rows.len() as u32) < actions {
         let Some(last) = t.rows.last() else { return };
@@ -604,7 +621,7 @@ fn pad_trace(t: &mut Trace, actions: u32) {
     }
 }
 
-/// Extends a stopped robot's frames to `len` (see [`record_team_life`]).
+/// Extends a stopped robot's frames to `len` (see [`record_life`]).
 fn pad_frames(f: &mut Vec<Frame>, len: usize) {
     while f.len() < len {
         let Some(last) = f.last() else { return };
@@ -633,23 +650,15 @@ pub fn record(
     genome: &shaping_runtime::genome::Genome,
     opts: &shaping_runtime::controller::EpisodeOptions,
 ) -> Result<Recorded, String> {
-    if stage.world.robots <= 1 {
-        let (result, trace, episode) = run_recorded_one(stage, genome, opts)?;
-        let scene = Sim::new(&stage.world, shaping_runtime::controller::episode_rngs(opts.seed).0).scene();
-        return Ok(Recorded { result, trace, others: Vec::new(), episode, scene });
-    }
-    // As `run_team_episode`.
-    let mut team = Team::new(&stage.world, opts.seed);
     let mut run =
         TeamRun::new(stage, genome, opts.seed).map_err(|e| format!("stage `{}`: {e}", stage.name))?;
-    let scene = team.sim(0).scene();
-    let life = record_team_life(&mut run, &mut team, opts, None);
+    let life = record_life(&mut run, &stage.world, opts.seed, opts, None);
     let mut result = life.result.team;
     if stage.inheritance == shaping_runtime::program::Inheritance::Lamarckian {
         result.learned = Some(run.write_back(genome));
     }
-    let parts = [Part { stage: &stage.name, scene: scene.clone(), frames: life.frames }];
+    let parts = [Part { stage: &stage.name, scene: life.scene.clone(), frames: life.frames }];
     let mut episode = episode(stage, opts.seed, opts.learning, &life.trace, &parts);
     episode.add_others(&life.others);
-    Ok(Recorded { result, trace: life.trace, others: life.others, episode, scene })
+    Ok(Recorded { result, trace: life.trace, others: life.others, episode, scene: life.scene })
 }

@@ -6,15 +6,13 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::Value;
-use shaping_runtime::controller::{
-    episode_rngs, run_episode, Controller, EpisodeOptions, EpisodeResult, TeamRun, Trace,
-};
+use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult, TeamRun, Trace};
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Param, Program, Stage, StageRun};
-use shaping_runtime::sim::{Scene, Sim, Team};
+use shaping_runtime::sim::Scene;
 
-use crate::episode::{self, Part, Recorder, Stoppable};
+use crate::episode::{self, Part};
 use crate::error::{Error, ErrorKind, Result};
 use crate::files::{create_dir, write_atomic, DirLock};
 use crate::rundir::{self, compact_json, to_json};
@@ -792,63 +790,6 @@ pub fn before_after(
     if lives == 0 {
         return Err(Error::io(format!("error: test stage `{}` has no life to run", stage.name)));
     }
-    let team = |st: &Stage| (0..st.variant_count()).any(|v| st.variant_world(v).robots > 1);
-    if team(parent) || team(stage) {
-        return team_before_after(parent, stage, genome, actions, lives, learning, seed, stop);
-    }
-    let (_, rng) = episode_rngs(seed);
-    let mut ctl = Controller::new(stage, genome, rng)
-        .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
-    let opts = EpisodeOptions { actions, learning, seed };
-    let mut trace = Trace::default();
-    let mut life = Trace::default();
-    let mut parts = Vec::new();
-    let mut results = [Vec::new(), Vec::new()];
-    for (half, world) in [parent, stage].into_iter().enumerate() {
-        for k in 0..lives {
-            // With variants, life k runs in variant k mod their number.
-            let w = world.variant_world(k as usize % world.variant_count());
-            ctl.use_world(w);
-            let sim = Sim::new(w, evolve::seed::test_life_seed(seed, half == 1, k));
-            let scene = sim.scene();
-            let mut robot = Stoppable::new(sim, stop);
-            let mut rec = Recorder::new(&mut robot);
-            results[half].push(ctl.run(&mut rec, &opts, Some(&mut life)));
-            if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-                // The life was cut short: nothing of this test is a result.
-                return Err(interrupted_test(stage, half == 1, k, lives));
-            }
-            let frames = rec.frames;
-            let from = trace.rows.len() as u32;
-            trace.modules.clone_from(&life.modules);
-            trace.rows.extend(life.rows.drain(..).map(|mut r| {
-                r.action += from;
-                r
-            }));
-            parts.push(Part { stage: &world.name, scene, frames });
-        }
-    }
-    let switch = results[0].iter().map(|r| r.actions).sum();
-    let scene = parts[lives as usize].scene.clone();
-    let episode = episode::episode(stage, seed, learning, &trace, &parts);
-    let [before, after] = results;
-    Ok(BeforeAfter { trace, switch, before, after, scene, episode, others: Vec::new() })
-}
-
-/// [`before_after`] of a team: every life the team's (one set of
-/// controllers through all lives, as one controller is for one robot),
-/// each life's result the team's; the trace robot 0's, the others' beside.
-#[allow(clippy::too_many_arguments)]
-fn team_before_after(
-    parent: &Stage,
-    stage: &Stage,
-    genome: &Genome,
-    actions: u32,
-    lives: u32,
-    learning: bool,
-    seed: u64,
-    stop: Option<&AtomicBool>,
-) -> Result<BeforeAfter, Error> {
     let mut run = TeamRun::new(stage, genome, seed)
         .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
     let opts = EpisodeOptions { actions, learning, seed };
@@ -858,13 +799,14 @@ fn team_before_after(
     let mut results = [Vec::new(), Vec::new()];
     for (half, world) in [parent, stage].into_iter().enumerate() {
         for k in 0..lives {
+            // With variants, life k runs in variant k mod their number.
             let w = world.variant_world(k as usize % world.variant_count());
             run.use_world(w);
-            let mut team = Team::new(w, evolve::seed::test_life_seed(seed, half == 1, k));
-            let scene = team.sim(0).scene();
-            let life = episode::record_team_life(&mut run, &mut team, &opts, stop);
+            let life_seed = evolve::seed::test_life_seed(seed, half == 1, k);
+            let life = episode::record_life(&mut run, w, life_seed, &opts, stop);
             results[half].push(life.result.team);
             if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
+                // The life was cut short: nothing of this test is a result.
                 return Err(interrupted_test(stage, half == 1, k, lives));
             }
             let from = trace.rows.len() as u32;
@@ -882,7 +824,7 @@ fn team_before_after(
                 o.part = parts.len();
                 others.push(o);
             }
-            parts.push(Part { stage: &world.name, scene, frames: life.frames });
+            parts.push(Part { stage: &world.name, scene: life.scene, frames: life.frames });
         }
     }
     let switch = results[0].iter().map(|r| r.actions).sum();

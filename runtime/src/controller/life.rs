@@ -12,7 +12,7 @@
 //! every controller is given after each action; one robot has neither.
 //! [`team_result`] is the one aggregation of the robots' results.
 
-use super::{tally, Controller, EpisodeOptions, EpisodeResult, Robot, Trace, TraceRow};
+use super::{tally, ActionReport, Controller, EpisodeOptions, EpisodeResult, Robot, Trace, TraceRow};
 use crate::catalog::CHANNELS;
 use crate::program::Stage;
 use crate::sim::{Command, Outcome, Pose};
@@ -90,13 +90,26 @@ impl<R: Robot> Robot for &mut R {
     }
 }
 
-/// What a caller of [`live`] does during the life (nothing, by default).
+/// What a caller of [`live`] does during the life (nothing, by default):
+/// a recorder of its frames, a trace written as it goes, a stop.
 pub trait Hooks<'s, B: Bodies> {
-    /// Before robot `robot`'s controller acts.
-    fn before(&mut self, _ctl: &mut Controller<'s>, _robot: &B::Member<'_>) {}
-    /// After a traced robot acted: its row, and the robot as the action
-    /// left it.
-    fn row(&mut self, _row: &TraceRow, _robot: &B::Member<'_>) {}
+    /// Robot `i`'s controller started its life: it has sensed the world
+    /// before the first action ([`Controller::percept`]).
+    fn started(&mut self, _i: usize, _ctl: &Controller<'s>, _robot: &B::Member<'_>) {}
+    /// Before robot `i`'s controller acts.
+    fn before(&mut self, _i: usize, _ctl: &mut Controller<'s>, _robot: &B::Member<'_>) {}
+    /// Robot `i` acted (`report`) and sensed what its action left
+    /// ([`Controller::percept`]); `row` is its trace's row of the action
+    /// when it is traced.
+    fn acted(
+        &mut self,
+        _i: usize,
+        _ctl: &Controller<'s>,
+        _report: &ActionReport,
+        _row: Option<&TraceRow>,
+        _robot: &B::Member<'_>,
+    ) {
+    }
     /// After every robot acted once; `false` ends the life.
     fn after_action(&mut self, _bodies: &B) -> bool {
         true
@@ -132,7 +145,9 @@ pub fn live<'s, B: Bodies>(
             c.begin_trace(t);
         }
         bodies.prepare(i);
-        c.start(&mut bodies.member(i));
+        let mut member = bodies.member(i);
+        c.start(&mut member);
+        hooks.started(i, c, &member);
     }
     let mut actions = 0;
     for a in 0..opts.actions {
@@ -146,15 +161,15 @@ pub fn live<'s, B: Bodies>(
             }
             bodies.prepare(i);
             let mut member = bodies.member(i);
-            hooks.before(c, &member);
+            hooks.before(i, c, &member);
             let rep = c.act(&mut member);
             tally(&mut robots[i], &mut fitness[i], &rep);
+            let mut row = None;
             if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
                 t.rows.push(c.trace_row(a, &rep, &robots[i], &member));
-                if let Some(row) = t.rows.last() {
-                    hooks.row(row, &member);
-                }
+                row = t.rows.last();
             }
+            hooks.acted(i, c, &rep, row, &member);
         }
         actions += 1;
         if let Some(s) = bodies.state(groups) {

@@ -102,7 +102,7 @@ pub use life::{live, team_result, Bodies, Hooks, Solo};
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
-pub use team::{run_team_episode, TeamBodies, TeamResult, TeamRun, TeamWatch};
+pub use team::{episode_with, run_team_episode, TeamBodies, TeamMember, TeamResult, TeamRun};
 
 /// How to run one episode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -946,11 +946,20 @@ struct SoloHooks<F, G> {
 impl<'s, R: Robot, F: FnMut(&mut Controller<'s>, &R), G: FnMut(&TraceRow, &R)>
     life::Hooks<'s, life::Solo<'_, R>> for SoloHooks<F, G>
 {
-    fn before(&mut self, ctl: &mut Controller<'s>, robot: &&mut R) {
+    fn before(&mut self, _i: usize, ctl: &mut Controller<'s>, robot: &&mut R) {
         (self.before)(ctl, robot)
     }
-    fn row(&mut self, row: &TraceRow, robot: &&mut R) {
-        (self.after)(row, robot)
+    fn acted(
+        &mut self,
+        _i: usize,
+        _: &Controller<'s>,
+        _: &ActionReport,
+        row: Option<&TraceRow>,
+        robot: &&mut R,
+    ) {
+        if let Some(row) = row {
+            (self.after)(row, robot)
+        }
     }
 }
 

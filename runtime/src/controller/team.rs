@@ -19,36 +19,29 @@ use super::{
 };
 use crate::catalog::CHANNELS;
 use crate::genome::Genome;
-use crate::program::Stage;
+use crate::program::{Stage, World};
 use crate::sim::{robot_seed, Command, Outcome, Pose, Sim, Team};
 
-/// What a recorder sees of a team's life ([`TeamRun::run_watched`]): each
-/// robot's sensing and commands, as they happen (the unit type sees nothing).
-pub trait TeamWatch {
-    /// Robot `i` sensed `out`, the team as it is now.
-    fn sensed(&mut self, _i: usize, _out: &[f32; CHANNELS], _team: &Team) {}
-    /// Robot `i` is about to execute `cmd`.
-    fn commanded(&mut self, _i: usize, _cmd: &Command) {}
-}
-
-impl TeamWatch for () {}
-
 /// Robot `i` of a team, as its controller sees it.
-pub struct Member<'t, W: TeamWatch = ()> {
+pub struct TeamMember<'t> {
     team: &'t mut Team,
     i: usize,
-    watch: &'t mut W,
 }
 
-impl<W: TeamWatch> Robot for Member<'_, W> {
+impl TeamMember<'_> {
+    /// Its simulator.
+    pub fn sim(&self) -> &Sim {
+        self.team.sim(self.i)
+    }
+}
+
+impl Robot for TeamMember<'_> {
     #[inline]
     fn sense(&mut self, out: &mut [f32; CHANNELS]) {
         self.team.sense(self.i, out);
-        self.watch.sensed(self.i, out, self.team);
     }
     #[inline]
     fn step(&mut self, cmd: &Command) -> Outcome {
-        self.watch.commanded(self.i, cmd);
         self.team.step(self.i, cmd)
     }
     fn alive(&self) -> bool {
@@ -134,21 +127,7 @@ impl<'s> TeamRun<'s> {
         traces: Option<&mut [Trace]>,
         after: impl FnMut(&Team) -> bool,
     ) -> TeamResult {
-        self.run_watched(team, opts, traces, &mut (), after)
-    }
-
-    /// [`TeamRun::run`], `watch` told of every robot's sensing and commands
-    /// (a recorder of the life's frames; it draws no random number, so the
-    /// life is the one [`TeamRun::run`] lives).
-    pub fn run_watched<W: TeamWatch>(
-        &mut self,
-        team: &mut Team,
-        opts: &EpisodeOptions,
-        traces: Option<&mut [Trace]>,
-        watch: &mut W,
-        after: impl FnMut(&Team) -> bool,
-    ) -> TeamResult {
-        self.run_in(&mut TeamBodies { team, watch }, opts, traces, &mut AfterAction(after))
+        self.run_in(&mut TeamBodies { team }, opts, traces, &mut AfterAction(after))
     }
 
     /// Lives one life in `bodies` (fresh: one robot's or a team's), robot
@@ -169,16 +148,14 @@ impl<'s> TeamRun<'s> {
     }
 }
 
-/// A team's robots as the bodies of a life ([`super::live`]), `watch` told
-/// of every robot's sensing and commands.
-pub struct TeamBodies<'t, W: TeamWatch = ()> {
+/// A team's robots as the bodies of a life ([`super::live`]).
+pub struct TeamBodies<'t> {
     pub team: &'t mut Team,
-    pub watch: &'t mut W,
 }
 
-impl<W: TeamWatch> super::Bodies for TeamBodies<'_, W> {
+impl Bodies for TeamBodies<'_> {
     type Member<'a>
-        = Member<'a, W>
+        = TeamMember<'a>
     where
         Self: 'a;
     fn robots(&self) -> usize {
@@ -193,8 +170,8 @@ impl<W: TeamWatch> super::Bodies for TeamBodies<'_, W> {
     fn prepare(&mut self, i: usize) {
         self.team.prepare(i);
     }
-    fn member(&mut self, i: usize) -> Member<'_, W> {
-        Member { team: &mut *self.team, i, watch: &mut *self.watch }
+    fn member(&mut self, i: usize) -> TeamMember<'_> {
+        TeamMember { team: &mut *self.team, i }
     }
     fn state(&mut self, groups: bool) -> Option<[f32; 3]> {
         Some(self.team.state(groups))
@@ -204,8 +181,8 @@ impl<W: TeamWatch> super::Bodies for TeamBodies<'_, W> {
 /// [`TeamRun::run`]'s `after`, called with the team after every action.
 struct AfterAction<F>(F);
 
-impl<'s, W: TeamWatch, F: FnMut(&Team) -> bool> super::Hooks<'s, TeamBodies<'_, W>> for AfterAction<F> {
-    fn after_action(&mut self, bodies: &TeamBodies<'_, W>) -> bool {
+impl<'s, F: FnMut(&Team) -> bool> Hooks<'s, TeamBodies<'_>> for AfterAction<F> {
+    fn after_action(&mut self, bodies: &TeamBodies<'_>) -> bool {
         (self.0)(bodies.team)
     }
 }
@@ -224,9 +201,7 @@ pub fn run_team_episode(
 }
 
 /// [`run_team_episode`], one robot's simulator wrapped by `robot` (a watch
-/// or a stop; a team's robots are not wrapped). The one place that decides
-/// the bodies of an episode: one robot is a team of one, whose body needs
-/// no neighbours and no team state.
+/// or a stop; a team's robots are not wrapped).
 pub(crate) fn episode_in<R: Robot>(
     stage: &Stage,
     genome: &Genome,
@@ -235,16 +210,36 @@ pub(crate) fn episode_in<R: Robot>(
     robot: impl FnOnce(Sim) -> R,
 ) -> Result<TeamResult, ControllerError> {
     let mut run = TeamRun::new(stage, genome, opts.seed)?;
-    let mut res = if stage.world.robots > 1 {
-        run.run(&mut Team::new(&stage.world, opts.seed), opts, traces, |_| true)
-    } else {
-        let mut sim = robot(Sim::new(&stage.world, opts.seed));
-        run.run_in(&mut Solo(&mut sim), opts, traces, &mut ())
-    };
+    let mut res = episode_with(&mut run, &stage.world, opts.seed, opts, traces, robot, &mut ());
     if stage.inheritance == crate::program::Inheritance::Lamarckian {
         res.team.learned = Some(run.write_back(genome));
     }
     Ok(res)
+}
+
+/// One life of `run`'s controllers in a fresh `world` of seed `seed` (its
+/// robots', `world.robots`), `hooks` called as it goes: the one place that
+/// decides the bodies of a life. One robot is a team of one, whose body
+/// needs no neighbours and no team state; its simulator is wrapped by
+/// `robot` (a watch or a stop; a team's robots are not wrapped).
+pub fn episode_with<'s, R: Robot, H>(
+    run: &mut TeamRun<'s>,
+    world: &World,
+    seed: u64,
+    opts: &EpisodeOptions,
+    traces: Option<&mut [Trace]>,
+    robot: impl FnOnce(Sim) -> R,
+    hooks: &mut H,
+) -> TeamResult
+where
+    H: for<'b> Hooks<'s, Solo<'b, R>> + for<'b> Hooks<'s, TeamBodies<'b>>,
+{
+    if world.robots > 1 {
+        run.run_in(&mut TeamBodies { team: &mut Team::new(world, seed) }, opts, traces, hooks)
+    } else {
+        let mut sim = robot(Sim::new(world, seed));
+        run.run_in(&mut Solo(&mut sim), opts, traces, hooks)
+    }
 }
 
 impl TeamRun<'_> {
