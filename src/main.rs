@@ -576,7 +576,12 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             experiment::experiment(&plan, jobs, None)
         }
         Command::Report { dir, output } => {
-            let path = html::write(&dir, output.as_deref())?;
+            let unsealed = std::cell::RefCell::new(Vec::new());
+            let path =
+                html::write_with(&dir, output.as_deref(), &|p| unsealed.borrow_mut().push(p.to_path_buf()))?;
+            if let Some(w) = shaping_engine::files::unsealed_warning(&unsealed.borrow()) {
+                eprintln!("{w}");
+            }
             let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
             eprintln!("wrote {} ({} kB)", path.display(), size.div_ceil(1000));
             Ok(())

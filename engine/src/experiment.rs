@@ -273,7 +273,7 @@ impl Plan {
         let json = serde_json::json!({ "file": title, "seeds": self.seeds, "sets": sets, "points": points });
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::io(format!("error: cannot serialise the summary: {e}")))?;
-        write_atomic(&self.out.join("summary.json"), format!("{text}\n").as_bytes())?;
+        crate::files::write_sealed(&self.out, &[("summary.json", format!("{text}\n").as_bytes())])?;
         if !self.args.sets.is_empty() {
             let md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
             write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
@@ -437,7 +437,10 @@ fn sweep_table(
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Error> {
-    let bytes = crate::files::read_bytes(path)?;
+    // Sealed by the seed's run (a test stage's files are written each time
+    // it runs).
+    let bytes =
+        crate::files::read_checked(path, rundir::REWRITE, &|_| {})?.ok_or_else(|| missing(path))?.bytes;
     serde_json::from_slice(&bytes)
         .map_err(|e| Error::new(ErrorKind::Corrupt, format!("error: cannot read `{}`: {e}", path.display())))
 }

@@ -14,9 +14,17 @@
 //!   take it.
 //! - [`seal`] and [`unseal`]: a saved result (`checkpoint.json`,
 //!   `trained.json`) ends with a `"checksum"` field, the FNV-1a of the rest
-//!   of the text; reading verifies it. A file written before checksums
-//!   existed reads as before and gets one when it is next written.
+//!   of the text; reading verifies it.
+//! - [`write_sealed`] and [`read_checked`]: every file a report or a resume
+//!   reads is sealed in its directory's [`SEALS`] (`.seals`: each file's
+//!   FNV-1a, itself sealed), written by the one writer of the directory
+//!   around the files: first the new checksums beside the old, then the
+//!   files, then the new ones alone, so a kill anywhere leaves each file
+//!   matching its seal. A file whose seal does not match is `Corrupt`,
+//!   naming it; a file with no seal (a directory written before seals) is
+//!   read, and the caller is told ([`Unsealed`]) so that it warns.
 
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
 use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
@@ -173,6 +181,204 @@ fn open_lock_file(path: &Path) -> std::io::Result<File> {
 #[cfg(not(unix))]
 fn open_lock_file(path: &Path) -> std::io::Result<File> {
     OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path)
+}
+
+/// The name of a directory's seals ([`write_sealed`]).
+pub const SEALS: &str = ".seals";
+
+/// Told of each file read without a seal ([`read_checked`]): written
+/// before runs sealed their files, so damage to it cannot be detected.
+pub type Unsealed<'a> = &'a dyn Fn(&Path);
+
+/// The warning about files read without a seal.
+pub fn unsealed_warning(paths: &[PathBuf]) -> Option<String> {
+    let mut paths = paths.to_vec();
+    paths.sort();
+    paths.dedup();
+    let first = paths.first()?;
+    let which = match paths.len() {
+        1 => format!("`{}` has no seal", first.display()),
+        n => format!("{n} files have no seal (`{}` and {} more)", first.display(), n - 1),
+    };
+    Some(format!(
+        "warning: {which}: written before runs sealed their files (or its seal was removed), so damage to it \
+         cannot be detected; running the stage again (`--fresh`) seals it"
+    ))
+}
+
+/// What `DIR/.seals` holds: each sealed file's checksums (FNV-1a, 16 hex
+/// digits), the one written last first; two only while a write is under
+/// way (or was killed).
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
+struct Seals {
+    format: u32,
+    files: BTreeMap<String, Vec<String>>,
+}
+
+const SEALS_FORMAT: u32 = 1;
+
+fn checksum_hex(bytes: &[u8]) -> String {
+    format!("{:016x}", fnv1a(bytes))
+}
+
+/// The seals of `dir`: `None` where there are none; damaged ones are
+/// `Corrupt`, naming them.
+fn read_seals(dir: &Path) -> Result<Option<Seals>> {
+    let path = dir.join(SEALS);
+    let bytes = match std::fs::read(&path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(format!("error: cannot read `{}`: {e}", path.display()))),
+    };
+    let corrupt = |why: &str| {
+        Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: the seals `{}` are corrupt ({why}): the files beside them cannot be checked; delete it to \
+                 read them unchecked (with a warning), or run the stage again (`--fresh`)",
+                path.display()
+            ),
+        )
+    };
+    let text = std::str::from_utf8(&bytes).map_err(|_| corrupt("not UTF-8"))?;
+    let body = match unseal(text) {
+        Sealed::Verified(body) => body,
+        Sealed::Unsealed(_) => return Err(corrupt("they have no checksum")),
+        Sealed::Damaged => return Err(corrupt("their checksum does not match their contents")),
+    };
+    let seals: Seals = serde_json::from_str(&body).map_err(|e| corrupt(&e.to_string()))?;
+    if seals.format != SEALS_FORMAT {
+        return Err(corrupt(&format!("format {}, this shaping reads format {SEALS_FORMAT}", seals.format)));
+    }
+    Ok(Some(seals))
+}
+
+fn write_seals(dir: &Path, seals: &Seals) -> Result<()> {
+    let json = serde_json::to_string_pretty(seals)
+        .map_err(|e| Error::io(format!("error: cannot serialise the seals: {e}")))?;
+    write_atomic(&dir.join(SEALS), seal(&json).as_bytes())
+}
+
+/// Writes `files` (name and contents) into `dir`, each whole
+/// ([`write_atomic`]), and seals them in `dir`'s [`SEALS`]: the new
+/// checksums are added beside the old ones before the files are written
+/// and the old ones dropped after, so that a kill at any point leaves every
+/// file matching a seal. Seals that do not read are replaced (the files
+/// they sealed then read as unsealed, with a warning).
+pub fn write_sealed(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
+    let mut seals = read_seals(dir).ok().flatten().unwrap_or_default();
+    seals.format = SEALS_FORMAT;
+    let sums: Vec<String> = files.iter().map(|(_, bytes)| checksum_hex(bytes)).collect();
+    let mut pending = false;
+    for ((name, _), sum) in files.iter().zip(&sums) {
+        let known = seals.files.entry((*name).to_string()).or_default();
+        if !known.contains(sum) {
+            known.insert(0, sum.clone());
+            pending = true;
+        }
+    }
+    if pending {
+        write_seals(dir, &seals)?;
+    }
+    for (name, bytes) in files {
+        write_atomic(&dir.join(name), bytes)?;
+    }
+    let mut settled = false;
+    for ((name, _), sum) in files.iter().zip(&sums) {
+        let known = seals.files.entry((*name).to_string()).or_default();
+        if known.len() != 1 || known[0] != *sum {
+            *known = vec![sum.clone()];
+            settled = true;
+        }
+    }
+    if settled {
+        write_seals(dir, &seals)?;
+    }
+    Ok(())
+}
+
+/// Moves every file of `from` (written by [`write_sealed`]) into `to`, and
+/// `from`'s seals into `to`'s as [`write_sealed`] does: the new checksums
+/// beside the old first, the files, then the new ones alone. `from` is
+/// removed.
+pub fn move_sealed(from: &Path, to: &Path) -> Result<()> {
+    let fail = |e: std::io::Error| {
+        Error::io(format!(
+            "error: cannot move the files of `{}` into `{}`: {e}",
+            from.display(),
+            to.display()
+        ))
+    };
+    let new = read_seals(from)?.unwrap_or_default();
+    let mut seals = read_seals(to).ok().flatten().unwrap_or_default();
+    seals.format = SEALS_FORMAT;
+    for (name, sums) in &new.files {
+        let known = seals.files.entry(name.clone()).or_default();
+        for sum in sums.iter().rev() {
+            if !known.contains(sum) {
+                known.insert(0, sum.clone());
+            }
+        }
+    }
+    if !new.files.is_empty() {
+        write_seals(to, &seals)?;
+    }
+    for entry in std::fs::read_dir(from).map_err(fail)? {
+        let entry = entry.map_err(fail)?;
+        if entry.file_name() != SEALS {
+            std::fs::rename(entry.path(), to.join(entry.file_name())).map_err(fail)?;
+        }
+    }
+    for (name, sums) in new.files {
+        seals.files.insert(name, sums);
+    }
+    if !seals.files.is_empty() {
+        write_seals(to, &seals)?;
+    }
+    let _ = std::fs::remove_file(from.join(SEALS));
+    std::fs::remove_dir(from).map_err(fail)
+}
+
+/// A file read by [`read_checked`].
+#[derive(Debug)]
+pub struct Checked {
+    pub bytes: Vec<u8>,
+    /// Its seal matched (`false`: it has none).
+    pub sealed: bool,
+}
+
+/// Reads `path` (`None` when there is no such file) and checks it against
+/// its seal in its directory's [`SEALS`]: a file whose seal does not match
+/// is `Corrupt`, naming it, with `advice`; one without a seal is read, and
+/// `unsealed` told.
+pub fn read_checked(path: &Path, advice: &str, unsealed: Unsealed<'_>) -> Result<Option<Checked>> {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(format!("error: cannot read `{}`: {e}", path.display()))),
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let seals = read_seals(dir)?;
+    let Some(sums) = seals.as_ref().and_then(|s| s.files.get(&name)) else {
+        unsealed(path);
+        return Ok(Some(Checked { bytes, sealed: false }));
+    };
+    if !sums.contains(&checksum_hex(&bytes)) {
+        return Err(Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: `{}` is corrupt: its checksum does not match its contents (sealed in `{}`): it was changed \
+                 after the run wrote it; {advice}",
+                path.display(),
+                dir.join(SEALS).display()
+            ),
+        ));
+    }
+    Ok(Some(Checked { bytes, sealed: true }))
 }
 
 const CHECKSUM_FIELD: &str = ",\n  \"checksum\": \"";

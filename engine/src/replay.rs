@@ -12,7 +12,7 @@ use shaping_runtime::sim::Sim;
 use shaping_runtime::controller::EpisodeResult;
 
 use crate::error::Error;
-use crate::files::{create_dir, write_atomic};
+use crate::files::{create_dir, write_sealed};
 use crate::run::{Event, Observer};
 use crate::{animation, episode, html, load, report, run, rundir};
 
@@ -113,9 +113,10 @@ pub fn choose(
             // From the program as it is: the checkpoint, where there is one,
             // must still fit, and `best.genome` be its best.
             if rundir::checkpoint_path(&dir).exists() {
-                rundir::checked_best(&program, source, &dir)?.1
+                rundir::checked_best_with(&program, source, &dir, &|p| run::warn_unsealed(observer, p))?.1
             } else {
-                read_genome(&path)?
+                let warn = |p: &Path| run::warn_unsealed(observer, p);
+                rundir::read_best_genome(&dir, &warn)?.map_or_else(|| read_genome(&path), Ok)?
             }
         }
     };
@@ -193,9 +194,9 @@ pub fn replay(
     // A team's world is the one its robots started in.
     let scene = if others.is_empty() { Sim::new(&stage.world, seed).scene() } else { team_scene };
     report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
-    write_atomic(&out.join("episode.json"), rundir::compact_json(&ep)?.as_bytes())?;
+    write_sealed(&out, &[("episode.json", rundir::compact_json(&ep)?.as_bytes())])?;
     rundir::write_program(&out, &program)?;
-    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    write_sealed(&out, &[("genome", &rundir::genome_bytes(&genome))])?;
     let report = if args.report { Some(html::write(&out, None)?) } else { None };
     let mut animations = Vec::new();
     if args.gif.is_some() || args.mp4.is_some() {

@@ -14,7 +14,7 @@ use shaping_runtime::sim::Scene;
 
 use crate::episode::{self, Part};
 use crate::error::{Error, ErrorKind, Result};
-use crate::files::{create_dir, write_atomic, DirLock};
+use crate::files::{create_dir, unsealed_warning, write_sealed, DirLock, Unsealed};
 use crate::rundir::{self, compact_json, to_json};
 use crate::sweep::Assignment;
 use crate::{html, report, RECORDED_TRAINING_ACTIONS};
@@ -350,7 +350,13 @@ fn interrupted(message: String) -> Error {
 /// checkpoint and `trained.json` fits the program (training stages bound
 /// in order as the run binds them; the check stops at a training stage
 /// that has to be trained again, whose weights are not known yet).
-fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Result<Saved> {
+fn precheck(
+    program: &Program,
+    stages: &[usize],
+    out: &Path,
+    seed: u64,
+    unsealed: Unsealed<'_>,
+) -> Result<Saved> {
     let mut saved = Saved::none(program);
     let mut seeds_of: Vec<(&str, u64)> = Vec::new();
     let mut bound = program.clone();
@@ -360,7 +366,7 @@ fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Resul
         let dir = rundir::stage_dir(out, &st.name);
         match st.run {
             StageRun::Evolve(_) => {
-                if let Some(cp) = rundir::read_checkpoint(&dir)? {
+                if let Some(cp) = rundir::read_checkpoint_with(&dir, unsealed)? {
                     seeds_of.push((&st.name, cp.seed));
                     if binding && cp.seed == seed {
                         let path = rundir::checkpoint_path(&dir);
@@ -369,7 +375,7 @@ fn precheck(program: &Program, stages: &[usize], out: &Path, seed: u64) -> Resul
                     saved.checkpoints[i] = Some(cp);
                 }
             }
-            StageRun::Train { .. } => match rundir::read_trained(&dir)? {
+            StageRun::Train { .. } => match rundir::read_trained_with(&dir, unsealed)? {
                 Some(t) => {
                     seeds_of.push((&st.name, t.run_seed));
                     if binding && t.run_seed == seed {
@@ -461,8 +467,9 @@ impl Runner<'_> {
         let seed = run_seed(&program, opts.seed);
         let local = Local::new(opts.jobs)?;
         let _lock = DirLock::acquire(&out)?;
+        let warn = |path: &Path| warn_unsealed(self.observer, path);
         let mut saved =
-            if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed)? };
+            if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed, &warn)? };
         // The compiled program, for `shaping report` (and `shaping run program.json`).
         rundir::write_program(&out, &program)?;
         let evaluator = self.evaluator.unwrap_or(&local);
@@ -551,7 +558,14 @@ fn best_episode(stage: &Stage, cp: &Checkpoint, seed: u64, dir: &Path) -> Result
     let opts = EpisodeOptions { actions: evo.actions, learning: true, seed };
     let (_, _, ep) =
         episode::run_recorded(stage, &genome, &opts).map_err(|e| Error::io(format!("error: {e}")))?;
-    write_atomic(&dir.join("episode.json"), compact_json(&ep)?.as_bytes())
+    write_sealed(dir, &[("episode.json", compact_json(&ep)?.as_bytes())])
+}
+
+/// Warns through `observer` that `path` was read without a seal.
+pub fn warn_unsealed(observer: &dyn Observer, path: &Path) {
+    if let Some(w) = unsealed_warning(&[path.to_path_buf()]) {
+        observer.event(Event::Warning(w));
+    }
 }
 
 /// The final checkpoint of the nearest evolved ancestor of `index`.
@@ -639,11 +653,9 @@ impl Runner<'_> {
         while !evolve::is_finished(program, &cp) {
             evaluator.context(format!("generation {} of stage `{}`", cp.generation, stage.name), &path);
             let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
-            rundir::write_checkpoint(dir, &cp)?;
-            write_atomic(
-                &dir.join("generations.csv"),
-                report::generations_csv(&cp.history, &report::variant_names(stage)).as_bytes(),
-            )?;
+            let csv = report::generations_csv(&cp.history, &report::variant_names(stage));
+            let checkpoint = rundir::checkpoint_bytes(&cp)?;
+            write_sealed(dir, &[("checkpoint.json", &checkpoint), ("generations.csv", csv.as_bytes())])?;
             self.observer.event(Event::Generation { stage: &stage.name, stats: &stats });
             if stats.crowded_episodes > 0 && !warned {
                 // Said at once (a long run may be stopped), and again with the
@@ -698,11 +710,9 @@ impl Runner<'_> {
         }
         let (genome, fitness) = evolve::best_of(&cp)
             .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
-        rundir::write_best_genome(dir, &genome)?;
-        write_atomic(
-            &dir.join("generations.csv"),
-            report::generations_csv(&cp.history, &report::variant_names(stage)).as_bytes(),
-        )?;
+        let csv = report::generations_csv(&cp.history, &report::variant_names(stage));
+        let best = rundir::genome_bytes(&genome);
+        write_sealed(dir, &[("best.genome", &best), ("generations.csv", csv.as_bytes())])?;
         report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
         self.observer.event(Event::Evolved {
             stage: &stage.name,
@@ -921,20 +931,7 @@ impl Runner<'_> {
                 return Err(e);
             }
         };
-        let moved = std::fs::read_dir(&staging).and_then(|entries| {
-            for entry in entries {
-                let entry = entry?;
-                std::fs::rename(entry.path(), dir.join(entry.file_name()))?;
-            }
-            std::fs::remove_dir(&staging)
-        });
-        moved.map_err(|e| {
-            Error::io(format!(
-                "error: cannot move the files of `{}` into `{}`: {e}",
-                staging.display(),
-                dir.display()
-            ))
-        })?;
+        crate::files::move_sealed(&staging, dir)?;
         let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
         if let Some(w) = lives_crowding(&ba).warning(&stage.name, dir, ("life", "lives")) {
             self.observer.event(Event::Warning(w));
@@ -992,9 +989,9 @@ fn test_files(
         &stopped,
     )?;
     check()?;
-    write_atomic(&dir.join("episode.json"), compact_json(&ba.episode)?.as_bytes())?;
+    write_sealed(dir, &[("episode.json", compact_json(&ba.episode)?.as_bytes())])?;
     check()?;
-    write_atomic(&dir.join("best.genome"), format!("{}\n", outcome.genome.to_bitstring()).as_bytes())?;
+    write_sealed(dir, &[("best.genome", &rundir::genome_bytes(&outcome.genome))])?;
     let perf = |r: &EpisodeResult| {
         serde_json::json!({
             "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
@@ -1041,7 +1038,7 @@ fn test_files(
         summary["placement_failures"] = serde_json::json!(crowding.placements);
     }
     check()?;
-    write_atomic(&dir.join("summary.json"), to_json(&summary)?.as_bytes())?;
+    write_sealed(dir, &[("summary.json", to_json(&summary)?.as_bytes())])?;
     Ok(summary)
 }
 
@@ -1139,8 +1136,8 @@ impl Runner<'_> {
             .map_err(|e| Error::io(format!("error: {e}")))?;
         let (trace, ep) = (&rec.trace, &rec.episode);
         report::episode_files(dir, &stage.name, stage, trace, &rec.others, ep, &rec.scene, &[], None)?;
-        write_atomic(&dir.join("episode.json"), compact_json(ep)?.as_bytes())?;
-        rundir::write_trained(dir, &trained)?;
+        let bytes = rundir::trained_bytes(&trained)?;
+        write_sealed(dir, &[("episode.json", compact_json(ep)?.as_bytes()), ("trained.json", &bytes)])?;
         self.observer.event(Event::Trained { stage, trained: &trained, recorded, reused: false, dir });
         Ok(trained)
     }
@@ -1176,7 +1173,7 @@ pub fn bind_training(
         let saved = match run_dir {
             Some(d) => {
                 let dir = rundir::stage_dir(d, &program.stages[i].name);
-                match rundir::read_trained(&dir)? {
+                match rundir::read_trained_with(&dir, &|path| warn_unsealed(observer, path))? {
                     Some(t) => match evolve::train::check(program, i, &t) {
                         Ok(()) => Some(t),
                         Err(e) => {

@@ -11,10 +11,13 @@
 //! DIR/STAGE/trained.json      training stages: the learned weights, with a checksum
 //! DIR/STAGE/summary.json      test stages
 //! DIR/STAGE/episode.json, trace.csv, *.svg, *.png
+//! DIR/STAGE/.seals            the checksums of the files above that a
+//!                             report or a resume reads (files::write_sealed)
 //! ```
 //!
 //! An experiment's directory holds `seed-N/` run directories (under a
-//! sweep, `POINT/seed-N/`), and `summary.md`, `summary.json`.
+//! sweep, `POINT/seed-N/`), and `summary.md`, `summary.json` (sealed in its
+//! `.seals`).
 
 use std::path::{Path, PathBuf};
 
@@ -25,7 +28,7 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
 use crate::error::{Error, ErrorKind, Result};
-use crate::files::{read_bytes, seal, unseal, write_atomic, Sealed};
+use crate::files::{read_bytes, read_checked, seal, unseal, write_atomic, write_sealed, Sealed, Unsealed};
 
 /// A stage's directory in run directory `out`.
 pub fn stage_dir(out: &Path, stage: &str) -> PathBuf {
@@ -63,26 +66,61 @@ pub fn compact_json<T: Serialize>(value: &T) -> Result<String> {
     serde_json::to_string(value).map_err(|e| Error::io(format!("error: cannot serialise: {e}")))
 }
 
-/// Reads a saved result that carries a checksum ([`seal`]): `Ok(None)` if
-/// there is no file.
-fn read_sealed<T: DeserializeOwned>(path: &Path, what: &str, advice: &str) -> Result<Option<T>> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    parse_sealed(&read_bytes(path)?, &path.display().to_string(), what, advice).map(Some)
+/// Reads a saved result that carries a checksum ([`seal`]) and is sealed
+/// in its directory ([`read_checked`]): `Ok(None)` if there is no file. A
+/// file without its checksum is read only when its directory has no seal
+/// for it either (written before checksums), and `unsealed` is told; one
+/// that its seal lists is checked by it.
+fn read_sealed<T: DeserializeOwned>(
+    path: &Path,
+    what: &str,
+    advice: &str,
+    unsealed: Unsealed<'_>,
+) -> Result<Option<T>> {
+    let Some(file) = read_checked(path, advice, &|_| {})? else { return Ok(None) };
+    let legacy = if file.sealed { Legacy::Sealed } else { Legacy::Accept(unsealed) };
+    parse_sealed(&file.bytes, path, what, advice, legacy).map(Some)
 }
 
-/// A saved result from its bytes: its checksum verified (a file without
-/// one is read as it is), then parsed; `name` and `what` name the file in
-/// errors, `advice` says what to do with a damaged one.
-fn parse_sealed<T: DeserializeOwned>(bytes: &[u8], name: &str, what: &str, advice: &str) -> Result<T> {
+/// What [`parse_sealed`] does with a file without its checksum.
+enum Legacy<'a> {
+    /// Its directory's seal matched it: it is what the run wrote.
+    Sealed,
+    /// Nothing sealed it: read, and the caller told.
+    Accept(Unsealed<'a>),
+    /// Refused (bytes of unknown origin: the fuzzer's).
+    Refuse,
+}
+
+/// A saved result from its bytes: its checksum verified, then parsed;
+/// `path` and `what` name the file in errors, `advice` says what to do
+/// with a damaged one.
+fn parse_sealed<T: DeserializeOwned>(
+    bytes: &[u8],
+    path: &Path,
+    what: &str,
+    advice: &str,
+    legacy: Legacy<'_>,
+) -> Result<T> {
+    let name = path.display();
     let corrupt = |why: String| {
         Error::new(ErrorKind::Corrupt, format!("error: {what} `{name}` is corrupt ({why}); {advice}"))
     };
     let text = std::str::from_utf8(bytes).map_err(|e| corrupt(format!("not UTF-8: {e}")))?;
     let body = match unseal(text) {
         Sealed::Verified(body) => std::borrow::Cow::Owned(body),
-        Sealed::Unsealed(body) => std::borrow::Cow::Borrowed(body),
+        Sealed::Unsealed(body) => match legacy {
+            Legacy::Sealed => std::borrow::Cow::Borrowed(body),
+            Legacy::Accept(unsealed) => {
+                unsealed(path);
+                std::borrow::Cow::Borrowed(body)
+            }
+            Legacy::Refuse => {
+                return Err(corrupt(
+                    "it has no checksum: it was removed, or the file was not written by a run".into(),
+                ))
+            }
+        },
         Sealed::Damaged => {
             return Err(corrupt(
                 "its checksum does not match its contents: it was changed after it was written".into(),
@@ -96,48 +134,96 @@ const CHECKPOINT: (&str, &str) =
     ("the checkpoint", "move it away or pass `--fresh` to start the stage again");
 const TRAINED: (&str, &str) = ("the trained weights", "delete it or pass `--fresh`");
 
-/// A stage's checkpoint, if there is one (a damaged one is an error).
+/// A stage's checkpoint, if there is one (a damaged one is an error); one
+/// written before checksums is read without a word (see
+/// [`read_checkpoint_with`]).
 pub fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
-    read_sealed(&checkpoint_path(dir), CHECKPOINT.0, CHECKPOINT.1)
+    read_checkpoint_with(dir, &|_| {})
+}
+
+/// [`read_checkpoint`], telling `unsealed` of a checkpoint written before
+/// checksums (no checksum and no seal), for a warning.
+pub fn read_checkpoint_with(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Checkpoint>> {
+    read_sealed(&checkpoint_path(dir), CHECKPOINT.0, CHECKPOINT.1, unsealed)
 }
 
 /// A checkpoint from the bytes of a `checkpoint.json` (`name` names it in
-/// errors); whether it fits a program is [`evolve::resume`]'s to say.
+/// errors; one without its checksum is refused); whether it fits a program
+/// is [`evolve::resume`]'s to say.
 pub fn parse_checkpoint(bytes: &[u8], name: &str) -> Result<Checkpoint> {
-    parse_sealed(bytes, name, CHECKPOINT.0, CHECKPOINT.1)
+    parse_sealed(bytes, Path::new(name), CHECKPOINT.0, CHECKPOINT.1, Legacy::Refuse)
 }
 
 /// Trained weights from the bytes of a `trained.json` (`name` names it in
-/// errors); whether they fit a program is [`evolve::train::check`]'s to say.
+/// errors; one without its checksum is refused); whether they fit a
+/// program is [`evolve::train::check`]'s to say.
 pub fn parse_trained(bytes: &[u8], name: &str) -> Result<Trained> {
-    parse_sealed(bytes, name, TRAINED.0, TRAINED.1)
+    parse_sealed(bytes, Path::new(name), TRAINED.0, TRAINED.1, Legacy::Refuse)
+}
+
+/// The bytes of a stage's checkpoint as written: sealed ([`seal`]).
+pub fn checkpoint_bytes(cp: &Checkpoint) -> Result<Vec<u8>> {
+    Ok(seal(&to_json(cp)?).into_bytes())
 }
 
 /// Writes a stage's checkpoint, sealed.
 pub fn write_checkpoint(dir: &Path, cp: &Checkpoint) -> Result<()> {
-    write_atomic(&checkpoint_path(dir), seal(&to_json(cp)?).as_bytes())
+    write_sealed(dir, &[("checkpoint.json", &checkpoint_bytes(cp)?)])
 }
 
-/// A training stage's learned weights, if saved (a damaged file is an error).
+/// A training stage's learned weights, if saved (a damaged file is an
+/// error; see [`read_checkpoint`]).
 pub fn read_trained(dir: &Path) -> Result<Option<Trained>> {
-    read_sealed(&trained_path(dir), TRAINED.0, TRAINED.1)
+    read_trained_with(dir, &|_| {})
+}
+
+/// [`read_trained`], telling `unsealed` of a file written before checksums.
+pub fn read_trained_with(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Trained>> {
+    read_sealed(&trained_path(dir), TRAINED.0, TRAINED.1, unsealed)
+}
+
+/// The bytes of `trained.json`: sealed.
+pub fn trained_bytes(trained: &Trained) -> Result<Vec<u8>> {
+    Ok(seal(&to_json(trained)?).into_bytes())
 }
 
 /// Writes a training stage's learned weights, sealed.
 pub fn write_trained(dir: &Path, trained: &Trained) -> Result<()> {
-    write_atomic(&trained_path(dir), seal(&to_json(trained)?).as_bytes())
+    write_sealed(dir, &[("trained.json", &trained_bytes(trained)?)])
 }
 
-/// Writes `best.genome`.
+/// The bytes of a genome file.
+pub fn genome_bytes(genome: &Genome) -> Vec<u8> {
+    format!("{}\n", genome.to_bitstring()).into_bytes()
+}
+
+/// Writes `best.genome`, sealed.
 pub fn write_best_genome(dir: &Path, genome: &Genome) -> Result<()> {
-    write_atomic(&best_genome_path(dir), format!("{}\n", genome.to_bitstring()).as_bytes())
+    write_sealed(dir, &[("best.genome", &genome_bytes(genome))])
+}
+
+/// What to do with a damaged file a run derived (a genome, statistics, an
+/// episode, a summary).
+pub const REWRITE: &str = "run the same command again to write it anew";
+
+/// A stage's `best.genome` as the run wrote it (`None`: no file), checked
+/// against its seal ([`read_checked`]); one without a seal is read, and
+/// `unsealed` told.
+pub fn read_best_genome(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Genome>> {
+    let path = best_genome_path(dir);
+    let Some(file) = read_checked(&path, REWRITE, unsealed)? else { return Ok(None) };
+    parse_genome(&file.bytes, &path).map(Some)
 }
 
 /// Reads a genome file (`best.genome`): a string of 0 and 1; any other
 /// character is refused naming its line and column.
 pub fn read_genome(path: &Path) -> Result<Genome> {
-    let bytes = read_bytes(path)?;
-    let text = String::from_utf8_lossy(&bytes);
+    parse_genome(&read_bytes(path)?, path)
+}
+
+/// A genome from the bytes of file `path` (see [`read_genome`]).
+fn parse_genome(bytes: &[u8], path: &Path) -> Result<Genome> {
+    let text = String::from_utf8_lossy(bytes);
     Genome::parse_bitstring(&text).map_err(|(position, c)| {
         let before: String = text.chars().take(position - 1).collect();
         let line = before.matches('\n').count() + 1;
@@ -157,7 +243,10 @@ pub fn read_genome(path: &Path) -> Result<Genome> {
 /// which must be the checkpoint's best where a checkpoint is beside it (a
 /// hand-edited or damaged `best.genome` is refused, naming it).
 pub fn read_best(dir: &Path) -> Result<Genome> {
-    let genome = read_genome(&best_genome_path(dir))?;
+    let genome = match read_best_genome(dir, &|_| {})? {
+        Some(genome) => genome,
+        None => read_genome(&best_genome_path(dir))?,
+    };
     if let Some(cp) = read_checkpoint(dir)? {
         check_best(dir, &genome, &cp)?;
     }
@@ -187,8 +276,18 @@ pub fn check_best(dir: &Path, genome: &Genome, cp: &Checkpoint) -> Result<()> {
 /// where present, must be the checkpoint's best. Returns the checkpoint and
 /// the best with its fitness.
 pub fn checked_best(program: &Program, index: usize, dir: &Path) -> Result<(Checkpoint, Genome, f32)> {
+    checked_best_with(program, index, dir, &|_| {})
+}
+
+/// [`checked_best`], telling `unsealed` of files read without a seal.
+pub fn checked_best_with(
+    program: &Program,
+    index: usize,
+    dir: &Path,
+    unsealed: Unsealed<'_>,
+) -> Result<(Checkpoint, Genome, f32)> {
     let path = checkpoint_path(dir);
-    let cp = read_checkpoint(dir)?.ok_or_else(|| {
+    let cp = read_checkpoint_with(dir, unsealed)?.ok_or_else(|| {
         Error::new(
             ErrorKind::Io,
             format!("error: there is no checkpoint `{}`: run the stage first", path.display()),
@@ -208,7 +307,10 @@ pub fn checked_best(program: &Program, index: usize, dir: &Path) -> Result<(Chec
     })?;
     let best = best_genome_path(dir);
     if best.exists() {
+        // The checkpoint's best (which says what changed), then the bytes
+        // the run wrote.
         check_best(dir, &read_genome(&best)?, &cp)?;
+        read_best_genome(dir, &|_| {})?;
     }
     Ok((cp, genome, fitness))
 }
@@ -247,8 +349,30 @@ mod tests {
         let err = read_trained(dir.path()).unwrap_err();
         assert_eq!(err.kind(), ErrorKind::Corrupt);
         assert!(err.message().contains("checksum does not match"), "{err}");
-        // A file written before checksums existed reads as before.
+        // Its checksum removed (or its key misspelt) and a digit changed:
+        // its seal in `.seals` still refuses it.
+        let unsealed = text.replace("0.25", "0.35");
+        let at = unsealed.rfind(",\n  \"checksum\"").unwrap();
+        for bare in [format!("{}\n}}", &unsealed[..at]), unsealed.replace("\"checksum\"", "\"checksun\"")] {
+            std::fs::write(&path, &bare).unwrap();
+            let err = read_trained(dir.path()).unwrap_err();
+            assert_eq!(err.kind(), ErrorKind::Corrupt, "{bare}");
+            assert!(err.message().contains("trained.json"), "{err}");
+        }
+        // A file written before checksums (and seals) existed is read, and
+        // the caller told, for a warning.
+        std::fs::remove_file(dir.path().join(crate::files::SEALS)).unwrap();
         std::fs::write(&path, to_json(&trained).unwrap()).unwrap();
-        assert_eq!(read_trained(dir.path()).unwrap().unwrap(), trained);
+        let told = std::cell::Cell::new(0);
+        let read = read_trained_with(dir.path(), &|p| {
+            assert_eq!(p, path);
+            told.set(told.get() + 1);
+        });
+        assert_eq!(read.unwrap().unwrap(), trained);
+        assert_eq!(told.get(), 1);
+        // The same bytes from nowhere (the fuzzer's) are refused.
+        let err = parse_trained(to_json(&trained).unwrap().as_bytes(), "t.json").unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Corrupt);
+        assert!(err.message().contains("no checksum"), "{err}");
     }
 }

@@ -108,6 +108,23 @@ fn the_report_names_a_damaged_genome_summary_or_checkpoint() {
         ("bigger/summary.json", "{", "is not a test stage's summary"),
         ("navigation/checkpoint.json", "{}", "is corrupt"),
     ];
+    // Sealed, each is refused as not what the run wrote.
+    for (file, content, _) in &cases {
+        let path = d.join(file);
+        let good = std::fs::read(&path).unwrap();
+        std::fs::write(&path, content).unwrap();
+        let err = error(html::write(d, None));
+        assert_eq!(err.kind(), shaping_engine::ErrorKind::Corrupt, "{err}");
+        assert!(
+            err.message().contains(&format!("`{}` is corrupt", path.display())),
+            "{file} = {content:?}: {err}"
+        );
+        std::fs::write(&path, good).unwrap();
+    }
+    // Without seals (a run from before them), what is wrong with each.
+    for stage in ["navigation", "bigger"] {
+        std::fs::remove_file(d.join(stage).join(shaping_engine::files::SEALS)).unwrap();
+    }
     for (file, content, wanted) in cases {
         let path = d.join(file);
         let good = std::fs::read(&path).unwrap();

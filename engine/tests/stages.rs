@@ -101,7 +101,8 @@ stage evolved {
         "{table}"
     );
     assert!(!table.contains("dodge   weight"), "trained weights are not genes: {table}");
-    // As written before activation weights were saved.
+    // As written before activation weights were saved (and before seals).
+    std::fs::remove_file(out.join("practice").join(shaping_engine::files::SEALS)).unwrap();
     let mut old = saved.clone();
     old.as_object_mut().unwrap().remove("activation");
     std::fs::write(&path, serde_json::to_string(&old).unwrap()).unwrap();

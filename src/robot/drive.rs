@@ -11,10 +11,11 @@ use shaping_runtime::program::Stage;
 use shaping_runtime::robot::{RobotError, SerialRobot};
 
 use super::port::{interrupt_flag, SerialPort};
-use crate::load::{create_dir, write_atomic};
+use crate::load::create_dir;
 use crate::out::outln;
 use crate::CliError;
 use shaping_engine::episode::{self, Part, Recorder};
+use shaping_engine::files::write_sealed;
 use shaping_engine::{replay, report};
 
 use crate::run;
@@ -139,8 +140,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let parts = [Part { stage: &stage.name, scene: scene.clone(), frames }];
     let ep = episode::episode(stage, seed, learning, &trace, &parts);
     report::episode_pictures(&out, &stage.name, stage, &trace, &scene)?;
-    write_atomic(&out.join("episode.json"), serde_json::to_string(&ep).unwrap_or_default().as_bytes())?;
-    write_atomic(&out.join("genome"), format!("{}\n", genome.to_bitstring()).as_bytes())?;
+    // Sealed, as a replay's are (`trace.csv` is written as the robot drives).
+    let episode = serde_json::to_string(&ep).unwrap_or_default();
+    let genome_file = shaping_engine::rundir::genome_bytes(&genome);
+    write_sealed(&out, &[("episode.json", episode.as_bytes()), ("genome", &genome_file)])?;
     let done = trace.rows.len();
     let rate = if elapsed > 0.0 { done as f64 / elapsed } else { 0.0 };
     let summary = serde_json::json!({
@@ -152,10 +155,8 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
         "recharges": result.as_ref().map(|r| r.recharges), "collisions": result.as_ref().map(|r| r.collisions),
         "error": error.as_ref().map(|e| e.to_string()),
     });
-    write_atomic(
-        &out.join("summary.json"),
-        serde_json::to_string_pretty(&summary).unwrap_or_default().as_bytes(),
-    )?;
+    let summary_file = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    write_sealed(&out, &[("summary.json", summary_file.as_bytes())])?;
     if let Some(err) = &error {
         eprintln!("stopped after {done} actions; what ran is in {}", out.display());
         return Err(CliError::io(failure(err, &stopped)));

@@ -15,6 +15,7 @@ use shaping_runtime::program::{
 use crate::episode::{Episode, EPISODE_FORMAT};
 use crate::error::Error;
 use crate::experiment::spread;
+use crate::files::{read_checked, Unsealed};
 use crate::{load, rundir};
 
 /// Version of the data embedded in a report.
@@ -184,13 +185,22 @@ pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, Error> 
     Ok(rows)
 }
 
-fn read_text(path: &Path) -> Result<String, Error> {
-    let bytes = crate::files::read_bytes(path)?;
+/// The bytes of `path` as the run wrote them: checked against its seal
+/// (a damaged file is an error naming it; one without a seal is read and
+/// `u` told).
+fn read_sealed(path: &Path, u: Unsealed<'_>) -> Result<Vec<u8>, Error> {
+    read_checked(path, rundir::REWRITE, u)?
+        .map(|f| f.bytes)
+        .ok_or_else(|| Error::io(format!("error: cannot read `{}`: there is no such file", path.display())))
+}
+
+fn read_text(path: &Path, u: Unsealed<'_>) -> Result<String, Error> {
+    let bytes = read_sealed(path, u)?;
     String::from_utf8(bytes).map_err(|_| Error::io(format!("error: `{}` is not UTF-8 text", path.display())))
 }
 
-fn read_episode(path: &Path) -> Result<Episode, Error> {
-    let bytes = crate::files::read_bytes(path)?;
+fn read_episode(path: &Path, u: Unsealed<'_>) -> Result<Episode, Error> {
+    let bytes = read_sealed(path, u)?;
     let ep: Episode = serde_json::from_slice(&bytes).map_err(|e| {
         Error::io(format!("error: `{}` is not an episode written by shaping: {e}", path.display()))
     })?;
@@ -220,11 +230,11 @@ fn read_episode(path: &Path) -> Result<Episode, Error> {
 
 /// The genome in `path` (`None` when there is no such file: the stage has
 /// not run); one that is not a genome of `stage` is an error naming it.
-fn read_genome(path: &Path, stage: &Stage) -> Result<Option<Genome>, Error> {
+fn read_genome(path: &Path, stage: &Stage, u: Unsealed<'_>) -> Result<Option<Genome>, Error> {
     if !path.exists() {
         return Ok(None);
     }
-    let text = read_text(path)?;
+    let text = read_text(path, u)?;
     let bad = |what: String| {
         Error::io(format!("error: `{}` is not a genome of stage `{}`: {what}", path.display(), stage.name))
     };
@@ -602,14 +612,14 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
 }
 
 /// Per evolved stage, its own rows of one run's `generations.csv` files.
-fn run_fitness(program: &Program, run: &Path) -> Result<Vec<Vec<GenRow>>, Error> {
+fn run_fitness(program: &Program, run: &Path, u: Unsealed<'_>) -> Result<Vec<Vec<GenRow>>, Error> {
     let mut out = vec![Vec::new(); program.stages.len()];
     for (i, st) in program.stages.iter().enumerate() {
         let path = run.join(&st.name).join("generations.csv");
         if !matches!(st.run, StageRun::Evolve(_)) || !path.exists() {
             continue;
         }
-        let rows = parse_generations(&read_text(&path)?, &path)?;
+        let rows = parse_generations(&read_text(&path, u)?, &path)?;
         out[i] = rows.into_iter().filter(|r| r.stage == st.name).collect();
     }
     Ok(out)
@@ -647,14 +657,14 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
 /// A test stage's `summary.json` (`None` when there is none); one without
 /// what the page shows (the lives, and per world the fitness and events)
 /// is an error naming the file and what is missing.
-fn read_summary(path: &Path) -> Result<Option<serde_json::Value>, Error> {
+fn read_summary(path: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
     if !path.exists() {
         return Ok(None);
     }
     let bad = |what: String| {
         Error::io(format!("error: `{}` is not a test stage's summary: {what}", path.display()))
     };
-    let v: serde_json::Value = serde_json::from_str(&read_text(path)?).map_err(|e| bad(e.to_string()))?;
+    let v: serde_json::Value = serde_json::from_str(&read_text(path, u)?).map_err(|e| bad(e.to_string()))?;
     if !v.is_object() {
         return Err(bad("it is not a JSON object".into()));
     }
@@ -682,6 +692,7 @@ fn run_stages(
     program: &Program,
     run: &Path,
     only: Option<usize>,
+    u: Unsealed<'_>,
 ) -> Result<(Vec<StageView>, Vec<Episode>), Error> {
     let mut views = Vec::new();
     let mut episodes = Vec::new();
@@ -690,8 +701,8 @@ fn run_stages(
         if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
             continue;
         }
-        let genome = read_genome(&dir.join("best.genome"), st)?;
-        let cp = rundir::read_checkpoint(&dir)?;
+        let genome = read_genome(&dir.join("best.genome"), st, u)?;
+        let cp = rundir::read_checkpoint_with(&dir, u)?;
         if let (Some(g), Some(cp), StageRun::Evolve(_)) = (&genome, &cp, &st.run) {
             // The best the checkpoint beside it holds (a `best.genome`
             // changed after the run wrote it is an error naming it).
@@ -705,7 +716,7 @@ fn run_stages(
             view.run = run_text(st, Some(cp.seed));
             view.crowded = crowded_generations(st, cp);
         }
-        view.results = read_summary(&dir.join("summary.json"))?;
+        view.results = read_summary(&dir.join("summary.json"), u)?;
         if let Some(r) = &view.results {
             if let (Some(n), Some(p)) = (r["crowded_lives"].as_u64(), r["placement_failures"].as_u64()) {
                 let lives = 2 * r["lives"].as_u64().unwrap_or(1);
@@ -713,20 +724,20 @@ fn run_stages(
             }
         }
         if matches!(st.run, StageRun::Train { .. }) {
-            view.crowded = crowded_training(&dir);
+            view.crowded = crowded_training(&dir, u)?;
         }
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
             let pdir = run.join(&pst.name);
-            if let Some(cp) = rundir::read_checkpoint(&pdir)? {
-                let parent_best = read_genome(&pdir.join("best.genome"), pst)?;
+            if let Some(cp) = rundir::read_checkpoint_with(&pdir, u)? {
+                let parent_best = read_genome(&pdir.join("best.genome"), pst, u)?;
                 provenance(program, i, a, g, &cp, parent_best.as_ref(), &mut view);
             }
         }
         views.push(view);
         let ep = dir.join("episode.json");
         if ep.exists() {
-            episodes.push(read_episode(&ep)?);
+            episodes.push(read_episode(&ep, u)?);
         }
     }
     Ok((views, episodes))
@@ -757,12 +768,11 @@ fn crowded_generations(st: &shaping_runtime::program::Stage, cp: &Checkpoint) ->
 }
 
 /// The training life's overlapping placements, if any (`trained.json` in
-/// stage directory `dir`; one that does not read is left to the commands
-/// that use it).
-fn crowded_training(dir: &Path) -> Option<String> {
-    let t = rundir::read_trained(dir).ok()??;
+/// stage directory `dir`; a damaged one is an error naming it).
+fn crowded_training(dir: &Path, u: Unsealed<'_>) -> Result<Option<String>, Error> {
+    let Some(t) = rundir::read_trained_with(dir, u)? else { return Ok(None) };
     let p = u64::from(t.result.placement_failures);
-    (p > 0).then(|| crowded_words("in its training life", p))
+    Ok((p > 0).then(|| crowded_words("in its training life", p)))
 }
 
 /// The nearest ancestor of evolved stage `index` that evolved (test stages
@@ -878,10 +888,8 @@ fn series_of(program: &Program, fitness: &[Vec<GenRow>], only: Option<usize>) ->
 /// The run directories of an experiment's (or a sweep point's) seeds: those
 /// its `summary.json` covers, when there is one (a directory may hold other
 /// seeds' runs, from earlier experiments), else every `seed-N` on disk.
-fn seed_dirs(dir: &Path) -> Vec<(u64, PathBuf)> {
-    let covered: Option<Vec<u64>> = std::fs::read(dir.join("summary.json"))
-        .ok()
-        .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok())
+fn seed_dirs(dir: &Path, u: Unsealed<'_>) -> Result<Vec<(u64, PathBuf)>, Error> {
+    let covered: Option<Vec<u64>> = summary_json(dir, u)?
         .and_then(|v| v["seeds"].as_array().map(|a| a.iter().filter_map(|s| s.as_u64()).collect()));
     let mut seeds: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
         .into_iter()
@@ -895,7 +903,15 @@ fn seed_dirs(dir: &Path) -> Vec<(u64, PathBuf)> {
         })
         .collect();
     seeds.sort();
-    seeds
+    Ok(seeds)
+}
+
+/// An experiment's (or a sweep's) `summary.json` in `dir`, if there is one
+/// that is JSON (a damaged one is an error naming it).
+fn summary_json(dir: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
+    let path = dir.join("summary.json");
+    let Some(file) = read_checked(&path, rundir::REWRITE, u)? else { return Ok(None) };
+    Ok(serde_json::from_slice(&file.bytes).ok())
 }
 
 fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
@@ -918,16 +934,16 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
 
 /// The `summary.json` of a sweep in `dir`, if there is one (with points in
 /// directories of their own).
-fn sweep_summary(dir: &Path) -> Option<serde_json::Value> {
-    let bytes = std::fs::read(dir.join("summary.json")).ok()?;
-    let v: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
-    let points = v["points"].as_array()?;
-    (!points.is_empty() && points.iter().all(|p| p["dir"].as_str().is_some_and(|d| d != "."))).then_some(v)
+fn sweep_summary(dir: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
+    let Some(v) = summary_json(dir, u)? else { return Ok(None) };
+    let Some(points) = v["points"].as_array() else { return Ok(None) };
+    let sweep = !points.is_empty() && points.iter().all(|p| p["dir"].as_str().is_some_and(|d| d != "."));
+    Ok(sweep.then_some(v))
 }
 
 /// A sweep's directory: the experiment report of its best point (by the
 /// median chosen best of the last evolved stage), listing every point.
-fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, Error> {
+fn sweep(dir: &Path, summary: serde_json::Value, u: Unsealed<'_>) -> Result<ReportData, Error> {
     let points = summary["points"].as_array().cloned().unwrap_or_default();
     let score = |p: &serde_json::Value| {
         p["stages"]
@@ -945,11 +961,11 @@ fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, Error> {
         return Err(Error::io(format!("error: the sweep in `{}` has no points", dir.display())));
     };
     let point_dir = dir.join(best["dir"].as_str().unwrap_or_default());
-    let seeds = seed_dirs(&point_dir);
+    let seeds = seed_dirs(&point_dir, u)?;
     if seeds.is_empty() {
         return Err(Error::io(format!("error: the point `{}` has no seed directories", point_dir.display())));
     }
-    let mut data = experiment(&point_dir, &seeds)?;
+    let mut data = experiment(&point_dir, &seeds, u)?;
     data.kind = "sweep";
     data.source = dir.display().to_string();
     let name = best["name"].as_str().unwrap_or_default().to_string();
@@ -959,8 +975,17 @@ fn sweep(dir: &Path, summary: serde_json::Value) -> Result<ReportData, Error> {
     Ok(data)
 }
 
-/// Gathers a report's data from a run, stage, experiment or replay directory.
+/// Gathers a report's data from a run, stage, experiment or replay
+/// directory. Every file read is checked against its seal (a damaged one
+/// is an error naming it); one without a seal is read without a word (see
+/// [`collect_with`]).
 pub fn collect(dir: &Path) -> Result<ReportData, Error> {
+    collect_with(dir, &|_| {})
+}
+
+/// [`collect`], telling `u` of each file read without a seal (written
+/// before runs sealed their files), for a warning.
+pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
     if !dir.is_dir() {
         return Err(Error::io(format!("error: `{}` is not a directory", dir.display())));
     }
@@ -969,7 +994,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
         let program = load::load_built(&here)?;
         if dir.join("episode.json").exists() {
             // A replay: one episode of one stage.
-            let ep = read_episode(&dir.join("episode.json"))?;
+            let ep = read_episode(&dir.join("episode.json"), u)?;
             let (index, _) = program.stage(&ep.stage).ok_or_else(|| {
                 Error::io(format!(
                     "error: `{}` replays stage `{}`, which `{}` does not have",
@@ -979,7 +1004,7 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
                 ))
             })?;
             let st = &program.stages[index];
-            let genome = read_genome(&dir.join("genome"), st)?;
+            let genome = read_genome(&dir.join("genome"), st, u)?;
             let mut data = base("replay", &program, dir);
             data.stages.push(stage_view(&program, index, genome.as_ref().map(|g| (g, "genome".to_string()))));
             data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
@@ -987,18 +1012,22 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
             return Ok(data);
         }
         let mut data = base("run", &program, dir);
-        let fitness = run_fitness(&program, dir)?;
+        let fitness = run_fitness(&program, dir, u)?;
         data.fitness = series_of(&program, &fitness, None);
-        (data.stages, data.episodes) = run_stages(&program, dir, None)?;
+        (data.stages, data.episodes) = run_stages(&program, dir, None, u)?;
         data.episodes_note = "the best individual of each stage".into();
         return Ok(data);
     }
-    let seeds = seed_dirs(dir);
+    let seeds = seed_dirs(dir, u)?;
     if !seeds.is_empty() {
-        let mut data = experiment(dir, &seeds)?;
+        let mut data = experiment(dir, &seeds, u)?;
         // A point of a sweep lists the sweep's points.
         let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
-        if let (Some(summary), Some(name)) = (dir.parent().and_then(sweep_summary), name) {
+        let summary = match dir.parent() {
+            Some(parent) => sweep_summary(parent, u)?,
+            None => None,
+        };
+        if let (Some(summary), Some(name)) = (summary, name) {
             let listed =
                 summary["points"].as_array().is_some_and(|p| p.iter().any(|x| x["dir"] == name.as_str()));
             if listed {
@@ -1008,8 +1037,8 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
         }
         return Ok(data);
     }
-    if let Some(summary) = sweep_summary(dir) {
-        return sweep(dir, summary);
+    if let Some(summary) = sweep_summary(dir, u)? {
+        return sweep(dir, summary, u);
     }
     // A stage directory inside a run.
     let parent = dir.parent().filter(|p| p.join("program.json").exists());
@@ -1018,9 +1047,9 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
         let program = load::load_built(&run.join("program.json"))?;
         if let Some((index, _)) = program.stage(&name) {
             let mut data = base("stage", &program, dir);
-            let fitness = run_fitness(&program, run)?;
+            let fitness = run_fitness(&program, run, u)?;
             data.fitness = series_of(&program, &fitness, Some(index));
-            (data.stages, data.episodes) = run_stages(&program, run, Some(index))?;
+            (data.stages, data.episodes) = run_stages(&program, run, Some(index), u)?;
             data.episodes_note = format!("the best individual of stage `{name}`");
             return Ok(data);
         }
@@ -1031,11 +1060,11 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
     )))
 }
 
-fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, Error> {
+fn experiment(dir: &Path, seeds: &[(u64, PathBuf)], u: Unsealed<'_>) -> Result<ReportData, Error> {
     let program = load::load_built(&seeds[0].1.join("program.json"))?;
     let mut per_seed = Vec::new();
     for (_, run) in seeds {
-        per_seed.push(run_fitness(&program, run)?);
+        per_seed.push(run_fitness(&program, run, u)?);
     }
     let mut data = base("experiment", &program, dir);
     data.seeds = seeds.iter().map(|s| s.0).collect();
@@ -1060,7 +1089,7 @@ fn experiment(dir: &Path, seeds: &[(u64, PathBuf)]) -> Result<ReportData, Error>
     order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let pick = order[(order.len() - 1) / 2].1;
     let (seed, run) = &seeds[pick];
-    (data.stages, data.episodes) = run_stages(&program, run, None)?;
+    (data.stages, data.episodes) = run_stages(&program, run, None, u)?;
     data.shown_seed = Some(*seed);
     data.episodes_note = format!(
         "seed {seed}, the median of {} seeds by the final best fitness{}; genomes and episodes of that seed",

@@ -11,7 +11,7 @@ mod tests;
 use std::path::{Path, PathBuf};
 
 use crate::error::Error;
-use crate::files::write_atomic;
+use crate::files::{write_atomic, Unsealed};
 
 pub use data::{collect, ReportData};
 
@@ -58,10 +58,16 @@ pub fn page(data: &ReportData) -> Result<String, Error> {
 /// Writes the report of `dir` to `out` (default `dir/report.html`) and
 /// returns the path written.
 pub fn write(dir: &Path, out: Option<&Path>) -> Result<PathBuf, Error> {
+    write_with(dir, out, &|_| {})
+}
+
+/// [`write`], telling `unsealed` of each file read without a seal
+/// ([`data::collect_with`]), for a warning.
+pub fn write_with(dir: &Path, out: Option<&Path>, unsealed: Unsealed<'_>) -> Result<PathBuf, Error> {
     if let Some(out) = out {
         replaceable(out)?;
     }
-    let data = collect(dir)?;
+    let data = data::collect_with(dir, unsealed)?;
     let html = page(&data)?;
     let path = out.map_or_else(|| dir.join(FILE_NAME), Path::to_path_buf);
     write_atomic(&path, html.as_bytes())?;
