@@ -216,6 +216,13 @@ impl Plan {
             no_report: true,
             sets: assignments.clone(),
         };
+        // A seed's (or a point's) directory is the experiment's own: a link
+        // planted there is refused, not followed.
+        for dir in [self.point_dir(point as usize), opts.out.clone()] {
+            if dir != self.out {
+                rundir::create_stage_dir(&dir)?;
+            }
+        }
         runner.run(self.program.clone(), &opts)
     }
 

@@ -29,6 +29,7 @@ use std::fs::{File, OpenOptions};
 use std::io::{Read as _, Write as _};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 
 use shaping_runtime::evolve::fingerprint::fnv1a;
 
@@ -76,8 +77,12 @@ pub fn create_dir(path: &Path) -> Result<()> {
         .map_err(|e| Error::io(format!("error: cannot create directory `{}`: {e}", path.display())))
 }
 
-/// Writes a file atomically (see the module's documentation).
+/// Writes a file atomically (see the module's documentation). Under a
+/// directory this process has locked ([`DirLock`]), the lock must still be
+/// there: a lock file removed or replaced by hand may have let another run
+/// in, and this one stops rather than mix its files with that run's.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
+    check_locks(path)?;
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let fail = |e: std::io::Error| Error::io(format!("error: cannot write `{}`: {e}", path.display()));
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -118,6 +123,66 @@ pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
 pub struct DirLock {
     _file: File,
     path: PathBuf,
+}
+
+/// A lock this process holds: its directory, its file and the file's
+/// identity when it was taken.
+struct Held {
+    dir: PathBuf,
+    lock: PathBuf,
+    id: Option<(u64, u64)>,
+}
+
+/// The locks this process holds, for [`check_locks`].
+static HELD: Mutex<Vec<Held>> = Mutex::new(Vec::new());
+
+/// The device and inode of a file (`None` where there are none).
+fn file_id(meta: &std::fs::Metadata) -> Option<(u64, u64)> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt as _;
+        Some((meta.dev(), meta.ino()))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = meta;
+        None
+    }
+}
+
+/// Refuses a write to `path` under a directory this process locked whose
+/// lock file is no longer the one it locked (removed, or replaced by
+/// another run's).
+fn check_locks(path: &Path) -> Result<()> {
+    let held = HELD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    for h in held.iter().filter(|h| h.id.is_some() && path.starts_with(&h.dir)) {
+        let now = std::fs::symlink_metadata(&h.lock).ok().and_then(|m| file_id(&m));
+        if now != h.id {
+            let what = if now.is_none() { "was removed" } else { "was replaced" };
+            return Err(Error::new(
+                ErrorKind::Locked,
+                format!(
+                    "error: the lock `{}` {what} while this process held it, so another run may be writing into `{}`; \
+                     stopped before writing `{}` (what was written before is saved): make sure no other run uses \
+                     the directory, then run the same command again",
+                    h.lock.display(),
+                    h.dir.display(),
+                    path.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl Drop for DirLock {
+    fn drop(&mut self) {
+        let mut held = HELD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let id = self._file.metadata().ok().and_then(|m| file_id(&m));
+        if let Some(at) = held.iter().position(|h| h.lock == self.path && h.id == id) {
+            held.remove(at);
+        }
+    }
 }
 
 impl DirLock {
@@ -161,6 +226,12 @@ impl DirLock {
             text = format!("{name}, {text}");
         }
         let _ = file.set_len(0).and_then(|()| file.write_all(text.as_bytes())).and_then(|()| file.flush());
+        let id = file.metadata().ok().and_then(|m| file_id(&m));
+        HELD.lock().unwrap_or_else(std::sync::PoisonError::into_inner).push(Held {
+            dir: dir.to_path_buf(),
+            lock: path.clone(),
+            id,
+        });
         Ok(DirLock { _file: file, path })
     }
 
@@ -326,6 +397,7 @@ pub fn move_sealed(from: &Path, to: &Path) -> Result<()> {
     for entry in std::fs::read_dir(from).map_err(fail)? {
         let entry = entry.map_err(fail)?;
         if entry.file_name() != SEALS {
+            check_locks(&to.join(entry.file_name()))?;
             std::fs::rename(entry.path(), to.join(entry.file_name())).map_err(fail)?;
         }
     }

@@ -167,6 +167,8 @@ pub fn replay(
     let Chosen { program, index, genome, training_seed } = chosen;
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let stage = &program.stages[index];
+    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
+    rundir::check_replay_out(&out)?;
     let (actions, learning) = match &stage.run {
         StageRun::Evolve(e) => (e.actions, true),
         // One life of the test, in the stage's own world.
@@ -184,7 +186,6 @@ pub fn replay(
     let recorded = episode::record(stage, &genome, &EpisodeOptions { actions, learning, seed })
         .map_err(|e| Error::io(format!("error: {e}")))?;
     let episode::Recorded { result: r, trace, others, episode: ep, scene: team_scene } = recorded;
-    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     let mut crowding = run::Crowding::default();
     crowding.add(r.placement_failures);
     if let Some(w) = crowding.warning(&stage.name, &out, ("episode", "episodes")) {

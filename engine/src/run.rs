@@ -486,7 +486,7 @@ impl Runner<'_> {
                 )));
             }
             let dir = rundir::stage_dir(&out, &program.stages[index].name);
-            create_dir(&dir)?;
+            rundir::create_stage_dir(&dir)?;
             if let StageRun::Train { .. } = program.stages[index].run {
                 let trained = self.train_step(&program, index, seed, &dir, saved.trained[index].take())?;
                 evolve::train::bind(&mut program, index, &trained)

@@ -17,7 +17,7 @@
 //!
 //! An experiment's directory holds `seed-N/` run directories (under a
 //! sweep, `POINT/seed-N/`), and `summary.md`, `summary.json` (sealed in its
-//! `.seals`).
+//! `.seals`). A stage directory is a directory, never a link to one.
 
 use std::path::{Path, PathBuf};
 
@@ -33,6 +33,72 @@ use crate::files::{read_bytes, read_checked, seal, unseal, write_atomic, write_s
 /// A stage's directory in run directory `out`.
 pub fn stage_dir(out: &Path, stage: &str) -> PathBuf {
     out.join(stage)
+}
+
+/// Creates a stage's directory `dir` (or an experiment's seed or point
+/// directory): a link planted there is refused, not followed, as the links
+/// at temporary names are ([`crate::files::write_atomic`]).
+pub fn create_stage_dir(dir: &Path) -> Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(dir) {
+        if meta.file_type().is_symlink() {
+            return Err(Error::new(
+                ErrorKind::Invalid,
+                format!(
+                    "error: `{}` is a symbolic link; a run writes only into directories of its own, never through \
+                     a link: remove it, or choose another `--out`",
+                    dir.display()
+                ),
+            ));
+        }
+    }
+    crate::files::create_dir(dir)
+}
+
+/// The files only a run writes into its directories: one of them in a
+/// directory makes it a run's (or a stage's, an experiment's).
+const RUN_FILES: &[&str] =
+    &["checkpoint.json", "trained.json", "generations.csv", "best.genome", "summary.json", ".lock"];
+
+/// Refuses a replay's output directory `out` that is a run's: a stage
+/// directory (a replay would replace its `episode.json` and `trace.csv`), a
+/// run directory (its `program.json`) or an experiment's; and a link. A
+/// replay's own directory (its `genome` beside `program.json`), a new one
+/// or any other is fine.
+pub fn check_replay_out(out: &Path) -> Result<()> {
+    let refuse = |what: String| {
+        Error::new(
+            ErrorKind::Invalid,
+            format!(
+                "error: `{}` is {what}; a replay never writes into a run's directories: choose another `--out` \
+                 (by default a replay writes into `STAGE/replay` of the run)",
+                out.display()
+            ),
+        )
+    };
+    // A stage's directory, made or not yet.
+    let run = out.parent().filter(|p| program_path(p).exists());
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned());
+    if let (Some(run), Some(name)) = (run, name) {
+        let program = crate::load::load_built(&program_path(run));
+        if program.is_ok_and(|p| p.stage(&name).is_some()) {
+            return Err(refuse(format!("the directory of stage `{name}` of the run in `{}`", run.display())));
+        }
+    }
+    let Ok(meta) = std::fs::symlink_metadata(out) else { return Ok(()) };
+    if meta.file_type().is_symlink() {
+        return Err(refuse("a symbolic link".into()));
+    }
+    if !meta.is_dir() {
+        return Ok(());
+    }
+    let replay = out.join("genome").exists() && out.join("episode.json").exists();
+    if program_path(out).exists() && !replay {
+        return Err(refuse("a run directory (it holds `program.json`)".into()));
+    }
+    if let Some(file) = RUN_FILES.iter().find(|f| out.join(f).exists()) {
+        return Err(refuse(format!("a directory of a run (it holds `{file}`)")));
+    }
+    Ok(())
 }
 
 /// `STAGE/checkpoint.json`.

@@ -1,11 +1,19 @@
 //! Only what a run sealed is trusted (issue 47): a checksum removed is no
-//! way around it, and every file a report or a resume reads is sealed.
+//! way around it, every file a report or a resume reads is sealed, a
+//! replay never writes into a run's stage directory, a link planted in
+//! place of a stage directory is refused, and a lock removed by hand is
+//! said by the run that held it.
 
 mod common;
 
-use common::{error, options, run, tiny, Log};
-use shaping_engine::files::SEALS;
-use shaping_engine::run::Runner;
+use std::cell::Cell;
+use std::path::Path;
+use std::sync::{Arc, Barrier};
+
+use common::{error, files, options, run, tiny, tiny_bat, Log};
+use shaping_engine::files::{DirLock, SEALS};
+use shaping_engine::replay::{self, ReplayOptions};
+use shaping_engine::run::{Event, Observer, Runner};
 use shaping_engine::{html, ErrorKind};
 
 /// `text` with its last `"checksum"` field removed, as a hand edit leaves it.
@@ -109,4 +117,155 @@ fn every_file_the_report_reads_is_checked_against_its_seal() {
     assert_eq!(names, ["check/best.genome", "check/episode.json", "check/summary.json"]);
     let warning = shaping_engine::files::unsealed_warning(&told).unwrap();
     assert!(warning.starts_with("warning: 3 files have no seal (`"), "{warning}");
+}
+
+/// 47.8: `replay --out RUN/STAGE` would replace the stage's `episode.json`:
+/// refused before anything runs, as are the run's own directory and a link.
+#[test]
+fn a_replay_never_writes_into_a_run_s_directories() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = dir.path().join("run");
+    run(tiny(), &options(&run_dir)).unwrap();
+    let before = files(&run_dir);
+    let replay_into = |out: &Path| {
+        let args = ReplayOptions {
+            file: tiny_bat(),
+            stage: Some("second".into()),
+            run: Some(run_dir.clone()),
+            out: Some(out.to_path_buf()),
+            ..ReplayOptions::default()
+        };
+        replay::replay(tiny(), &args, &shaping_engine::run::Silent)
+    };
+    for (out, what) in [
+        (
+            run_dir.join("second"),
+            format!("the directory of stage `second` of the run in `{}`", run_dir.display()),
+        ),
+        (run_dir.clone(), "a run directory (it holds `program.json`)".to_string()),
+    ] {
+        let err = error(replay_into(&out));
+        assert_eq!(err.kind(), ErrorKind::Invalid, "{err}");
+        assert_eq!(
+            err.message(),
+            format!(
+                "error: `{}` is {what}; a replay never writes into a run's directories: choose another `--out` \
+                 (by default a replay writes into `STAGE/replay` of the run)",
+                out.display()
+            )
+        );
+    }
+    // A stage's directory that is not there yet is the stage's all the same.
+    std::fs::remove_file(run_dir.join(DirLock::FILE)).unwrap();
+    let mut program = tiny();
+    program.stages[1].name = "third".into();
+    shaping_engine::rundir::write_program(&run_dir, &program).unwrap();
+    let err = error(replay_into(&run_dir.join("third")));
+    assert!(err.message().contains("is the directory of stage `third` of the run in `"), "{err}");
+    // A directory a run wrote, wherever it is.
+    let moved = dir.path().join("moved");
+    std::fs::create_dir(&moved).unwrap();
+    std::fs::copy(run_dir.join("first/checkpoint.json"), moved.join("checkpoint.json")).unwrap();
+    let err = error(replay_into(&moved));
+    assert!(err.message().contains("is a directory of a run (it holds `checkpoint.json`)"), "{err}");
+    assert!(!run_dir.join("third").exists());
+    shaping_engine::rundir::write_program(&run_dir, &tiny()).unwrap();
+    #[cfg(unix)]
+    {
+        let link = dir.path().join("link");
+        std::os::unix::fs::symlink(run_dir.join("first"), &link).unwrap();
+        let err = error(replay_into(&link));
+        assert!(err.message().contains("is a symbolic link"), "{err}");
+    }
+    assert_eq!(files(&run_dir), before, "nothing of the run was touched");
+    // Its own directory, and an earlier replay's, are fine.
+    let out = dir.path().join("replayed");
+    replay_into(&out).unwrap();
+    replay_into(&out).unwrap();
+    replay_into(&run_dir.join("second/replay")).unwrap();
+}
+
+/// 47.8: a link planted in place of a stage's directory is refused, not
+/// followed.
+#[cfg(unix)]
+#[test]
+fn a_link_planted_in_place_of_a_stage_directory_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    let out = dir.path().join("run");
+    std::fs::create_dir(&out).unwrap();
+    std::os::unix::fs::symlink(&elsewhere, out.join("first")).unwrap();
+    let err = error(run(tiny(), &options(&out)));
+    assert_eq!(err.kind(), ErrorKind::Invalid, "{err}");
+    assert_eq!(
+        err.message(),
+        format!(
+            "error: `{}` is a symbolic link; a run writes only into directories of its own, never through a \
+             link: remove it, or choose another `--out`",
+            out.join("first").display()
+        )
+    );
+    assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0, "nothing written through the link");
+}
+
+/// Removes the run's lock at its first generation, then lets it go on.
+struct RemoveLock {
+    barrier: Arc<Barrier>,
+    held: Cell<bool>,
+}
+
+impl Observer for RemoveLock {
+    fn event(&self, event: Event<'_>) {
+        if let Event::Generation { .. } = event {
+            if !self.held.replace(true) {
+                self.barrier.wait();
+                self.barrier.wait();
+            }
+        }
+    }
+}
+
+/// 47.8: a `.lock` deleted by hand lets a second run in; the first says,
+/// at its next write, that its lock was removed, and stops.
+#[test]
+fn a_run_whose_lock_was_removed_says_so_at_its_next_write() {
+    let dir = tempfile::tempdir().unwrap();
+    let barrier = Arc::new(Barrier::new(2));
+    let out = dir.path().to_path_buf();
+    let first = {
+        let barrier = Arc::clone(&barrier);
+        std::thread::spawn(move || {
+            let observer = RemoveLock { barrier, held: Cell::new(false) };
+            let runner = Runner { observer: &observer, ..Runner::default() };
+            runner.run(tiny(), &options(&out)).map(|_| ())
+        })
+    };
+    barrier.wait();
+    let lock = dir.path().join(DirLock::FILE);
+    std::fs::remove_file(&lock).unwrap();
+    // Another process gets in: its lock is a new file (in this process, a
+    // second lock of the directory could be told from the first by nothing
+    // but the thread).
+    std::fs::write(&lock, "shaping, process 1").unwrap();
+    barrier.wait();
+    let err = first.join().unwrap().unwrap_err();
+    assert_eq!(err.kind(), ErrorKind::Locked, "{err}");
+    assert!(
+        err.message().starts_with(&format!(
+            "error: the lock `{}` was replaced while this process held it, so another run may be writing into `{}`; \
+             stopped before writing `{}",
+            lock.display(),
+            dir.path().display(),
+            dir.path().join("first").join(SEALS).display()
+        )),
+        "{err}"
+    );
+    // Removed and not replaced.
+    let held = DirLock::acquire(dir.path()).unwrap();
+    std::fs::remove_file(held.path()).unwrap();
+    let err = shaping_engine::files::write_atomic(&dir.path().join("x"), b"x").unwrap_err();
+    assert!(err.message().contains("` was removed while this process held it"), "{err}");
+    drop(held);
+    shaping_engine::files::write_atomic(&dir.path().join("x"), b"x").unwrap();
 }
