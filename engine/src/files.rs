@@ -23,6 +23,8 @@
 //!   matching its seal. A file whose seal does not match is `Corrupt`,
 //!   naming it; a file with no seal (a directory written before seals) is
 //!   read, and the caller is told ([`Unsealed`]) so that it warns.
+//! - [`remove_stale_temporaries`]: under a new lock, the temporary files
+//!   that killed processes left behind.
 
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
@@ -232,6 +234,7 @@ impl DirLock {
             lock: path.clone(),
             id,
         });
+        remove_stale_temporaries(dir);
         Ok(DirLock { _file: file, path })
     }
 
@@ -252,6 +255,53 @@ fn open_lock_file(path: &Path) -> std::io::Result<File> {
 #[cfg(not(unix))]
 fn open_lock_file(path: &Path) -> std::io::Result<File> {
     OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path)
+}
+
+/// The process that wrote temporary file `name` ([`write_atomic`]'s
+/// `.NAME.PID.N.tmp`), if it is one.
+fn temporary_owner(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
+    let (rest, n) = rest.rsplit_once('.')?;
+    let (target, pid) = rest.rsplit_once('.')?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    (!target.is_empty() && digits(n) && digits(pid)).then(|| pid.parse().ok()).flatten()
+}
+
+/// Whether process `pid` may be alive: `false` only when it is known to be
+/// gone (`/proc` has no entry for it); where there is no `/proc`, every
+/// process may be.
+fn may_be_alive(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
+}
+
+/// Removes the temporary files of [`write_atomic`] that processes which
+/// are gone left in `dir` and the directories below it (a kill during a
+/// write leaves one; a checkpoint's may be megabytes). Called under the
+/// directory's lock; a live process's file and anything that is not a
+/// plain file (a link) are left alone, and nothing is followed.
+pub fn remove_stale_temporaries(dir: &Path) {
+    // A run's stage, an experiment's point, seed and stage, and `.writing`.
+    const DEPTH: usize = 5;
+    let mut stack = vec![(dir.to_path_buf(), 0)];
+    while let Some((d, depth)) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else { continue };
+        for entry in entries.flatten() {
+            let Ok(kind) = entry.file_type() else { continue };
+            if kind.is_dir() && depth < DEPTH {
+                stack.push((entry.path(), depth + 1));
+            } else if kind.is_file() {
+                let name = entry.file_name();
+                let stale = temporary_owner(&name.to_string_lossy()).is_some_and(|pid| !may_be_alive(pid));
+                if stale {
+                    let _ = std::fs::remove_file(entry.path());
+                }
+            }
+        }
+    }
 }
 
 /// The name of a directory's seals ([`write_sealed`]).

@@ -1,8 +1,9 @@
 //! Only what a run sealed is trusted (issue 47): a checksum removed is no
 //! way around it, every file a report or a resume reads is sealed, a
 //! replay never writes into a run's stage directory, a link planted in
-//! place of a stage directory is refused, and a lock removed by hand is
-//! said by the run that held it.
+//! place of a stage directory is refused, a lock removed by hand is said
+//! by the run that held it, and the temporary files of killed processes
+//! go.
 
 mod common;
 
@@ -11,7 +12,7 @@ use std::path::Path;
 use std::sync::{Arc, Barrier};
 
 use common::{error, files, options, run, tiny, tiny_bat, Log};
-use shaping_engine::files::{DirLock, SEALS};
+use shaping_engine::files::{remove_stale_temporaries, DirLock, SEALS};
 use shaping_engine::replay::{self, ReplayOptions};
 use shaping_engine::run::{Event, Observer, Runner};
 use shaping_engine::{html, ErrorKind};
@@ -268,4 +269,49 @@ fn a_run_whose_lock_was_removed_says_so_at_its_next_write() {
     assert!(err.message().contains("` was removed while this process held it"), "{err}");
     drop(held);
     shaping_engine::files::write_atomic(&dir.path().join("x"), b"x").unwrap();
+}
+
+/// 47.9: a killed write's temporary file is removed by the next run in the
+/// directory, under its lock; a live process's is not.
+#[test]
+fn the_next_run_removes_the_temporary_files_of_dead_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A process that is gone: a child that has exited (and been waited for).
+    let mut child = std::process::Command::new("true").spawn().unwrap();
+    let dead = child.id();
+    child.wait().unwrap();
+    let alive = std::process::id();
+    std::fs::create_dir_all(dir.path().join("first/.writing")).unwrap();
+    let stale = [
+        dir.path().join(format!(".program.json.{dead}.0.tmp")),
+        dir.path().join(format!("first/.checkpoint.json.{dead}.7.tmp")),
+        dir.path().join(format!("first/.writing/.summary.json.{dead}.2.tmp")),
+    ];
+    let kept = [
+        dir.path().join(format!("first/.checkpoint.json.{alive}.3.tmp")),
+        dir.path().join("first/.checkpoint.json.tmp"),
+        dir.path().join(format!("first/checkpoint.json.{dead}.1.tmp")),
+        dir.path().join(format!("first/.{dead}.1.tmp")),
+    ];
+    for f in stale.iter().chain(&kept) {
+        std::fs::write(f, "partial").unwrap();
+    }
+    run(tiny(), &options(dir.path())).unwrap();
+    for f in &stale {
+        assert!(!f.exists(), "{} removed", f.display());
+    }
+    for f in &kept {
+        assert!(f.exists(), "{} kept", f.display());
+    }
+    // Called directly: links are never removed or followed.
+    #[cfg(unix)]
+    {
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "precious").unwrap();
+        let link = dir.path().join(format!(".best.genome.{dead}.0.tmp"));
+        std::os::unix::fs::symlink(&victim, &link).unwrap();
+        remove_stale_temporaries(dir.path());
+        assert!(std::fs::symlink_metadata(&link).is_ok());
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    }
 }
