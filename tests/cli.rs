@@ -788,3 +788,54 @@ fn json_diagnostics_have_lines_and_columns() {
     let human = run(shaping().arg("check").arg(&file).args(["--error-format", "plain"]));
     assert!(text(&human.stderr).contains("window_too_large.bat:12:50"), "{}", text(&human.stderr));
 }
+
+/// `report` shows a damaged file by name, exit 2, and warns about files
+/// from before seals (read, but unchecked); `replay --out` into a stage's
+/// directory is refused before anything runs.
+#[test]
+fn report_names_a_damaged_file_and_warns_about_unsealed_ones() {
+    let dir = scratch("seals");
+    let runs = dir.join("run");
+    assert!(run_tiny(&runs, &["--no-report"]).status.success());
+    let genome = runs.join("first/best.genome");
+    let good = std::fs::read_to_string(&genome).unwrap();
+    let flipped = match good.strip_prefix('0') {
+        Some(rest) => format!("1{rest}"),
+        None => format!("0{}", &good[1..]),
+    };
+    std::fs::write(&genome, flipped).unwrap();
+    let r = run(shaping().arg("report").arg(&runs));
+    assert_eq!(r.status.code(), Some(2), "{}", text(&r.stderr));
+    assert!(
+        text(&r.stderr).contains(&format!("error: `{}` is corrupt", genome.display())),
+        "{}",
+        text(&r.stderr)
+    );
+    std::fs::write(&genome, good).unwrap();
+    std::fs::remove_file(runs.join("first/.seals")).unwrap();
+    let r = run(shaping().arg("report").arg(&runs));
+    assert!(r.status.success(), "{}", text(&r.stderr));
+    let err = text(&r.stderr);
+    assert!(
+        err.starts_with(&format!(
+            "warning: 3 files have no seal (`{}` and 2 more): written before runs sealed their files",
+            genome.display()
+        )),
+        "{err}"
+    );
+    let episode = std::fs::read(runs.join("second/episode.json")).unwrap();
+    let r = run(shaping()
+        .arg("replay")
+        .arg(tiny())
+        .args(["--stage", "second", "--run"])
+        .arg(&runs)
+        .arg("--out")
+        .arg(runs.join("second")));
+    assert_eq!(r.status.code(), Some(2), "{}", text(&r.stderr));
+    assert!(
+        text(&r.stderr).contains("a replay never writes into a run's directories"),
+        "{}",
+        text(&r.stderr)
+    );
+    assert_eq!(std::fs::read(runs.join("second/episode.json")).unwrap(), episode);
+}
