@@ -317,13 +317,13 @@ pub fn unsealed_warning(paths: &[PathBuf]) -> Option<String> {
     paths.sort();
     paths.dedup();
     let first = paths.first()?;
-    let which = match paths.len() {
-        1 => format!("`{}` has no seal", first.display()),
-        n => format!("{n} files have no seal (`{}` and {} more)", first.display(), n - 1),
+    let (which, it) = match paths.len() {
+        1 => (format!("`{}` has no seal", first.display()), "it"),
+        n => (format!("{n} files have no seal (`{}` and {} more)", first.display(), n - 1), "them"),
     };
     Some(format!(
-        "warning: {which}: written before runs sealed their files (or its seal was removed), so damage to it \
-         cannot be detected; running the stage again (`--fresh`) seals it"
+        "warning: {which}: written before runs sealed their files (or the seal was removed), so damage to {it} \
+         cannot be detected; running the stage again (`--fresh`) seals {it}"
     ))
 }
 
