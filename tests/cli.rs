@@ -790,8 +790,8 @@ fn json_diagnostics_have_lines_and_columns() {
 }
 
 /// `report` shows a damaged file by name, exit 2, and warns about files
-/// from before seals (read, but unchecked); `replay --out` into a stage's
-/// directory is refused before anything runs.
+/// from before seals (read, but unchecked); `replay --out` and `drive
+/// --out` into a stage's directory are refused before anything runs.
 #[test]
 fn report_names_a_damaged_file_and_warns_about_unsealed_ones() {
     let dir = scratch("seals");
@@ -837,5 +837,16 @@ fn report_names_a_damaged_file_and_warns_about_unsealed_ones() {
         "{}",
         text(&r.stderr)
     );
+    assert_eq!(std::fs::read(runs.join("second/episode.json")).unwrap(), episode);
+    // `drive` too, before the port is opened.
+    let r = run(shaping()
+        .arg("drive")
+        .arg(tiny())
+        .args(["--stage", "second", "--port", "/dev/no-such-port", "--run"])
+        .arg(&runs)
+        .arg("--out")
+        .arg(runs.join("second")));
+    assert_eq!(r.status.code(), Some(2), "{}", text(&r.stderr));
+    assert!(text(&r.stderr).contains("`drive` never writes into a run's directories"), "{}", text(&r.stderr));
     assert_eq!(std::fs::read(runs.join("second/episode.json")).unwrap(), episode);
 }

@@ -65,12 +65,18 @@ const RUN_FILES: &[&str] =
 /// replay's own directory (its `genome` beside `program.json`), a new one
 /// or any other is fine.
 pub fn check_replay_out(out: &Path) -> Result<()> {
+    check_output_dir(out, "a replay", "replay")
+}
+
+/// [`check_replay_out`] for any command that writes an episode's files
+/// (`who`: "a replay", "`drive`"), by default into `STAGE/{sub}` of the run.
+pub fn check_output_dir(out: &Path, who: &str, sub: &str) -> Result<()> {
     let refuse = |what: String| {
         Error::new(
             ErrorKind::Invalid,
             format!(
-                "error: `{}` is {what}; a replay never writes into a run's directories: choose another `--out` \
-                 (by default a replay writes into `STAGE/replay` of the run)",
+                "error: `{}` is {what}; {who} never writes into a run's directories: choose another `--out` \
+                 (by default {who} writes into `STAGE/{sub}` of the run)",
                 out.display()
             ),
         )

@@ -80,6 +80,8 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let stage = &program.stages[index];
     check_robot_world(stage)?;
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
+    shaping_engine::rundir::check_output_dir(&out, "`drive`", "drive")?;
     // The life length and learning the stage declares, as in `replay`.
     let declared = EvalOptions::of(stage);
     let actions = args.actions.unwrap_or(declared.actions);
@@ -110,7 +112,6 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let scene = robot.host().scene();
     // The trace is written as the robot drives: a process killed (even with
     // SIGKILL) keeps every action but the last few.
-    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
     create_dir(&out)?;
     let mut written = report::TraceWriter::create(&out.join("trace.csv"), stage)?;
     let started = Instant::now();
