@@ -30,6 +30,9 @@ pub fn experiment(plan: &Plan, jobs: Option<usize>, cluster: Option<&Coordinator
         }
     }
     let finished = plan.finish()?;
+    if let Some(w) = shaping_engine::files::unsealed_warning(&finished.unsealed) {
+        eprintln!("{w}");
+    }
     out!("{}", finished.summary)?;
     for path in finished.reports {
         eprintln!("report: {}", path.display());

@@ -238,6 +238,8 @@ impl Plan {
     /// reports, from the files the tasks wrote.
     pub fn finish(&self) -> Result<Finished, Error> {
         let mut finished = Finished::default();
+        let unsealed = std::cell::RefCell::new(Vec::new());
+        let u = |p: &Path| unsealed.borrow_mut().push(p.to_path_buf());
         let program = &self.program;
         // Titled by the file: several files may share a robot (and so a program name).
         let title = self
@@ -254,7 +256,8 @@ impl Plan {
             // The point's program: the values that ran, not the file's.
             let mut ran = program.clone();
             sweep::apply(&mut ran, point)?;
-            let (md, stages) = summarise(&ran, &self.stages, &heading, &dir, &self.seeds, &self.criteria)?;
+            let (md, stages) =
+                summarise(&ran, &self.stages, &heading, &dir, &self.seeds, &self.criteria, &u)?;
             write_atomic(&dir.join("summary.md"), md.as_bytes())?;
             if self.args.sets.is_empty() {
                 finished.summary.push_str(&md);
@@ -290,22 +293,28 @@ impl Plan {
         if !self.args.no_report {
             // After `summary.json`: a point's report lists the sweep's points.
             for i in 0..self.points.len() {
-                finished.reports.push(crate::html::write(&self.point_dir(i), None)?);
+                finished.reports.push(crate::html::write_with(&self.point_dir(i), None, &u)?);
             }
             if !self.args.sets.is_empty() {
-                finished.reports.push(crate::html::write(&self.out, None)?);
+                finished.reports.push(crate::html::write_with(&self.out, None, &u)?);
             }
         }
+        finished.unsealed = unsealed.take();
+        finished.unsealed.sort();
+        finished.unsealed.dedup();
         Ok(finished)
     }
 }
 
 /// What an experiment's end wrote: the summary to show (the `summary.md`
-/// of its point, or the sweep's table) and the reports.
+/// of its point, or the sweep's table) and the reports; and the files it
+/// read without a seal (written before seals), for a warning
+/// ([`crate::files::unsealed_warning`]).
 #[derive(Clone, Debug, Default)]
 pub struct Finished {
     pub summary: String,
     pub reports: Vec<PathBuf>,
+    pub unsealed: Vec<PathBuf>,
 }
 
 /// Most seeds an experiment runs.
@@ -443,11 +452,12 @@ fn sweep_table(
     md
 }
 
-fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T, Error> {
-    // Sealed by the seed's run (a test stage's files are written each time
-    // it runs).
+fn read_json<T: serde::de::DeserializeOwned>(
+    unsealed: crate::files::Unsealed<'_>,
+    path: &Path,
+) -> Result<T, Error> {
     let bytes =
-        crate::files::read_checked(path, rundir::REWRITE, &|_| {})?.ok_or_else(|| missing(path))?.bytes;
+        crate::files::read_checked(path, rundir::REWRITE, unsealed)?.ok_or_else(|| missing(path))?.bytes;
     serde_json::from_slice(&bytes)
         .map_err(|e| Error::new(ErrorKind::Corrupt, format!("error: cannot read `{}`: {e}", path.display())))
 }
@@ -469,6 +479,7 @@ fn summarise(
     out: &Path,
     seeds: &[u64],
     criteria: &[(String, f32)],
+    unsealed: crate::files::Unsealed<'_>,
 ) -> Result<(String, Vec<serde_json::Value>), Error> {
     let mut json = Vec::new();
     let mut md = String::new();
@@ -492,7 +503,7 @@ fn summarise(
                 let criterion = criteria.iter().find(|(s, _)| *s == stage.name).map(|c| c.1);
                 for &seed in seeds {
                     let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
-                    let cp: Checkpoint = rundir::read_checkpoint(&dir)?
+                    let cp: Checkpoint = rundir::read_checkpoint_with(&dir, unsealed)?
                         .ok_or_else(|| missing(&rundir::checkpoint_path(&dir)))?;
                     let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
                     if let Some(last) = own.last() {
@@ -547,8 +558,8 @@ fn summarise(
                 let mut perf = Vec::new();
                 for &seed in seeds {
                     let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
-                    let t =
-                        rundir::read_trained(&dir)?.ok_or_else(|| missing(&rundir::trained_path(&dir)))?;
+                    let t = rundir::read_trained_with(&dir, unsealed)?
+                        .ok_or_else(|| missing(&rundir::trained_path(&dir)))?;
                     let learners =
                         stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
                     perf.extend(learners.map(|(_, p)| *p as f64));
@@ -569,6 +580,7 @@ fn summarise(
                 let mut rel = Vec::new();
                 for &seed in seeds {
                     let v: serde_json::Value = read_json(
+                        unsealed,
                         &rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name).join("summary.json"),
                     )?;
                     fit.push(v["fitness"].as_f64().unwrap_or(f64::NAN));

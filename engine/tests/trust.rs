@@ -315,3 +315,26 @@ fn the_next_run_removes_the_temporary_files_of_dead_processes() {
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
     }
 }
+
+/// An experiment's summaries and reports read its seeds' files as a report
+/// does: those without a seal are listed for a warning.
+#[test]
+fn an_experiment_lists_the_files_it_read_without_a_seal() {
+    use shaping_engine::experiment::{ExperimentOptions, Plan};
+    let dir = tempfile::tempdir().unwrap();
+    let opts = || ExperimentOptions { no_report: false, ..common::tiny_experiment(dir.path(), 2) };
+    let finished = common::experiment(tiny(), opts()).unwrap();
+    assert_eq!(finished.unsealed, Vec::<std::path::PathBuf>::new());
+    for seed in ["seed-1", "seed-2"] {
+        std::fs::remove_file(dir.path().join(seed).join("second").join(SEALS)).unwrap();
+    }
+    let finished = Plan::new(tiny(), opts()).unwrap().finish().unwrap();
+    let names: Vec<String> = finished
+        .unsealed
+        .iter()
+        .map(|p| p.strip_prefix(dir.path()).unwrap().display().to_string())
+        .filter(|p| p.contains("/second/"))
+        .collect();
+    assert!(names.iter().any(|n| n.ends_with("second/best.genome")), "{names:?}");
+    assert!(names.iter().any(|n| n.ends_with("second/generations.csv")), "{names:?}");
+}
