@@ -101,7 +101,9 @@ pub fn check_output_dir(out: &Path, who: &str, sub: &str) -> Result<()> {
     if program_path(out).exists() && !replay {
         return Err(refuse("a run directory (it holds `program.json`)".into()));
     }
-    if let Some(file) = RUN_FILES.iter().find(|f| out.join(f).exists()) {
+    // A drive's or a replay's own directory holds a `summary.json` too.
+    let own = |f: &&&str| replay && **f == "summary.json";
+    if let Some(file) = RUN_FILES.iter().filter(|f| !own(f)).find(|f| out.join(f).exists()) {
         return Err(refuse(format!("a directory of a run (it holds `{file}`)")));
     }
     Ok(())
