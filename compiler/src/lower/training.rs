@@ -226,7 +226,9 @@ impl Lower<'_> {
                     span: set.name.span.into(),
                     what: "evolution setting",
                     name: n.to_string(),
-                    help: did_you_mean(n, EVOLVE_SETTINGS),
+                    help: did_you_mean(n, EVOLVE_SETTINGS).or_else(|| {
+                        Some(format!("the evolution settings are {}", expr::backticked(&EVOLVE_SETTINGS)))
+                    }),
                 }),
             }
         }
