@@ -283,6 +283,7 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::unsigned | Rule::literal => "a number",
         Rule::unit | Rule::unknown_unit => "a unit",
         Rule::range => "a range `lo..hi`",
+        Rule::variants_aggregate => "`mean` or `min`",
         Rule::robot | Rule::robot_adds => "`robot`",
         Rule::genome => "`genome`",
         Rule::stage => "`stage`",
@@ -1443,7 +1444,7 @@ fn variants(p: Pair<Rule>) -> VariantsDecl {
     let mut list = Vec::new();
     for c in p.into_inner() {
         match c.as_rule() {
-            Rule::ident => aggregate = name(c),
+            Rule::variants_aggregate => aggregate = name(c),
             Rule::variants_draw => {
                 draw = c.into_inner().find(|q| q.as_rule() == Rule::quantity).map(quantity)
             }
