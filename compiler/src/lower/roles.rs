@@ -111,10 +111,7 @@ impl Lower<'_> {
                     where_: what,
                     robots,
                     roles: sum,
-                    help: format!(
-                        "with roles, the team is the roles' robots ({}): leave `robots` out of the world, or change the roles' `robots`",
-                        st_roles.iter().map(|r| format!("`{}` {}", r.name, r.robots)).collect::<Vec<_>>().join(", ")
-                    ),
+                    help: self.role_robots_help(st_roles, heads, block),
                 });
             }
             Some(_) => {}
@@ -127,6 +124,30 @@ impl Lower<'_> {
             }
         }
         ws.world.robots = sum.min(u64::from(MAX_ROBOTS)) as u32;
+    }
+
+    /// How to make `robots N` in `block` agree with the roles: in the stage
+    /// that declares them, leave it out or change the roles; in a stage that
+    /// inherits them (whose roles it may not change, `S0028`), leave it out,
+    /// or change a role's robots for a run with `--set`.
+    fn role_robots_help(&self, st_roles: &[Role], heads: &[Span], block: Span) -> String {
+        let roles =
+            st_roles.iter().map(|r| format!("`{}` {}", r.name, r.robots)).collect::<Vec<_>>().join(", ");
+        let declaring = heads.first().and_then(|&h| self.file.stages.iter().find(|s| within(h, s.span)));
+        match declaring {
+            Some(d) if !within(block, d.span) => {
+                let role = st_roles.first().map_or("ROLE", |r| r.name.as_str());
+                let here = self.file.stages.iter().find(|s| within(block, s.span));
+                let stage = here.map_or("STAGE", |s| s.name.text.as_str());
+                format!(
+                    "with roles, the team is the roles' robots ({roles}), declared by stage `{}` and kept by the stages that extend it: leave `robots` out here; to run this stage with other numbers, pass `--set {stage}.{role}.robots=N`",
+                    d.name.text
+                )
+            }
+            _ => format!(
+                "with roles, the team is the roles' robots ({roles}): leave `robots` out of the world, or change the roles' `robots`"
+            ),
+        }
     }
 
     /// A stage with roles (declared, or inherited from the stage it
