@@ -46,21 +46,26 @@ pub fn check(source: &str, file_name: &str) -> (Option<Program>, Diagnostics) {
     let (mut program, mut diagnostics) = lower::lower(&file, file_name);
     if !units.is_empty() {
         // Every unknown unit, and every other mistake: what the checks say
-        // of a quantity with an unknown unit (read as a bare number) is a
-        // consequence of the unit, not reported.
+        // of a quantity with an unknown unit (read as a bare number), or of
+        // a part of the file that holds one (`arena 1.2m x 1.2m`: an arena
+        // too small for the body), is a consequence of the unit, not reported.
         program = None;
         diagnostics.retain(|e| {
-            let at = first_label(e);
-            !units.iter().any(|(q, _)| at.is_some_and(|a| q.start <= a && a < q.end.max(q.start + 1)))
+            let Some((at, len)) = first_label(e) else { return true };
+            !units.iter().any(|(q, _)| {
+                let inside = q.start <= at && at < q.end.max(q.start + 1);
+                let around = at <= q.start && q.end <= at + len;
+                inside || around
+            })
         });
         diagnostics.extend(units.into_iter().map(|(_, e)| e));
-        diagnostics.sort_by_key(first_label);
+        diagnostics.sort_by_key(|e| first_label(e).map(|(at, _)| at));
     }
     (program, Diagnostics::new(file_name, source, diagnostics))
 }
 
-/// Where the first label of a diagnostic is.
-fn first_label(e: &Error) -> Option<usize> {
+/// Where the first label of a diagnostic is: its offset and length.
+fn first_label(e: &Error) -> Option<(usize, usize)> {
     use miette::Diagnostic;
-    e.labels().and_then(|mut l| l.next()).map(|l| l.offset())
+    e.labels().and_then(|mut l| l.next()).map(|l| (l.offset(), l.len()))
 }

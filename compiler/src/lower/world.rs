@@ -627,10 +627,18 @@ impl Lower<'_> {
                 (_, _, Some(arena)) => (*arena, "too small for the body"),
                 (_, _, None) => (stage, "does not fit"),
             };
-            let help = if ws.arena_bare && arena.is_some() {
+            // A bare arena read in the wrong unit: the larger unit in which it fits.
+            let fits = |scale: f32| diameter < w.min(d) * scale;
+            let help = if ws.arena_bare && arena.is_some() && fits(10.0) {
                 format!(
                     "a length without a unit is in millimetres: for centimetres, write `arena {}cm x {}cm`",
                     w, d
+                )
+            } else if ws.arena_bare && arena.is_some() && fits(1000.0) {
+                format!(
+                    "a length without a unit is in millimetres: for metres, write `arena {}mm x {}mm`",
+                    w * 1000.0,
+                    d * 1000.0
                 )
             } else {
                 format!("the body is {diameter} mm wide (twice its `radius`); make the arena larger")
