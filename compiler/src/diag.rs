@@ -324,6 +324,17 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    #[error("stage `{stage}` evolves, but has no genes of its own: evolution would not change it")]
+    #[diagnostic(code(S0029))]
+    EvolvedWithoutGenes {
+        #[label("{label}")]
+        span: SourceSpan,
+        stage: String,
+        label: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

@@ -227,9 +227,16 @@ pub const EXPLANATIONS: &[Explanation] = &[
     Explanation {
         code: "S0028",
         title: "roles where a stage cannot have them",
-        text: "Roles are declared by a stage that extends no stage and evolves its team. A training stage trains the modules of one robot, so it has no roles. A stage that extends a stage with roles keeps its roles, their modules and links (their genes frozen) and declares none of its own: it changes the world, the fitness or the evolution (a `test` stage, or an evolved stage in a new world).",
+        text: "Roles are declared by a stage that extends no stage and evolves its team. A training stage trains the modules of one robot, so it has no roles. A stage that extends a stage with roles keeps its roles, their modules and links (their genes frozen) and declares none of its own: it is a `test` stage, which runs the team's best in its own world (an evolved stage would have no genes to evolve: `S0029`).",
         wrong: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }"), "stage t extends s {\n  module n { sense ir  behavior back }\n}\n"),
-        right: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }"), "stage t extends s {\n  world changes { arena 500mm x 500mm }\n}\n"),
+        right: concat!(robot!(), stage!("role a robots 2 { module m { sense ir  behavior forward } }"), "stage t extends s {\n  world changes { arena 500mm x 500mm }\n  test best for 300 actions\n}\n"),
+    },
+    Explanation {
+        code: "S0029",
+        title: "an evolved stage without genes of its own",
+        text: "A stage evolves unless it tests (`test best ...`) or trains (`train for ...`), and evolution changes only the genes the stage introduces: those of earlier stages are frozen. A stage whose modules have only fixed or random weights and fixed links, or a later stage that adds no module and no evolvable link (a stage that extends a stage with roles can add none), would run generations over genomes that never change. Give it genes (`activation evolvable`, `weights evolvable` in a neural behavior, evolvable links, a new module), or, for a later stage, make it a `test` stage, which runs the best of the stage it extends in its world.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage bigger extends s {\n  world changes { arena 800mm x 800mm }\n}\n"),
+        right: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage bigger extends s {\n  world changes { arena 800mm x 800mm }\n  test best for 300 actions\n}\n"),
     },
 ];
 

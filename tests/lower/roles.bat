@@ -27,4 +27,5 @@ stage check extends gather {
 stage wider extends gather {
   world changes { arena 800mm x 800mm }
   fitness at end 1 - team.spread / 500, team min
+  test best for 100 actions
 }

@@ -9,4 +9,5 @@ stage t extends s {
   world changes { robots 2 }
   variants min { one { robots 1 } two { } }
   fitness adds team min
+  test best for 2 lives of 100 actions
 }

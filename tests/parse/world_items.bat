@@ -16,4 +16,5 @@ stage s {
 stage t extends s {
   world changes { cylinder post at (300mm, 400mm) diameter 60mm }
   world adds { wall from (0mm, 450mm) to (100mm, 450mm) }
+  test best for 300 actions
 }

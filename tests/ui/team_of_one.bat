@@ -6,4 +6,5 @@ stage alone {
 stage team extends alone {
   world { robots 3 }
   fitness adds at end -team.spread / 100, team min
+  test best for 100 actions
 }

@@ -17,6 +17,7 @@ stage t extends s {
 }
 stage u extends s {
   variants min { a { arena 500mm x 600mm } }   // not an item
+  test best for 100 actions
 }
 stage few extends s {
   variants min { a { } b { } c { } }

@@ -18,5 +18,5 @@ stage first {
 
 stage second extends first {
   world changes { lamp east at (390mm, 300mm) intensity 0 }
-  evolve { generations 2 }
+  test best for 300 actions
 }

@@ -1047,6 +1047,7 @@ impl<'a> Lower<'a> {
     ) -> (StageSt, Stage) {
         use ast::StageItem as I;
         let sname = decl.name.text.clone();
+        let errors_before = self.errors.len();
         // Hardware first: everything else may use it.
         for item in &decl.items {
             if let I::RobotAdds(hw, _) = item {
@@ -1167,6 +1168,7 @@ impl<'a> Lower<'a> {
         st.targets = std::mem::take(&mut self.targets);
         self.allocate(&mut st, s);
         self.check_role_genes(&st, decl);
+        self.check_evolved_genes(&st, decl, s, errors_before);
         self.check_genome_size(&st, decl);
         let mut stage = assemble(&st, &sname, s, parent);
         stage.variants = self.variant_worlds(&st, &sname, decl);

@@ -17,7 +17,7 @@ use crate::diag::Error;
 use crate::syntax::ast;
 
 /// How to make a role's modules evolvable, for messages.
-const EVOLVABLE_HELP: &str = "give one of its modules genes: `activation evolvable`, `weights evolvable` in a `behavior neural { ... }`, or evolvable links between its modules (`links all evolvable`)";
+pub(super) const EVOLVABLE_HELP: &str = "give one of its modules genes: `activation evolvable`, `weights evolvable` in a `behavior neural { ... }`, or evolvable links between its modules (`links all evolvable`)";
 
 /// Whether `inner` lies within `outer`.
 fn within(inner: Span, outer: Span) -> bool {

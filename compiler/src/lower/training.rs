@@ -114,6 +114,40 @@ impl Lower<'_> {
         }
     }
 
+    /// An evolved stage has genes of its own (frozen ones never change):
+    /// the error `S0029`, labelled where it evolves. Not reported after
+    /// another error of the stage (a module that failed has no genes), nor
+    /// for a stage that declares roles (a role without genes is `S0024`).
+    pub(super) fn check_evolved_genes(&mut self, st: &StageSt, decl: &ast::StageDecl, s: u16, since: usize) {
+        if !matches!(st.run, StageRun::Evolve(_))
+            || st.genes.iter().any(|g| g.stage == s)
+            || decl.roles().next().is_some()
+            || self.errors[since..].iter().any(|e| !e.is_warning())
+        {
+            return;
+        }
+        let own = decl.items.iter().find_map(|i| match i {
+            ast::StageItem::Evolve(_, sp) => Some(*sp),
+            _ => None,
+        });
+        let (span, label) = match (own, &decl.extends) {
+            (Some(sp), _) => (sp, "evolves here".to_string()),
+            (None, Some(p)) => (decl.name.span, format!("evolves, as stage `{}` does", p.text)),
+            (None, None) => (decl.name.span, "evolves (it has no `test` or `train`)".to_string()),
+        };
+        let help = match &decl.extends {
+            Some(_) if !st.roles.is_empty() => "a stage that extends a stage with roles keeps their genes, frozen, and adds none: make it a test stage (`test best for N actions`) to run the team in this world".to_string(),
+            Some(p) => format!("give it genes of its own (a new module, or new evolvable links: `link FROM -> TO evolvable`), or make it a test stage (`test best for N actions`) that runs the best of stage `{}` in this world", p.text),
+            None => super::roles::EVOLVABLE_HELP.to_string(),
+        };
+        self.errors.push(Error::EvolvedWithoutGenes {
+            span: span.into(),
+            stage: decl.name.text.clone(),
+            label,
+            help,
+        });
+    }
+
     pub(super) fn conflict_run(&mut self, span: Span, other: Span) {
         self.errors.push(Error::Conflict {
             span: span.into(),

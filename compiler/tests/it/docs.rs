@@ -174,11 +174,12 @@ mod world_facts {
 stage s {
   world { battery 50 actions }
   fitness per action 1
-  module m { sense ir  activation fixed 0  behavior forward }
+  module m { sense ir  behavior forward }
 }
 ";
         let p = shaping_compiler::compile(src, "battery.bat").unwrap();
-        let genome = shaping_runtime::genome::Genome { bits: vec![] };
+        // The one module drives whatever its genes.
+        let genome = shaping_runtime::genome::Genome { bits: vec![0; p.stages[0].layout.bits as usize] };
         let r = run_episode(
             &p.stages[0],
             &genome,

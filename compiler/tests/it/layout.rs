@@ -49,11 +49,11 @@ fn truncation_keeps_a_fifth_of_the_population_unless_told() {
     };
     let head = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n";
     let body = "fitness per action wheels[0]  module m { sense ir  behavior forward }";
-    let small = format!("{head}stage s {{ evolve {{ population 12 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} }}");
+    let small = format!("{head}stage s {{ evolve {{ population 12 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} module n {{ sense ir  behavior back }} }}");
     assert_eq!(keep(&small, 0), Selection::Truncation { keep: 2 });
     assert_eq!(keep(&small, 1), Selection::Truncation { keep: 6 });
     let told = format!(
-        "{head}stage s {{ evolve {{ population 12  selection truncation keep 3 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} }}"
+        "{head}stage s {{ evolve {{ population 12  selection truncation keep 3 }} {body} }}\nstage t extends s {{ evolve {{ population 30 }} module n {{ sense ir  behavior back }} }}"
     );
     assert_eq!(keep(&told, 0), Selection::Truncation { keep: 3 });
     assert_eq!(keep(&told, 1), Selection::Truncation { keep: 3 }, "an explicit keep is inherited");

@@ -15,20 +15,25 @@ stage alone {
 stage pack extends alone {
   world { robots 4 }
   fitness per action wheels[0], at end -team.spread / 100, team sum
+  test best for 100 actions
 }
 stage more extends pack {
   world changes { robots 6 }
   fitness adds per action 1
+  test best for 100 actions
 }
 stage again extends pack {
   fitness per action 1
+  test best for 100 actions
 }
 stage least extends pack {
   fitness adds team min
+  test best for 100 actions
 }
 stage varied extends alone {
   variants mean { few { } many { robots 3 } }
   fitness per action 1, team min
+  test best for 2 lives of 100 actions
 }
 ";
 

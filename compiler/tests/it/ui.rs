@@ -71,10 +71,11 @@ fn kind(e: &Error) -> &'static str {
         Error::EmptyRole { .. } => "EmptyRole",
         Error::RoleRobots { .. } => "RoleRobots",
         Error::RolesNotHere { .. } => "RolesNotHere",
+        Error::EvolvedWithoutGenes { .. } => "EvolvedWithoutGenes",
     }
 }
 
-const KINDS: [&str; 28] = [
+const KINDS: [&str; 29] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -103,6 +104,7 @@ const KINDS: [&str; 28] = [
     "EmptyRole",
     "RoleRobots",
     "RolesNotHere",
+    "EvolvedWithoutGenes",
 ];
 
 #[test]
