@@ -335,6 +335,19 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    /// The robot's or the team's state, or `distance_to`, where only
+    /// sensors are read (a module's reinforcement and conditions, `prev`).
+    #[error("{message}")]
+    #[diagnostic(code(S0030))]
+    NotASensor {
+        #[label("{label}")]
+        span: SourceSpan,
+        message: String,
+        label: String,
+        #[help]
+        help: Option<String>,
+    },
 }
 
 impl Error {

@@ -238,6 +238,13 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage bigger extends s {\n  world changes { arena 800mm x 800mm }\n}\n"),
         right: concat!(robot!(), stage!("module m { sense ir  behavior forward }"), "stage bigger extends s {\n  world changes { arena 800mm x 800mm }\n  test best for 300 actions\n}\n"),
     },
+    Explanation {
+        code: "S0030",
+        title: "the simulator's knowledge where only sensors are read",
+        text: "`robot.FIELD`, `team.FIELD` and `distance_to(NAME)` are what the simulator knows of the robot and its team, not what a robot senses: only a fitness reads them. A module's reinforcement program and its scripts' conditions read the robot's sensors (a real robot has no `team.grouped`), and `prev` reads a sensor's previous value, so `prev robot.x` has none. Read a sensor in the module, or move the term into the fitness.",
+        wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward  reinforce team.grouped > 0.5 ? 1 : -1 }")),
+        right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], at end team.grouped\n  module m { sense ir  behavior forward  reinforce max(ir) < 0.5 ? 1 : -1 }\n}\n"),
+    },
 ];
 
 /// The explanation of a code (`S0006`, any case).

@@ -286,7 +286,7 @@ impl Lower<'_> {
             }
         };
         if !scope.state || prev {
-            self.errors.push(Error::Value {
+            self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: "`distance_to` is the simulator's knowledge of the robot: only a fitness reads it"
                     .into(),
@@ -365,7 +365,7 @@ impl Lower<'_> {
             return Val::Err;
         };
         if !scope.state {
-            self.errors.push(Error::Value {
+            self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: format!(
                     "`{of}.{}` is the simulator's knowledge of the {of}: only a fitness reads it",
@@ -377,7 +377,7 @@ impl Lower<'_> {
             return Val::Err;
         }
         if prev {
-            self.errors.push(Error::Value {
+            self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: format!("`prev` reads sensors only, and `{of}.{}` is the {of}'s state", field.text),
                 label: "no previous value".into(),

@@ -72,10 +72,11 @@ fn kind(e: &Error) -> &'static str {
         Error::RoleRobots { .. } => "RoleRobots",
         Error::RolesNotHere { .. } => "RolesNotHere",
         Error::EvolvedWithoutGenes { .. } => "EvolvedWithoutGenes",
+        Error::NotASensor { .. } => "NotASensor",
     }
 }
 
-const KINDS: [&str; 29] = [
+const KINDS: [&str; 30] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -105,6 +106,7 @@ const KINDS: [&str; 29] = [
     "RoleRobots",
     "RolesNotHere",
     "EvolvedWithoutGenes",
+    "NotASensor",
 ];
 
 #[test]
