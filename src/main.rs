@@ -402,7 +402,13 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             match format {
                 LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index))?,
                 LayoutFormat::Json => {
-                    let json = serde_json::to_string_pretty(&program.stages[index].layout)
+                    let st = &program.stages[index];
+                    let layout = serde_json::json!({
+                        "stage": st.name,
+                        "bits": st.layout.bits,
+                        "genes": shaping_compiler::layout_rows(&program, index),
+                    });
+                    let json = serde_json::to_string_pretty(&layout)
                         .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
                     outln!("{json}")?;
                 }

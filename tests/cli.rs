@@ -180,6 +180,30 @@ fn layout_shows_frozen_and_evolvable_genes() {
     assert!(err.contains("no stage `nope`") && err.contains("navigation"), "{err}");
 }
 
+/// `layout --format json`: the table's rows as data, with its names
+/// (stages, modules, what each gene is), not indices and enums.
+#[test]
+fn layout_json_names_what_the_table_shows() {
+    let file = root().join("examples/khepera.bat");
+    let out = run(shaping().arg("layout").arg(&file).args(["--stage", "collect", "--format", "json"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["stage"], "collect");
+    let genes = v["genes"].as_array().unwrap();
+    let table = text(&run(shaping().arg("layout").arg(&file).args(["--stage", "collect"])).stdout);
+    assert_eq!(
+        genes.len(),
+        table.lines().filter(|l| l.contains("frozen") || l.contains("evolvable")).count() - 1
+    );
+    assert_eq!(genes[0]["stage"], "navigation");
+    assert!(genes[0]["module"].is_string() && genes[0]["frozen"] == true, "{}", genes[0]);
+    assert_eq!(genes[0]["what"], "bias");
+    let weight = genes.iter().find(|g| g["kind"] == "weight").unwrap();
+    assert!(weight["input"].as_str().unwrap().contains('['), "{weight}");
+    let link = genes.iter().find(|g| g["kind"] == "link").unwrap();
+    assert_eq!(link["what"], format!("link {}", link["link"].as_str().unwrap()));
+}
+
 #[test]
 fn graph_is_dot() {
     let out = run(shaping().arg("graph").arg(root().join("examples/khepera.bat")));

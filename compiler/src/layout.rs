@@ -3,6 +3,8 @@
 
 use std::fmt::Write as _;
 
+use serde::Serialize;
+
 use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Part, Program, Stage, StageRun, World};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
@@ -28,9 +30,70 @@ pub fn module_label(stage: &Stage, i: usize) -> String {
     }
 }
 
+/// One gene of a stage's layout, with the names the layout table shows:
+/// what [`layout_rows`] returns, and `shaping layout --format json` prints.
+/// A gene is `bits` bits of the genome from `offset`, the most significant
+/// bit first, read as a whole number `g` and decoded to `lo + (hi - lo) * g
+/// / (2^bits - 1)`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LayoutRow {
+    /// The gene's index in the layout.
+    pub gene: u32,
+    pub offset: u32,
+    pub bits: u8,
+    /// The stage that introduced the gene.
+    pub stage: String,
+    /// Its module: `avoid`, or `role.avoid` in a stage with roles.
+    pub module: String,
+    /// The role of the team that runs the module, in a stage with roles.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub team_role: Option<String>,
+    /// What it encodes, as the table's `role` column: `bias`, `weight
+    /// ir[3]`, `link avoid -> wander`, `behavior out1 weight ir[0]`.
+    pub what: String,
+    /// `activation`, `behavior` (a neural behavior's network) or `link`.
+    pub part: &'static str,
+    /// `bias`, `weight`, `context` (a recurrent unit's weight from the
+    /// previous activations) or `link`.
+    pub kind: &'static str,
+    /// The sensor element a weight reads: `ir[3]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<String>,
+    /// The hidden unit the gene belongs to (its bias, or a weight into it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hidden: Option<u16>,
+    /// The hidden unit a weight comes from (`weight h0 -> out`, `context h1 -> h0`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub from_hidden: Option<u16>,
+    /// The output of a neural behavior of several outputs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output: Option<u16>,
+    /// The link a link weight is: `avoid -> wander`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub link: Option<String>,
+    /// The gene's range, `lo..hi`.
+    pub lo: f32,
+    pub hi: f32,
+    /// Frozen (an earlier stage's: crossover and mutation leave it) or evolvable.
+    pub frozen: bool,
+}
+
+/// The rows of stage `stage`'s genome layout (index into `program.stages`;
+/// none for a stage the program lacks), in the layout's order.
+pub fn layout_rows(program: &Program, stage: usize) -> Vec<LayoutRow> {
+    let Some(st) = program.stages.get(stage) else { return Vec::new() };
+    (0..st.layout.genes.len() as u32).map(|i| describe(Some(program), st, i)).collect()
+}
+
 /// What gene `gene` of a stage's layout encodes, as the layout table shows it:
 /// `bias`, `weight ir[3]`, `link avoid -> wander`, `behavior out1 weight ir[0]`.
 pub fn role_text(stage: &Stage, gene: u32) -> String {
+    describe(None, stage, gene).what
+}
+
+/// Gene `gene` of stage `stage` as a row of the layout (`program`, when
+/// given, names the stage that introduced it).
+fn describe(program: Option<&Program>, stage: &Stage, gene: u32) -> LayoutRow {
     let g = &stage.layout.genes[gene as usize];
     let module = stage.modules.get(g.module as usize);
     let mname =
@@ -47,16 +110,65 @@ pub fn role_text(stage: &Stage, gene: u32) -> String {
         };
         chans.map(|c| channel_name(stage, c)).unwrap_or_else(|| format!("input {i}"))
     };
-    let text = match g.role {
-        GeneRole::Bias => "bias".to_string(),
-        GeneRole::Weight { input: i, hidden: None } => format!("weight {}", input(i)),
-        GeneRole::Weight { input: i, hidden: Some(h) } => format!("weight {} -> h{h}", input(i)),
-        GeneRole::HiddenBias { hidden } => format!("bias h{hidden}"),
-        GeneRole::HiddenOut { hidden } => format!("weight h{hidden} -> out"),
-        GeneRole::Context { from, hidden } => format!("context h{from} -> h{hidden}"),
-        GeneRole::Link { from } => format!("link {} -> {}", mname(from), mname(g.module)),
+    let team_role = (0..stage.roles.len())
+        .find(|&r| stage.role_modules(r).contains(&(g.module as usize)))
+        .and_then(|r| stage.roles.get(r))
+        .map(|r| r.name.clone());
+    let mut row = LayoutRow {
+        gene,
+        offset: g.offset,
+        bits: g.bits,
+        stage: program
+            .and_then(|p| p.stages.get(g.stage as usize))
+            .map(|s| s.name.clone())
+            .unwrap_or_default(),
+        module: module.map(|_| module_label(stage, g.module as usize)).unwrap_or_default(),
+        team_role,
+        what: String::new(),
+        part: if neural.is_some() { "behavior" } else { "activation" },
+        kind: "weight",
+        input: None,
+        hidden: None,
+        from_hidden: None,
+        output: None,
+        link: None,
+        lo: g.lo,
+        hi: g.hi,
+        frozen: g.frozen,
     };
-    match neural {
+    let text = match g.role {
+        GeneRole::Bias => {
+            row.kind = "bias";
+            "bias".to_string()
+        }
+        GeneRole::Weight { input: i, hidden } => {
+            row.input = Some(input(i));
+            row.hidden = hidden;
+            match hidden {
+                None => format!("weight {}", input(i)),
+                Some(h) => format!("weight {} -> h{h}", input(i)),
+            }
+        }
+        GeneRole::HiddenBias { hidden } => {
+            (row.kind, row.hidden) = ("bias", Some(hidden));
+            format!("bias h{hidden}")
+        }
+        GeneRole::HiddenOut { hidden } => {
+            row.from_hidden = Some(hidden);
+            format!("weight h{hidden} -> out")
+        }
+        GeneRole::Context { from, hidden } => {
+            (row.kind, row.from_hidden, row.hidden) = ("context", Some(from), Some(hidden));
+            format!("context h{from} -> h{hidden}")
+        }
+        GeneRole::Link { from } => {
+            let link = format!("{} -> {}", mname(from), mname(g.module));
+            (row.part, row.kind) = ("link", "link");
+            row.link = Some(link.clone());
+            format!("link {link}")
+        }
+    };
+    row.what = match neural {
         Some(nb) if nb.net.outputs > 1 => {
             let pos = nb.net.params.iter().position(|p| *p == Param::Gene(gene)).unwrap_or(0);
             let per_out =
@@ -65,14 +177,17 @@ pub fn role_text(stage: &Stage, gene: u32) -> String {
             let (i, h) = (nb.net.inputs as usize, nb.net.hidden as usize);
             let before = if h == 0 { 0 } else { Network::param_count_of(i, h, 0, nb.net.recurrent) };
             if pos >= before {
-                format!("behavior out{} {text}", (pos - before) / per_out)
+                let out = (pos - before) / per_out;
+                row.output = Some(out as u16);
+                format!("behavior out{out} {text}")
             } else {
                 format!("behavior {text}")
             }
         }
         Some(_) => format!("behavior {text}"),
         None => text,
-    }
+    };
+    row
 }
 
 /// The genome layout of stage `stage` (index into `program.stages`) as a
@@ -92,23 +207,17 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         program.stages.len(),
         program.name
     );
-    let rows: Vec<[String; 7]> = st
-        .layout
-        .genes
-        .iter()
-        .enumerate()
-        .map(|(i, g)| {
+    let rows: Vec<[String; 7]> = layout_rows(program, stage)
+        .into_iter()
+        .map(|r| {
             [
-                g.offset.to_string(),
-                g.bits.to_string(),
-                program.stages.get(g.stage as usize).map(|s| s.name.clone()).unwrap_or_default(),
-                st.modules
-                    .get(g.module as usize)
-                    .map(|_| module_label(st, g.module as usize))
-                    .unwrap_or_default(),
-                role_text(st, i as u32),
-                format!("{:.2}..{:.2}", g.lo, g.hi),
-                if g.frozen { "frozen" } else { "evolvable" }.to_string(),
+                r.offset.to_string(),
+                r.bits.to_string(),
+                r.stage,
+                r.module,
+                r.what,
+                format!("{:.2}..{:.2}", r.lo, r.hi),
+                if r.frozen { "frozen" } else { "evolvable" }.to_string(),
             ]
         })
         .collect();

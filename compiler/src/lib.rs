@@ -23,7 +23,7 @@ pub mod lower;
 pub mod syntax;
 
 pub use diag::{Diagnostics, Error};
-pub use layout::{module_label, render_graph, render_layout, role_text};
+pub use layout::{layout_rows, module_label, render_graph, render_layout, role_text, LayoutRow};
 pub use shaping_runtime::program::Program;
 
 /// Compiles the source of one architecture file. `file_name` names the

@@ -59,3 +59,37 @@ fn truncation_keeps_a_fifth_of_the_population_unless_told() {
     assert_eq!(keep(&told, 1), Selection::Truncation { keep: 3 }, "an explicit keep is inherited");
     assert_eq!(keep(&format!("{head}stage s {{ {body} }}"), 0), Selection::Truncation { keep: 20 });
 }
+
+/// `layout_rows` (`shaping layout --format json`): the names the table
+/// shows, and what each gene is, field by field.
+#[test]
+fn layout_rows_name_what_the_table_shows() {
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage first {
+  fitness per action wheels[0]
+  module go {
+    sense ir[2]
+    behavior neural { hidden 1 recurrent  outputs sign(2) -> forward | right | left | back  weights evolvable }
+  }
+}
+stage second extends first {
+  module back_off { sense ir[0]  activation evolvable hidden 1  behavior back }
+  links all evolvable
+}
+stage team {
+  fitness per action wheels[0]
+  role seeker robots 2 { module m { sense ir[7]  behavior forward } }
+}
+";
+    let p = compile_ok(src, "rows.bat");
+    let rows = shaping_compiler::layout_rows(&p, 1);
+    let table = shaping_compiler::render_layout(&p, 1);
+    for r in &rows {
+        let line = table.lines().nth(2 + r.gene as usize).unwrap();
+        assert!(line.contains(&r.what) && line.contains(&r.module) && line.contains(&r.stage), "{line}");
+    }
+    let team = shaping_compiler::layout_rows(&p, 2);
+    let json = serde_json::to_string_pretty(&serde_json::json!({ "second": rows, "team": team })).unwrap();
+    insta::assert_snapshot!(json);
+    assert!(shaping_compiler::layout_rows(&p, 9).is_empty());
+}
