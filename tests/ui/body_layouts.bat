@@ -14,7 +14,7 @@ stage t extends s {
   test best for 10 actions
 }
 stage u extends s {
-  world changes { body { ground at [(10mm, 1mm), (10mm, 2mm)] ground at [(1mm, 1mm)] proximity at [(1mm, 0mm), 0, 0, 0, 0, 0, 0, (28mm, 0mm)] facing [0, 0, 0, 0, 0, 0, 0, 90deg] } }
+  world changes { body { ground at [(10mm, 1mm), (10mm, 2mm)] ground at [(1mm, 1mm)] proximity at [(1mm, 0mm), 0, 0, 0, 0, 0, 0, (28mm, 0mm)] facing [0, 0, 0, 0, 0, 0, 0, 90mm] } }
   test best for 10 actions
 }
 stage v extends s {

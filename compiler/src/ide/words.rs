@@ -214,7 +214,7 @@ const LIST: &[Word] = &[
     w("height", C, CLAUSE, "`height H`: a lamp's height above the floor", ITEMS),
     w("intensity", C, CLAUSE, "`intensity K`: a lamp's brightness relative to the charger's lamp", ITEMS),
     w("grey", C, CLAUSE, "`grey G`: a zone's grey level, 0 black .. 1 white", ITEMS),
-    w("heading", C, CLAUSE, "`heading A`: degrees counter-clockwise from east", ITEMS),
+    w("heading", C, CLAUSE, "`heading A`: degrees counter-clockwise from east (`90` or `90deg`; radians as `1.57rad`); `robot.heading` reads radians", ITEMS),
     w("off", C, CLAUSE, "`off at N`: a lamp that switches off after the life's Nth action (`on at N`: on)", ITEMS),
     w("variants", C, STAGE, "`variants mean [draw N] { NAME { ITEMS } ... }`: named variants of the world; each individual is evaluated in every one", VARIANTS),
     w("draw", C, CLAUSE, "`draw N`: the variants drawn per generation (all, without it)", VARIANTS),
@@ -264,6 +264,8 @@ const LIST: &[Word] = &[
     w("mm", U, CLAUSE, "millimetres (a bare length is in millimetres)", LEXICAL),
     w("cm", U, CLAUSE, "centimetres", LEXICAL),
     w("ms", U, CLAUSE, "milliseconds", LEXICAL),
+    w("deg", U, CLAUSE, "degrees (a bare angle is in degrees)", LEXICAL),
+    w("rad", U, CLAUSE, "radians, as `robot.heading` reads them", LEXICAL),
 ];
 
 /// Every word: [`LIST`] and the catalog's sensor and actuator kinds (whose

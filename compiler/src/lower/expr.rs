@@ -29,7 +29,7 @@ pub const STATE_FIELDS: [(&str, usize, &str); 6] = [
     (
         "heading",
         shaping_runtime::state::ST_HEADING,
-        "the heading, radians counter-clockwise from east, -pi..pi",
+        "the heading, radians counter-clockwise from east, -pi..pi (a start's `heading` is written in degrees)",
     ),
     (
         "distance",

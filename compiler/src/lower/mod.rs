@@ -1342,6 +1342,7 @@ fn unit_desc(u: Unit) -> String {
         Unit::Mm | Unit::Cm => format!("a length (`{}`)", u.as_str()),
         Unit::Ms => "a duration (`ms`)".into(),
         Unit::Actions => "a count (`actions`)".into(),
+        Unit::Deg | Unit::Rad => format!("an angle (`{}`)", u.as_str()),
     }
 }
 

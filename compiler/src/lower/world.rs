@@ -260,9 +260,7 @@ impl Lower<'_> {
                         None => a,
                     };
                     let h = match heading {
-                        Some(q) => self
-                            .plain(q, "the heading (degrees)", -360.0, 360.0)
-                            .map(|d| Some(d.to_radians())),
+                        Some(q) => self.heading(q).map(|d| Some(d.to_radians())),
                         None => Some(None),
                     };
                     let (Some(from), Some(to), Some(heading)) = (a, b, h) else { continue };
@@ -843,18 +841,46 @@ impl Lower<'_> {
         Some(IrLayout { at: at.try_into().ok()?, facing: facing.try_into().ok()? })
     }
 
-    /// An angle in degrees, counter-clockwise from the heading: -180..180.
-    fn bearing(&mut self, q: &ast::Quantity, what: &str) -> Option<f32> {
-        if let Some(u) = q.unit {
-            self.errors.push(Error::Unit {
-                span: q.span.into(),
-                expected: "a plain number",
-                found: unit_desc(u),
-                help: Some(format!("{what} is in degrees, written without a unit")),
-            });
+    /// An angle, in degrees: a bare number or `deg`, or `rad` (radians,
+    /// converted). Any other unit is an error.
+    fn degrees(&mut self, q: &ast::Quantity, what: &str) -> Option<f64> {
+        match q.unit {
+            None | Some(Unit::Deg) => Some(q.value),
+            Some(Unit::Rad) => Some(q.value.to_degrees()),
+            Some(u) => {
+                self.errors.push(Error::Unit {
+                    span: q.span.into(),
+                    expected: "an angle",
+                    found: unit_desc(u),
+                    help: Some(format!(
+                        "{what} is an angle in degrees (`90` or `90deg`) or in radians (`1.57rad`)"
+                    )),
+                });
+                None
+            }
+        }
+    }
+
+    /// A start's `heading`: degrees (or `deg`, `rad`) counter-clockwise
+    /// from east, -360..360.
+    fn heading(&mut self, q: &ast::Quantity) -> Option<f32> {
+        let d = self.degrees(q, "the heading")?;
+        if !(-360.0..=360.0).contains(&d) {
+            self.value_error(
+                q.span,
+                "the heading must be between -360 and 360 degrees (or -6.28rad and 6.28rad), counter-clockwise from east".into(),
+                "out of range",
+                Some("a bare number is in degrees: `heading 90` faces north; `robot.heading` reads radians".into()),
+            );
             return None;
         }
-        if !(-180.0..=180.0).contains(&q.value) {
+        Some(d as f32)
+    }
+
+    /// An angle in degrees, counter-clockwise from the heading: -180..180.
+    fn bearing(&mut self, q: &ast::Quantity, what: &str) -> Option<f32> {
+        let value = self.degrees(q, what)?;
+        if !(-180.0..=180.0).contains(&value) {
             self.value_error(
                 q.span,
                 format!("{what} must be between -180 and 180 degrees, counter-clockwise from the heading"),
@@ -863,7 +889,7 @@ impl Lower<'_> {
             );
             return None;
         }
-        Some(q.value as f32)
+        Some(value as f32)
     }
 
     /// `(X, Y)` of the body frame, mm, on or inside the body of `radius`.

@@ -22,6 +22,10 @@ pub enum Unit {
     Cm,
     Ms,
     Actions,
+    /// Degrees, for an angle (`heading 90deg`).
+    Deg,
+    /// Radians, for an angle (`heading 1.57rad`).
+    Rad,
 }
 
 impl Unit {
@@ -31,6 +35,8 @@ impl Unit {
             Unit::Cm => "cm",
             Unit::Ms => "ms",
             Unit::Actions => "actions",
+            Unit::Deg => "deg",
+            Unit::Rad => "rad",
         }
     }
 }

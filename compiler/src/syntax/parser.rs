@@ -216,7 +216,7 @@ fn unknown_units(pairs: &pest::iterators::Pairs<Rule>) -> Vec<(Span, Error)> {
 }
 
 /// The units of the grammar's `unit` rule, for messages.
-const UNITS: &str = "the units are `mm` and `cm` (lengths), `ms` (durations) and `actions` (counts); a length without a unit is in millimetres";
+const UNITS: &str = "the units are `mm` and `cm` (lengths), `ms` (durations), `actions` (counts) and `deg` and `rad` (angles); a length without a unit is in millimetres, an angle in degrees";
 
 /// Rejects the first line longer than [`MAX_LINE`], labelled at its start.
 fn check_lines(src: &str) -> Option<Error> {
@@ -630,6 +630,8 @@ fn unit(p: &Pair<Rule>) -> Unit {
         "mm" => Unit::Mm,
         "cm" => Unit::Cm,
         "ms" => Unit::Ms,
+        "deg" => Unit::Deg,
+        "rad" => Unit::Rad,
         _ => Unit::Actions,
     }
 }

@@ -70,3 +70,30 @@ fn the_default_body_is_the_khepera() {
         assert!(!json.contains("preset") && !json.contains("\"ir\"") && !json.contains("ground"), "{json}");
     }
 }
+
+/// An angle is in degrees when bare or with `deg`, in radians with `rad`:
+/// a start's heading and a layout's bearings alike.
+#[test]
+fn angles_in_degrees_or_radians() {
+    let heading = |h: &str| {
+        let src = format!(
+            "robot r {{ sensor ir[8] proximity  actuator wheels[2] speed }}
+stage s {{
+  world {{ start at (200mm, 300mm) heading {h}  body {{ proximity facing [0, -45, -90, -150, 150, 90, 45, 0.5rad] }} }}
+  fitness per action wheels[0]
+  module m {{ sense ir  behavior forward }}
+}}
+"
+        );
+        let p = compile_ok(&src, "angles.bat");
+        let w = &p.stages[0].world;
+        let facing = w.body.ir.as_ref().expect("a layout").facing[7];
+        (w.items.start.as_ref().unwrap().heading.unwrap(), facing)
+    };
+    let right = std::f32::consts::FRAC_PI_2;
+    for h in ["90", "90deg", "90 deg", "1.5707963rad"] {
+        let (got, facing) = heading(h);
+        assert!((got - right).abs() < 1e-6, "{h}: {got}");
+        assert!((facing - 0.5f32.to_degrees()).abs() < 1e-4, "{facing}");
+    }
+}
