@@ -252,13 +252,17 @@ pub enum Error {
         help: String,
     },
 
-    /// A warning: `team` in a stage whose world has one robot.
-    #[error("stage `{stage}` combines a team's fitness, but its world has one robot")]
+    /// A warning: `team` in a stage whose world has one robot, or a fitness
+    /// reading the team's state (`team.spread`), which is then a constant.
+    #[error("stage `{stage}` {what}, but its world has one robot")]
     #[diagnostic(code(S0023), severity(Warning))]
     TeamOfOne {
-        #[label("no effect with one robot")]
+        #[label("{label}")]
         span: SourceSpan,
         stage: String,
+        /// `combines a team's fitness`, `reads `team.spread``.
+        what: String,
+        label: String,
         #[help]
         help: Option<String>,
     },
@@ -347,6 +351,20 @@ pub enum Error {
         label: String,
         #[help]
         help: Option<String>,
+    },
+
+    /// A warning: a module senses ambient light in a stage whose world
+    /// (and every variant's) has no lamp, so that every reading is 0.
+    #[error("stage `{stage}` senses `{sensor}`, but its world has no lamp: every reading is 0")]
+    #[diagnostic(code(S0031), severity(Warning))]
+    NoLamp {
+        #[label("module `{module}` senses it")]
+        span: SourceSpan,
+        stage: String,
+        sensor: String,
+        module: String,
+        #[help]
+        help: String,
     },
 }
 

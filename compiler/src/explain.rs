@@ -192,7 +192,7 @@ pub const EXPLANATIONS: &[Explanation] = &[
     Explanation {
         code: "S0023",
         title: "a team's fitness with one robot (a warning)",
-        text: "`team sum`, `team mean` or `team min` says how the fitness of a team's robots makes the team's; in a stage whose world (and every variant's) has one robot, it has no effect. The file compiles; declare `robots N` in the stage's `world`, or remove the clause.",
+        text: "`team sum`, `team mean` or `team min` says how the fitness of a team's robots makes the team's; in a stage whose world (and every variant's) has one robot, it has no effect. The same for a fitness that reads the team's state: with one robot, `team.spread` and `team.grouped` are always 0 and `team.largest` always 1. The file compiles; declare `robots N` in the stage's `world`, or remove the clause (or read the robot's own state, `robot.x` ...).",
         wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
     },
@@ -244,6 +244,13 @@ pub const EXPLANATIONS: &[Explanation] = &[
         text: "`robot.FIELD`, `team.FIELD` and `distance_to(NAME)` are what the simulator knows of the robot and its team, not what a robot senses: only a fitness reads them. A module's reinforcement program and its scripts' conditions read the robot's sensors (a real robot has no `team.grouped`), and `prev` reads a sensor's previous value, so `prev robot.x` has none. Read a sensor in the module, or move the term into the fitness.",
         wrong: concat!(robot!(), stage!("module m { sense ir  behavior forward  reinforce team.grouped > 0.5 ? 1 : -1 }")),
         right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], at end team.grouped\n  module m { sense ir  behavior forward  reinforce max(ir) < 0.5 ? 1 : -1 }\n}\n"),
+    },
+    Explanation {
+        code: "S0031",
+        title: "a light sensor in a world without a lamp (a warning)",
+        text: "An `ambient` sensor reads the light of the world's lamps (a `lamp` item, or a charger `with lamp`). In a stage whose world, and every variant's, has none, every reading is 0, so a module that senses it gets a constant input. The file compiles; add a lamp to the world, or sense something else.",
+        wrong: "robot r { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir, light  behavior forward }\n}\n",
+        right: "robot r { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }\nstage s {\n  world { lamp sun at (200mm, 300mm) }\n  fitness per action wheels[0]\n  module m { sense ir, light  behavior forward }\n}\n",
     },
 ];
 

@@ -8,6 +8,7 @@ robot epuck {
 stage puck {
   world {
     arena 500mm x 500mm
+    lamp sun at (250mm, 450mm)  // what `light` reads
     body e-puck { v_max 100  wheel_noise 0 }
   }
   fitness per action abs(wheels[0] + wheels[1]) / 2 * (1 - max(ir)) * floor[1]

@@ -3,7 +3,7 @@
 robot khepera { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }
 
 stage gather {
-  world { arena 600mm x 600mm }
+  world { arena 600mm x 600mm  lamp sun at (300mm, 300mm) }
   evolve { population 20  generations 5  actions 100 }
   fitness at end 1 - team.spread / 400, team mean
   role seeker robots 3 {

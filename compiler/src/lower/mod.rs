@@ -1173,6 +1173,7 @@ impl<'a> Lower<'a> {
         let mut stage = assemble(&st, &sname, s, parent);
         stage.variants = self.variant_worlds(&st, &sname, decl);
         self.check_team_clause(&stage, decl);
+        self.check_lamp(&st, &stage, s);
         (st, stage)
     }
 }

@@ -419,12 +419,55 @@ impl Lower<'_> {
                     self.errors.push(Error::TeamOfOne {
                         span: (*span).into(),
                         stage: stage.name.clone(),
+                        what: "combines a team's fitness".into(),
+                        label: "no effect with one robot".into(),
                         help: Some(
                             "`team` says how the fitness of several robots makes the team's: declare `robots N` in the stage's `world`, or remove the clause".into(),
                         ),
                     });
                 }
+                let mut reads = Vec::new();
+                for e in f.per_action.iter().chain(&f.at_end) {
+                    team_reads(e, &mut reads);
+                }
+                for (field, span) in reads {
+                    // The value `team.FIELD` has for one robot (see `TEAM_FIELDS`).
+                    let value = match field.as_str() {
+                        "spread" | "grouped" => "0",
+                        "largest" => "1",
+                        _ => continue,
+                    };
+                    self.errors.push(Error::TeamOfOne {
+                        span: span.into(),
+                        stage: stage.name.clone(),
+                        what: format!("reads `team.{field}`"),
+                        label: format!("always {value} with one robot"),
+                        help: Some(format!(
+                            "`team.{field}` measures a team of several robots: declare `robots N` in the stage's `world` (or a variant's), or read the robot's own state (`robot.x`, `robot.distance`, ...)"
+                        )),
+                    });
+                }
             }
+        }
+    }
+}
+
+/// The fields of `team.FIELD` an expression reads, where.
+fn team_reads(e: &ast::Expr, out: &mut Vec<(String, Span)>) {
+    use ast::ExprKind as K;
+    match &e.kind {
+        K::Team(field) => out.push((field.text.clone(), e.span)),
+        K::Number(..) | K::Ref(..) | K::State(_) => {}
+        K::Call(_, args) => args.iter().for_each(|a| team_reads(a, out)),
+        K::Unary(_, a) => team_reads(a, out),
+        K::Binary(_, a, b) => {
+            team_reads(a, out);
+            team_reads(b, out);
+        }
+        K::Cond(c, a, b) => {
+            team_reads(c, out);
+            team_reads(a, out);
+            team_reads(b, out);
         }
     }
 }

@@ -650,6 +650,48 @@ impl Lower<'_> {
         }
     }
 
+    /// A warning when a module this stage introduces senses ambient light
+    /// while the stage's world and every variant's have no lamp (a
+    /// charger's `with lamp` is one; a lamp intensity 0 is one, which a
+    /// variant or a later stage may light): every reading is 0. Once per
+    /// stage, at the first such module; not after a lamp refused with an error.
+    pub(super) fn check_lamp(&mut self, st: &StageSt, stage: &Stage, s: u16) {
+        let Some(light) = st.sensors.iter().find(|x| x.kind == catalog::SensorKind::Ambient) else { return };
+        let lit = |w: &World| {
+            !w.items.lamps.is_empty() || w.charger.as_ref().is_some_and(|c| c.lamp_height.is_some())
+        };
+        // A lamp refused with an error: the world without it is its consequence.
+        let refused = st.world.refused.iter().any(|(kind, _)| *kind == "lamp");
+        if refused || lit(&stage.world) || stage.variants.iter().flat_map(|v| &v.list).any(|v| lit(&v.world))
+        {
+            return;
+        }
+        let of_light =
+            |chans: &[u16]| chans.iter().any(|c| (light.channel..light.channel + light.count).contains(c));
+        let reads = st.modules.iter().filter(|m| m.stage == s).find_map(|m| {
+            let neural = match &m.behavior {
+                Some(Behavior::Neural(nb)) => of_light(&nb.inputs),
+                _ => false,
+            };
+            match (of_light(&m.inputs), neural) {
+                (true, _) => Some((m, m.inputs_span.unwrap_or(m.span))),
+                (false, true) => Some((m, m.span)),
+                _ => None,
+            }
+        });
+        let Some((m, span)) = reads else { return };
+        self.errors.push(Error::NoLamp {
+            span: span.into(),
+            stage: stage.name.clone(),
+            sensor: light.name.clone(),
+            module: m.name.clone(),
+            help: format!(
+                "`{}` is an `ambient` sensor, which reads the light of the world's lamps: add a lamp (`lamp at (X, Y)`, or a charger `with lamp`), or sense something else",
+                light.name
+            ),
+        });
+    }
+
     /// `body [PRESET] { ... }`: the preset (if any) replaces the whole body,
     /// then the settings and layouts change single values.
     pub(super) fn body(
@@ -1025,9 +1067,8 @@ pub(super) fn key_desc(key: &str) -> &'static str {
     }
 }
 
-/// Remembers that the named item of `kind` was refused with an error.
+/// Remembers that an item of `kind` was refused with an error (an unnamed
+/// one under the empty name, which no change names).
 fn refuse(ws: &mut WorldSt, kind: &'static str, name: Option<&ast::Name>) {
-    if let Some(n) = name {
-        ws.refused.insert((kind, n.text.clone()));
-    }
+    ws.refused.insert((kind, name.map(|n| n.text.clone()).unwrap_or_default()));
 }

@@ -73,10 +73,11 @@ fn kind(e: &Error) -> &'static str {
         Error::RolesNotHere { .. } => "RolesNotHere",
         Error::EvolvedWithoutGenes { .. } => "EvolvedWithoutGenes",
         Error::NotASensor { .. } => "NotASensor",
+        Error::NoLamp { .. } => "NoLamp",
     }
 }
 
-const KINDS: [&str; 30] = [
+const KINDS: [&str; 31] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -107,6 +108,7 @@ const KINDS: [&str; 30] = [
     "RolesNotHere",
     "EvolvedWithoutGenes",
     "NotASensor",
+    "NoLamp",
 ];
 
 #[test]
