@@ -366,6 +366,23 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    /// A warning: a variant a stage inherits restates an item the stage
+    /// changes, so that in that variant the stage's change is lost.
+    #[error("variant `{variant}` of stage `{from}` restates {item}, which stage `{stage}` changes: in that variant the change is lost")]
+    #[diagnostic(code(S0032), severity(Warning))]
+    VariantUndoesChange {
+        #[label(primary, "changed here")]
+        span: SourceSpan,
+        #[label("restated by variant `{variant}`")]
+        variant_span: SourceSpan,
+        stage: String,
+        variant: String,
+        from: String,
+        item: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

@@ -252,6 +252,13 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: "robot r { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }\nstage s {\n  fitness per action wheels[0]\n  module m { sense ir, light  behavior forward }\n}\n",
         right: "robot r { sensor ir[8] proximity  sensor light[8] ambient  actuator wheels[2] speed }\nstage s {\n  world { lamp sun at (200mm, 300mm) }\n  fitness per action wheels[0]\n  module m { sense ir, light  behavior forward }\n}\n",
     },
+    Explanation {
+        code: "S0032",
+        title: "a stage's world change that an inherited variant restates (a warning)",
+        text: "A stage without `variants` of its own inherits its parent's, each applied to the stage's world after the stage's own changes. A variant that restates an item the stage changes (the same lamp, wall, cylinder or zone by name, the start, the battery, the charger, the robots, or a part of the objects) puts its own item back: in that variant, the stage's change is lost (a test stage's lives in that variant run without it). The file compiles; declare the stage's own `variants { ... }`, which replace the inherited ones, with the change in each, or make the change in the variants themselves.",
+        wrong: concat!(robot!(), "stage s {\n  world { lamp sun at (200mm, 300mm) }\n  variants mean { near { lamp sun at (100mm, 100mm) } far { } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage dim extends s {\n  world changes { lamp sun at (200mm, 300mm) intensity 0.5 }\n  test best for 2 lives of 300 actions\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world { lamp sun at (200mm, 300mm) }\n  variants mean { near { lamp sun at (100mm, 100mm) } far { } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage dim extends s {\n  world changes { lamp sun at (200mm, 300mm) intensity 0.5 }\n  variants mean { near { lamp sun at (100mm, 100mm) intensity 0.5 } far { } }\n  test best for 2 lives of 300 actions\n}\n"),
+    },
 ];
 
 /// The explanation of a code (`S0006`, any case).

@@ -173,7 +173,65 @@ impl Lower<'_> {
         }
         if !here {
             self.errors.truncate(saved);
+            self.variants_undo_changes(v, st, sname, decl);
         }
         (!list.is_empty()).then_some(Variants { aggregate: v.aggregate, draw: v.draw, list })
+    }
+
+    /// The warning `S0032` for each item of `decl`'s own world blocks that
+    /// a variant it inherits (`v`) restates: the variant is applied to the
+    /// stage's world after the stage's changes, so in that variant the
+    /// stage's item is the variant's. With roles, the robots are the
+    /// roles' in every world (`S0027` says so): no change of them is lost.
+    fn variants_undo_changes(&mut self, v: &VariantsSt, st: &StageSt, sname: &str, decl: &ast::StageDecl) {
+        let own = decl.items.iter().filter_map(|i| match i {
+            ast::StageItem::World(w) => Some(&w.items),
+            _ => None,
+        });
+        let own: Vec<&ast::WorldItem> = own.flatten().collect();
+        let from = self.file.stages.iter().find(|s| s.span.start <= v.span.start && v.span.end <= s.span.end);
+        let from = from.map_or(String::new(), |s| s.name.text.clone());
+        for d in &v.decls {
+            for item in &d.world.items {
+                let Some(mine) = own.iter().find(|o| restates(o, item)) else { continue };
+                if !st.roles.is_empty() && item.key().0 == "robots" {
+                    continue;
+                }
+                let item = match item.key() {
+                    (kind, Some(name)) => format!("{kind} `{name}`"),
+                    (kind, None) => format!("the {kind}"),
+                };
+                self.errors.push(Error::VariantUndoesChange {
+                    span: mine.span().into(),
+                    variant_span: d.world.items.iter().find(|i| restates(mine, i)).map_or(d.span, |i| i.span()).into(),
+                    stage: sname.to_string(),
+                    variant: d.name.text.clone(),
+                    from: from.clone(),
+                    item,
+                    help: "the variants a stage inherits are applied to its world after its own changes: declare the stage's own `variants { ... }`, which replace them, with the change in each variant, or make the change in the variants".into(),
+                });
+            }
+        }
+    }
+}
+
+/// Whether world item `b` (of a variant) restates what `a` (of a stage)
+/// sets: the same item of a list by name, the same setting, or, for
+/// objects, a part of them both write.
+fn restates(a: &ast::WorldItem, b: &ast::WorldItem) -> bool {
+    use ast::WorldItem as W;
+    if let (
+        W::Objects { count: c1, diameter: d1, virtual_: v1, .. },
+        W::Objects { count: c2, diameter: d2, virtual_: v2, .. },
+    ) = (a, b)
+    {
+        return (c1.is_some() && c2.is_some())
+            || (d1.is_some() && d2.is_some())
+            || (v1.is_some() && v2.is_some());
+    }
+    match (a.key(), b.key()) {
+        ((k1, Some(n1)), (k2, Some(n2))) => k1 == k2 && n1 == n2,
+        ((k1, None), (k2, None)) => k1 == k2,
+        _ => false,
     }
 }

@@ -282,6 +282,28 @@ pub struct Point {
 }
 
 impl WorldItem {
+    /// What the item is, as a change names it: its kind (`lamp`, `start`,
+    /// `objects`, ...) and, for the items of lists, its name.
+    pub fn key(&self) -> (&'static str, Option<&str>) {
+        fn name(n: &Option<Name>) -> Option<&str> {
+            n.as_ref().map(|n| n.text.as_str())
+        }
+        match self {
+            WorldItem::Arena { .. } => ("arena", None),
+            WorldItem::Charger { .. } => ("charger", None),
+            WorldItem::Battery(..) => ("battery", None),
+            WorldItem::Recharge(..) => ("recharge", None),
+            WorldItem::Robots(..) => ("robots", None),
+            WorldItem::Objects { .. } => ("objects", None),
+            WorldItem::Body { .. } => ("body", None),
+            WorldItem::Wall { name: n, .. } => ("wall", name(n)),
+            WorldItem::Cylinder { name: n, .. } => ("cylinder", name(n)),
+            WorldItem::Lamp { name: n, .. } => ("lamp", name(n)),
+            WorldItem::Zone { name: n, .. } => ("zone", name(n)),
+            WorldItem::Start { .. } => ("start", None),
+        }
+    }
+
     pub fn span(&self) -> Span {
         match self {
             WorldItem::Arena { span, .. }

@@ -74,10 +74,11 @@ fn kind(e: &Error) -> &'static str {
         Error::EvolvedWithoutGenes { .. } => "EvolvedWithoutGenes",
         Error::NotASensor { .. } => "NotASensor",
         Error::NoLamp { .. } => "NoLamp",
+        Error::VariantUndoesChange { .. } => "VariantUndoesChange",
     }
 }
 
-const KINDS: [&str; 31] = [
+const KINDS: [&str; 32] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -109,6 +110,7 @@ const KINDS: [&str; 31] = [
     "EvolvedWithoutGenes",
     "NotASensor",
     "NoLamp",
+    "VariantUndoesChange",
 ];
 
 #[test]
@@ -126,4 +128,22 @@ fn every_error_kind_has_a_ui_test() {
     assert!(files >= 25, "{files} ui files, at least 25 expected");
     let missing: Vec<_> = KINDS.iter().filter(|k| !seen.contains(*k)).collect();
     assert!(missing.is_empty(), "error kinds without a ui test: {missing:?}");
+}
+
+/// What `S0032` warns about (`tests/ui/variant_undoes_change.bat`): the
+/// variants a stage inherits are applied after its own changes, so a
+/// variant that restates the lamp keeps its lamp, undimmed.
+#[test]
+fn an_inherited_variant_restating_an_item_keeps_its_own() {
+    let src = std::fs::read_to_string(crate::root().join("tests/ui/variant_undoes_change.bat")).unwrap();
+    let (program, d) = shaping_compiler::check(&src, "variant_undoes_change.bat");
+    let dimmed = &program.expect("warnings only").stages[1];
+    let lamp = |w: &shaping_runtime::program::World| w.items.lamps[0].intensity;
+    assert_eq!(lamp(&dimmed.world), 0.5);
+    let variants: Vec<(&str, f32)> =
+        dimmed.variants.as_ref().unwrap().list.iter().map(|v| (v.name.as_str(), lamp(&v.world))).collect();
+    assert_eq!(variants, [("left", 1.0), ("right", 1.0), ("same", 0.5)]);
+    let warned: Vec<String> = d.errors().iter().map(|e| e.to_string()).collect();
+    assert_eq!(warned.len(), 2);
+    assert!(warned[0].contains("`left`") && warned[1].contains("`right`"), "{warned:?}");
 }
