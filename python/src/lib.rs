@@ -410,19 +410,21 @@ impl Program {
     }
 
     /// The genes of `stage`'s genome, one dict per gene: the rows of
-    /// `shaping layout --format json` (`offset`, `bits`, `stage`, `module`,
-    /// `role`, `lo`, `hi`, `frozen`, ...).
+    /// `shaping layout --format json` (`gene`, `offset`, `bits`, `stage`
+    /// and `module` by name, `team_role` in a team with roles, `what`,
+    /// `part`, `kind`, `input`, `lo`, `hi`, `frozen`, ...).
     fn layout<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyAny>> {
-        let st = &self.program.stages[stage_index(&self.program, stage)?];
-        let genes = serde_json::to_value(&st.layout.genes)
+        let rows = shaping_compiler::layout_rows(&self.program, stage_index(&self.program, stage)?);
+        let genes = serde_json::to_value(&rows)
             .map_err(|e| ShapingError::new_err(format!("error: cannot serialise the layout: {e}")))?;
         json_to_py(py, &genes)
     }
 
     /// The roles of `stage`'s heterogeneous team, in order, one dict per
     /// role: `name`, `robots` (robot 0 plays the first role) and `modules`,
-    /// the indices of its modules (a gene of `layout` whose `module` is one
-    /// of them is the role's). Empty for a team of clones or one robot.
+    /// the indices of its modules (a gene of `layout` whose `team_role` is
+    /// the role's name is the role's). Empty for a team of clones or one
+    /// robot.
     fn roles<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyAny>> {
         let st = &self.program.stages[stage_index(&self.program, stage)?];
         let roles: Vec<serde_json::Value> = st

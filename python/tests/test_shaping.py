@@ -206,7 +206,7 @@ def test_evaluate_a_team_with_roles():
     # Each role's genes are one half of the genome, the first role's first.
     genes = program.layout("aggregate")
     half = ev.bits // 2
-    assert all((g["offset"] < half) == (g["module"] == 0) for g in genes)
+    assert all((g["offset"] < half) == (g["team_role"] == "first") for g in genes)
     for part in (slice(0, half), slice(half, ev.bits)):
         changed = g.copy()
         changed[:, part] = 1 - changed[:, part]
