@@ -204,10 +204,15 @@ impl DirLock {
             Err(std::fs::TryLockError::WouldBlock) => {
                 let holder = std::fs::read_to_string(&path).unwrap_or_default();
                 let holder = holder.trim();
-                let who = if holder.is_empty() {
-                    "another process".to_string()
-                } else {
-                    format!("another process ({holder})")
+                // `NAME, process PID`: a holder of this process is another
+                // thread's run (Python's threads, a library's two runs).
+                let ours = holder
+                    .rsplit_once("process ")
+                    .is_some_and(|(_, pid)| pid.parse::<u32>().ok() == Some(std::process::id()));
+                let who = match (holder.is_empty(), ours) {
+                    (true, _) => "another process".to_string(),
+                    (false, true) => format!("another run of this process ({holder})"),
+                    (false, false) => format!("another process ({holder})"),
                 };
                 return Err(Error::new(
                     ErrorKind::Locked,
@@ -604,6 +609,7 @@ mod tests {
         let err = DirLock::acquire(dir.path()).unwrap_err();
         assert_eq!(err.kind(), ErrorKind::Locked);
         assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
+        assert!(err.message().contains("in use by another run of this process"), "{err}");
         drop(first);
         DirLock::acquire(dir.path()).unwrap();
     }

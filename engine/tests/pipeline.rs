@@ -136,7 +136,7 @@ fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharm
     barrier.wait();
     let err = Runner::default().run(tiny(), &options(dir.path())).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Locked, "{err}");
-    assert!(err.message().contains("is in use by"), "{err}");
+    assert!(err.message().contains("is in use by another run of this process"), "{err}");
     assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
     barrier.wait();
     first.join().unwrap().unwrap();
