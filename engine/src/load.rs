@@ -130,7 +130,9 @@ pub fn parse_built(bytes: &[u8], name: &str) -> Result<Program, Error> {
 
 /// The memory a run of `stages` of `program` needs at its peak (its largest
 /// stage), in bytes: an evolved stage's population (see
-/// `shaping_runtime::limits`), a test or training stage's recording
+/// `shaping_runtime::limits`) and the recording of its best's episode
+/// (`episode.json`, every robot of a team), which is made while the
+/// population is held; a test or training stage's recording
 /// ([`recording_bytes`]).
 pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
     stages
@@ -139,7 +141,14 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
             let s = &program.stages[i];
             let modules = s.modules.len() as u64;
             match &s.run {
-                StageRun::Evolve(e) => limits::population_bytes(e.population.into(), s.layout.bits.into()),
+                StageRun::Evolve(e) => {
+                    let population = limits::population_bytes(e.population.into(), s.layout.bits.into());
+                    // The best's episode, in the stage's own world.
+                    let (objects, items) = world_size(&s.world);
+                    let robots = u64::from(s.world.robots.max(1));
+                    let recorded = u64::from(e.actions).saturating_mul(robots);
+                    population.saturating_add(recording_bytes(recorded, 1, modules, objects, items))
+                }
                 // Every action of every life of both worlds is recorded; the
                 // lives before the change are in the parent's world.
                 StageRun::Test { actions, lives, .. } => {
@@ -211,23 +220,72 @@ pub fn recording_bytes(actions: u64, lives: u64, modules: u64, objects: u64, ite
     actions.saturating_mul(per_action).saturating_add(lives.saturating_mul(per_life))
 }
 
-/// The memory this process may use: the machine's available memory (Linux:
-/// `MemAvailable` of `/proc/meminfo`), or the limit of its control group
-/// (`memory.max` less `memory.current`, cgroup v2, as in a Slurm job) where
-/// that is lower; `None` where neither can be read.
-pub fn available_memory() -> Option<u64> {
+/// The memory a process may still use, and the limit that says so.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Room {
+    bytes: u64,
+    /// How the message says where the room is ("available", ...).
+    limit: Limit,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Limit {
+    /// The machine's available memory.
+    Machine,
+    /// The memory limit of the process's control group.
+    Group,
+    /// The process's address-space limit (`ulimit -v`, `RLIMIT_AS`).
+    AddressSpace,
+}
+
+impl Room {
+    /// "only 0.6 GiB are available" and the like.
+    fn only(&self) -> String {
+        let gib = self.bytes as f64 / (1u64 << 30) as f64;
+        match self.limit {
+            Limit::Machine => format!("only {gib:.1} GiB are available"),
+            Limit::Group => format!("only {gib:.1} GiB are left under the memory limit of its control group"),
+            Limit::AddressSpace => {
+                format!("only {gib:.1} GiB of address space are left under its limit (`ulimit -v`)")
+            }
+        }
+    }
+}
+
+/// The memory this process may use: the least of the machine's available
+/// memory (Linux: `MemAvailable` of `/proc/meminfo`), the room under the
+/// limit of its control group (`memory.max` less `memory.current`, cgroup
+/// v2, as in a Slurm job) and the room under its address-space limit
+/// (`ulimit -v`: the soft `RLIMIT_AS` of `/proc/self/limits` less the
+/// process's `VmSize`); `None` where none can be read.
+fn available_memory() -> Option<Room> {
     let machine = std::fs::read_to_string("/proc/meminfo").ok().and_then(|info| {
         let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
         let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-        Some(kib * 1024)
+        Some(Room { bytes: kib * 1024, limit: Limit::Machine })
     });
     let group = std::fs::read_to_string("/proc/self/cgroup")
         .ok()
-        .and_then(|c| cgroup_room(&c, Path::new("/sys/fs/cgroup")));
-    match (machine, group) {
-        (Some(m), Some(g)) => Some(m.min(g)),
-        (m, g) => m.or(g),
-    }
+        .and_then(|c| cgroup_room(&c, Path::new("/sys/fs/cgroup")))
+        .map(|bytes| Room { bytes, limit: Limit::Group });
+    let address =
+        match (std::fs::read_to_string("/proc/self/limits"), std::fs::read_to_string("/proc/self/status")) {
+            (Ok(limits), Ok(status)) => address_room(&limits, &status),
+            _ => None,
+        }
+        .map(|bytes| Room { bytes, limit: Limit::AddressSpace });
+    [machine, group, address].into_iter().flatten().min_by_key(|r| r.bytes)
+}
+
+/// The room under the soft address-space limit of `limits` (the text of
+/// `/proc/self/limits`) for a process of the `VmSize` in `status` (the
+/// text of `/proc/self/status`); `None` when there is no limit.
+fn address_room(limits: &str, status: &str) -> Option<u64> {
+    let soft = limits.lines().find_map(|l| l.strip_prefix("Max address space"))?.split_whitespace().next()?;
+    let limit: u64 = soft.parse().ok()?;
+    let size: u64 =
+        status.lines().find_map(|l| l.strip_prefix("VmSize:"))?.split_whitespace().next()?.parse().ok()?;
+    Some(limit.saturating_sub(size.saturating_mul(1024)))
 }
 
 /// The room left under the cgroup v2 memory limit of the group named in
@@ -258,28 +316,54 @@ pub fn check_memory(program: &Program, stages: &[usize], copies: u64) -> Result<
     check_memory_within(program, stages, copies, available_memory())
 }
 
+/// Refuses to take `need` bytes for `what` ("evaluating 2 genomes") where
+/// this process has not the room ([`available_memory`]; where nothing can
+/// be read, above 1 TiB, which no machine has): an error of kind `Memory`
+/// that says how much is needed, under which limit how much is left, and
+/// `instead`, what to do.
+pub fn check_room(need: u64, what: &str, instead: &str) -> Result<()> {
+    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
+    let refuse = |left: String| {
+        Error::new(ErrorKind::Memory, format!("error: {what} needs about {:.1} GiB of memory{left}; {instead}", gib(need)))
+    };
+    match available_memory() {
+        Some(room) if need > room.bytes => Err(refuse(format!(", but {}", room.only()))),
+        None if need > 1 << 40 => Err(refuse(String::new())),
+        _ => Ok(()),
+    }
+}
+
 fn check_memory_within(
     program: &Program,
     stages: &[usize],
     copies: u64,
-    available: Option<u64>,
+    available: Option<Room>,
 ) -> Result<()> {
     let need = memory_estimate(program, stages).saturating_mul(copies.max(1));
     match available {
-        Some(have) if need > have => {
+        Some(have) if need > have.bytes => {
             let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-            let biggest = stages
-                .iter()
-                .copied()
-                .max_by_key(|&i| memory_estimate(program, &[i]))
-                .map(|i| program.stages[i].name.clone())
-                .unwrap_or_default();
-            Err(Error::new(ErrorKind::Memory, format!(
-                "error: this run needs about {:.1} GiB of memory (stage `{biggest}`), but only {:.1} GiB are available; \
-                 reduce the population, the genome or the number of actions",
-                gib(need),
-                gib(have)
-            )))
+            let Some(biggest) = stages.iter().copied().max_by_key(|&i| memory_estimate(program, &[i])) else {
+                return Ok(());
+            };
+            let stage = &program.stages[biggest];
+            // What to make smaller: a team's robots too (every robot of its
+            // best's episode is recorded).
+            let robots = if stage.world.robots > 1 { ", the number of robots" } else { "" };
+            let what = match stage.run {
+                StageRun::Evolve(_) => format!("the population, the genome{robots} or the number of actions"),
+                StageRun::Test { .. } => format!("the number of lives{robots} or of actions"),
+                StageRun::Train { .. } => format!("the number of actions{robots}"),
+            };
+            Err(Error::new(
+                ErrorKind::Memory,
+                format!(
+                    "error: this run needs about {:.1} GiB of memory (stage `{}`), but {}; reduce {what}",
+                    gib(need),
+                    stage.name,
+                    have.only(),
+                ),
+            ))
         }
         _ => Ok(()),
     }
@@ -296,22 +380,25 @@ pub fn check_recording(stage: &shaping_runtime::program::Stage, actions: u32) ->
 fn check_recording_within(
     stage: &shaping_runtime::program::Stage,
     actions: u32,
-    available: Option<u64>,
+    available: Option<Room>,
 ) -> Result<()> {
     let (objects, items) = world_size(&stage.world);
     // A team's every robot is recorded.
     let recorded = u64::from(actions).saturating_mul(u64::from(stage.world.robots.max(1)));
     let need = recording_bytes(recorded, 1, stage.modules.len() as u64, objects, items);
     match available {
-        Some(have) if need > have => {
+        Some(have) if need > have.bytes => {
             let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-            Err(Error::new(ErrorKind::Memory, format!(
-                "error: recording {actions} actions of stage `{}` needs about {:.1} GiB of memory, but only {:.1} GiB \
-                 are available; pass fewer `--actions`",
-                stage.name,
-                gib(need),
-                gib(have)
-            )))
+            Err(Error::new(
+                ErrorKind::Memory,
+                format!(
+                    "error: recording {actions} actions of stage `{}` needs about {:.1} GiB of memory, but {}; \
+                     pass fewer `--actions`",
+                    stage.name,
+                    gib(need),
+                    have.only()
+                ),
+            ))
         }
         _ => Ok(()),
     }
@@ -387,18 +474,68 @@ mod tests {
         Program { format: FORMAT_VERSION, name: "p".into(), stages: vec![stage] }
     }
 
+    fn room(bytes: u64) -> Option<Room> {
+        Some(Room { bytes, limit: Limit::Machine })
+    }
+
     #[test]
     fn a_run_larger_than_the_available_memory_is_refused_with_the_estimate() {
         let p = program(100_000, 5_000);
         let need = memory_estimate(&p, &[0]);
-        assert_eq!(need, 100_000 * 5_000 * (2 + limits::CHECKPOINT_BYTES_PER_BIT));
-        assert!(check_memory_within(&p, &[0], 1, Some(need)).is_ok());
+        let s = &p.stages[0];
+        let StageRun::Evolve(e) = &s.run else { unreachable!() };
+        let (objects, items) = world_size(&s.world);
+        let best = recording_bytes(e.actions.into(), 1, s.modules.len() as u64, objects, items);
+        assert_eq!(need, 100_000 * 5_000 * (2 + limits::CHECKPOINT_BYTES_PER_BIT) + best);
+        assert!(check_memory_within(&p, &[0], 1, room(need)).is_ok());
         assert!(check_memory_within(&p, &[0], 1, None).is_ok(), "unknown memory: no refusal");
-        let err = check_memory_within(&p, &[0], 1, Some(4 << 30)).unwrap_err().to_string();
+        let err = check_memory_within(&p, &[0], 1, room(4 << 30)).unwrap_err().to_string();
         assert!(
-            err.contains("needs about 6.5 GiB of memory (stage `navigation`), but only 4.0 GiB"),
+            err.contains(
+                "needs about 6.5 GiB of memory (stage `navigation`), but only 4.0 GiB are available"
+            ),
             "{err}"
         );
+        assert!(err.contains("reduce the population, the genome or the number of actions"), "{err}");
+    }
+
+    /// The episode of an evolved team's best is recorded robot by robot
+    /// while the population is held: 10,000 robots of 1,000 actions need
+    /// gigabytes where the population needs a few megabytes (a run that
+    /// went over `ulimit -v` after its checkpoint, at every rerun).
+    #[test]
+    fn an_evolved_team_is_estimated_with_the_recording_of_its_best() {
+        let mut p = program(20, 100);
+        let s = &mut p.stages[0];
+        s.world.robots = 10_000;
+        if let StageRun::Evolve(e) = &mut s.run {
+            e.actions = 1_000;
+        }
+        let need = memory_estimate(&p, &[0]);
+        assert!(need > 6 << 30, "{need}");
+        let address = Room { bytes: 600 << 20, limit: Limit::AddressSpace };
+        let err = check_memory_within(&p, &[0], 1, Some(address)).unwrap_err();
+        assert_eq!(err.kind(), ErrorKind::Memory);
+        let err = err.to_string();
+        assert!(
+            err.contains("but only 0.6 GiB of address space are left under its limit (`ulimit -v`)"),
+            "{err}"
+        );
+        assert!(
+            err.contains("reduce the population, the genome, the number of robots or the number of actions")
+        );
+    }
+
+    #[test]
+    fn the_address_space_limit_leaves_the_room_above_the_process_size() {
+        let limits = "Limit                     Soft Limit           Hard Limit           Units     \n\
+                      Max cpu time              unlimited            unlimited            seconds   \n\
+                      Max address space         716800000            unlimited            bytes     \n";
+        let status = "Name:\tshaping\nVmPeak:\t  200000 kB\nVmSize:\t  100000 kB\nVmRSS:\t 5000 kB\n";
+        assert_eq!(address_room(limits, status), Some(716_800_000 - 100_000 * 1024));
+        let unlimited = limits.replace("716800000", "unlimited");
+        assert_eq!(address_room(&unlimited, status), None);
+        assert_eq!(address_room(limits, "Name:\tx\n"), None);
     }
 
     /// A test stage of `lives` lives of `actions` actions with `modules`
@@ -484,9 +621,9 @@ mod tests {
         let p = test_program(1, 10, 3, 0, "");
         let stage = &p.stages[0];
         let need = recording_bytes(10_000_000, 1, 3, 0, 0);
-        assert!(check_recording_within(stage, 10_000_000, Some(need)).is_ok());
+        assert!(check_recording_within(stage, 10_000_000, room(need)).is_ok());
         assert!(check_recording_within(stage, 10_000_000, None).is_ok());
-        let err = check_recording_within(stage, 10_000_000, Some(need - 1)).unwrap_err().to_string();
+        let err = check_recording_within(stage, 10_000_000, room(need - 1)).unwrap_err().to_string();
         assert!(err.contains("recording 10000000 actions of stage `explore` needs about 7.7 GiB"), "{err}");
         assert!(err.contains("pass fewer `--actions`"), "{err}");
     }

@@ -143,20 +143,7 @@ impl Pool {
 /// fewer are available (the machine's or the control group's, as `run`
 /// checks): a MemoryError with the estimate and what to do.
 fn check_room(need: u64, what: &str, instead: &str) -> PyResult<()> {
-    let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
-    match load::available_memory() {
-        Some(have) if need > have => Err(PyMemoryError::new_err(format!(
-            "error: {what} needs about {:.1} GiB of memory, but only {:.1} GiB are available; {instead}",
-            gib(need),
-            gib(have)
-        ))),
-        // Where nothing can be read: what no machine has (1 TiB).
-        None if need > 1 << 40 => Err(PyMemoryError::new_err(format!(
-            "error: {what} needs about {:.1} GiB of memory; {instead}",
-            gib(need)
-        ))),
-        _ => Ok(()),
-    }
+    load::check_room(need, what, instead).map_err(|e| PyMemoryError::new_err(e.message().to_string()))
 }
 
 /// The most robot-actions [`interruptible`] runs on the caller's thread
