@@ -650,9 +650,28 @@ pub fn record(
     genome: &shaping_runtime::genome::Genome,
     opts: &shaping_runtime::controller::EpisodeOptions,
 ) -> Result<Recorded, String> {
+    record_until(stage, genome, opts, None)?
+        .ok_or_else(|| format!("the episode of stage `{}` was stopped", stage.name))
+}
+
+/// [`record`], given up once `stop` is set: before it starts, and at its
+/// next action; `None` when it was.
+pub fn record_until(
+    stage: &shaping_runtime::program::Stage,
+    genome: &shaping_runtime::genome::Genome,
+    opts: &shaping_runtime::controller::EpisodeOptions,
+    stop: Option<&AtomicBool>,
+) -> Result<Option<Recorded>, String> {
+    let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    if stopped() {
+        return Ok(None);
+    }
     let mut run =
         TeamRun::new(stage, genome, opts.seed).map_err(|e| format!("stage `{}`: {e}", stage.name))?;
-    let life = record_life(&mut run, &stage.world, opts.seed, opts, None);
+    let life = record_life(&mut run, &stage.world, opts.seed, opts, stop);
+    if stopped() {
+        return Ok(None);
+    }
     let mut result = life.result.team;
     if stage.inheritance == shaping_runtime::program::Inheritance::Lamarckian {
         result.learned = Some(run.write_back(genome));
@@ -660,5 +679,5 @@ pub fn record(
     let parts = [Part { stage: &stage.name, scene: life.scene.clone(), frames: life.frames }];
     let mut episode = episode(stage, opts.seed, opts.learning, &life.trace, &parts);
     episode.add_others(&life.others);
-    Ok(Recorded { result, trace: life.trace, others: life.others, episode, scene: life.scene })
+    Ok(Some(Recorded { result, trace: life.trace, others: life.others, episode, scene: life.scene }))
 }

@@ -324,7 +324,10 @@ pub fn check_memory(program: &Program, stages: &[usize], copies: u64) -> Result<
 pub fn check_room(need: u64, what: &str, instead: &str) -> Result<()> {
     let gib = |b: u64| b as f64 / (1u64 << 30) as f64;
     let refuse = |left: String| {
-        Error::new(ErrorKind::Memory, format!("error: {what} needs about {:.1} GiB of memory{left}; {instead}", gib(need)))
+        Error::new(
+            ErrorKind::Memory,
+            format!("error: {what} needs about {:.1} GiB of memory{left}; {instead}", gib(need)),
+        )
     };
     match available_memory() {
         Some(room) if need > room.bytes => Err(refuse(format!(", but {}", room.only()))),

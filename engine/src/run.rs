@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::Value;
-use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult, TeamRun, Trace};
+use shaping_runtime::controller::{
+    run_episode, run_episode_until, EpisodeOptions, EpisodeResult, TeamRun, Trace,
+};
 use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Param, Program, Stage, StageRun};
@@ -124,13 +126,14 @@ pub trait Evaluate {
 pub const MAX_JOBS: usize = 1024;
 
 /// Evaluation on this process's threads (a rayon pool of `jobs` threads).
-pub struct Local {
+pub struct Local<'a> {
     pool: rayon::ThreadPool,
+    stop: Option<&'a AtomicBool>,
 }
 
-impl Local {
+impl Local<'static> {
     /// A pool of `jobs` threads (one per core: `None`; 1 to [`MAX_JOBS`]).
-    pub fn new(jobs: Option<usize>) -> Result<Local> {
+    pub fn new(jobs: Option<usize>) -> Result<Local<'static>> {
         if let Some(j) = jobs.filter(|j| !(1..=MAX_JOBS).contains(j)) {
             return Err(Error::new(
                 ErrorKind::Invalid,
@@ -141,11 +144,21 @@ impl Local {
             .num_threads(jobs.unwrap_or(0))
             .build()
             .map_err(|e| Error::io(format!("error: cannot start worker threads: {e}")))?;
-        Ok(Local { pool })
+        Ok(Local { pool, stop: None })
     }
 }
 
-impl Evaluate for Local {
+impl Local<'_> {
+    /// Once `stop` is set, the episodes not yet started are not run and a
+    /// team's episode under way is given up at its next action: their
+    /// fitness is NaN, so the generation fails and nothing of it is kept
+    /// (see [`Runner`]).
+    pub fn stopped_by(self, stop: Option<&AtomicBool>) -> Local<'_> {
+        Local { pool: self.pool, stop }
+    }
+}
+
+impl Evaluate for Local<'_> {
     fn evaluate(
         &self,
         program: &Program,
@@ -154,7 +167,18 @@ impl Evaluate for Local {
         jobs: &[(&Genome, u64)],
     ) -> Vec<Evaluation> {
         let stage = &program.stages[index];
-        self.pool.install(|| evolve::evaluate_many(&evaluator(stage, actions), jobs))
+        let Some(stop) = self.stop else {
+            return self.pool.install(|| evolve::evaluate_many(&evaluator(stage, actions), jobs));
+        };
+        let worlds = evolve::VariantStages::of(stage);
+        let one = |genome: &Genome, seed: u64| {
+            let opts = EpisodeOptions { actions, learning: true, seed };
+            match run_episode_until(worlds.stage(seed), genome, &opts, || stop.load(Ordering::Relaxed)) {
+                Some(r) => Evaluation::of_episode(r),
+                None => Evaluation { fitness: f32::NAN, ..Evaluation::default() },
+            }
+        };
+        self.pool.install(|| evolve::evaluate_many(&one, jobs))
     }
 }
 
@@ -465,7 +489,7 @@ impl Runner<'_> {
         crate::load::check_memory(&program, &stages, 1)?;
         let out = opts.out.clone();
         let seed = run_seed(&program, opts.seed);
-        let local = Local::new(opts.jobs)?;
+        let local = Local::new(opts.jobs)?.stopped_by(self.interrupt);
         let _lock = DirLock::acquire(&out)?;
         let warn = |path: &Path| warn_unsealed(self.observer, path);
         let mut saved =
@@ -505,7 +529,7 @@ impl Runner<'_> {
                     let existing = saved.checkpoints[index].take();
                     let cp = self
                         .evolve_stage(&program, index, seed, parent, &dir, existing, opts.fresh, evaluator)?;
-                    best_episode(stage, &cp, seed, &dir)?;
+                    best_episode(stage, &cp, seed, &dir, self.interrupt)?;
                     if let Some((genome, best)) = evolve::best_of(&cp) {
                         results.push(StageOutcome::Evolve {
                             stage: stage.name.clone(),
@@ -551,14 +575,29 @@ impl Runner<'_> {
 
 /// `episode.json` of an evolved stage: one recorded episode of its best
 /// individual, the one `shaping replay FILE --stage S` shows by default
-/// (the run seed, the stage's life, learning on).
-fn best_episode(stage: &Stage, cp: &Checkpoint, seed: u64, dir: &Path) -> Result<()> {
+/// (the run seed, the stage's life, learning on). Once `stop` is set, a
+/// team's episode is given up at its next action and nothing is written.
+fn best_episode(
+    stage: &Stage,
+    cp: &Checkpoint,
+    seed: u64,
+    dir: &Path,
+    stop: Option<&AtomicBool>,
+) -> Result<()> {
     let StageRun::Evolve(evo) = &stage.run else { return Ok(()) };
     let Some((genome, _)) = evolve::best_of(cp) else { return Ok(()) };
     let opts = EpisodeOptions { actions: evo.actions, learning: true, seed };
-    let (_, _, ep) =
-        episode::run_recorded(stage, &genome, &opts).map_err(|e| Error::io(format!("error: {e}")))?;
-    write_sealed(dir, &[("episode.json", compact_json(&ep)?.as_bytes())])
+    let recorded =
+        episode::record_until(stage, &genome, &opts, stop).map_err(|e| Error::io(format!("error: {e}")))?;
+    let Some(recorded) = recorded else {
+        return Err(interrupted(format!(
+            "interrupted: stage `{}` stopped while recording its best's episode (`episode.json`); the stage is saved \
+             in `{}`, and the same command records it",
+            stage.name,
+            dir.display()
+        )));
+    };
+    write_sealed(dir, &[("episode.json", compact_json(&recorded.episode)?.as_bytes())])
 }
 
 /// Warns through `observer` that `path` was read without a seal.
@@ -634,14 +673,51 @@ impl Runner<'_> {
         // An evaluator's saved episodes (a robot's log) are tied to the stage
         // as the checkpoint is.
         evaluator.begin_stage(program, index, dir, evolve::fingerprint::digest(&cp.fingerprint), fresh)?;
-        let fail = |e| {
-            evaluator.failure().unwrap_or_else(|| Error::new(ErrorKind::Evaluation, format!("error: {e}")))
+        // A generation (or the choice of the best) whose episodes were given
+        // up for Ctrl-C fails (no results, see `many`) before the checkpoint
+        // changes: it is dropped whole, and the run resumes before it.
+        let fail = |e: evolve::EvolveError, cp: &Checkpoint| {
+            if let Some(f) = evaluator.failure() {
+                return f;
+            }
+            if self.stopped() && matches!(e, evolve::EvolveError::Inconsistent { .. }) {
+                return interrupted(if evolve::is_finished(program, cp) {
+                    format!(
+                        "interrupted: stage `{}` stopped while choosing its best, which is dropped; its generations \
+                         are saved in `{}`, and the same command resumes it",
+                        stage.name,
+                        path.display()
+                    )
+                } else if cp.generation == 0 {
+                    format!(
+                        "interrupted: stage `{}` stopped in its first generation, which is dropped; nothing of the \
+                         stage was saved, and the same command runs it",
+                        stage.name
+                    )
+                } else {
+                    format!(
+                        "interrupted: stage `{}` stopped in generation {} of {}, which is dropped; the {} before it \
+                         are saved in `{}`, and the same command resumes it",
+                        stage.name,
+                        cp.generation + 1,
+                        evo.generations,
+                        cp.generation,
+                        path.display()
+                    )
+                });
+            }
+            Error::new(ErrorKind::Evaluation, format!("error: {e}"))
         };
         // The episodes this process runs for the stage, for the warning about
         // a crowded world (the generations' are in their statistics too).
         let run_now = std::cell::Cell::new(Crowding::default());
         let many = |jobs: &[(&Genome, u64)]| {
             let evaluations = evaluator.evaluate(program, index, evo.actions, jobs);
+            if self.stopped() && evaluations.iter().any(|ev| ev.fitness.is_nan()) {
+                // Episodes given up for Ctrl-C: no result at all, so the
+                // generation (or the choice of the best) fails as a whole.
+                return Vec::new();
+            }
             let mut tally = run_now.get();
             for ev in &evaluations {
                 tally.add(ev.placement_failures);
@@ -652,7 +728,15 @@ impl Runner<'_> {
         let mut warned = false;
         while !evolve::is_finished(program, &cp) {
             evaluator.context(format!("generation {} of stage `{}`", cp.generation, stage.name), &path);
-            let stats = evolve::step_generation_with(program, &mut cp, &many).map_err(fail)?;
+            let stats = match evolve::step_generation_with(program, &mut cp, &many) {
+                Ok(stats) => stats,
+                Err(e) => {
+                    if self.stopped() {
+                        self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: false });
+                    }
+                    return Err(fail(e, &cp));
+                }
+            };
             let csv = report::generations_csv(&cp.history, &report::variant_names(stage));
             let checkpoint = rundir::checkpoint_bytes(&cp)?;
             write_sealed(dir, &[("checkpoint.json", &checkpoint), ("generations.csv", csv.as_bytes())])?;
@@ -694,7 +778,7 @@ impl Runner<'_> {
                 evolve::VALIDATE_CANDIDATES,
                 evolve::VALIDATE_EPISODES,
             )
-            .map_err(fail)?;
+            .map_err(|e| fail(e, &cp))?;
             rundir::write_checkpoint(dir, &cp)?;
         }
         let now = run_now.get();

@@ -7,13 +7,17 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use common::{load, options, read_text, run, tiny_bat, write_bat, Log};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use common::{load, options, read_text, result_files, run, tiny_bat, write_bat, Log};
 use shaping_engine::episode::{self, Episode};
 use shaping_engine::replay::{self, ReplayOptions};
-use shaping_engine::run::RunOptions;
+use shaping_engine::run::{Event, Observer, RunOptions, Runner};
+use shaping_engine::ErrorKind;
 use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
+use shaping_runtime::program::StageRun;
 
 /// `program` with `robots` robots in every stage's world, an 800 mm square arena.
 fn team(mut program: Program, robots: u32) -> Program {
@@ -179,6 +183,80 @@ fn a_stopped_team_test_stops_at_the_next_action() {
     let err = result.err().expect("stopped");
     assert_eq!(err.kind(), shaping_engine::ErrorKind::Interrupted, "{err}");
     assert!(err.message().contains("stopped in life 1 of 1"), "{err}");
+}
+
+/// Sets the flag, as Ctrl-C does, when `at` says so of an event.
+struct StopAt<'a> {
+    flag: &'a AtomicBool,
+    at: fn(&Event<'_>) -> bool,
+}
+
+impl Observer for StopAt<'_> {
+    fn event(&self, event: Event<'_>) {
+        if (self.at)(&event) {
+            self.flag.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
+/// Ctrl-C in an evolved team's generation gives its episodes up at their
+/// next action (a generation far too long to end ends at once: 3 robots
+/// without a battery for 200,000 actions), and the generation is dropped.
+#[test]
+fn an_evolved_teams_generation_is_given_up_at_the_next_action() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut program = team(load(&tiny_bat()), 3);
+    for st in &mut program.stages {
+        st.world.battery = None;
+        if let StageRun::Evolve(e) = &mut st.run {
+            e.actions = 200_000;
+        }
+    }
+    let flag = AtomicBool::new(false);
+    let runner = Runner { interrupt: Some(&flag), ..Runner::default() };
+    let err = std::thread::scope(|s| {
+        s.spawn(|| {
+            std::thread::sleep(std::time::Duration::from_millis(300));
+            flag.store(true, Ordering::Relaxed);
+        });
+        runner.run(program, &options(dir.path())).unwrap_err()
+    });
+    assert_eq!(err.kind(), ErrorKind::Interrupted, "{err}");
+    assert!(
+        err.message().contains("stage `first` stopped in its first generation, which is dropped"),
+        "{err}"
+    );
+    assert!(!dir.path().join("first/checkpoint.json").exists(), "nothing of the generation is saved");
+}
+
+/// A team stopped while choosing its best, then in the first generation of
+/// the next stage, resumes to the files of a run never stopped.
+#[test]
+fn a_team_stopped_in_a_generation_or_the_choice_of_its_best_resumes_to_the_straight_run() {
+    let program = team(load(&tiny_bat()), 3);
+    let straight = tempfile::tempdir().unwrap();
+    run(program.clone(), &options(straight.path())).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let opts = options(dir.path());
+    let flag = AtomicBool::new(false);
+    let choosing =
+        StopAt { flag: &flag, at: |e| matches!(e, Event::EvolveEnd { stage: "first", completed: true }) };
+    let runner = Runner { observer: &choosing, interrupt: Some(&flag), ..Runner::default() };
+    let err = runner.run(program.clone(), &opts).unwrap_err();
+    assert_eq!(err.kind(), ErrorKind::Interrupted, "{err}");
+    assert!(
+        err.message().contains("stage `first` stopped while choosing its best, which is dropped"),
+        "{err}"
+    );
+    assert!(!dir.path().join("first/best.genome").exists());
+    flag.store(false, Ordering::Relaxed);
+    let next = StopAt { flag: &flag, at: |e| matches!(e, Event::EvolveStart { stage: "second", .. }) };
+    let runner = Runner { observer: &next, interrupt: Some(&flag), ..Runner::default() };
+    let err = runner.run(program.clone(), &opts).unwrap_err();
+    assert!(err.message().contains("stage `second` stopped in its first generation"), "{err}");
+    assert!(!dir.path().join("second/checkpoint.json").exists());
+    run(program, &opts).unwrap();
+    assert!(result_files(straight.path()) == result_files(dir.path()), "the results differ");
 }
 
 /// A test whose changed world adds robots: the lives before the change

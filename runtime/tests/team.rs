@@ -3,7 +3,9 @@
 //! and a team's fitness is its robots' aggregated.
 
 use shaping_runtime::catalog::{CHANNELS, CH_IR};
-use shaping_runtime::controller::{run_episode, run_team_episode, EpisodeOptions, Trace};
+use shaping_runtime::controller::{
+    run_episode, run_episode_until, run_team_episode, run_team_episode_until, EpisodeOptions, Trace,
+};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::*;
 use shaping_runtime::sim::{Command, ObjectState, Pose, Team};
@@ -33,6 +35,35 @@ fn a_team_of_one_is_the_one_robot() {
         assert_eq!(team.team.descriptors, one.descriptors, "seed {seed}");
         assert_eq!(team.robots[0].grips, one.grips);
     }
+}
+
+/// A team's episode asks whether to stop before it starts and after each
+/// action, and gives up at once when told to (a large team's episode may
+/// last minutes: Ctrl-C must not wait for its end); one not given up is
+/// the episode itself.
+#[test]
+fn a_teams_episode_is_given_up_at_the_next_action_once_told() {
+    let stage = Stage { world: World { robots: 3, ..testkit::collect().world }, ..testkit::collect() };
+    let g = genome_of(&stage, 2);
+    let opts = EpisodeOptions { actions: 50, learning: true, seed: 4 };
+    let whole = run_team_episode(&stage, &g, &opts, None).unwrap();
+    let asked = std::cell::Cell::new(0u32);
+    let count = || {
+        asked.set(asked.get() + 1);
+        false
+    };
+    let same = run_team_episode_until(&stage, &g, &opts, None, count).unwrap();
+    assert_eq!(same.as_ref(), Some(&whole));
+    assert_eq!(asked.get(), 1 + whole.team.actions, "once before and once after each action");
+    asked.set(0);
+    let after_ten = || {
+        asked.set(asked.get() + 1);
+        asked.get() > 10
+    };
+    assert_eq!(run_team_episode_until(&stage, &g, &opts, None, after_ten).unwrap(), None);
+    assert_eq!(asked.get(), 11, "given up after its tenth action");
+    assert_eq!(run_episode_until(&stage, &g, &opts, || true), None);
+    assert_eq!(run_episode_until(&stage, &g, &opts, || false), Some(run_episode(&stage, &g, &opts, None)));
 }
 
 #[test]

@@ -102,7 +102,10 @@ pub use life::{live, team_result, Bodies, Hooks, Solo};
 pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
-pub use team::{episode_with, run_team_episode, TeamBodies, TeamMember, TeamResult, TeamRun};
+pub use team::{
+    episode_with, run_team_episode, run_team_episode_until, StopWhen, TeamBodies, TeamMember, TeamResult,
+    TeamRun,
+};
 
 /// How to run one episode.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -1048,6 +1051,23 @@ pub fn run_episode(
     episode(stage, genome, opts, trace).unwrap_or_default()
 }
 
+/// [`run_episode`] given up once `stop` returns true: asked before the
+/// episode and after each of its actions ([`run_team_episode_until`]).
+/// `None` when it was given up; an episode that was not is
+/// [`run_episode`]'s.
+pub fn run_episode_until(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    stop: impl Fn() -> bool,
+) -> Option<EpisodeResult> {
+    match team::run_team_episode_until(stage, genome, opts, None, stop) {
+        Ok(r) => r.map(|r| r.team),
+        // As `run_episode`: an empty result.
+        Err(_) => Some(EpisodeResult::default()),
+    }
+}
+
 /// [`run_episode`] on a stage that may not have been validated: validates
 /// it and the genome first and reports what is wrong.
 pub fn try_run_episode(
@@ -1089,7 +1109,8 @@ fn episode_on<R: Robot>(
     robot: impl FnOnce(Sim) -> R,
 ) -> Result<EpisodeResult, ControllerError> {
     // Of a team: the team's result, robot 0's trace.
-    Ok(team::episode_in(stage, genome, opts, trace.map(std::slice::from_mut), robot)?.team)
+    let res = team::episode_in(stage, genome, opts, trace.map(std::slice::from_mut), robot, || false)?;
+    Ok(res.unwrap_or_default().team)
 }
 
 /// Checks that the controller can run `stage` with `genome`: the stage passes

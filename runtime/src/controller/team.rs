@@ -197,24 +197,61 @@ pub fn run_team_episode(
     opts: &EpisodeOptions,
     traces: Option<&mut [Trace]>,
 ) -> Result<TeamResult, ControllerError> {
-    episode_in(stage, genome, opts, traces, |sim| sim)
+    Ok(run_team_episode_until(stage, genome, opts, traces, || false)?.unwrap_or_default())
 }
 
-/// [`run_team_episode`], one robot's simulator wrapped by `robot` (a watch
-/// or a stop; a team's robots are not wrapped).
+/// [`run_team_episode`] given up once `stop` returns true, which is asked
+/// before the episode and after each of its actions (an action of a large
+/// team takes long, and an episode thousands of them): `None` when it was
+/// given up, and nothing of the episode is a result. An episode that is not
+/// given up is [`run_team_episode`]'s.
+pub fn run_team_episode_until(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    traces: Option<&mut [Trace]>,
+    stop: impl Fn() -> bool,
+) -> Result<Option<TeamResult>, ControllerError> {
+    episode_in(stage, genome, opts, traces, |sim| sim, stop)
+}
+
+/// [`run_team_episode_until`], one robot's simulator wrapped by `robot` (a
+/// watch or a stop; a team's robots are not wrapped).
 pub(crate) fn episode_in<R: Robot>(
     stage: &Stage,
     genome: &Genome,
     opts: &EpisodeOptions,
     traces: Option<&mut [Trace]>,
     robot: impl FnOnce(Sim) -> R,
-) -> Result<TeamResult, ControllerError> {
+    stop: impl Fn() -> bool,
+) -> Result<Option<TeamResult>, ControllerError> {
+    if stop() {
+        return Ok(None);
+    }
     let mut run = TeamRun::new(stage, genome, opts.seed)?;
-    let mut res = episode_with(&mut run, &stage.world, opts.seed, opts, traces, robot, &mut ());
+    let mut hooks = StopWhen { stop, stopped: false };
+    let mut res = episode_with(&mut run, &stage.world, opts.seed, opts, traces, robot, &mut hooks);
+    if hooks.stopped {
+        return Ok(None);
+    }
     if stage.inheritance == crate::program::Inheritance::Lamarckian {
         res.team.learned = Some(run.write_back(genome));
     }
-    Ok(res)
+    Ok(Some(res))
+}
+
+/// Hooks that end a life once `stop` returns true, asked after each action
+/// (`stopped` says whether it did).
+pub struct StopWhen<F> {
+    pub stop: F,
+    pub stopped: bool,
+}
+
+impl<'s, B: Bodies, F: Fn() -> bool> Hooks<'s, B> for StopWhen<F> {
+    fn after_action(&mut self, _: &B) -> bool {
+        self.stopped = (self.stop)();
+        !self.stopped
+    }
 }
 
 /// One life of `run`'s controllers in a fresh `world` of seed `seed` (its
