@@ -874,3 +874,27 @@ fn report_names_a_damaged_file_and_warns_about_unsealed_ones() {
     assert!(text(&r.stderr).contains("`drive` never writes into a run's directories"), "{}", text(&r.stderr));
     assert_eq!(std::fs::read(runs.join("second/episode.json")).unwrap(), episode);
 }
+
+/// A run directory belongs to one file: a run of another file into it is
+/// refused naming both, with nothing written, and `--fresh` replaces it;
+/// the directory's own `program.json` may be run into it again.
+#[test]
+fn a_run_of_another_file_into_a_run_directory_is_refused_naming_both() {
+    let dir = scratch("owner");
+    let out = dir.join("out");
+    assert!(run_tiny(&out, &["--no-report"]).status.success());
+    let other = dir.join("other.bat");
+    std::fs::write(&other, std::fs::read_to_string(tiny()).unwrap().replace("population 12", "population 8"))
+        .unwrap();
+    let before = std::fs::read(out.join("program.json")).unwrap();
+    let r = run_file(&other, &out, &[]);
+    let err = text(&r.stderr);
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(err.contains("holds a run of `tiny.bat`, not of `other.bat`"), "{err}");
+    assert_eq!(std::fs::read(out.join("program.json")).unwrap(), before);
+    let own = run_file(&out.join("program.json"), &out, &[]);
+    assert!(own.status.success(), "{}", text(&own.stderr));
+    let r = run_file(&other, &out, &["--fresh"]);
+    assert!(r.status.success(), "{}", text(&r.stderr));
+    assert!(text(&std::fs::read(out.join("source.json")).unwrap()).contains("\"other.bat\""));
+}

@@ -223,7 +223,12 @@ impl Plan {
                 rundir::create_stage_dir(&dir)?;
             }
         }
-        runner.run(self.program.clone(), &opts)
+        let file = &self.args.file;
+        if file.extension().is_some_and(|e| e != "json") {
+            runner.run_file(self.program.clone(), file, &opts)
+        } else {
+            runner.run(self.program.clone(), &opts)
+        }
     }
 
     /// Names a task in progress lines: `seed 3` or `seed 3 of mutation=0.01`.

@@ -382,7 +382,7 @@ fn precheck(
     unsealed: Unsealed<'_>,
 ) -> Result<Saved> {
     let mut saved = Saved::none(program);
-    let mut seeds_of: Vec<(&str, u64)> = Vec::new();
+    let mut seeds_of: Vec<(&str, u64, PathBuf)> = Vec::new();
     let mut bound = program.clone();
     let mut binding = true;
     for &i in stages {
@@ -391,7 +391,7 @@ fn precheck(
         match st.run {
             StageRun::Evolve(_) => {
                 if let Some(cp) = rundir::read_checkpoint_with(&dir, unsealed)? {
-                    seeds_of.push((&st.name, cp.seed));
+                    seeds_of.push((&st.name, cp.seed, rundir::checkpoint_path(&dir)));
                     if binding && cp.seed == seed {
                         let path = rundir::checkpoint_path(&dir);
                         evolve::check_resume_of(&bound, i, &cp).map_err(|e| stale(&path, &e))?;
@@ -401,7 +401,7 @@ fn precheck(
             }
             StageRun::Train { .. } => match rundir::read_trained_with(&dir, unsealed)? {
                 Some(t) => {
-                    seeds_of.push((&st.name, t.run_seed));
+                    seeds_of.push((&st.name, t.run_seed, rundir::trained_path(&dir)));
                     if binding && t.run_seed == seed {
                         let path = rundir::trained_path(&dir);
                         evolve::train::check(&bound, i, &t).map_err(|e| stale(&path, &e))?;
@@ -417,13 +417,33 @@ fn precheck(
             StageRun::Test { .. } => {}
         }
     }
-    let mut seeds: Vec<u64> = seeds_of.iter().map(|&(_, s)| s).collect();
+    let mut seeds: Vec<u64> = seeds_of.iter().map(|&(_, s, _)| s).collect();
     seeds.sort_unstable();
     seeds.dedup();
-    if seeds.len() < 2 {
-        return Ok(saved);
+    match seeds[..] {
+        [] => return Ok(saved),
+        [s] if s == seed => return Ok(saved),
+        // Saved results of one other seed: `--seed` resumes them only if
+        // they fit the program as it is; say so only then.
+        [other] => {
+            let path = &seeds_of[0].2;
+            return Err(match precheck(program, stages, out, other, &|_| {}) {
+                Ok(_) => other_seed(path, other, seed),
+                Err(e) if e.kind() == ErrorKind::Stale => Error::new(
+                    ErrorKind::Stale,
+                    format!(
+                        "error: `{}` belongs to a run with seed {other} (this run has seed {seed}), which `--seed {other}` \
+                         would not resume either: {}",
+                        path.display(),
+                        e.message().trim_start_matches("error: ")
+                    ),
+                ),
+                Err(e) => e,
+            });
+        }
+        _ => {}
     }
-    let which: Vec<String> = seeds_of.iter().map(|(name, s)| format!("`{name}` seed {s}")).collect();
+    let which: Vec<String> = seeds_of.iter().map(|(name, s, _)| format!("`{name}` seed {s}")).collect();
     Err(Error::new(
         ErrorKind::Stale,
         format!(
@@ -433,6 +453,95 @@ fn precheck(
             which.join(", ")
         ),
     ))
+}
+
+/// A run directory belongs to one program: refuses a run of another into
+/// `out` (`previous`: its `program.json`), by the file's name where both
+/// are known (`source.json`, `source`), else by the program's name.
+fn check_owner(
+    out: &Path,
+    previous: Option<&Program>,
+    program: &Program,
+    source: Option<&str>,
+) -> Result<()> {
+    let theirs = match (rundir::read_source(out), source) {
+        (Some(was), Some(now)) if was != now => format!("`{was}`, not of `{now}`"),
+        (Some(_), Some(_)) => return Ok(()),
+        _ => match previous {
+            Some(p) if p.name != program.name => format!("program `{}`, not of `{}`", p.name, program.name),
+            _ => return Ok(()),
+        },
+    };
+    Err(Error::new(
+        ErrorKind::Stale,
+        format!(
+            "error: `{}` holds a run of {theirs} (a run directory belongs to one program); choose another `--out`, \
+             or pass `--fresh` to replace that run with this one",
+            out.display()
+        ),
+    ))
+}
+
+/// `program.json` describes every stage directory beside it: refuses,
+/// before anything is written, a run that would rewrite it with another
+/// definition of a stage it does not run (a `--set` of a stage outside its
+/// `--stage`, a stage edited in the file, a stage extending one that
+/// changed) whose directory holds results. `now` is the program with the
+/// run's settings and the file's own, `stages` those the run runs.
+fn check_described(
+    out: &Path,
+    previous: &Program,
+    now: (&Program, &Program),
+    stages: &[usize],
+) -> Result<()> {
+    use evolve::fingerprint::{changes, fingerprint};
+    let (program, file) = now;
+    let mut changed = Vec::new();
+    let mut by_sets = true;
+    for (i, st) in program.stages.iter().enumerate() {
+        let dir = rundir::stage_dir(out, &st.name);
+        if stages.contains(&i) || !holds_results(&dir) {
+            continue;
+        }
+        let Some((j, _)) = previous.stage(&st.name) else { continue };
+        let was = fingerprint(previous, j);
+        let what = changes(&was, &fingerprint(program, i));
+        if what.is_empty() {
+            continue;
+        }
+        by_sets &= changes(&was, &fingerprint(file, i)).is_empty();
+        changed.push((st.name.as_str(), what.join("; "), dir));
+    }
+    if changed.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<String> = changed.iter().map(|(n, _, _)| format!("`{n}`")).collect();
+    let why: Vec<&str> = changed.iter().map(|(_, w, _)| w.as_str()).collect();
+    let dirs: Vec<String> = changed.iter().map(|(_, _, d)| format!("`{}`", d.display())).collect();
+    let (stage, them, it) =
+        if changed.len() == 1 { ("stage", "its", "it") } else { ("stages", "their", "them") };
+    let sets =
+        if by_sets { format!("leave out the `--set` values that change {it}, ") } else { String::new() };
+    Err(Error::new(
+        ErrorKind::Stale,
+        format!(
+            "error: this run would rewrite `{}` with another definition of {stage} {} ({}) without running {it}, \
+             and {them} results in {} would no longer be of the program described there; {sets}pass `--fresh` \
+             without `--stage` to run every stage again, move {} away, or choose another `--out`",
+            rundir::program_path(out).display(),
+            names.join(", "),
+            why.join("; "),
+            dirs.join(", "),
+            dirs.join(", ")
+        ),
+    ))
+}
+
+/// A stage directory holds results of a run (not only a replay's).
+fn holds_results(dir: &Path) -> bool {
+    ["checkpoint.json", "trained.json", "best.genome", "summary.json", "episode.json"]
+        .iter()
+        .any(|f| dir.join(f).exists())
 }
 
 /// What a run resumes from, read once by [`precheck`]: per stage, its
@@ -474,8 +583,30 @@ impl Runner<'_> {
 
     /// Runs the stages of `program` (with `opts.sets` applied) into
     /// `opts.out`, resuming what is saved there, and locks the directory
-    /// while it does.
-    pub fn run(&self, mut program: Program, opts: &RunOptions) -> Result<RunOutcome> {
+    /// while it does. The directory belongs to one program: a run of
+    /// another (by `program.json`'s name) is refused unless `opts.fresh`.
+    pub fn run(&self, program: Program, opts: &RunOptions) -> Result<RunOutcome> {
+        self.run_source(program, None, opts)
+    }
+
+    /// [`Runner::run`] of the program compiled from the file `source` (a
+    /// `.bat` file): the directory records the file's name (`source.json`),
+    /// and a run of another file into it is refused unless `opts.fresh`
+    /// (several files may share a program's name, their robot's).
+    pub fn run_file(&self, program: Program, source: &Path, opts: &RunOptions) -> Result<RunOutcome> {
+        let name = source.file_name().map(|n| n.to_string_lossy().into_owned());
+        self.run_source(program, name.as_deref(), opts)
+    }
+
+    fn run_source(
+        &self,
+        mut program: Program,
+        source: Option<&str>,
+        opts: &RunOptions,
+    ) -> Result<RunOutcome> {
+        // The file's own program, to tell a change made by `--set` from one
+        // made in the file.
+        let file = program.clone();
         crate::sweep::apply(&mut program, &opts.sets)?;
         if program.stages.is_empty() {
             return Err(Error::new(ErrorKind::Invalid, "error: the program has no stages"));
@@ -492,10 +623,22 @@ impl Runner<'_> {
         let local = Local::new(opts.jobs)?.stopped_by(self.interrupt);
         let _lock = DirLock::acquire(&out)?;
         let warn = |path: &Path| warn_unsealed(self.observer, path);
+        let previous = rundir::read_program(&out);
+        if !opts.fresh {
+            check_owner(&out, previous.as_ref(), &program, source)?;
+        }
+        if let Some(previous) = &previous {
+            check_described(&out, previous, (&program, &file), &stages)?;
+        }
         let mut saved =
             if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed, &warn)? };
         // The compiled program, for `shaping report` (and `shaping run program.json`).
         rundir::write_program(&out, &program)?;
+        // Whose it is: the file, where it is known; a run that replaced
+        // another program's leaves no name of that one.
+        if source.is_some() || opts.fresh {
+            rundir::write_source(&out, source)?;
+        }
         let evaluator = self.evaluator.unwrap_or(&local);
         let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
         let mut results = Vec::new();

@@ -3,6 +3,7 @@
 //!
 //! ```text
 //! DIR/program.json            the compiled program (with any --set applied)
+//! DIR/source.json             the name of the file it was compiled from
 //! DIR/report.html
 //! DIR/.lock                   held while a run writes (files::DirLock)
 //! DIR/STAGE/checkpoint.json   evolved stages: resumable, with a checksum
@@ -397,6 +398,56 @@ pub fn program_path(out: &Path) -> PathBuf {
 /// Writes `program.json`.
 pub fn write_program(out: &Path, program: &Program) -> Result<()> {
     write_atomic(&program_path(out), compact_json(program)?.as_bytes())
+}
+
+/// The program of a run directory as its `program.json` describes it, if
+/// one is there and reads (a run's own file; one that does not read names
+/// no program to compare with).
+pub fn read_program(out: &Path) -> Option<Program> {
+    let bytes = std::fs::read(program_path(out)).ok()?;
+    crate::load::parse_built(&bytes, "program.json").ok()
+}
+
+/// `source.json` of a run directory: the name of the file (`khepera.bat`)
+/// its program was compiled from, the program the directory belongs to.
+pub fn source_path(out: &Path) -> PathBuf {
+    out.join("source.json")
+}
+
+/// The contents of `source.json`.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Source {
+    /// [`SOURCE_FORMAT`].
+    pub format: u32,
+    /// The file's name, without its directory.
+    pub file: String,
+}
+
+/// The format of `source.json`.
+pub const SOURCE_FORMAT: u32 = 1;
+
+/// The file a run directory's program was compiled from, if `source.json`
+/// says (none for a run of a built program, or through the library).
+pub fn read_source(out: &Path) -> Option<String> {
+    let bytes = std::fs::read(source_path(out)).ok()?;
+    let source: Source = serde_json::from_slice(&bytes).ok()?;
+    (source.format == SOURCE_FORMAT).then_some(source.file)
+}
+
+/// Writes `source.json` (`None`: removes it, the program's file being unknown).
+pub fn write_source(out: &Path, file: Option<&str>) -> Result<()> {
+    match file {
+        Some(file) => {
+            let source = Source { format: SOURCE_FORMAT, file: file.to_string() };
+            write_atomic(&source_path(out), to_json(&source)?.as_bytes())
+        }
+        None => match std::fs::remove_file(source_path(out)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(Error::io(format!("error: cannot remove `{}`: {e}", source_path(out).display())))
+            }
+            _ => Ok(()),
+        },
+    }
 }
 
 #[cfg(test)]

@@ -43,7 +43,8 @@ fn a_sweep_point_is_the_run_with_its_settings() {
         sets: sets(&["first.evolve.mutation=0.2", "first.world.battery=100"]),
         ..options(&alone)
     };
-    run(tiny(), &opts).unwrap();
+    // As `shaping run tiny.bat` runs it (the file's name in `source.json`).
+    Runner::default().run_file(tiny(), &common::tiny_bat(), &opts).unwrap();
     let in_sweep = result_files(&d.join("sweep").join(point).join("seed-2"));
     assert!(in_sweep.len() >= 6, "{in_sweep:?}");
     let names = |v: &[(String, Vec<u8>)]| v.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();

@@ -8,7 +8,7 @@ mod common;
 use std::sync::atomic::AtomicBool;
 
 use common::{
-    as_if_killed, error, load, options, read_json, read_text, result_files, root, run, tiny, tiny_bat,
+    as_if_killed, error, files, load, options, read_json, read_text, result_files, root, run, tiny, tiny_bat,
     write_bat, Log, Seen, StopAfter,
 };
 use shaping_engine::run::StageOutcome;
@@ -243,4 +243,110 @@ fn stages_of_two_seeds_in_one_directory_are_named() {
     // The stage alone still resumes; `--fresh` starts everything again.
     run(tiny(), &first_99).unwrap();
     run(tiny(), &shaping_engine::run::RunOptions { fresh: true, ..options(dir.path()) }).unwrap();
+}
+
+/// A run directory belongs to one program: a run of another file into it
+/// is refused naming both files before anything is written (two files of
+/// one robot share a program's name, and a stage name), and `--fresh`
+/// replaces that run, as the message says. Through the library, with no
+/// file named, a colliding stage of another seed is not said to resume
+/// with `--seed` when it would not.
+#[test]
+fn a_run_of_another_file_into_a_directory_is_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = read_text(&tiny_bat());
+    let (a, a_program) = write_bat(d, "a.bat", &source);
+    let other = source.replace("population 12", "population 10").replace("seed 3", "seed 2");
+    let (b, b_program) = write_bat(d, "b.bat", &other);
+    let out = d.join("out");
+    let runner = shaping_engine::run::Runner::default();
+    runner.run_file(a_program.clone(), &a, &options(&out)).unwrap();
+    let before = files(&out);
+    let err = error(runner.run_file(b_program.clone(), &b, &options(&out)));
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    assert!(err.message().contains("holds a run of `a.bat`, not of `b.bat`"), "{err}");
+    assert!(err.message().contains("pass `--fresh` to replace that run with this one"), "{err}");
+    assert!(files(&out) == before, "nothing written");
+    // The same file again resumes.
+    runner.run_file(a_program, &a, &options(&out)).unwrap();
+
+    // Without a file's name: its stages of seed 3 do not fit the other
+    // program, so `--seed 3` is not the advice.
+    let err = error(run(b_program.clone(), &options(&out)));
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    let msg = err.message();
+    assert!(
+        msg.contains("belongs to a run with seed 3 (this run has seed 2), which `--seed 3` would not resume"),
+        "{err}"
+    );
+    assert!(msg.contains("the settings of `first` changed"), "{err}");
+    assert!(files(&out) == before, "nothing written");
+    let with_3 = shaping_engine::run::RunOptions { seed: Some(3), ..options(&out) };
+    assert_eq!(error(run(b_program.clone(), &with_3)).kind(), ErrorKind::Stale);
+
+    let fresh = shaping_engine::run::RunOptions { fresh: true, ..options(&out) };
+    runner.run_file(b_program.clone(), &b, &fresh).unwrap();
+    assert_eq!(read_json(&out.join("source.json"))["file"], "b.bat");
+    runner.run_file(b_program, &b, &options(&out)).unwrap();
+}
+
+/// Saved stages of one other seed that fit the program: `--seed` resumes
+/// them, as the message says, and nothing is written before it says so.
+#[test]
+fn saved_stages_of_another_seed_name_the_seed_that_resumes_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let seven = shaping_engine::run::RunOptions { seed: Some(7), ..options(dir.path()) };
+    run(tiny(), &seven).unwrap();
+    let before = files(dir.path());
+    let err = error(run(tiny(), &options(dir.path())));
+    assert!(
+        err.message()
+            .contains("belongs to a run with seed 7 (this run has seed 3); pass `--seed 7` to resume it"),
+        "{err}"
+    );
+    assert!(files(dir.path()) == before, "nothing written");
+    run(tiny(), &seven).unwrap();
+}
+
+/// `program.json` describes every stage directory beside it: a run of one
+/// stage that would describe another stage's results with settings they
+/// were not run with (or with a parent they did not extend) is refused,
+/// naming that stage and the ways out, and each way out works.
+#[test]
+fn a_run_that_would_misdescribe_a_stage_it_does_not_run_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path();
+    run(tiny(), &options(out)).unwrap();
+    let before = files(out);
+    let first = |sets: &[&str]| shaping_engine::run::RunOptions {
+        stage: Some("first".into()),
+        sets: common::sets(sets),
+        ..options(out)
+    };
+    let err = error(run(tiny(), &first(&["second.world.arena=800x900"])));
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    let msg = err.message();
+    assert!(
+        msg.contains("with another definition of stage `second` (the world of `second` changed)"),
+        "{err}"
+    );
+    assert!(msg.contains("leave out the `--set` values that change it"), "{err}");
+    assert!(msg.contains("pass `--fresh` without `--stage` to run every stage again"), "{err}");
+    assert!(files(out) == before, "nothing written");
+    // A stage it extends changed: its results are of the old one.
+    let fresh_first =
+        shaping_engine::run::RunOptions { fresh: true, ..first(&["first.evolve.mutation=0.2"]) };
+    let err = error(run(tiny(), &fresh_first));
+    assert!(err.message().contains("which `second` extends, changed"), "{err}");
+    assert!(files(out) == before, "nothing written");
+    // The ways out: without the setting of `second`; every stage again;
+    // `second` moved away.
+    run(tiny(), &first(&[])).unwrap();
+    let all = shaping_engine::run::RunOptions { fresh: true, ..first(&["second.world.arena=800x900"]) };
+    run(tiny(), &shaping_engine::run::RunOptions { stage: None, ..all }).unwrap();
+    let program = read_json(&out.join("program.json"));
+    assert_eq!(program["stages"][1]["world"]["arena"], serde_json::json!([800.0, 900.0]));
+    std::fs::remove_dir_all(out.join("second")).unwrap();
+    run(tiny(), &fresh_first).unwrap();
 }
