@@ -75,6 +75,40 @@ pub struct Chosen {
     pub training_seed: Option<u64>,
 }
 
+/// The program a replay (or `drive`) of run directory `run_dir` runs:
+/// `program` (the file's, with `given`, the `--set` values passed), or,
+/// when the run's `program.json` is `program` with other settings (ones
+/// `given` does not name: a run made with `--set`, or a setting since
+/// edited in the file), the run's own program, which the observer is told
+/// with the settings.
+pub fn with_run_settings(
+    program: Program,
+    run_dir: &Path,
+    given: &[crate::sweep::Assignment],
+    observer: &dyn Observer,
+) -> Program {
+    let Some(ran) = rundir::read_program(run_dir) else { return program };
+    if ran == program {
+        return program;
+    }
+    let Some(found) = crate::sweep::settings_between(&program, &ran) else { return program };
+    // A setting given for the replay is the user's to keep (`*.PATH` names
+    // it in every stage).
+    let named =
+        |t: &str| given.iter().any(|(g, _)| g == t || g.strip_prefix('*').is_some_and(|p| t.ends_with(p)));
+    if found.iter().any(|(t, _)| named(t)) {
+        return program;
+    }
+    let sets: Vec<String> = found.iter().map(|(t, v)| format!("--set {t}={v}")).collect();
+    observer.event(Event::Warning(format!(
+        "note: the run in `{}` is of this file with other settings (`{}`): replaying the run's own program (its \
+         `program.json`)",
+        run_dir.display(),
+        sets.join(" ")
+    )));
+    ran
+}
+
 /// Loads `file`, binds the training stages from run directory `run` (default
 /// `runs/<file stem>`) and picks the individual: `--genome`, else the best
 /// of the stage (or of the evolved stage it tests) in the run directory.
@@ -113,6 +147,7 @@ pub fn choose(
             // From the program as it is: the checkpoint, where there is one,
             // must still fit, and `best.genome` be its best.
             if rundir::checkpoint_path(&dir).exists() {
+                not_of_this_program(&program, source, &dir, file, &run_dir)?;
                 rundir::checked_best_with(&program, source, &dir, &|p| run::warn_unsealed(observer, p))?.1
             } else {
                 let warn = |p: &Path| run::warn_unsealed(observer, p);
@@ -129,6 +164,42 @@ pub fn choose(
         )));
     }
     Ok(Chosen { program, index, genome, training_seed })
+}
+
+/// Refuses a saved best that is not of `program` (the file's, with the
+/// replay's settings), saying how to replay it: with the run's own
+/// `program.json` (which [`with_run_settings`] takes by itself when only
+/// settings differ), or after running the file again elsewhere. A damaged
+/// or missing checkpoint is left to [`rundir::checked_best`] to name.
+fn not_of_this_program(
+    program: &Program,
+    index: usize,
+    dir: &Path,
+    file: &Path,
+    run_dir: &Path,
+) -> Result<(), Error> {
+    let Ok(Some(cp)) = rundir::read_checkpoint(dir) else { return Ok(()) };
+    let Err(e) = evolve::check_resume_of(program, index, &cp) else { return Ok(()) };
+    let own = rundir::program_path(run_dir);
+    let theirs = if own.exists() {
+        format!(
+            "replay it with the run's own program (`shaping replay {} --run {} --stage {}`), or ",
+            own.display(),
+            run_dir.display(),
+            program.stages[index].name
+        )
+    } else {
+        String::new()
+    };
+    Err(Error::new(
+        crate::ErrorKind::Stale,
+        format!(
+            "error: the best individual in `{}` is not of this program: {e}; {theirs}run `{}` again into another \
+             `--out` and replay that",
+            dir.display(),
+            file.display()
+        ),
+    ))
 }
 
 /// What a replay did: the episode's result, where its files are, its
@@ -156,6 +227,8 @@ pub fn replay(
     if args.mp4.is_some() {
         animation::ffmpeg()?;
     }
+    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let program = with_run_settings(program, &run_dir, &args.sets, observer);
     let chosen = choose(
         program,
         &args.file,
@@ -165,7 +238,6 @@ pub fn replay(
         observer,
     )?;
     let Chosen { program, index, genome, training_seed } = chosen;
-    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let stage = &program.stages[index];
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
     rundir::check_replay_out(&out)?;

@@ -148,6 +148,52 @@ pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
         .map_err(|e| Error::new(ErrorKind::Invalid, format!("error: `--set {}`: {e}", point_name(point))))
 }
 
+/// The settings that make `file` (a file's program, with any settings
+/// already given) into `ran` (a run's `program.json`), as `--set` values
+/// in stage order, if settings alone do: each one found is applied as
+/// `--set` applies it (to the stages extending it that had its value), and
+/// the result must be `ran` itself. `None` when something else differs (or
+/// nothing does: `Some` of none).
+pub fn settings_between(file: &Program, ran: &Program) -> Option<Vec<Assignment>> {
+    let names = |p: &Program| p.stages.iter().map(|s| s.name.clone()).collect::<Vec<_>>();
+    if names(file) != names(ran) {
+        return None;
+    }
+    let mut now = file.clone();
+    let mut found = Vec::new();
+    for i in 0..now.stages.len() {
+        let stage = &now.stages[i];
+        let mut paths: Vec<String> = FIELDS.iter().map(|(p, _)| p.to_string()).collect();
+        for m in 0..stage.modules.len() {
+            paths.extend(MODULE_FIELDS.iter().map(|(f, _)| format!("{}.{f}", stage.module_label(m))));
+        }
+        paths.extend(stage.roles.iter().map(|r| format!("{}.robots", r.name)));
+        for path in paths {
+            let (Ok(was), Ok(value)) = (get(&now.stages[i], &path), get(&ran.stages[i], &path)) else {
+                continue;
+            };
+            if was == value {
+                continue;
+            }
+            set(&mut now, i, &path, &value).ok()?;
+            found.push((format!("{}.{path}", now.stages[i].name), text(kind(&path)?, &value)));
+        }
+    }
+    (now == *ran).then_some(found)
+}
+
+/// A value as `--set` takes it (numbers as the `f32` they are held in).
+fn text(kind: Kind, value: &Value) -> String {
+    let short = |v: f64| (v as f32).to_string();
+    match (kind, value) {
+        (_, Value::Count(n)) => n.to_string(),
+        (_, Value::Real(v)) => short(*v),
+        (_, Value::Word(w)) => w.clone(),
+        (Kind::Range, Value::Pair(lo, hi)) => format!("{}..{}", short(*lo), short(*hi)),
+        (_, Value::Pair(w, d)) => format!("{}x{}", short(*w), short(*d)),
+    }
+}
+
 /// The value kinds of the settings.
 #[derive(Clone, Copy, Debug)]
 enum Kind {

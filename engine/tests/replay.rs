@@ -177,22 +177,50 @@ fn the_trace_has_what_the_robot_sensed_and_did() {
 }
 
 /// A replay takes `--set` as a run does: a run made with a setting changed
-/// on a parent stage replays with the same setting.
+/// on a parent stage replays with the same setting, given or not (the
+/// file with the run's settings is the run's `program.json`: that program
+/// replays, and the replay says so). A setting given that the run did not
+/// have is refused with advice that works: the run's own program.
 #[test]
 fn a_replay_takes_the_settings_the_run_was_made_with() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let out = d.join("run");
-    let set = sets(&["first.evolve.generations=2"]);
+    let set = sets(&["first.evolve.generations=2", "second.world.arena=500x700"]);
     run(tiny(), &RunOptions { sets: set.clone(), ..options(&out) }).unwrap();
     let plain = ReplayOptions { stage: Some("second".into()), ..opts(&tiny_bat(), &out, &d.join("plain")) };
-    let err = error(replay::replay(tiny(), &plain, &Log::default()));
-    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
-    assert!(err.message().contains("is not of this program"), "{err}");
+    let log = Log::default();
+    replay::replay(tiny(), &plain, &log).unwrap();
+    let said = log.warnings().join("\n");
+    assert!(
+        said.contains(
+            "is of this file with other settings (`--set first.evolve.generations=2 --set second.world.arena=500x700`): \
+             replaying the run's own program"
+        ),
+        "{said}"
+    );
     let with = ReplayOptions { sets: set, ..opts(&tiny_bat(), &out, &d.join("with")) };
     let with = ReplayOptions { stage: Some("second".into()), ..with };
-    replay::replay(tiny(), &with, &Log::default()).unwrap();
-    assert!(d.join("with/trace.csv").exists());
+    replay::replay(tiny(), &with, &log).unwrap();
+    assert!(log.warnings().is_empty(), "the same settings given: nothing to say");
+    assert!(read_text(&d.join("with/trace.csv")) == read_text(&d.join("plain/trace.csv")));
+
+    let other = ReplayOptions { sets: sets(&["first.evolve.generations=3"]), ..plain.clone() };
+    let err = error(replay::replay(tiny(), &other, &log));
+    assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
+    let own = out.join("program.json");
+    let advice = format!(
+        "replay it with the run's own program (`shaping replay {} --run {} --stage second`)",
+        own.display(),
+        out.display()
+    );
+    assert!(err.message().contains("is not of this program"), "{err}");
+    assert!(err.message().contains("the generations of `first`, which `second` extends, changed"), "{err}");
+    assert!(err.message().contains(&advice), "{err}");
+    // Following it.
+    let ran = ReplayOptions { file: own.clone(), out: Some(d.join("own")), ..plain };
+    replay::replay(load(&own), &ran, &log).unwrap();
+    assert!(read_text(&d.join("own/trace.csv")) == read_text(&d.join("plain/trace.csv")));
 }
 
 /// `trace.csv` written as an episode goes (as `drive` writes it) is, once

@@ -122,18 +122,26 @@ fn an_edited_file_is_not_resumed_from_its_old_checkpoint() {
         assert!(msg.contains("cannot resume from") && msg.contains("checkpoint.json"), "{err}");
         assert!(msg.contains(what) && msg.contains("`--fresh`") && msg.contains("`--out`"), "{err}");
     }
-    // Nor does `replay` take the run's best for the edited stage.
+    // Nor does `replay` take the run's best for the edited stage, but for
+    // the run's own program, which it replays when only settings differ.
     let args = replay::ReplayOptions {
         file: file.clone(),
         run: Some(out.clone()),
         out: Some(dir.path().join("r")),
         ..replay::ReplayOptions::default()
     };
+    let log = Log::default();
+    replay::replay(load(&file), &args, &log).unwrap();
+    let said = log.warnings().join("\n");
+    assert!(said.contains("is of this file with other settings (`--set s.world.arena="), "{said}");
+    std::fs::remove_dir_all(dir.path().join("r")).unwrap();
+    write_bat(dir.path(), "s.bat", &EDITED.replace("behavior turn left", "behavior turn right"));
     let err = error(replay::replay(load(&file), &args, &Log::default()));
     assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
     assert!(
         err.message().contains("is not of this program")
-            && err.message().contains("the world of `s` changed"),
+            && err.message().contains("the modules of `s` changed")
+            && err.message().contains("replay it with the run's own program (`shaping replay"),
         "{err}"
     );
     assert!(!dir.path().join("r").exists(), "the refused replay wrote nothing");

@@ -68,18 +68,21 @@ pub fn failure(err: &RobotError, stopped: &Result<(), RobotError>) -> String {
 
 pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let program = crate::load::load_program(&args.file, args.error_format)?;
+    let terminal = run::Terminal::new(true, false);
+    // A run made with `--set`: its own program, as `replay` takes it.
+    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
+    let program = replay::with_run_settings(program, &run_dir, &[], &terminal);
     let chosen = replay::choose(
         program,
         &args.file,
         args.stage.as_deref(),
         args.genome.as_deref(),
         args.run.as_deref(),
-        &run::Terminal::new(true, false),
+        &terminal,
     )?;
     let replay::Chosen { program, index, genome, training_seed } = chosen;
     let stage = &program.stages[index];
     check_robot_world(stage)?;
-    let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
     shaping_engine::rundir::check_output_dir(&out, "`drive`", "drive")?;
     // The life length and learning the stage declares, as in `replay`.
