@@ -486,42 +486,53 @@ fn check_owner(
 /// before anything is written, a run that would rewrite it with another
 /// definition of a stage it does not run (a `--set` of a stage outside its
 /// `--stage`, a stage edited in the file, a stage extending one that
-/// changed) whose directory holds results. `now` is the program with the
-/// run's settings and the file's own, `stages` those the run runs.
+/// changed) whose directory holds results. `file` is the file's program,
+/// `sets` the run's settings, `program` the file's with them, `stages`
+/// those the run runs. Where leaving some `--set` values out would do, the
+/// message names them (found by leaving each out in turn and keeping the
+/// omissions that bring the programs closer).
 fn check_described(
     out: &Path,
     previous: &Program,
-    now: (&Program, &Program),
+    (program, file, sets): (&Program, &Program, &[Assignment]),
     stages: &[usize],
 ) -> Result<()> {
-    use evolve::fingerprint::{changes, fingerprint};
-    let (program, file) = now;
-    let mut changed = Vec::new();
-    let mut by_sets = true;
-    for (i, st) in program.stages.iter().enumerate() {
-        let dir = rundir::stage_dir(out, &st.name);
-        if stages.contains(&i) || !holds_results(&dir) {
-            continue;
-        }
-        let Some((j, _)) = previous.stage(&st.name) else { continue };
-        let was = fingerprint(previous, j);
-        let what = changes(&was, &fingerprint(program, i));
-        if what.is_empty() {
-            continue;
-        }
-        by_sets &= changes(&was, &fingerprint(file, i)).is_empty();
-        changed.push((st.name.as_str(), what.join("; "), dir));
-    }
+    let changed = misdescribed(out, previous, program, stages);
     if changed.is_empty() {
         return Ok(());
     }
-    let names: Vec<String> = changed.iter().map(|(n, _, _)| format!("`{n}`")).collect();
-    let why: Vec<&str> = changed.iter().map(|(_, w, _)| w.as_str()).collect();
-    let dirs: Vec<String> = changed.iter().map(|(_, _, d)| format!("`{}`", d.display())).collect();
+    let distance =
+        |p: &Program| -> usize { misdescribed(out, previous, p, stages).iter().map(|m| m.parts).sum() };
+    let mut keep: Vec<Assignment> = sets.to_vec();
+    let mut left_out = Vec::new();
+    let mut now = distance(program);
+    for a in sets {
+        let trial: Vec<Assignment> = keep.iter().filter(|k| *k != a).cloned().collect();
+        let mut p = file.clone();
+        if crate::sweep::apply(&mut p, &trial).is_err() {
+            continue;
+        }
+        let d = distance(&p);
+        if d < now {
+            (now, keep) = (d, trial);
+            left_out.push(format!("`--set {}={}`", a.0, a.1));
+        }
+    }
+    let names: Vec<String> = changed.iter().map(|m| format!("`{}`", m.stage)).collect();
+    let why: Vec<&str> = changed.iter().map(|m| m.what.as_str()).collect();
+    let dirs: Vec<String> = changed.iter().map(|m| format!("`{}`", m.dir.display())).collect();
     let (stage, them, it) =
         if changed.len() == 1 { ("stage", "its", "it") } else { ("stages", "their", "them") };
-    let sets =
-        if by_sets { format!("leave out the `--set` values that change {it}, ") } else { String::new() };
+    // Or the settings the directory's run was made with, missing here.
+    let made_with = crate::sweep::settings_between(program, previous).filter(|f| !f.is_empty());
+    let sets = match made_with {
+        _ if now == 0 => format!("leave out {}, ", left_out.join(" and ")),
+        Some(found) => {
+            let found: Vec<String> = found.iter().map(|(t, v)| format!("--set {t}={v}")).collect();
+            format!("add `{}` (the settings its run was made with), ", found.join(" "))
+        }
+        None => String::new(),
+    };
     Err(Error::new(
         ErrorKind::Stale,
         format!(
@@ -535,6 +546,49 @@ fn check_described(
             dirs.join(", ")
         ),
     ))
+}
+
+/// A stage whose results `program.json` would no longer describe.
+struct Misdescribed<'a> {
+    stage: &'a str,
+    /// What changed, in words.
+    what: String,
+    /// How many parts of its fingerprint changed.
+    parts: usize,
+    dir: PathBuf,
+}
+
+/// The stages of `program` outside `stages` whose directories in `out`
+/// hold results and whose definition (their fingerprint: the stage and
+/// the evolved stages it extends) differs from `previous`'s.
+fn misdescribed<'a>(
+    out: &Path,
+    previous: &Program,
+    program: &'a Program,
+    stages: &[usize],
+) -> Vec<Misdescribed<'a>> {
+    use evolve::fingerprint::{changes, fingerprint};
+    let mut found = Vec::new();
+    for (i, st) in program.stages.iter().enumerate() {
+        let dir = rundir::stage_dir(out, &st.name);
+        if stages.contains(&i) || !holds_results(&dir) {
+            continue;
+        }
+        let Some((j, _)) = previous.stage(&st.name) else { continue };
+        let (was, now) = (fingerprint(previous, j), fingerprint(program, i));
+        let what = changes(&was, &now);
+        if what.is_empty() {
+            continue;
+        }
+        let parts = was.len().abs_diff(now.len())
+            + was
+                .iter()
+                .zip(&now)
+                .map(|(a, b)| a.parts.iter().filter(|(k, v)| b.parts.get(*k) != Some(v)).count())
+                .sum::<usize>();
+        found.push(Misdescribed { stage: &st.name, what: what.join("; "), parts: parts.max(1), dir });
+    }
+    found
 }
 
 /// A stage directory holds results of a run (not only a replay's).
@@ -628,7 +682,7 @@ impl Runner<'_> {
             check_owner(&out, previous.as_ref(), &program, source)?;
         }
         if let Some(previous) = &previous {
-            check_described(&out, previous, (&program, &file), &stages)?;
+            check_described(&out, previous, (&program, &file, &opts.sets), &stages)?;
         }
         let mut saved =
             if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed, &warn)? };

@@ -339,7 +339,7 @@ fn a_run_that_would_misdescribe_a_stage_it_does_not_run_is_refused() {
         msg.contains("with another definition of stage `second` (the world of `second` changed)"),
         "{err}"
     );
-    assert!(msg.contains("leave out the `--set` values that change it"), "{err}");
+    assert!(msg.contains("leave out `--set second.world.arena=800x900`, "), "{err}");
     assert!(msg.contains("pass `--fresh` without `--stage` to run every stage again"), "{err}");
     assert!(files(out) == before, "nothing written");
     // A stage it extends changed: its results are of the old one.
@@ -347,6 +347,7 @@ fn a_run_that_would_misdescribe_a_stage_it_does_not_run_is_refused() {
         shaping_engine::run::RunOptions { fresh: true, ..first(&["first.evolve.mutation=0.2"]) };
     let err = error(run(tiny(), &fresh_first));
     assert!(err.message().contains("which `second` extends, changed"), "{err}");
+    assert!(err.message().contains("leave out `--set first.evolve.mutation=0.2`, "), "{err}");
     assert!(files(out) == before, "nothing written");
     // The ways out: without the setting of `second`; every stage again;
     // `second` moved away.
@@ -355,6 +356,13 @@ fn a_run_that_would_misdescribe_a_stage_it_does_not_run_is_refused() {
     run(tiny(), &shaping_engine::run::RunOptions { stage: None, ..all }).unwrap();
     let program = read_json(&out.join("program.json"));
     assert_eq!(program["stages"][1]["world"]["arena"], serde_json::json!([800.0, 900.0]));
+    // Now the file without the setting is what would misdescribe `second`.
+    let err = error(run(tiny(), &first(&[])));
+    assert!(
+        err.message().contains("add `--set second.world.arena=800x900` (the settings its run was made with)"),
+        "{err}"
+    );
+    run(tiny(), &first(&["second.world.arena=800x900"])).unwrap();
     std::fs::remove_dir_all(out.join("second")).unwrap();
     run(tiny(), &fresh_first).unwrap();
 }
