@@ -239,11 +239,7 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
     let started = Instant::now();
     // A built program (`program.json`) names no file: the directory's own
     // program.json may be run into it.
-    let outcome = if args.file.extension().is_some_and(|e| e == "json") {
-        runner.run(program, &opts)
-    } else {
-        runner.run_file(program, &args.file, &opts)
-    };
+    let outcome = runner.run_file(program, &args.file, &opts);
     if let Some(e) = terminal.take_failure() {
         return Err(e);
     }

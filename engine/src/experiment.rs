@@ -223,12 +223,7 @@ impl Plan {
                 rundir::create_stage_dir(&dir)?;
             }
         }
-        let file = &self.args.file;
-        if file.extension().is_some_and(|e| e != "json") {
-            runner.run_file(self.program.clone(), file, &opts)
-        } else {
-            runner.run(self.program.clone(), &opts)
-        }
+        runner.run_file(self.program.clone(), &self.args.file, &opts)
     }
 
     /// Names a task in progress lines: `seed 3` or `seed 3 of mutation=0.01`.

@@ -643,11 +643,15 @@ impl Runner<'_> {
         self.run_source(program, None, opts)
     }
 
-    /// [`Runner::run`] of the program compiled from the file `source` (a
-    /// `.bat` file): the directory records the file's name (`source.json`),
+    /// [`Runner::run`] of the program loaded from the file `source`: of a
+    /// `.bat` file, the directory records the file's name (`source.json`),
     /// and a run of another file into it is refused unless `opts.fresh`
-    /// (several files may share a program's name, their robot's).
+    /// (several files may share a program's name, their robot's); a built
+    /// program (`.json`) is [`Runner::run`]'s.
     pub fn run_file(&self, program: Program, source: &Path, opts: &RunOptions) -> Result<RunOutcome> {
+        if source.extension().is_some_and(|e| e == "json") {
+            return self.run(program, opts);
+        }
         let name = source.file_name().map(|n| n.to_string_lossy().into_owned());
         self.run_source(program, name.as_deref(), opts)
     }

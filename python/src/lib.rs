@@ -140,8 +140,8 @@ impl Pool {
 }
 
 /// Refuses, before allocating, a call that would need `need` bytes where
-/// fewer are available (the machine's or the control group's, as `run`
-/// checks): a MemoryError with the estimate and what to do.
+/// fewer are available (the machine's, the control group's or the address
+/// space's, as `run` checks): a MemoryError with the estimate and what to do.
 fn check_room(need: u64, what: &str, instead: &str) -> PyResult<()> {
     load::check_room(need, what, instead).map_err(|e| PyMemoryError::new_err(e.message().to_string()))
 }
@@ -1486,7 +1486,7 @@ fn run(
     let out = out.unwrap_or_else(|| engine_run::default_out(&path));
     let options = RunOptions { stage, seed, out, jobs, fresh, no_report: !report, sets };
     let outcome = observed(py, callback, |observer, stop| {
-        Runner { observer, evaluator: None, interrupt: Some(stop) }.run(program, &options)
+        Runner { observer, evaluator: None, interrupt: Some(stop) }.run_file(program, &path, &options)
     })?;
     Ok(Run::of(outcome))
 }
