@@ -22,6 +22,7 @@ pub mod replay;
 pub mod report;
 pub mod run;
 pub mod rundir;
+pub mod stats;
 pub mod stepper;
 pub mod sweep;
 

@@ -36,19 +36,10 @@ pub fn rolling_mean(values: &[f32], window: usize) -> Vec<f32> {
     out
 }
 
-/// Median of a non-empty slice of finite values (NaN for an empty one).
+/// Median of a slice of finite values (NaN for an empty one): the engine's
+/// one median, `stats::median`.
 pub(super) fn median(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return f64::NAN;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let m = v.len() / 2;
-    if v.len() % 2 == 1 {
-        v[m]
-    } else {
-        (v[m - 1] + v[m]) / 2.0
-    }
+    crate::stats::median(values).unwrap_or(f64::NAN)
 }
 
 /// A Cartesian chart with light grid, tick labels and axis names (when text
