@@ -295,6 +295,25 @@ enum Command {
         #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
+    /// Compare finished experiment directories (each with its `seed-N/`
+    /// runs, the same stages in each): per stage and measure the median with
+    /// its bootstrap 95% interval and, for every pair, the Mann-Whitney U
+    /// test's p-value and the Vargha-Delaney A12 (Holm-corrected for more
+    /// than two directories), as Markdown or `--json`.
+    Compare {
+        /// Experiment directories (at least two, each of at least 2 seeds).
+        #[arg(required = true, num_args = 2..)]
+        dirs: Vec<PathBuf>,
+        /// `STAGE=FITNESS`: also compare the generation reaching it.
+        #[arg(long)]
+        criterion: Vec<String>,
+        /// Compare this stage only (directories that ran other stages too).
+        #[arg(long)]
+        stage: Option<String>,
+        /// Print the comparison as JSON (the `tests` of `summary.json`).
+        #[arg(long)]
+        json: bool,
+    },
     /// Write one self-contained HTML page (no network needed) for a run, stage,
     /// experiment or replay directory: the replay animated with its module
     /// activations, fitness, architecture and genome layout.
@@ -580,6 +599,16 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             }
             let _ = rank_timeout;
             experiment::experiment(&plan, jobs, None)
+        }
+        Command::Compare { dirs, criterion, stage, json } => {
+            let opts = shaping_engine::compare::CompareOptions { dirs, criterion, stage };
+            let tests = shaping_engine::compare::compare(&opts)?;
+            if json {
+                let text = serde_json::to_string_pretty(&tests)
+                    .map_err(|e| CliError::io(format!("error: cannot serialise the comparison: {e}")))?;
+                return print_text(&text);
+            }
+            print_text(&shaping_engine::compare::markdown(&tests, "# Comparison"))
         }
         Command::Report { dir, output } => {
             let unsealed = std::cell::RefCell::new(Vec::new());

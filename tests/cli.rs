@@ -898,3 +898,32 @@ fn a_run_of_another_file_into_a_run_directory_is_refused_naming_both() {
     assert!(r.status.success(), "{}", text(&r.stderr));
     assert!(text(&std::fs::read(out.join("source.json")).unwrap()).contains("\"other.bat\""));
 }
+
+/// `compare` of two finished experiments prints the tests as Markdown (or
+/// JSON with `--json`); a directory of one seed is refused with status 2,
+/// saying why, and so is a single directory.
+#[test]
+fn compare_prints_the_tests_of_two_experiments() {
+    let dir = scratch("compare");
+    let (a, b, one) = (dir.join("a"), dir.join("b"), dir.join("one"));
+    for (out, seeds, first) in [(&a, "3", "1"), (&b, "3", "4"), (&one, "1", "1")] {
+        let args = ["--seeds", seeds, "--first-seed", first, "--no-report", "--jobs", "2"];
+        let done = run(shaping().arg("experiment").arg(tiny()).arg("--out").arg(out).args(args));
+        assert!(done.status.success(), "{}", text(&done.stderr));
+    }
+    let out = run(shaping().arg("compare").arg(&a).arg(&b));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let md = text(&out.stdout);
+    assert!(md.starts_with("# Comparison\n"), "{md}");
+    assert!(md.contains("| pair | U | p-value | A12 | size | test |") && md.contains("| 1 vs 2 |"), "{md}");
+    let out = run(shaping().arg("compare").arg(&a).arg(&b).arg("--json"));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let pair = &json["measures"][0]["pairs"][0];
+    assert!(pair["p_value"].is_number() && pair["a12"].is_number(), "{json}");
+    let out = run(shaping().arg("compare").arg(&a).arg(&one));
+    assert_eq!(out.status.code(), Some(2));
+    let err = text(&out.stderr);
+    assert!(err.contains("no test: `") && err.contains("needs at least 2 seeds per side"), "{err}");
+    assert_eq!(run(shaping().arg("compare").arg(&a)).status.code(), Some(2));
+}

@@ -14,7 +14,7 @@ use crate::files::{write_atomic, DirLock};
 use crate::load;
 use crate::rundir;
 use crate::sweep::{self, Assignment, Set};
-use crate::{plot, report, run};
+use crate::{compare, plot, report, run};
 
 /// What an experiment runs.
 #[derive(Clone, Debug, Default)]
@@ -76,7 +76,7 @@ fn fmt_spread(s: Option<Spread>, digits: usize) -> String {
 }
 
 /// Parses `STAGE=VALUE` criteria (`navigation=0.7`).
-fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Error> {
+pub(crate) fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Error> {
     args.iter()
         .map(|c| {
             let (stage, value) = c.split_once('=').ok_or_else(|| {
@@ -249,6 +249,7 @@ impl Plan {
             .map_or_else(|| program.name.clone(), |s| s.to_string_lossy().into_owned());
         let mut points = Vec::new();
         let mut table = Vec::new();
+        let mut groups = Vec::new();
         for (i, point) in self.points.iter().enumerate() {
             let dir = self.point_dir(i);
             let name = sweep::point_name(point);
@@ -256,8 +257,20 @@ impl Plan {
             // The point's program: the values that ran, not the file's.
             let mut ran = program.clone();
             sweep::apply(&mut ran, point)?;
-            let (md, stages) =
+            let (mut md, stages) =
                 summarise(&ran, &self.stages, &heading, &dir, &self.seeds, &self.criteria, &u)?;
+            groups.push((
+                if point.is_empty() { title.clone() } else { name.clone() },
+                compare::read_measures(&ran, &self.stages, &dir, &self.seeds, &self.criteria)?,
+            ));
+            if self.args.sets.is_empty() {
+                // One point: its medians' intervals (a sweep's tests are in its table).
+                md.push('\n');
+                md.push_str(&compare::markdown(
+                    &compare::tests(&groups),
+                    "## Medians with their 95% intervals",
+                ));
+            }
             write_atomic(&dir.join("summary.md"), md.as_bytes())?;
             if self.args.sets.is_empty() {
                 finished.summary.push_str(&md);
@@ -280,12 +293,19 @@ impl Plan {
             .iter()
             .map(|s| serde_json::json!({ "target": s.target, "values": s.values }))
             .collect();
-        let json = serde_json::json!({ "file": title, "seeds": self.seeds, "sets": sets, "points": points });
+        // The tests between points (a point's median and interval alone
+        // without a sweep), after the figures that were there before them.
+        let tests = compare::tests(&groups);
+        let json = serde_json::json!({
+            "file": title, "seeds": self.seeds, "sets": sets, "points": points, "tests": tests,
+        });
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::io(format!("error: cannot serialise the summary: {e}")))?;
         crate::files::write_sealed(&self.out, &[("summary.json", format!("{text}\n").as_bytes())])?;
         if !self.args.sets.is_empty() {
-            let md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
+            let mut md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
+            md.push('\n');
+            md.push_str(&compare::markdown(&tests, "## Tests between points"));
             write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
             finished.summary.push_str(&md);
             sweep_plot(&self.out.join("sweep"), &title, &table)?;

@@ -9,6 +9,7 @@
 
 pub mod animation;
 pub mod bench;
+pub mod compare;
 pub mod descriptors;
 pub mod diag;
 pub mod episode;

@@ -86,7 +86,9 @@ fn a_sweep_point_is_the_run_with_its_settings() {
         "| point | `first.evolve.mutation` | `first.world.battery` | first final best | first chosen best |";
     assert!(md.contains(head), "{md}");
     assert!(md.contains("| 3 | 0.2 | 100 | "), "{md}");
-    assert_eq!(md.lines().filter(|l| l.starts_with("| ") && l.contains(" | 0.")).count(), 4, "{md}");
+    // One row per point in the table (the tests between points follow it).
+    let table = md.split("\n## Tests between points").next().unwrap();
+    assert_eq!(table.lines().filter(|l| l.starts_with("| ") && l.contains(" | 0.")).count(), 4, "{md}");
     assert!(d.join("sweep/sweep.svg").exists() && d.join("sweep/sweep.png").exists());
     assert!(d.join("sweep").join(point).join("summary.md").exists(), "no summary of the point");
 }

@@ -93,6 +93,20 @@ fn an_experiments_and_a_sweeps_summaries_are_pinned() {
     };
     experiment(common::tiny(), opts).unwrap();
     check("sweep of tiny.bat", dir.path(), SWEEP);
+    // The statistics (issue 51) were appended: without them, the summaries
+    // are the bytes pinned before (`summary.json` 0xd4e4137643321c7c,
+    // `summary.md` 0x808fc26fbee3eb0f).
+    let json = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
+    let value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert!(value["tests"]["measures"].is_array(), "{json}");
+    // `tests` is the last key: cut it out of the text.
+    let (head, _) = json.split_once(",\n  \"tests\": ").unwrap();
+    let before = format!("{head}\n}}\n");
+    assert_eq!(fnv1a(before.as_bytes()), 0xd4e4137643321c7c, "{before}");
+    let md = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    let (table, tests) = md.split_once("\n## Tests between points").unwrap();
+    assert_eq!(fnv1a(table.as_bytes()), 0x808fc26fbee3eb0f, "{table}");
+    assert!(tests.contains("| p-value |") && tests.contains("1 vs 2"), "{tests}");
 }
 
 const KHEPERA: &[(&str, u64)] = &[
@@ -178,6 +192,8 @@ const SWEEP: &[(&str, u64)] = &[
     ("first.evolve.mutation=0.2/seed-2/second/episode.json", 0x453a7eaf4ea8f6a9),
     ("first.evolve.mutation=0.2/seed-2/second/generations.csv", 0x7400b864a706108d),
     ("first.evolve.mutation=0.2/summary.md", 0xca9eeeddaed0d351),
-    ("summary.json", 0xd4e4137643321c7c),
-    ("summary.md", 0x808fc26fbee3eb0f),
+    // With the statistics appended (issue 51); the bytes before them are
+    // checked in the test.
+    ("summary.json", 0x6db58ef708d8dea9),
+    ("summary.md", 0x79782fdf8116011e),
 ];

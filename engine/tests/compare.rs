@@ -1,0 +1,188 @@
+//! `compare`: finished experiments compared stage by stage and measure by
+//! measure (the numbers themselves are tested against SciPy's in the
+//! library's `stats` and `compare` tests), and what it refuses.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{experiment, load, root, tiny, tiny_experiment};
+use shaping_engine::compare::{compare, CompareOptions, Tests};
+use shaping_engine::experiment::ExperimentOptions;
+use shaping_engine::stats;
+use shaping_engine::sweep::parse_set;
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// Equal JSON, numbers within reading's rounding (serde_json's parser may
+/// miss the nearest double by one unit in the last place).
+fn same(a: &serde_json::Value, b: &serde_json::Value) -> bool {
+    use serde_json::Value::{Array, Number, Object};
+    match (a, b) {
+        (Number(x), Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            (x - y).abs() <= 1e-15 * x.abs().max(y.abs())
+        }
+        (Array(x), Array(y)) => x.len() == y.len() && x.iter().zip(y).all(|(x, y)| same(x, y)),
+        (Object(x), Object(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
+fn opts(dirs: &[&Path]) -> CompareOptions {
+    CompareOptions { dirs: dirs.iter().map(|d| d.to_path_buf()).collect(), ..CompareOptions::default() }
+}
+
+fn err(o: &CompareOptions) -> String {
+    compare(o).map(|_| ()).unwrap_err().message().to_string()
+}
+
+/// Each seed's chosen best of `stage`, from its checkpoint.
+fn chosen(dir: &Path, seeds: std::ops::RangeInclusive<u64>, stage: &str) -> Vec<f64> {
+    seeds
+        .map(|s| {
+            read_json(&dir.join(format!("seed-{s}/{stage}/checkpoint.json")))["best"][1].as_f64().unwrap()
+                as f32 as f64
+        })
+        .collect()
+}
+
+fn tiny_into(dir: &Path, first_seed: u64, seeds: u64) -> PathBuf {
+    experiment(tiny(), ExperimentOptions { first_seed, ..tiny_experiment(dir, seeds) }).unwrap();
+    dir.to_path_buf()
+}
+
+#[test]
+fn two_experiments_are_compared_measure_by_measure() {
+    let d = tempfile::tempdir().unwrap();
+    let a = tiny_into(&d.path().join("a"), 1, 3);
+    let b = tiny_into(&d.path().join("b"), 4, 3);
+    let t: Tests =
+        compare(&CompareOptions { criterion: vec!["first=0.3".into()], ..opts(&[&a, &b]) }).unwrap();
+    assert_eq!(t.groups, [a.display().to_string(), b.display().to_string()]);
+    assert!(!t.holm);
+    let names: Vec<(&str, &str)> =
+        t.measures.iter().map(|m| (m.stage.as_str(), m.measure.as_str())).collect();
+    assert_eq!(
+        names,
+        [
+            ("first", "final_best"),
+            ("first", "chosen_best"),
+            ("first", "final_mean"),
+            ("first", "best_ever"),
+            ("first", "generation_reaching_criterion"),
+            ("second", "final_best"),
+            ("second", "chosen_best"),
+            ("second", "final_mean"),
+            ("second", "best_ever"),
+        ]
+    );
+    // The chosen bests are the checkpoints', and the test is the statistics' on them.
+    let m = &t.measures[6];
+    let (va, vb) = (chosen(&a, 1..=3, "second"), chosen(&b, 4..=6, "second"));
+    let want = stats::mann_whitney(&va, &vb).unwrap();
+    assert_eq!(m.pairs[0].p_value, Some(want.p_value));
+    assert_eq!(m.pairs[0].a12, stats::a12(&va, &vb));
+    assert_eq!(m.groups[0].median, stats::median(&va));
+    assert_eq!(m.groups[1].interval, stats::median_ci(&vb));
+    let json = serde_json::to_value(&t).unwrap();
+    for pair in json["measures"].as_array().unwrap().iter().flat_map(|m| m["pairs"].as_array().unwrap()) {
+        assert!(pair["p_value"].is_number() && pair["a12"].is_number(), "{pair}");
+    }
+}
+
+/// A sweep's `summary.json` holds the same tests as `compare` of its points.
+#[test]
+fn a_sweeps_tests_are_compares_of_its_points() {
+    let d = tempfile::tempdir().unwrap();
+    let sets = vec![parse_set("first.evolve.mutation=0.01,0.2,0.5").unwrap()];
+    experiment(tiny(), ExperimentOptions { sets, ..tiny_experiment(d.path(), 3) }).unwrap();
+    let summary = read_json(&d.path().join("summary.json"));
+    let points: Vec<PathBuf> = summary["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| d.path().join(p["dir"].as_str().unwrap()))
+        .collect();
+    let t = compare(&opts(&points.iter().map(|p| p.as_path()).collect::<Vec<_>>())).unwrap();
+    assert!(t.holm);
+    let mut from_compare = serde_json::to_value(&t).unwrap();
+    let mut in_summary = summary["tests"].clone();
+    assert_eq!(
+        in_summary["groups"],
+        serde_json::json!([
+            "first.evolve.mutation=0.01",
+            "first.evolve.mutation=0.2",
+            "first.evolve.mutation=0.5"
+        ])
+    );
+    from_compare["groups"] = serde_json::Value::Null;
+    in_summary["groups"] = serde_json::Value::Null;
+    assert!(same(&from_compare, &in_summary), "{from_compare}\n{in_summary}");
+    assert!(in_summary["measures"][0]["pairs"][2]["p_holm"].is_number(), "{in_summary}");
+    let md = std::fs::read_to_string(d.path().join("summary.md")).unwrap();
+    assert!(
+        md.contains("## Tests between points") && md.contains("| Holm p |") && md.contains("| 2 vs 3 |"),
+        "{md}"
+    );
+}
+
+#[test]
+fn compare_refuses_different_stages_single_seeds_and_missing_measures() {
+    let d = tempfile::tempdir().unwrap();
+    let a = tiny_into(&d.path().join("a"), 1, 2);
+    let first_only = d.path().join("first-only");
+    experiment(tiny(), ExperimentOptions { stage: Some("first".into()), ..tiny_experiment(&first_only, 2) })
+        .unwrap();
+    let e = err(&opts(&[&a, &first_only]));
+    assert!(
+        e.contains("ran different stages: `first` (evolved), `second` (evolved) against `first` (evolved)")
+            && e.contains("`--stage NAME`"),
+        "{e}"
+    );
+    // One stage that both ran compares.
+    let t = compare(&CompareOptions { stage: Some("first".into()), ..opts(&[&a, &first_only]) }).unwrap();
+    assert!(t.measures.iter().all(|m| m.stage == "first"));
+    let e = err(&CompareOptions { stage: Some("second".into()), ..opts(&[&a, &first_only]) });
+    assert!(e.contains("did not run stage `second`"), "{e}");
+
+    let one = tiny_into(&d.path().join("one"), 1, 1);
+    let e = err(&opts(&[&a, &one]));
+    assert_eq!(
+        e,
+        format!(
+            "error: no test: `{}` has 1 seed (`seed-1`); the Mann-Whitney test needs at least 2 seeds per side",
+            one.display()
+        )
+    );
+    let e = err(&opts(&[&a, d.path()]));
+    assert!(e.contains("has no `seed-N` directory: it is not an experiment's directory"), "{e}");
+    assert!(err(&opts(&[&a])).contains("at least two experiment directories"));
+
+    // A test stage's figure missing from one directory's files.
+    let report = root().join("tests/cli/report.bat");
+    let run = |dir: &Path, first_seed: u64| {
+        let o = ExperimentOptions { file: report.clone(), first_seed, ..tiny_experiment(dir, 2) };
+        experiment(load(&report), o).unwrap();
+    };
+    let (x, y) = (d.path().join("x"), d.path().join("y"));
+    run(&x, 1);
+    run(&y, 3);
+    assert!(compare(&opts(&[&x, &y])).unwrap().measures.iter().any(|m| m.measure == "grips"));
+    let summary = y.join("seed-4/bigger/summary.json");
+    let mut s = read_json(&summary);
+    s.as_object_mut().unwrap().remove("grips");
+    std::fs::write(&summary, serde_json::to_string(&s).unwrap()).unwrap();
+    let e = err(&opts(&[&x, &y]));
+    assert_eq!(
+        e,
+        format!(
+            "error: measure `grips` of stage `bigger` is missing in `{}` (1 of 2 seeds), which other directories have",
+            y.display()
+        )
+    );
+}
