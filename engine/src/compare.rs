@@ -26,8 +26,18 @@ pub struct StageMeasures {
 
 /// The measures compared: an evolved stage's, a test stage's (a training
 /// stage has none: its figure is per learning module, not per seed).
-pub const EVOLVE_MEASURES: [&str; 5] =
-    ["final_best", "chosen_best", "final_mean", "best_ever", "generation_reaching_criterion"];
+pub const EVOLVE_MEASURES: [&str; 10] = [
+    "final_best",
+    "chosen_best",
+    "final_mean",
+    "best_ever",
+    "final_worst",
+    "final_best_recharges",
+    "final_best_grips",
+    "final_best_releases_outside",
+    "generation_reaching_criterion",
+    "evaluations_reaching_criterion",
+];
 pub const TEST_MEASURES: [&str; 3] = ["fitness", "grips", "releases_outside"];
 
 fn read_json(path: &Path) -> Result<serde_json::Value, Error> {
@@ -46,8 +56,11 @@ fn missing(path: &Path) -> Error {
 /// The measures of `stages` of `program` over `seeds` in experiment
 /// directory `dir` (its `seed-N/` run directories), as the summaries read
 /// them: an evolved stage's final best, chosen best, final mean and best
-/// ever, and, with a criterion, the generation whose best first reaches it
-/// (a seed that never does counts as the stage's generations plus one,
+/// ever, the last generation's worst and its best's recharges, grips and
+/// releases outside (the other columns of `generations.csv`), and, with a
+/// criterion, the generation whose best first reaches it and the
+/// evaluations until then (that many generations of the stage's population;
+/// a seed that never reaches it counts as the stage's generations plus one,
 /// after every seed that does); a test stage's fitness, grips and releases
 /// outside.
 pub fn read_measures(
@@ -62,22 +75,30 @@ pub fn read_measures(
         match &stage.run {
             StageRun::Evolve(evo) => {
                 let criterion = criteria.iter().find(|(s, _)| *s == stage.name).map(|c| c.1);
-                let mut v: [Vec<f64>; 5] = Default::default();
+                let mut v: [Vec<f64>; 10] = Default::default();
                 for &seed in seeds {
                     let sdir = rundir::stage_dir(&rundir::seed_dir(dir, seed), &stage.name);
                     let cp: Checkpoint = rundir::read_checkpoint(&sdir)?
                         .ok_or_else(|| missing(&rundir::checkpoint_path(&sdir)))?;
                     let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
-                    v[0].push(own.last().map_or(f64::NAN, |l| l.best as f64));
+                    // The last generation's columns of `generations.csv`.
+                    let last = |f: fn(&GenStats) -> f64| own.last().map_or(f64::NAN, |l| f(l));
+                    v[0].push(last(|l| l.best as f64));
                     v[1].push(shaping_runtime::evolve::best_of(&cp).map_or(f64::NAN, |(_, f)| f as f64));
-                    v[2].push(own.last().map_or(f64::NAN, |l| l.mean as f64));
+                    v[2].push(last(|l| l.mean as f64));
                     v[3].push(own.iter().map(|h| h.best as f64).fold(f64::NAN, f64::max));
+                    v[4].push(last(|l| l.worst as f64));
+                    v[5].push(last(|l| l.best_recharges as f64));
+                    v[6].push(last(|l| l.best_grips as f64));
+                    v[7].push(last(|l| l.best_releases_outside as f64));
                     if let Some(c) = criterion {
-                        v[4].push(
-                            own.iter().find(|h| h.best >= c).map_or(f64::from(evo.generations) + 1.0, |h| {
-                                h.stage_generation as f64 + 1.0
-                            }),
-                        );
+                        let generations = own
+                            .iter()
+                            .find(|h| h.best >= c)
+                            .map_or(f64::from(evo.generations) + 1.0, |h| h.stage_generation as f64 + 1.0);
+                        v[8].push(generations);
+                        // EXPERIMENTS.md's count: a generation evaluates the population.
+                        v[9].push(generations * f64::from(evo.population));
                     }
                 }
                 let measures = EVOLVE_MEASURES
@@ -251,7 +272,8 @@ pub fn tests(groups: &[(String, Vec<StageMeasures>)]) -> Tests {
 /// Digits a measure's values are shown with.
 fn digits(measure: &str) -> usize {
     match measure {
-        "generation_reaching_criterion" => 0,
+        "generation_reaching_criterion" | "evaluations_reaching_criterion" => 0,
+        "final_best_recharges" | "final_best_grips" | "final_best_releases_outside" => 1,
         "grips" | "releases_outside" => 1,
         _ => 3,
     }
@@ -274,10 +296,12 @@ pub fn markdown(t: &Tests, heading: &str) -> String {
     let groups: Vec<String> = t.groups.iter().enumerate().map(|(i, g)| format!("{} `{g}`", i + 1)).collect();
     let _ = writeln!(md, "Groups: {}.\n", groups.join(", "));
     let _ = writeln!(md, "Figures: {}.\n", t.method);
-    if t.measures.iter().any(|m| m.measure == "generation_reaching_criterion") {
+    if t.measures.iter().any(|m| m.measure.ends_with("_reaching_criterion")) {
         let _ = writeln!(
             md,
-            "A seed that never reaches a criterion counts as reaching it at the stage's generations plus one.\n"
+            "A seed that never reaches a criterion counts as reaching it at the stage's generations plus one \
+             (evaluations: that many generations of the stage's population, the count EXPERIMENTS.md uses, \
+             without the earlier stages').\n"
         );
     }
     let mut head = vec!["stage", "measure", "group", "seeds", "median [95% interval]"];

@@ -65,24 +65,20 @@ fn two_experiments_are_compared_measure_by_measure() {
         compare(&CompareOptions { criterion: vec!["first=0.3".into()], ..opts(&[&a, &b]) }).unwrap();
     assert_eq!(t.groups, [a.display().to_string(), b.display().to_string()]);
     assert!(!t.holm);
-    let names: Vec<(&str, &str)> =
-        t.measures.iter().map(|m| (m.stage.as_str(), m.measure.as_str())).collect();
-    assert_eq!(
-        names,
-        [
-            ("first", "final_best"),
-            ("first", "chosen_best"),
-            ("first", "final_mean"),
-            ("first", "best_ever"),
-            ("first", "generation_reaching_criterion"),
-            ("second", "final_best"),
-            ("second", "chosen_best"),
-            ("second", "final_mean"),
-            ("second", "best_ever"),
-        ]
-    );
+    let names: Vec<String> = t.measures.iter().map(|m| format!("{} {}", m.stage, m.measure)).collect();
+    let columns = "final_best chosen_best final_mean best_ever final_worst final_best_recharges final_best_grips final_best_releases_outside";
+    let mut want: Vec<String> = columns.split(' ').map(|m| format!("first {m}")).collect();
+    want.extend([
+        "first generation_reaching_criterion".into(),
+        "first evaluations_reaching_criterion".into(),
+    ]);
+    want.extend(columns.split(' ').map(|m| format!("second {m}")));
+    assert_eq!(names, want);
+    // Evaluations: generations of the population of 12.
+    let (generations, evaluations) = (&t.measures[8].groups[0], &t.measures[9].groups[0]);
+    assert_eq!(evaluations.median.unwrap(), generations.median.unwrap() * 12.0);
     // The chosen bests are the checkpoints', and the test is the statistics' on them.
-    let m = &t.measures[6];
+    let m = &t.measures[11];
     let (va, vb) = (chosen(&a, 1..=3, "second"), chosen(&b, 4..=6, "second"));
     let want = stats::mann_whitney(&va, &vb).unwrap();
     assert_eq!(m.pairs[0].p_value, Some(want.p_value));
