@@ -115,11 +115,11 @@ pub enum Method {
 }
 
 impl Method {
-    /// In words, for a summary.
+    /// In a word, for a summary's table (whose text says what each is).
     pub fn words(self) -> &'static str {
         match self {
             Method::Exact => "exact",
-            Method::Normal => "normal approximation, tie and continuity corrected",
+            Method::Normal => "normal",
         }
     }
 }
