@@ -374,6 +374,24 @@ fn seeds_of(dir: &Path) -> Result<Vec<u64>, Error> {
     Ok(seeds)
 }
 
+/// Why `dir` (without `seed-N/`) is no experiment's directory: a sweep's
+/// names its points' directories, which are.
+fn not_an_experiment(dir: &Path) -> String {
+    let name = dir.display();
+    let points: Vec<String> = read_json(&dir.join("summary.json"))
+        .ok()
+        .and_then(|s| {
+            let points = s["points"].as_array()?.iter().filter_map(|p| p["dir"].as_str().map(String::from));
+            Some(points.filter(|p| p != ".").map(|p| format!("`{}`", dir.join(p).display())).collect())
+        })
+        .unwrap_or_default();
+    if points.is_empty() {
+        format!("error: `{name}` has no `seed-N` directory: it is not an experiment's directory")
+    } else {
+        format!("error: `{name}` is a sweep; compare its points' directories: {}", points.join(", "))
+    }
+}
+
 /// The stages run in a seed's directory (those with a directory), in program order.
 fn stages_run(program: &Program, seed_dir: &Path) -> Vec<usize> {
     (0..program.stages.len())
@@ -398,10 +416,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Tests, Error> {
         let name = dir.display().to_string();
         let seeds = seeds_of(dir)?;
         let Some(&seed) = seeds.first() else {
-            return Err(Error::new(
-                ErrorKind::Invalid,
-                format!("error: `{name}` has no `seed-N` directory: it is not an experiment's directory"),
-            ));
+            return Err(Error::new(ErrorKind::Invalid, not_an_experiment(dir)));
         };
         if seeds.len() < 2 {
             return Err(Error::new(

@@ -158,6 +158,17 @@ fn compare_refuses_different_stages_single_seeds_and_missing_measures() {
     let e = err(&opts(&[&a, d.path()]));
     assert!(e.contains("has no `seed-N` directory: it is not an experiment's directory"), "{e}");
     assert!(err(&opts(&[&a])).contains("at least two experiment directories"));
+    let sweep = d.path().join("sweep");
+    let sets = vec![parse_set("first.evolve.mutation=0.01,0.2").unwrap()];
+    experiment(tiny(), ExperimentOptions { sets, ..tiny_experiment(&sweep, 2) }).unwrap();
+    let e = err(&opts(&[&a, &sweep]));
+    assert_eq!(
+        e,
+        format!(
+            "error: `{0}` is a sweep; compare its points' directories: `{0}/first.evolve.mutation=0.01`, `{0}/first.evolve.mutation=0.2`",
+            sweep.display()
+        )
+    );
 
     // A test stage's figure missing from one directory's files.
     let report = root().join("tests/cli/report.bat");
