@@ -40,17 +40,10 @@ pub const EVOLVE_MEASURES: [&str; 10] = [
 ];
 pub const TEST_MEASURES: [&str; 3] = ["fitness", "grips", "releases_outside"];
 
+/// A JSON file of an experiment, checked against its seal (one written
+/// before seals is read as it is).
 fn read_json(path: &Path) -> Result<serde_json::Value, Error> {
-    let bytes = crate::files::read_bytes(path)?;
-    serde_json::from_slice(&bytes)
-        .map_err(|e| Error::new(ErrorKind::Corrupt, format!("error: cannot read `{}`: {e}", path.display())))
-}
-
-fn missing(path: &Path) -> Error {
-    Error::new(
-        ErrorKind::Io,
-        format!("error: cannot read `{}`: the seed's run did not write it", path.display()),
-    )
+    crate::experiment::read_json(&|_| {}, path)
 }
 
 /// The measures of `stages` of `program` over `seeds` in experiment
@@ -79,7 +72,7 @@ pub fn read_measures(
                 for &seed in seeds {
                     let sdir = rundir::stage_dir(&rundir::seed_dir(dir, seed), &stage.name);
                     let cp: Checkpoint = rundir::read_checkpoint(&sdir)?
-                        .ok_or_else(|| missing(&rundir::checkpoint_path(&sdir)))?;
+                        .ok_or_else(|| crate::experiment::missing(&rundir::checkpoint_path(&sdir)))?;
                     let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
                     // The last generation's columns of `generations.csv`.
                     let last = |f: fn(&GenStats) -> f64| own.last().map_or(f64::NAN, |l| f(l));

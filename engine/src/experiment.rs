@@ -472,7 +472,7 @@ fn sweep_table(
     md
 }
 
-fn read_json<T: serde::de::DeserializeOwned>(
+pub(crate) fn read_json<T: serde::de::DeserializeOwned>(
     unsealed: crate::files::Unsealed<'_>,
     path: &Path,
 ) -> Result<T, Error> {
@@ -483,7 +483,7 @@ fn read_json<T: serde::de::DeserializeOwned>(
 }
 
 /// A file that a seed's run must have written.
-fn missing(path: &Path) -> Error {
+pub(crate) fn missing(path: &Path) -> Error {
     Error::new(
         ErrorKind::Io,
         format!("error: cannot read `{}`: the seed's run did not write it", path.display()),

@@ -184,6 +184,11 @@ fn compare_refuses_different_stages_single_seeds_and_missing_measures() {
     let mut s = read_json(&summary);
     s.as_object_mut().unwrap().remove("grips");
     std::fs::write(&summary, serde_json::to_string(&s).unwrap()).unwrap();
+    // An edited file is refused as damaged (its seal); one without a seal
+    // (written before seals) is read, and then its missing measure named.
+    let e = err(&opts(&[&x, &y]));
+    assert!(e.contains("summary.json` is corrupt"), "{e}");
+    std::fs::remove_file(y.join("seed-4/bigger/.seals")).unwrap();
     let e = err(&opts(&[&x, &y]));
     assert_eq!(
         e,
