@@ -463,31 +463,35 @@ struct LifeRecorder<'a> {
 }
 
 impl LifeRecorder<'_> {
-    /// Robot `i` sensed `percept` after the command `wheels` (zero at the
-    /// start), its gripper as given, in `world` (whose objects robot 0's
-    /// frames keep).
+    /// Robot `i` has sensed (its controller's percept) after the command
+    /// `wheels` (zero at the start); robot 0's frames keep the objects of
+    /// its world, which is returned.
     fn sensed(
         &mut self,
         i: usize,
-        percept: &[f32; CHANNELS],
-        gripper: [bool; 2],
+        ctl: &Controller<'_>,
         wheels: [f32; 2],
-        world: Option<&Scene>,
-    ) {
+        robot: &impl Seen,
+    ) -> Option<Scene> {
         if self.frames.len() <= i {
             self.frames.resize(i + 1, Vec::new());
         }
-        let objects = world.filter(|_| i == 0).map(object_rows).unwrap_or_default();
-        self.frames[i].push(frame_of(percept, gripper[0], gripper[1], wheels, objects));
+        let (gripper, world) = robot.seen(i == 0);
+        let objects = world.as_ref().filter(|_| i == 0).map(object_rows).unwrap_or_default();
+        self.frames[i].push(frame_of(ctl.percept(), gripper[0], gripper[1], wheels, objects));
+        world
     }
 
-    fn started(&mut self, i: usize, pose: Pose, scene: impl FnOnce() -> Scene) {
+    /// Robot `i` started its life: its first frame, its start, and robot
+    /// 0's world before the first action.
+    fn started(&mut self, i: usize, ctl: &Controller<'_>, robot: &impl Seen) {
+        let world = self.sensed(i, ctl, [0.0; 2], robot);
         if self.starts.len() <= i {
             self.starts.resize(i + 1, Pose::default());
         }
-        self.starts[i] = pose;
+        self.starts[i] = robot.pose_now();
         if i == 0 {
-            self.scene = Some(scene());
+            self.scene = world;
         }
     }
 
@@ -496,11 +500,37 @@ impl LifeRecorder<'_> {
     }
 }
 
+/// What [`LifeRecorder`] reads of a robot of a life: its gripper `[arm
+/// down, claw closed]` and, when asked, its world; its pose.
+trait Seen {
+    fn seen(&self, world: bool) -> ([bool; 2], Option<Scene>);
+    fn pose_now(&self) -> Pose;
+}
+
+impl<R: Shown> Seen for &mut R {
+    fn seen(&self, _: bool) -> ([bool; 2], Option<Scene>) {
+        // One robot: its world gives the gripper too.
+        let scene = self.scene();
+        ([scene.arm_down, scene.claw_closed], Some(scene))
+    }
+    fn pose_now(&self) -> Pose {
+        self.pose()
+    }
+}
+
+impl Seen for TeamMember<'_> {
+    fn seen(&self, world: bool) -> ([bool; 2], Option<Scene>) {
+        let sim = self.sim();
+        ([sim.arm_down(), sim.claw_closed()], world.then(|| sim.scene()))
+    }
+    fn pose_now(&self) -> Pose {
+        self.sim().pose()
+    }
+}
+
 impl<'s, R: Shown> Hooks<'s, Solo<'_, R>> for LifeRecorder<'_> {
     fn started(&mut self, i: usize, ctl: &Controller<'s>, robot: &&mut R) {
-        let scene = robot.scene();
-        self.sensed(i, ctl.percept(), [scene.arm_down, scene.claw_closed], [0.0; 2], Some(&scene));
-        LifeRecorder::started(self, i, robot.pose(), || scene);
+        LifeRecorder::started(self, i, ctl, robot);
     }
     fn acted(
         &mut self,
@@ -510,8 +540,7 @@ impl<'s, R: Shown> Hooks<'s, Solo<'_, R>> for LifeRecorder<'_> {
         _: Option<&TraceRow>,
         robot: &&mut R,
     ) {
-        let scene = robot.scene();
-        self.sensed(i, ctl.percept(), [scene.arm_down, scene.claw_closed], rep.command.wheels, Some(&scene));
+        self.sensed(i, ctl, rep.command.wheels, robot);
     }
     fn after_action(&mut self, _: &Solo<'_, R>) -> bool {
         self.go_on()
@@ -520,8 +549,7 @@ impl<'s, R: Shown> Hooks<'s, Solo<'_, R>> for LifeRecorder<'_> {
 
 impl<'s> Hooks<'s, TeamBodies<'_>> for LifeRecorder<'_> {
     fn started(&mut self, i: usize, ctl: &Controller<'s>, robot: &TeamMember<'_>) {
-        self.team_sensed(i, ctl, [0.0; 2], robot);
-        LifeRecorder::started(self, i, robot.sim().pose(), || robot.sim().scene());
+        LifeRecorder::started(self, i, ctl, robot);
     }
     fn acted(
         &mut self,
@@ -531,20 +559,10 @@ impl<'s> Hooks<'s, TeamBodies<'_>> for LifeRecorder<'_> {
         _: Option<&TraceRow>,
         robot: &TeamMember<'_>,
     ) {
-        self.team_sensed(i, ctl, rep.command.wheels, robot);
+        self.sensed(i, ctl, rep.command.wheels, robot);
     }
     fn after_action(&mut self, _: &TeamBodies<'_>) -> bool {
         self.go_on()
-    }
-}
-
-impl LifeRecorder<'_> {
-    /// A team's robot `i` sensed (its world's objects drawn for robot 0 only).
-    fn team_sensed(&mut self, i: usize, ctl: &Controller<'_>, wheels: [f32; 2], robot: &TeamMember<'_>) {
-        let sim = robot.sim();
-        let gripper = [sim.arm_down(), sim.claw_closed()];
-        let scene = (i == 0).then(|| sim.scene());
-        self.sensed(i, ctl.percept(), gripper, wheels, scene.as_ref());
     }
 }
 

@@ -8,7 +8,7 @@ mod common;
 use std::cell::Cell;
 use std::sync::{Arc, Barrier};
 
-use common::{files, options, read_text, root, tiny};
+use common::{files, options, read_text, root, tiny, Holding};
 use shaping_engine::files::{unseal, Sealed};
 use shaping_engine::run::{Event, Observer, RunOptions, Runner, StageOutcome};
 use shaping_engine::{html, replay, ErrorKind};
@@ -101,23 +101,6 @@ fn a_run_writes_its_files_the_same_on_one_or_two_threads() {
     }
 }
 
-/// Stops at its first generation until the test has tried a second run.
-struct Holding {
-    barrier: Arc<Barrier>,
-    held: Cell<bool>,
-}
-
-impl Observer for Holding {
-    fn event(&self, event: Event<'_>) {
-        if let Event::Generation { .. } = event {
-            if !self.held.replace(true) {
-                self.barrier.wait();
-                self.barrier.wait();
-            }
-        }
-    }
-}
-
 #[test]
 fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharmed() {
     let dir = tempfile::tempdir().unwrap();
@@ -128,7 +111,7 @@ fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharm
     let first = {
         let barrier = Arc::clone(&barrier);
         std::thread::spawn(move || {
-            let observer = Holding { barrier, held: Cell::new(false) };
+            let observer = Holding::new(barrier);
             let runner = Runner { observer: &observer, ..Runner::default() };
             runner.run(tiny(), &options(&out)).map(|_| ())
         })

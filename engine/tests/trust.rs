@@ -7,14 +7,13 @@
 
 mod common;
 
-use std::cell::Cell;
 use std::path::Path;
 use std::sync::{Arc, Barrier};
 
-use common::{error, files, options, run, tiny, tiny_bat, Log};
+use common::{error, files, options, run, tiny, tiny_bat, Holding, Log};
 use shaping_engine::files::{remove_stale_temporaries, DirLock, SEALS};
 use shaping_engine::replay::{self, ReplayOptions};
-use shaping_engine::run::{Event, Observer, Runner};
+use shaping_engine::run::Runner;
 use shaping_engine::{html, ErrorKind};
 
 /// `text` with its last `"checksum"` field removed, as a hand edit leaves it.
@@ -210,23 +209,6 @@ fn a_link_planted_in_place_of_a_stage_directory_is_refused() {
     assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0, "nothing written through the link");
 }
 
-/// Removes the run's lock at its first generation, then lets it go on.
-struct RemoveLock {
-    barrier: Arc<Barrier>,
-    held: Cell<bool>,
-}
-
-impl Observer for RemoveLock {
-    fn event(&self, event: Event<'_>) {
-        if let Event::Generation { .. } = event {
-            if !self.held.replace(true) {
-                self.barrier.wait();
-                self.barrier.wait();
-            }
-        }
-    }
-}
-
 /// 47.8: a `.lock` deleted by hand lets a second run in; the first says,
 /// at its next write, that its lock was removed, and stops.
 #[test]
@@ -237,7 +219,7 @@ fn a_run_whose_lock_was_removed_says_so_at_its_next_write() {
     let first = {
         let barrier = Arc::clone(&barrier);
         std::thread::spawn(move || {
-            let observer = RemoveLock { barrier, held: Cell::new(false) };
+            let observer = Holding::new(barrier);
             let runner = Runner { observer: &observer, ..Runner::default() };
             runner.run(tiny(), &options(&out)).map(|_| ())
         })

@@ -263,3 +263,28 @@ pub fn as_if_killed(dir: &Path) {
     std::fs::remove_file(dir.join("generations.csv")).unwrap();
     std::fs::write(dir.join(".generations.csv.4242.7.tmp"), "stage,generation\nfirst,0").unwrap();
 }
+
+/// An observer that holds a run at its first generation until the test has
+/// done what it does meanwhile: it waits twice on `barrier` (the test waits
+/// once before and once after), then lets the run go on.
+pub struct Holding {
+    barrier: std::sync::Arc<std::sync::Barrier>,
+    held: Cell<bool>,
+}
+
+impl Holding {
+    pub fn new(barrier: std::sync::Arc<std::sync::Barrier>) -> Holding {
+        Holding { barrier, held: Cell::new(false) }
+    }
+}
+
+impl Observer for Holding {
+    fn event(&self, event: Event<'_>) {
+        if let Event::Generation { .. } = event {
+            if !self.held.replace(true) {
+                self.barrier.wait();
+                self.barrier.wait();
+            }
+        }
+    }
+}
