@@ -52,6 +52,7 @@ impl<R: Robot> Bodies for Solo<'_, R> {
     fn robots(&self) -> usize {
         1
     }
+    #[inline]
     fn alive(&self, _i: usize) -> bool {
         self.0.alive()
     }
@@ -69,12 +70,15 @@ impl<R: Robot> Robot for &mut R {
     fn step(&mut self, cmd: &Command) -> Outcome {
         (**self).step(cmd)
     }
+    #[inline]
     fn alive(&self) -> bool {
         (**self).alive()
     }
+    #[inline]
     fn battery(&self) -> f32 {
         (**self).battery()
     }
+    #[inline]
     fn pose(&self) -> Pose {
         (**self).pose()
     }
@@ -82,6 +86,7 @@ impl<R: Robot> Robot for &mut R {
     fn position(&self) -> [f32; 2] {
         (**self).position()
     }
+    #[inline]
     fn holding(&self) -> Option<bool> {
         (**self).holding()
     }
@@ -155,7 +160,8 @@ pub fn live<'s, B: Bodies>(
             break;
         }
         bodies.begin_action();
-        for (i, c) in ctls.iter_mut().enumerate() {
+        for (i, ((c, res), fit)) in ctls.iter_mut().zip(robots.iter_mut()).zip(fitness.iter_mut()).enumerate()
+        {
             if !bodies.alive(i) {
                 continue;
             }
@@ -163,10 +169,10 @@ pub fn live<'s, B: Bodies>(
             let mut member = bodies.member(i);
             hooks.before(i, c, &member);
             let rep = c.act(&mut member);
-            tally(&mut robots[i], &mut fitness[i], &rep);
+            tally(res, fit, &rep);
             let mut row = None;
             if let Some(t) = traces.as_deref_mut().and_then(|t| t.get_mut(i)) {
-                t.rows.push(c.trace_row(a, &rep, &robots[i], &member));
+                t.rows.push(c.trace_row(a, &rep, res, &member));
                 row = t.rows.last();
             }
             hooks.acted(i, c, &rep, row, &member);
