@@ -7,7 +7,7 @@
 //! fitness terms read as `robot.distance`, `robot.squares`, ...).
 //!
 //! The episodes are the ones a run evaluates: [`evaluate`] runs a genome's
-//! episodes as [`crate::run::evaluator`] runs each one (the stage's
+//! episodes as [`shaping_runtime::evolve::evaluator`] runs each one (the stage's
 //! `actions`, learning on) and combines them as `evolve` combines an
 //! individual's `evaluations` episodes: the fitness is their mean (summed
 //! in f64), the events are summed, and the learned genome is the last
@@ -16,7 +16,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult};
-use shaping_runtime::evolve::{seed, Evaluation, Events};
+use shaping_runtime::evolve::{seed, Episode, Evaluation, Events};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Stage, StageRun};
 pub use shaping_runtime::state::{Descriptors, SQUARE_MM};
@@ -39,24 +39,24 @@ pub struct Described {
     pub descriptors: Descriptors,
 }
 
-/// The episode seeds of individual `individual` of generation
+/// The episodes of individual `individual` of generation
 /// `generation` of evolved stage `stage` evaluated with seed `seed`: those
 /// a run with run seed `seed` gives the individual of that index in that
 /// generation of the stage ([`seed::episode_seed`]`(seed, stage,
 /// generation, individual, e)`, `e` from 0 to the stage's `evaluations` -
 /// 1; one episode if it declares none). In a stage with variants, those
-/// episodes in every variant ([`seed::variant_seed`]), variant after
+/// episodes in every variant ([`Episode::in_variant`]), variant after
 /// variant (a run draws some with `draw N`; here all are run).
-pub fn seeds(stage: &Stage, index: usize, seed: u64, generation: u32, individual: usize) -> Vec<u64> {
+pub fn episodes(stage: &Stage, index: usize, seed: u64, generation: u32, individual: usize) -> Vec<Episode> {
     let episodes = match &stage.run {
         StageRun::Evolve(evo) => evo.evaluations.max(1),
         StageRun::Test { .. } | StageRun::Train { .. } => 1,
     };
     let one = |e| seed::episode_seed(seed, index, generation, individual, e);
     match &stage.variants {
-        None => (0..episodes).map(one).collect(),
+        None => (0..episodes).map(|e| Episode::plain(one(e))).collect(),
         Some(v) => (0..v.list.len())
-            .flat_map(|k| (0..episodes).map(move |e| seed::variant_seed(one(e), k)))
+            .flat_map(|k| (0..episodes).map(move |e| Episode::in_variant(one(e), k)))
             .collect(),
     }
 }
@@ -70,15 +70,16 @@ pub fn actions(stage: &Stage) -> u32 {
     }
 }
 
-/// Evaluates `genome` on `stage` over one episode per seed of `seeds` (the
+/// Evaluates `genome` on `stage` over `episodes` (the
 /// stage's actions, learning on), combined as `evolve` combines an
 /// individual's episodes: the fitness is the mean (summed in f64), the
 /// events and collisions and placement failures are summed, the learned
 /// genome is the last episode's (with variants, the fitness is the mean
 /// per variant, aggregated as the stage declares); the final pose is the last episode's, the
-/// path length and the squares visited the means over the episodes.
-pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
-    evaluate_unless(stage, genome, seeds, &AtomicBool::new(false)).unwrap_or_default()
+/// path length and the squares visited the means over the episodes. An
+/// episode in a variant the stage does not declare makes the fitness NaN.
+pub fn evaluate(stage: &Stage, genome: &Genome, episodes: &[Episode]) -> Described {
+    evaluate_unless(stage, genome, episodes, &AtomicBool::new(false)).unwrap_or_default()
 }
 
 /// [`evaluate`], stopped between two episodes once `stop` is set (Python's
@@ -88,7 +89,7 @@ pub fn evaluate(stage: &Stage, genome: &Genome, seeds: &[u64]) -> Described {
 pub fn evaluate_unless(
     stage: &Stage,
     genome: &Genome,
-    seeds: &[u64],
+    episodes: &[Episode],
     stop: &AtomicBool,
 ) -> Option<Described> {
     let actions = actions(stage);
@@ -101,13 +102,16 @@ pub fn evaluate_unless(
     let worlds = shaping_runtime::evolve::VariantStages::of(stage);
     // With variants: each variant's fitness sum and episodes.
     let mut per = vec![(0.0f64, 0u32); stage.variants.as_ref().map_or(0, |v| v.list.len())];
-    for &s in seeds {
+    for &e in episodes {
         if stop.load(Ordering::Relaxed) {
             return None;
         }
-        let (r, d) = episode(worlds.stage(s), genome, &EpisodeOptions { actions, learning: true, seed: s });
+        let Some(world) = worlds.stage(e) else {
+            return Some(Described { evaluation: Evaluation::unknown_variant(), ..Described::default() });
+        };
+        let (r, d) = episode(world, genome, &EpisodeOptions { actions, learning: true, seed: e.seed });
         sum += f64::from(r.fitness);
-        if let Some(p) = per.get_mut(seed::seed_variant(s)) {
+        if let Some(p) = e.variant.and_then(|v| per.get_mut(v)) {
             p.0 += f64::from(r.fitness);
             p.1 += 1;
         }
@@ -122,10 +126,12 @@ pub fn evaluate_unless(
         squares += f64::from(d.squares_visited);
         last = d;
     }
-    let n = seeds.len().max(1) as f64;
+    let n = episodes.len().max(1) as f64;
     let fitness = match &stage.variants {
-        None => (sum / n) as f32,
-        Some(v) => v.aggregate.of(per.iter().filter(|p| p.1 > 0).map(|p| (p.0 / f64::from(p.1)) as f32)),
+        Some(v) if per.iter().any(|p| p.1 > 0) => {
+            v.aggregate.of(per.iter().filter(|p| p.1 > 0).map(|p| (p.0 / f64::from(p.1)) as f32))
+        }
+        _ => (sum / n) as f32,
     };
     Some(Described {
         evaluation: Evaluation { fitness, learned, events, placement_failures },
@@ -141,7 +147,7 @@ pub fn evaluate_unless(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::{bind_training, evaluator, Silent};
+    use crate::run::{bind_training, Silent};
     use rand::{Rng, SeedableRng};
     use shaping_runtime::evolve;
     use shaping_runtime::program::Program;
@@ -166,12 +172,12 @@ mod tests {
         let program = khepera();
         let stage = &program.stages[1];
         let StageRun::Evolve(evo) = &stage.run else { panic!("navigation is evolved") };
-        let run = evaluator(stage, evo.actions);
+        let run = evolve::evaluator(stage, evolve::EvalOptions { actions: evo.actions, learning: true });
         for k in 0..4 {
             let genome = random_genome(stage.layout.bits, k);
             let s = 1000 + k;
-            let d = evaluate(stage, &genome, &[s]);
-            assert_eq!(d.evaluation, run(&genome, s));
+            let d = evaluate(stage, &genome, &[Episode::plain(s)]);
+            assert_eq!(d.evaluation, run(&genome, Episode::plain(s)));
             let r = shaping_runtime::controller::run_episode(
                 stage,
                 &genome,
@@ -185,7 +191,7 @@ mod tests {
             assert!(p.heading.abs() <= std::f32::consts::PI + 1e-6);
             assert!(p.path_length >= 0.0 && p.squares_visited >= 1.0);
             // Deterministic.
-            assert_eq!(evaluate(stage, &genome, &[s]), d);
+            assert_eq!(evaluate(stage, &genome, &[Episode::plain(s)]), d);
         }
     }
 
@@ -196,7 +202,7 @@ mod tests {
         let program = khepera();
         let stage = &program.stages[1];
         let genome = random_genome(stage.layout.bits, 3);
-        let s = seeds(stage, 1, 5, 0, 2);
+        let s = episodes(stage, 1, 5, 0, 2);
         let go = AtomicBool::new(false);
         assert_eq!(evaluate_unless(stage, &genome, &s, &go), Some(evaluate(stage, &genome, &s)));
         assert_eq!(evaluate_unless(stage, &genome, &s, &AtomicBool::new(true)), None);
@@ -214,9 +220,10 @@ mod tests {
         let seed = 7;
         let mut cp = evolve::start_stage(&program, 1, seed, None).unwrap();
         let stage = &program.stages[1];
-        evolve::step_generation(&program, &mut cp, &evaluator(stage, actions)).unwrap();
+        let run = evolve::evaluator(stage, evolve::EvalOptions { actions, learning: true });
+        evolve::step_generation(&program, &mut cp, &run).unwrap();
         for (i, genome) in cp.population.iter().enumerate() {
-            let s = seeds(stage, 1, seed, 0, i);
+            let s = episodes(stage, 1, seed, 0, i);
             assert_eq!(s.len(), 3);
             let d = evaluate(stage, genome, &s);
             assert_eq!(d.evaluation.fitness, cp.fitness[i], "individual {i}");
@@ -231,7 +238,7 @@ mod tests {
             assert!((f64::from(d.descriptors.path_length) - mean).abs() < 1e-3);
         }
         let best = cp.history[0].best_index as usize;
-        let d = evaluate(stage, &cp.population[best], &seeds(stage, 1, seed, 0, best));
+        let d = evaluate(stage, &cp.population[best], &episodes(stage, 1, seed, 0, best));
         assert_eq!(d.evaluation.events.recharges, cp.history[0].best_recharges);
     }
 }

@@ -6,10 +6,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde_json::Value;
-use shaping_runtime::controller::{
-    run_episode, run_episode_until, EpisodeOptions, EpisodeResult, TeamRun, Trace,
-};
-use shaping_runtime::evolve::{self, Checkpoint, Evaluation, GenStats, Trained};
+use shaping_runtime::controller::{EpisodeOptions, EpisodeResult, TeamRun, Trace};
+use shaping_runtime::evolve::{self, Checkpoint, Episode, Evaluation, GenStats, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Param, Program, Stage, StageRun};
 use shaping_runtime::sim::Scene;
@@ -111,7 +109,7 @@ pub trait Evaluate {
         program: &Program,
         index: usize,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, Episode)],
     ) -> Vec<Evaluation>;
     /// What the next evaluations are for, and the checkpoint a new run would
     /// resume from (for the messages of a failure).
@@ -164,21 +162,14 @@ impl Evaluate for Local<'_> {
         program: &Program,
         index: usize,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, Episode)],
     ) -> Vec<Evaluation> {
         let stage = &program.stages[index];
-        let Some(stop) = self.stop else {
-            return self.pool.install(|| evolve::evaluate_many(&evaluator(stage, actions), jobs));
-        };
-        let worlds = evolve::VariantStages::of(stage);
-        let one = |genome: &Genome, seed: u64| {
-            let opts = EpisodeOptions { actions, learning: true, seed };
-            match run_episode_until(worlds.stage(seed), genome, &opts, || stop.load(Ordering::Relaxed)) {
-                Some(r) => Evaluation::of_episode(r),
-                None => Evaluation { fitness: f32::NAN, ..Evaluation::default() },
-            }
-        };
-        self.pool.install(|| evolve::evaluate_many(&one, jobs))
+        let opts = evolve::EvalOptions { actions, learning: true };
+        let stop = self.stop;
+        let evaluate =
+            evolve::evaluator_until(stage, opts, || stop.is_some_and(|s| s.load(Ordering::Relaxed)));
+        self.pool.install(|| evolve::evaluate_many(&evaluate, jobs))
     }
 }
 
@@ -276,21 +267,6 @@ pub fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
         cur = program.stages[i].parent;
     }
     None
-}
-
-/// Evaluation of one genome in an evolved stage: one episode with local learning on.
-/// In a stage with variants, the episode seed names the variant the
-/// episode runs in (`evolve::seed::variant_seed`).
-pub fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, u64) -> Evaluation + Sync + '_ {
-    let worlds = evolve::VariantStages::of(stage);
-    move |genome: &Genome, seed: u64| {
-        Evaluation::of_episode(run_episode(
-            worlds.stage(seed),
-            genome,
-            &EpisodeOptions { actions, learning: true, seed },
-            None,
-        ))
-    }
 }
 
 /// Episodes whose world could not be placed apart: some placement (an
@@ -912,7 +888,7 @@ impl Runner<'_> {
         // The episodes this process runs for the stage, for the warning about
         // a crowded world (the generations' are in their statistics too).
         let run_now = std::cell::Cell::new(Crowding::default());
-        let many = |jobs: &[(&Genome, u64)]| {
+        let many = |jobs: &[(&Genome, Episode)]| {
             let evaluations = evaluator.evaluate(program, index, evo.actions, jobs);
             if self.stopped() && evaluations.iter().any(|ev| ev.fitness.is_nan()) {
                 // Episodes given up for Ctrl-C: no result at all, so the

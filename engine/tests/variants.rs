@@ -2,9 +2,9 @@
 //! declared, every individual is evaluated in each (or in the drawn ones),
 //! and its fitness is the mean or the minimum of the variants' fitness.
 
-use shaping_engine::run::evaluator;
-use shaping_runtime::evolve::{self, seed};
-use shaping_runtime::program::{Aggregate, Program};
+use shaping_runtime::evolve::{self, seed, Episode, EvalOptions, Evaluation};
+use shaping_runtime::genome::Genome;
+use shaping_runtime::program::{Aggregate, Program, Stage};
 
 /// A robot that stands still where the variant starts it: its fitness is
 /// the start's x.
@@ -31,6 +31,10 @@ fn program() -> Program {
     shaping_compiler::compile(SRC, "variants.bat").unwrap()
 }
 
+fn evaluator(stage: &Stage, actions: u32) -> impl Fn(&Genome, Episode) -> Evaluation + Sync + '_ {
+    evolve::evaluator(stage, EvalOptions { actions, learning: true })
+}
+
 #[test]
 fn a_variant_changes_the_world_as_declared() {
     let p = program();
@@ -42,13 +46,33 @@ fn a_variant_changes_the_world_as_declared() {
     let east = v.list[1].world.items.start.as_ref().unwrap();
     assert_eq!((east.from, east.to), ([300.0, 200.0], [300.0, 200.0]));
     assert_eq!(v.list[1].world.arena, st.world.arena);
-    // An episode runs in the variant its seed names.
+    // An episode runs in the variant it names.
     let eval = evaluator(st, 3);
-    let genome = shaping_runtime::genome::Genome::zeros(st.layout.bits as usize);
+    let genome = Genome::zeros(st.layout.bits as usize);
     for (k, x) in [100.0, 300.0, 350.0].into_iter().enumerate() {
-        let f = eval(&genome, seed::variant_seed(12345, k)).fitness;
+        let f = eval(&genome, Episode::in_variant(12345, k)).fitness;
         assert!((f - x).abs() < 1e-3, "variant {k}: {f}");
     }
+}
+
+/// The variant travels beside the seed: a seed never chooses one (a seed
+/// whose low bits read 2 runs the variant it is given, or the stage's own
+/// world without one), and a variant the stage does not declare runs
+/// nothing (NaN), rather than some other variant.
+#[test]
+fn the_variant_is_the_episode_s_not_its_seed_s() {
+    let p = program();
+    let st = &p.stages[0];
+    let eval = evaluator(st, 3);
+    let genome = Genome::zeros(st.layout.bits as usize);
+    let seed = seed::variant_seed(12345, 2);
+    let east = eval(&genome, Episode { seed, variant: Some(1) }).fitness;
+    assert!((east - 300.0).abs() < 1e-3, "{east}");
+    let own = eval(&genome, Episode::plain(seed)).fitness;
+    assert!((own - 100.0).abs() < 1e-3, "the stage's own start: {own}");
+    assert!(eval(&genome, Episode { seed, variant: Some(3) }).fitness.is_nan());
+    let d = shaping_engine::descriptors::evaluate(st, &genome, &[Episode { seed, variant: Some(64) }]);
+    assert!(d.evaluation.fitness.is_nan());
 }
 
 fn run(p: &Program) -> Vec<evolve::GenStats> {

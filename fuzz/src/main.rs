@@ -336,7 +336,7 @@ static SAVED: std::sync::OnceLock<Saved> = std::sync::OnceLock::new();
 
 /// A cheap stand-in for an episode: the share of ones, so a generation
 /// costs nothing and still ranks individuals.
-fn ones(g: &Genome, _seed: u64) -> Evaluation {
+fn ones(g: &Genome, _episode: evolve::Episode) -> Evaluation {
     let ones = g.bits.iter().filter(|&&b| b == 1).count();
     Evaluation { fitness: ones as f32 / g.bits.len().max(1) as f32, ..Evaluation::default() }
 }
@@ -389,8 +389,14 @@ fn saved(root: &Path) -> Saved {
 struct Ones;
 
 impl run::Evaluate for Ones {
-    fn evaluate(&self, _: &Program, _: usize, _: u32, jobs: &[(&Genome, u64)]) -> Vec<Evaluation> {
-        jobs.iter().map(|&(g, seed)| ones(g, seed)).collect()
+    fn evaluate(
+        &self,
+        _: &Program,
+        _: usize,
+        _: u32,
+        jobs: &[(&Genome, evolve::Episode)],
+    ) -> Vec<Evaluation> {
+        jobs.iter().map(|&(g, episode)| ones(g, episode)).collect()
     }
 }
 

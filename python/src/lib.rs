@@ -782,7 +782,7 @@ impl Evaluator {
         let (index, seed) = (self.index, self.seed);
         let pool = self.pool.get()?;
         let actions = (genomes.len() as u64)
-            .saturating_mul(descriptors::seeds(stage, index, seed, generation, 0).len() as u64)
+            .saturating_mul(descriptors::episodes(stage, index, seed, generation, 0).len() as u64)
             .saturating_mul(u64::from(descriptors::actions(stage)))
             .saturating_mul(u64::from(stage.world.robots.max(1)));
         let results = interruptible(py, actions, |stop| {
@@ -791,8 +791,8 @@ impl Evaluator {
                     .par_iter()
                     .zip(individuals.par_iter())
                     .map(|(g, &i)| {
-                        let seeds = descriptors::seeds(stage, index, seed, generation, i as usize);
-                        descriptors::evaluate_unless(stage, g, &seeds, stop)
+                        let episodes = descriptors::episodes(stage, index, seed, generation, i as usize);
+                        descriptors::evaluate_unless(stage, g, &episodes, stop)
                     })
                     .collect::<Option<Vec<Described>>>()
             })

@@ -2,7 +2,7 @@
 
 use shaping_runtime::evolve::{
     self, best_of, check_resume, frozen_mask, is_finished, seed, start_stage, step_generation, test_best,
-    Checkpoint, Evaluation, EvolveError, GenStats,
+    Checkpoint, Episode, Evaluation, EvolveError, GenStats,
 };
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{
@@ -92,17 +92,17 @@ fn one_stage(population: u32, generations: u32) -> Program {
 
 /// Fraction of ones among the evolvable bits, plus a small seed-dependent
 /// noise (so the episode seed matters, as in a noisy simulation).
-fn onemax(mask: Vec<bool>) -> impl Fn(&Genome, u64) -> Evaluation + Sync {
-    move |g: &Genome, episode: u64| {
+fn onemax(mask: Vec<bool>) -> impl Fn(&Genome, Episode) -> Evaluation + Sync {
+    move |g: &Genome, episode: Episode| {
         let free = mask.iter().filter(|&&m| !m).count().max(1);
         let ones = g.bits.iter().zip(&mask).filter(|(&b, &m)| b == 1 && !m).count();
-        let noise = (seed::splitmix64(episode) >> 40) as f32 / (1u64 << 24) as f32 * 0.01;
+        let noise = (seed::splitmix64(episode.seed) >> 40) as f32 / (1u64 << 24) as f32 * 0.01;
         Evaluation { fitness: ones as f32 / free as f32 + noise, learned: None, ..Default::default() }
     }
 }
 
 /// Noise-free: fraction of ones over all bits.
-fn ones(g: &Genome, _episode: u64) -> Evaluation {
+fn ones(g: &Genome, _episode: Episode) -> Evaluation {
     Evaluation {
         fitness: g.bits.iter().filter(|&&b| b == 1).count() as f32 / g.bits.len() as f32,
         ..Default::default()
@@ -458,7 +458,7 @@ fn lamarckian_write_back_changes_only_evolvable_bits() {
     let mut cp1 = start_stage(&program, 1, 2, Some(&cp0)).unwrap();
     let before = cp1.population.clone();
     // "Learning" sets every bit to 1, frozen ones included.
-    let learn = |g: &Genome, _: u64| Evaluation {
+    let learn = |g: &Genome, _: Episode| Evaluation {
         fitness: 0.5,
         learned: Some(Genome { bits: vec![1; g.bits.len()] }),
         ..Default::default()
@@ -479,7 +479,7 @@ fn lamarckian_write_back_changes_only_evolvable_bits() {
 
     // A learned genome of the wrong length is an error, not a panic.
     program.stages[1].inheritance = Inheritance::Lamarckian;
-    let bad = |_: &Genome, _: u64| Evaluation {
+    let bad = |_: &Genome, _: Episode| Evaluation {
         fitness: 0.5,
         learned: Some(Genome { bits: vec![1; 3] }),
         ..Default::default()
@@ -498,7 +498,8 @@ fn evaluations_average_episodes_with_distinct_seeds() {
         evo.evaluations = 3;
     }
     let seen = std::sync::Mutex::new(Vec::new());
-    let eval = |_: &Genome, s: u64| {
+    let eval = |_: &Genome, e: Episode| {
+        let s = e.seed;
         seen.lock().unwrap().push(s);
         Evaluation { fitness: (s % 7) as f32, learned: None, ..Default::default() }
     };
@@ -531,7 +532,7 @@ fn test_stage_runs_the_parents_best() {
     let out = test_best(&program, 1, 8, &cp, &ones).unwrap();
     assert_eq!(out.genome, best);
     assert_eq!(out.parent_fitness, best_fitness);
-    assert_eq!(out.evaluation.fitness, ones(&best, 0).fitness);
+    assert_eq!(out.evaluation.fitness, ones(&best, Episode::plain(0)).fitness);
     assert_eq!(out.seed, seed::test_seed(8, 1, 0));
     // A stage extending a test stage starts from the evolved ancestor.
     program.stages.push(stage("more", Some(1), layout(12, 10), StageRun::Evolve(evolution(10, 1))));
@@ -608,7 +609,7 @@ fn bad_input_is_an_error_not_a_panic() {
     run_stage(&not_extension, &mut cp0, &ones);
     assert!(matches!(start_stage(&not_extension, 1, 1, Some(&cp0)), Err(EvolveError::NotAnExtension { .. })));
 
-    let nan = |_: &Genome, _: u64| Evaluation { fitness: f32::NAN, learned: None, ..Default::default() };
+    let nan = |_: &Genome, _: Episode| Evaluation { fitness: f32::NAN, learned: None, ..Default::default() };
     let mut cp = start_stage(&program, 0, 1, None).unwrap();
     let err = step_generation(&program, &mut cp, &nan).unwrap_err();
     assert!(matches!(err, EvolveError::NonFiniteFitness { index: 0, generation: 0, .. }), "{err}");
@@ -638,7 +639,7 @@ fn validate_best_prefers_the_best_mean_over_a_lucky_evaluation() {
     cp.population = (0..10).map(|i| Genome { bits: vec![u8::from(i == 4); bits] }).collect();
     cp.fitness = (0..10).map(|i| if i == 4 { 0.9 } else { 0.1 }).collect();
     cp.best = Some((Genome { bits: vec![0; bits] }, 10.0));
-    let fresh = |g: &Genome, _e: u64| ones(g, 0);
+    let fresh = |g: &Genome, _e: Episode| ones(g, Episode::plain(0));
     let (g, f) = evolve::validate_best(&program, &mut cp, &fresh, 4, 3).unwrap();
     assert_eq!(g.bits, vec![1; bits], "the all-ones genome wins on fresh episodes");
     assert_eq!(f, 1.0);
@@ -646,13 +647,13 @@ fn validate_best_prefers_the_best_mean_over_a_lucky_evaluation() {
     assert_eq!(best_of(&cp), Some((g.clone(), 1.0)));
 
     // Idempotent: a second call (e.g. after resuming a finished run) keeps it.
-    let never = |_: &Genome, _: u64| -> Evaluation { panic!("not evaluated again") };
+    let never = |_: &Genome, _: Episode| -> Evaluation { panic!("not evaluated again") };
     assert_eq!(evolve::validate_best(&program, &mut cp, &never, 4, 3).unwrap(), (g, 1.0));
 
     // Every candidate sees the same episode seeds, and they are distinct.
     let seen = std::sync::Mutex::new(Vec::new());
-    let record = |g: &Genome, e: u64| {
-        seen.lock().unwrap().push((g.bits[0], e));
+    let record = |g: &Genome, e: Episode| {
+        seen.lock().unwrap().push((g.bits[0], e.seed));
         ones(g, e)
     };
     let mut cp2 = start_stage(&program, 0, 3, None).unwrap();
@@ -672,7 +673,8 @@ fn generation_stats_carry_the_best_individuals_events_summed_over_its_episodes()
         evo.evaluations = 2;
     }
     // Events that identify the individual (its count of ones) and the episode.
-    let eval = |g: &Genome, s: u64| {
+    let eval = |g: &Genome, e: Episode| {
+        let s = e.seed;
         let ones = g.bits.iter().filter(|&&b| b == 1).count() as u32;
         Evaluation {
             fitness: ones as f32,

@@ -3,7 +3,9 @@
 use proptest::prelude::*;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use shaping_runtime::evolve::{frozen_mask, next_generation, start_stage, step_generation, Evaluation};
+use shaping_runtime::evolve::{
+    frozen_mask, next_generation, start_stage, step_generation, Episode, Evaluation,
+};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{
     Body, Evolution, Fitness, Gene, GeneRole, GenomeLayout, Inheritance, Program, Selection, Stage, StageRun,
@@ -168,7 +170,7 @@ proptest! {
         };
         // Fitness counts every bit, frozen ones too: selection would favour
         // changing them if the GA could.
-        let eval = |g: &Genome, _: u64| Evaluation { fitness: g.bits.iter().map(|&b| b as f32).sum(), learned: None, ..Default::default() };
+        let eval = |g: &Genome, _: Episode| Evaluation { fitness: g.bits.iter().map(|&b| b as f32).sum(), learned: None, ..Default::default() };
         let mut cp0 = start_stage(&program, 0, seed, None).unwrap();
         for _ in 0..3 {
             step_generation(&program, &mut cp0, &eval).unwrap();

@@ -21,7 +21,7 @@ mod mpi;
 #[cfg_attr(not(feature = "mpi"), allow(dead_code))]
 pub mod wire;
 
-use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::evolve::{Episode, Evaluation};
 use shaping_runtime::genome::Genome;
 
 #[cfg(feature = "mpi")]
@@ -50,9 +50,12 @@ pub fn launcher() -> Option<(&'static str, Option<u64>)> {
 pub fn evaluate_local(
     stage: &shaping_runtime::program::Stage,
     actions: u32,
-    jobs: &[(&Genome, u64)],
+    jobs: &[(&Genome, Episode)],
 ) -> Vec<Evaluation> {
-    let eval = shaping_engine::run::evaluator(stage, actions);
+    let eval = shaping_runtime::evolve::evaluator(
+        stage,
+        shaping_runtime::evolve::EvalOptions { actions, learning: true },
+    );
     shaping_runtime::evolve::evaluate_many(&eval, jobs)
 }
 
@@ -63,7 +66,7 @@ impl shaping_engine::run::Evaluate for Coordinator {
         program: &shaping_runtime::program::Program,
         index: usize,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, Episode)],
     ) -> Vec<Evaluation> {
         Coordinator::evaluate(self, program, index, actions, jobs)
     }
@@ -85,7 +88,7 @@ impl Coordinator {
         _: &shaping_runtime::program::Program,
         _: usize,
         _: u32,
-        _: &[(&Genome, u64)],
+        _: &[(&Genome, Episode)],
     ) -> Vec<Evaluation> {
         match *self {}
     }

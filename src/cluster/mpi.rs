@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 use mpi::point_to_point::{Destination, MatchedReceiveVec, Source};
 use mpi::topology::{Communicator, Rank, SimpleCommunicator};
 use mpi::Threading;
-use shaping_runtime::evolve::Evaluation;
+use shaping_runtime::evolve::{Episode, Evaluation};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
@@ -238,7 +238,7 @@ impl Coordinator {
         program: &Program,
         index: usize,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, Episode)],
     ) -> Vec<Evaluation> {
         let started = Instant::now();
         let stage = &program.stages[index];
@@ -712,7 +712,7 @@ fn serve(
                 let Some(st) = p.stages.get(stage as usize) else {
                     fail(format!("work for stage {stage}, the program has {}", p.stages.len()))
                 };
-                let refs: Vec<(&Genome, u64)> = jobs.iter().map(|(seed, g)| (g, *seed)).collect();
+                let refs: Vec<(&Genome, Episode)> = jobs.iter().map(|(episode, g)| (g, *episode)).collect();
                 let evaluations = pool.install(|| super::evaluate_local(st, actions, &refs));
                 send(Request::Results { batch, evaluations });
             }

@@ -2,7 +2,7 @@
 //! then little-endian integers and length-prefixed byte strings. Fitness
 //! travels as its bit pattern, so a result is the same on every rank.
 
-use shaping_runtime::evolve::{Evaluation, Events};
+use shaping_runtime::evolve::{Episode, Evaluation, Events};
 use shaping_runtime::genome::Genome;
 
 /// From a worker rank to rank 0: each is also a request for the next reply.
@@ -27,7 +27,7 @@ pub enum Reply {
     Load { version: u32, program: Vec<u8> },
     /// Episodes of stage `stage`, each `(episode seed, genome)`, with
     /// `actions` actions and local learning on.
-    Work { version: u32, batch: u64, stage: u32, actions: u32, jobs: Vec<(u64, Genome)> },
+    Work { version: u32, batch: u64, stage: u32, actions: u32, jobs: Vec<(Episode, Genome)> },
     /// The run is over: leave.
     Stop,
     /// Run a whole seed of a sweep point and write its files.
@@ -50,6 +50,11 @@ impl Writer {
     fn bytes(&mut self, v: &[u8]) {
         self.u32(v.len() as u32);
         self.0.extend_from_slice(v);
+    }
+    /// An episode: its seed, then its variant (`u32::MAX`: none).
+    fn episode(&mut self, e: Episode) {
+        self.u64(e.seed);
+        self.u32(e.variant.map_or(u32::MAX, |v| v as u32));
     }
 }
 
@@ -83,6 +88,11 @@ impl<'a> Reader<'a> {
     fn bytes(&mut self) -> Result<&'a [u8], String> {
         let n = self.u32()? as usize;
         self.take(n)
+    }
+    fn episode(&mut self) -> Result<Episode, String> {
+        let seed = self.u64()?;
+        let variant = Some(self.u32()?).filter(|&v| v != u32::MAX).map(|v| v as usize);
+        Ok(Episode { seed, variant })
     }
     fn string(&mut self) -> Result<String, String> {
         Ok(String::from_utf8_lossy(self.bytes()?).into_owned())
@@ -185,8 +195,8 @@ impl Reply {
                 w.u32(*stage);
                 w.u32(*actions);
                 w.u32(jobs.len() as u32);
-                for (seed, genome) in jobs {
-                    w.u64(*seed);
+                for (episode, genome) in jobs {
+                    w.episode(*episode);
                     w.bytes(&genome.bits);
                 }
             }
@@ -206,7 +216,7 @@ impl Reply {
         batch: u64,
         stage: u32,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, Episode)],
     ) -> Vec<u8> {
         let mut w = Writer::default();
         w.u8(1);
@@ -215,8 +225,8 @@ impl Reply {
         w.u32(stage);
         w.u32(actions);
         w.u32(jobs.len() as u32);
-        for (genome, seed) in jobs {
-            w.u64(*seed);
+        for (genome, episode) in jobs {
+            w.episode(*episode);
             w.bytes(&genome.bits);
         }
         w.0
@@ -231,8 +241,8 @@ impl Reply {
                 let n = r.u32()? as usize;
                 let mut jobs = Vec::with_capacity(n.min(data.len()));
                 for _ in 0..n {
-                    let seed = r.u64()?;
-                    jobs.push((seed, Genome { bits: r.bytes()?.to_vec() }));
+                    let episode = r.episode()?;
+                    jobs.push((episode, Genome { bits: r.bytes()?.to_vec() }));
                 }
                 Reply::Work { version, batch, stage, actions, jobs }
             }
@@ -312,9 +322,13 @@ mod tests {
             batch: 17,
             stage: 2,
             actions: 300,
-            jobs: vec![(9, g[0].clone()), (u64::MAX, g[1].clone())],
+            jobs: vec![
+                (Episode::plain(9), g[0].clone()),
+                (Episode { seed: u64::MAX, variant: Some(63) }, g[1].clone()),
+            ],
         };
-        let borrowed: Vec<(&Genome, u64)> = vec![(&g[0], 9), (&g[1], u64::MAX)];
+        let borrowed: Vec<(&Genome, Episode)> =
+            vec![(&g[0], Episode::plain(9)), (&g[1], Episode { seed: u64::MAX, variant: Some(63) })];
         assert_eq!(work.encode(), Reply::encode_work(3, 17, 2, 300, &borrowed));
         let task = Reply::Task { point: u32::MAX, seed: 12 };
         for case in [work, Reply::Load { version: 1, program: b"{}".to_vec() }, Reply::Stop, task] {
@@ -327,7 +341,7 @@ mod tests {
         assert!(Request::decode(&[]).unwrap_err().contains("truncated"));
         assert!(Request::decode(&[9]).unwrap_err().contains("unknown request kind 9"));
         assert!(Reply::decode(&[2, 0]).unwrap_err().contains("left over"));
-        let mut work = Reply::encode_work(1, 1, 0, 10, &[(&Genome { bits: vec![1; 8] }, 5)]);
+        let mut work = Reply::encode_work(1, 1, 0, 10, &[(&Genome { bits: vec![1; 8] }, Episode::plain(5))]);
         work.truncate(work.len() - 2);
         assert!(Reply::decode(&work).unwrap_err().contains("truncated"));
         // A length prefix larger than the message.

@@ -179,10 +179,12 @@ impl Evaluate for RobotRun {
         program: &Program,
         index: usize,
         actions: u32,
-        jobs: &[(&Genome, u64)],
+        jobs: &[(&Genome, shaping_runtime::evolve::Episode)],
     ) -> Vec<Evaluation> {
+        // The robot lives in the room it is in: a variant's world is not
+        // made, only its episode's seed is used.
         let stage = &program.stages[index];
-        jobs.iter().map(|&(genome, seed)| self.evaluate_one(stage, actions, genome, seed)).collect()
+        jobs.iter().map(|&(genome, e)| self.evaluate_one(stage, actions, genome, e.seed)).collect()
     }
 
     fn failure(&self) -> Option<CliError> {

@@ -5,7 +5,7 @@ use crate::controller::{self, ControllerError, EpisodeOptions};
 use crate::genome::Genome;
 use crate::program::{Stage, StageRun};
 
-use super::Evaluation;
+use super::{Episode, Evaluation};
 
 /// How episodes of a stage run: its life length in actions, and whether local
 /// learning is on.
@@ -30,26 +30,48 @@ impl EvalOptions {
     }
 }
 
-/// An evaluation function running one controller episode of `stage` per call,
-/// seeded with the episode seed. The stage is checked once here (with a zero
-/// genome of its layout's length), so the episodes of genomes of that length,
-/// which the GA always makes, cannot fail. With `inheritance: lamarckian`
-/// the learned genome is returned for write-back.
+/// The evaluation function of `stage`: one controller episode per call, in
+/// the episode's variant, seeded with its seed (an episode of a variant the
+/// stage does not declare has a NaN fitness), living and learning as `opts`
+/// says. With `inheritance: lamarckian` the learned genome is returned for
+/// write-back. The stage is not checked here ([`evaluate_with_controller`]
+/// does).
+pub fn evaluator(stage: &Stage, opts: EvalOptions) -> impl Fn(&Genome, Episode) -> Evaluation + Sync + '_ {
+    evaluator_until(stage, opts, || false)
+}
+
+/// [`evaluator`] whose episodes are given up once `stop` returns true
+/// (asked before an episode and after each action): a given-up episode has
+/// a NaN fitness.
+pub fn evaluator_until<'s>(
+    stage: &'s Stage,
+    opts: EvalOptions,
+    stop: impl Fn() -> bool + Sync + 's,
+) -> impl Fn(&Genome, Episode) -> Evaluation + Sync + 's {
+    let worlds = VariantStages::of(stage);
+    move |genome: &Genome, episode: Episode| {
+        let Some(stage) = worlds.stage(episode) else { return Evaluation::unknown_variant() };
+        let opts = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed: episode.seed };
+        match controller::run_episode_until(stage, genome, &opts, &stop) {
+            Some(r) => Evaluation::of_episode(r),
+            None => Evaluation { fitness: f32::NAN, ..Evaluation::default() },
+        }
+    }
+}
+
+/// [`evaluator`] of a stage checked once here (with a zero genome of its
+/// layout's length), so the episodes of genomes of that length, which the
+/// GA always makes, cannot fail.
 pub fn evaluate_with_controller(
     stage: &Stage,
     opts: EvalOptions,
-) -> Result<impl Fn(&Genome, u64) -> Evaluation + Sync + '_, ControllerError> {
+) -> Result<impl Fn(&Genome, Episode) -> Evaluation + Sync + '_, ControllerError> {
     controller::validate(stage, &Genome::zeros(stage.layout.bits as usize))?;
-    let worlds = VariantStages::of(stage);
-    Ok(move |genome: &Genome, seed: u64| {
-        let episode = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed };
-        Evaluation::of_episode(controller::run_episode(worlds.stage(seed), genome, &episode, None))
-    })
+    Ok(evaluator(stage, opts))
 }
 
-/// A stage in each of its variants: which stage an episode seed runs
-/// ([`super::seed::variant_seed`] names the variant in a stage with
-/// variants). Made once per evaluation function, not per episode.
+/// A stage in each of its variants: which stage an [`Episode`] runs. Made
+/// once per evaluation function, not per episode.
 pub struct VariantStages<'s> {
     stage: &'s Stage,
     each: Vec<Stage>,
@@ -63,12 +85,13 @@ impl<'s> VariantStages<'s> {
         VariantStages { stage, each }
     }
 
-    /// The stage an episode of seed `seed` runs: the variant its seed
-    /// names, or the stage itself without variants.
-    pub fn stage(&self, seed: u64) -> &Stage {
-        if self.each.is_empty() {
-            return self.stage;
+    /// The stage `episode` runs: the stage in its variant, or the stage
+    /// itself for an episode without one; `None` for a variant the stage
+    /// does not declare.
+    pub fn stage(&self, episode: Episode) -> Option<&Stage> {
+        match episode.variant {
+            None => Some(self.stage),
+            Some(v) => self.each.get(v),
         }
-        &self.each[super::seed::seed_variant(seed).min(self.each.len() - 1)]
     }
 }

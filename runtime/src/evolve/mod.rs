@@ -54,7 +54,7 @@ use serde::{Deserialize, Serialize};
 pub use error::EvolveError;
 pub use fingerprint::{fingerprint, Fingerprint};
 pub use ga::{frozen_mask, next_generation, ranking};
-pub use glue::{evaluate_with_controller, EvalOptions, VariantStages};
+pub use glue::{evaluate_with_controller, evaluator, evaluator_until, EvalOptions, VariantStages};
 pub use train::{train_all, train_stage, Trained};
 
 use crate::genome::Genome;
@@ -63,18 +63,43 @@ use crate::program::{Evolution, Inheritance, Program, Stage, StageRun};
 /// Version of the [`Checkpoint`] format.
 pub const CHECKPOINT_FORMAT: u32 = 2;
 
-/// Runs one episode of a genome with the given episode seed.
-pub type Evaluate<'a> = &'a (dyn Fn(&Genome, u64) -> Evaluation + Sync);
+/// One episode to run: its seed and, in a stage with variants, which of
+/// the stage's declared variants (by index) its world is. The variant
+/// travels beside the seed: whatever a caller passes as a seed, it never
+/// chooses a variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Episode {
+    pub seed: u64,
+    /// `None`: the stage's own world (a stage without variants; in a stage
+    /// with variants, its world before any variant's changes).
+    pub variant: Option<usize>,
+}
 
-/// Runs a list of episodes, each a genome and its episode seed, and returns
+impl Episode {
+    /// An episode of the stage's own world.
+    pub fn plain(seed: u64) -> Episode {
+        Episode { seed, variant: None }
+    }
+
+    /// Episode `seed` in variant `variant`: its seed is
+    /// [`seed::variant_seed`]`(seed, variant)`, a seed of its own per variant.
+    pub fn in_variant(seed: u64, variant: usize) -> Episode {
+        Episode { seed: seed::variant_seed(seed, variant), variant: Some(variant) }
+    }
+}
+
+/// Runs one episode of a genome.
+pub type Evaluate<'a> = &'a (dyn Fn(&Genome, Episode) -> Evaluation + Sync);
+
+/// Runs a list of episodes, each a genome and its episode, and returns
 /// their results in the same order: the hook through which the episodes of a
 /// generation can be spread over several processes (the CLI's MPI backend).
 /// Which process or thread runs an episode must not change its result.
-pub type EvaluateMany<'a> = &'a dyn Fn(&[(&Genome, u64)]) -> Vec<Evaluation>;
+pub type EvaluateMany<'a> = &'a dyn Fn(&[(&Genome, Episode)]) -> Vec<Evaluation>;
 
 /// [`EvaluateMany`] over `evaluate` on rayon's current thread pool.
-pub fn evaluate_many(evaluate: Evaluate, jobs: &[(&Genome, u64)]) -> Vec<Evaluation> {
-    jobs.par_iter().map(|&(genome, seed)| evaluate(genome, seed)).collect()
+pub fn evaluate_many(evaluate: Evaluate, jobs: &[(&Genome, Episode)]) -> Vec<Evaluation> {
+    jobs.par_iter().map(|&(genome, episode)| evaluate(genome, episode)).collect()
 }
 
 /// The result of one episode.
@@ -97,6 +122,12 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
+    /// The result of an episode in a variant its stage does not declare:
+    /// nothing ran, and its fitness is NaN.
+    pub fn unknown_variant() -> Evaluation {
+        Evaluation { fitness: f32::NAN, ..Evaluation::default() }
+    }
+
     /// The evaluation of one controller episode.
     pub fn of_episode(result: crate::controller::EpisodeResult) -> Evaluation {
         Evaluation {
@@ -191,19 +222,19 @@ pub fn drawn_variants(stage: &Stage, run_seed: u64, index: usize, generation: u3
 }
 
 /// The jobs of one individual: `episodes` episodes per variant of
-/// `variants` (episode `e` of variant `v` seeded by `seed(e)` with the
-/// variant in its low bits), or `episodes` episodes without variants.
+/// `variants` (episode `e` of variant `v`: [`Episode::in_variant`]`(seed(e),
+/// v)`), or `episodes` episodes without variants.
 fn individual_jobs<'g>(
     genome: &'g Genome,
     variants: &'g [usize],
     episodes: u32,
     seed: impl Fn(u32) -> u64 + Copy + 'g,
-) -> impl Iterator<Item = (&'g Genome, u64)> + 'g {
-    let plain = variants.is_empty().then(|| (0..episodes).map(move |e| (genome, seed(e))));
+) -> impl Iterator<Item = (&'g Genome, Episode)> + 'g {
+    let plain = variants.is_empty().then(|| (0..episodes).map(move |e| (genome, Episode::plain(seed(e)))));
     let varied = variants
         .iter()
         .copied()
-        .flat_map(move |v| (0..episodes).map(move |e| (genome, seed::variant_seed(seed(e), v))));
+        .flat_map(move |v| (0..episodes).map(move |e| (genome, Episode::in_variant(seed(e), v))));
     plain.into_iter().flatten().chain(varied)
 }
 
@@ -402,7 +433,7 @@ pub fn step_generation_with(
     let episodes = evo.evaluations.max(1);
     let variants = drawn_variants(st, run_seed, stage, g);
     let per_individual = episodes as usize * variants.len().max(1);
-    let jobs: Vec<(&Genome, u64)> = population
+    let jobs: Vec<(&Genome, Episode)> = population
         .iter()
         .enumerate()
         .flat_map(|(i, genome)| {
@@ -630,7 +661,7 @@ pub fn validate_best_with(
     let variants = st.variants.as_ref().map_or(0, |v| v.list.len());
     let variants: Vec<usize> = (0..variants).collect();
     let per_candidate = episodes as usize * variants.len().max(1);
-    let jobs: Vec<(&Genome, u64)> = pool
+    let jobs: Vec<(&Genome, Episode)> = pool
         .iter()
         .flat_map(|&g| {
             individual_jobs(g, &variants, episodes, move |e| seed::validate_seed(run_seed, stage, e))
@@ -706,7 +737,7 @@ pub fn test_best(
     evaluate: Evaluate,
 ) -> Result<TestOutcome, EvolveError> {
     let TestSubject { genome, parent_fitness, seed } = test_subject(program, stage, seed, parent)?;
-    let evaluation = evaluate(&genome, seed);
+    let evaluation = evaluate(&genome, Episode::plain(seed));
     Ok(TestOutcome { genome, parent_fitness, seed, evaluation })
 }
 

@@ -80,22 +80,19 @@ pub fn validate_seed(run_seed: u64, stage: usize, episode: u32) -> u64 {
     mix(run_seed, &[DOMAIN_VALIDATE, stage as u64, episode as u64])
 }
 
-/// The low bits of an episode seed that name its variant, in a stage with
-/// variants ([`variant_seed`]): 8, for at most
-/// [`crate::limits::MAX_VARIANTS`] variants.
+/// The low bits of an episode seed that [`variant_seed`] replaces: 8.
 const VARIANT_MASK: u64 = 0xff;
 
-/// The seed of an episode of a stage with variants in variant `variant`:
-/// `seed` with its low 8 bits replaced by the variant's index, so the
-/// evaluation of the episode ([`super::glue`], the engine's) finds the
-/// variant in the seed it is given, whatever runs it (threads, MPI ranks).
+// Every variant's seeds differ from every other's only while the variants
+// fit in the replaced bits.
+const _: () = assert!(crate::limits::MAX_VARIANTS as u64 <= VARIANT_MASK + 1);
+
+/// The seed of episode `seed` in variant `variant` of a stage with
+/// variants: `seed` with its low 8 bits replaced by the variant's index, so
+/// each variant's episode has a seed of its own (the variant itself travels
+/// in [`super::Episode::variant`], never read back from the seed).
 pub fn variant_seed(seed: u64, variant: usize) -> u64 {
     (seed & !VARIANT_MASK) | (variant as u64 & VARIANT_MASK)
-}
-
-/// The variant an episode seed of a stage with variants names ([`variant_seed`]).
-pub fn seed_variant(seed: u64) -> usize {
-    (seed & VARIANT_MASK) as usize
 }
 
 /// Seed of the RNG that draws the variants generation `generation` of a
