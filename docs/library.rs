@@ -20,7 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             StageOutcome::Train { stage, performance, .. } => println!("{stage}: trained, {performance:?}"),
             StageOutcome::Test { stage, summary } => {
-                println!("{stage}: tested, fitness {} after the change", summary["fitness"])
+                println!("{stage}: tested, fitness {} after the change", summary.fitness)
             }
         }
     }

@@ -155,7 +155,7 @@ impl Observer for Terminal {
             }
             Event::Tested { stage, summary, lives, before, after, dir } => {
                 if self.json {
-                    self.print_json(summary.to_string());
+                    self.print_json(serde_json::to_value(summary).map(|v| v.to_string()).unwrap_or_default());
                 } else if !self.quiet {
                     let how = if lives == 1 {
                         String::new()

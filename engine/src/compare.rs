@@ -40,12 +40,6 @@ pub const EVOLVE_MEASURES: [&str; 10] = [
 ];
 pub const TEST_MEASURES: [&str; 3] = ["fitness", "grips", "releases_outside"];
 
-/// A JSON file of an experiment, checked against its seal (one written
-/// before seals is read as it is).
-fn read_json(path: &Path) -> Result<serde_json::Value, Error> {
-    crate::experiment::read_json(&|_| {}, path)
-}
-
 /// The measures of `stages` of `program` over `seeds` in experiment
 /// directory `dir` (its `seed-N/` run directories), as the summaries read
 /// them: an evolved stage's final best, chosen best, final mean and best
@@ -105,11 +99,11 @@ pub fn read_measures(
             StageRun::Test { .. } => {
                 let mut v: [Vec<f64>; 3] = Default::default();
                 for &seed in seeds {
-                    let s = read_json(
-                        &rundir::stage_dir(&rundir::seed_dir(dir, seed), &stage.name).join("summary.json"),
-                    )?;
-                    for (k, m) in TEST_MEASURES.iter().enumerate() {
-                        v[k].push(s[*m].as_f64().unwrap_or(f64::NAN));
+                    let s = crate::experiment::seed_test_summary(dir, seed, &stage.name, &|_| {})?;
+                    for (k, x) in
+                        [s.fitness, f64::from(s.grips), f64::from(s.releases_outside)].into_iter().enumerate()
+                    {
+                        v[k].push(x);
                     }
                 }
                 let measures = TEST_MEASURES.iter().copied().zip(v).collect();
@@ -122,7 +116,7 @@ pub fn read_measures(
 }
 
 /// One group's figures of a measure.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GroupFigures {
     /// The seeds with a value.
     pub seeds: usize,
@@ -132,7 +126,7 @@ pub struct GroupFigures {
 }
 
 /// The test of a pair of groups (`a` against `b`, numbered from 1).
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PairTest {
     pub a: usize,
     pub b: usize,
@@ -152,7 +146,7 @@ pub struct PairTest {
 }
 
 /// One measure of one stage, over the groups.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MeasureTests {
     pub stage: String,
     pub measure: String,
@@ -162,7 +156,7 @@ pub struct MeasureTests {
 
 /// The comparison of groups: what `summary.json` keeps under `tests` and
 /// `shaping compare` prints.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Tests {
     /// The groups' names, numbered from 1 in the pairs.
     pub groups: Vec<String>,
@@ -371,11 +365,12 @@ fn seeds_of(dir: &Path) -> Result<Vec<u64>, Error> {
 /// names its points' directories, which are.
 fn not_an_experiment(dir: &Path) -> String {
     let name = dir.display();
-    let points: Vec<String> = read_json(&dir.join("summary.json"))
+    let points: Vec<String> = rundir::read_experiment_summary(dir, &|_| {})
         .ok()
-        .and_then(|s| {
-            let points = s["points"].as_array()?.iter().filter_map(|p| p["dir"].as_str().map(String::from));
-            Some(points.filter(|p| p != ".").map(|p| format!("`{}`", dir.join(p).display())).collect())
+        .flatten()
+        .map(|s| {
+            let points = s.points.into_iter().map(|p| p.dir);
+            points.filter(|p| p != ".").map(|p| format!("`{}`", dir.join(p).display())).collect()
         })
         .unwrap_or_default();
     if points.is_empty() {

@@ -10,9 +10,9 @@ use shaping_runtime::evolve::{Checkpoint, GenStats};
 use shaping_runtime::program::{Program, StageRun};
 
 use crate::error::{Error, ErrorKind};
-use crate::files::{write_atomic, DirLock};
+use crate::files::DirLock;
 use crate::load;
-use crate::rundir;
+use crate::rundir::{self, StageFigures, TestSummary};
 use crate::sweep::{self, Assignment, Set};
 use crate::{compare, plot, report, run};
 
@@ -37,12 +37,17 @@ pub struct ExperimentOptions {
 
 /// Median, minimum and maximum; mean and standard deviation (the sample's,
 /// 0 for one value).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Spread {
+    #[serde(deserialize_with = "rundir::nan_if_null")]
     pub median: f64,
+    #[serde(deserialize_with = "rundir::nan_if_null")]
     pub min: f64,
+    #[serde(deserialize_with = "rundir::nan_if_null")]
     pub max: f64,
+    #[serde(deserialize_with = "rundir::nan_if_null")]
     pub mean: f64,
+    #[serde(deserialize_with = "rundir::nan_if_null")]
     pub sd: f64,
 }
 
@@ -162,7 +167,7 @@ impl Plan {
                 ),
             ));
         }
-        let out = args.out.clone().unwrap_or_else(|| run::default_out(&args.file).join("experiment"));
+        let out = args.out.clone().unwrap_or_else(|| rundir::experiment_dir(&run::default_out(&args.file)));
         Ok(Plan { seeds: (args.first_seed..end).collect(), args, program, criteria, points, stages, out })
     }
 
@@ -271,44 +276,38 @@ impl Plan {
                     "## Medians with their 95% intervals",
                 ));
             }
-            write_atomic(&dir.join("summary.md"), md.as_bytes())?;
+            rundir::write_summary_md(&dir, &md)?;
             if self.args.sets.is_empty() {
                 finished.summary.push_str(&md);
             }
-            let settings: serde_json::Map<String, serde_json::Value> =
-                point.iter().map(|(t, v)| (t.clone(), serde_json::Value::String(v.clone()))).collect();
+            let settings = point.iter().map(|(t, v)| (t.clone(), v.clone())).collect();
             let dir_name = if point.is_empty() {
                 ".".to_string()
             } else {
                 sweep::point_dir_name(point, &self.args.sets)
             };
-            points.push(
-                serde_json::json!({ "name": name, "dir": dir_name, "settings": settings, "stages": stages }),
-            );
-            table.push((point.clone(), stages));
+            table.push((point.clone(), stages.clone()));
+            points.push(rundir::PointSummary { name, dir: dir_name, settings, stages });
         }
-        let sets: Vec<serde_json::Value> = self
+        let sets = self
             .args
             .sets
             .iter()
-            .map(|s| serde_json::json!({ "target": s.target, "values": s.values }))
+            .map(|s| rundir::SweepSet { target: s.target.clone(), values: s.values.clone() })
             .collect();
         // The tests between points (a point's median and interval alone
         // without a sweep), after the figures that were there before them.
         let tests = compare::tests(&groups);
-        let json = serde_json::json!({
-            "file": title, "seeds": self.seeds, "sets": sets, "points": points, "tests": tests,
-        });
-        let text = serde_json::to_string_pretty(&json)
-            .map_err(|e| Error::io(format!("error: cannot serialise the summary: {e}")))?;
-        crate::files::write_sealed(&self.out, &[("summary.json", format!("{text}\n").as_bytes())])?;
+        let summary =
+            rundir::ExperimentSummary { file: title.clone(), seeds: self.seeds.clone(), sets, points, tests };
+        rundir::write_experiment_summary(&self.out, &summary)?;
         if !self.args.sets.is_empty() {
             let mut md = sweep_table(&title, &self.args.sets, &self.seeds, &table);
             md.push('\n');
-            md.push_str(&compare::markdown(&tests, "## Tests between points"));
-            write_atomic(&self.out.join("summary.md"), md.as_bytes())?;
+            md.push_str(&compare::markdown(&summary.tests, "## Tests between points"));
+            rundir::write_summary_md(&self.out, &md)?;
             finished.summary.push_str(&md);
-            sweep_plot(&self.out.join("sweep"), &title, &table)?;
+            sweep_plot(&rundir::picture_path(&self.out, rundir::Picture::Sweep), &title, &table)?;
         }
         if !self.args.no_report {
             // After `summary.json`: a point's report lists the sweep's points.
@@ -344,23 +343,22 @@ pub const MAX_SEEDS: u64 = 10_000;
 const MAX_POINTS: usize = 10_000;
 
 /// `sweep.svg`/`.png`: each evolved stage's chosen best per point.
-fn sweep_plot(
-    stem: &Path,
-    title: &str,
-    table: &[(Vec<Assignment>, Vec<serde_json::Value>)],
-) -> Result<(), Error> {
+fn sweep_plot(stem: &Path, title: &str, table: &[(Vec<Assignment>, Vec<StageFigures>)]) -> Result<(), Error> {
     let Some((_, first)) = table.first() else { return Ok(()) };
     let series: Vec<plot::SweepSeries> = first
         .iter()
         .enumerate()
-        .filter(|(_, s)| s["kind"] == "evolve")
+        .filter(|(_, s)| matches!(s, StageFigures::Evolve { .. }))
         .map(|(k, s)| plot::SweepSeries {
-            stage: s["stage"].as_str().unwrap_or("").to_string(),
+            stage: s.stage().to_string(),
             values: table
                 .iter()
                 .map(|(_, stages)| {
-                    let c = &stages[k]["chosen_best"];
-                    Some((c["median"].as_f64()?, c["min"].as_f64()?, c["max"].as_f64()?))
+                    let Some(StageFigures::Evolve { chosen_best: Some(c), .. }) = stages.get(k) else {
+                        return None;
+                    };
+                    let finite = [c.median, c.min, c.max].iter().all(|x| x.is_finite());
+                    finite.then_some((c.median, c.min, c.max))
                 })
                 .collect(),
         })
@@ -396,7 +394,7 @@ fn sweep_table(
     title: &str,
     sets: &[Set],
     seeds: &[u64],
-    table: &[(Vec<Assignment>, Vec<serde_json::Value>)],
+    table: &[(Vec<Assignment>, Vec<StageFigures>)],
 ) -> String {
     let mut md = String::new();
     let _ = writeln!(
@@ -413,8 +411,10 @@ fn sweep_table(
     let evolved: Vec<(String, bool)> = table.first().map_or_else(Vec::new, |(_, stages)| {
         stages
             .iter()
-            .filter(|s| s["kind"] == "evolve")
-            .map(|s| (s["stage"].as_str().unwrap_or("").to_string(), !s["criterion"].is_null()))
+            .filter_map(|s| match s {
+                StageFigures::Evolve { stage, criterion, .. } => Some((stage.clone(), criterion.is_some())),
+                _ => None,
+            })
             .collect()
     });
     for (stage, criterion) in &evolved {
@@ -428,8 +428,8 @@ fn sweep_table(
     let tests: Vec<String> = table.first().map_or_else(Vec::new, |(_, stages)| {
         stages
             .iter()
-            .filter(|s| s["kind"] == "test")
-            .map(|s| s["stage"].as_str().unwrap_or("").to_string())
+            .filter(|s| matches!(s, StageFigures::Test { .. }))
+            .map(|s| s.stage().to_string())
             .collect()
     });
     for stage in &tests {
@@ -437,33 +437,33 @@ fn sweep_table(
     }
     let _ = writeln!(md, "| {} |", head.join(" | "));
     let _ = writeln!(md, "|{}", "---|".repeat(head.len()));
-    let cell = |v: &serde_json::Value, digits: usize| {
-        let get = |k: &str| v[k].as_f64();
-        match (get("median"), get("min"), get("max"), get("mean"), get("sd")) {
-            (Some(median), Some(min), Some(max), Some(mean), Some(sd)) => {
-                fmt_spread(Some(Spread { median, min, max, mean, sd }), digits)
-            }
-            _ => "-".to_string(),
+    // A figure that is not a number (written `null`) leaves its cell empty.
+    let cell = |v: &Option<Spread>, digits: usize| match v {
+        Some(s) if [s.median, s.min, s.max, s.mean, s.sd].iter().all(|x| x.is_finite()) => {
+            fmt_spread(Some(*s), digits)
         }
+        _ => "-".to_string(),
     };
     for (i, (point, stages)) in table.iter().enumerate() {
         let mut row: Vec<String> = vec![(i + 1).to_string()];
         row.extend(point.iter().map(|(_, v)| v.clone()));
-        for s in stages.iter().filter(|s| s["kind"] == "evolve") {
-            row.push(cell(&s["final_best"], 3));
-            row.push(cell(&s["chosen_best"], 3));
-            if !s["criterion"].is_null() {
-                let c = &s["criterion"];
-                let never = c["unreached"].as_u64().unwrap_or(0);
+        for s in stages {
+            let StageFigures::Evolve { final_best, chosen_best, criterion, .. } = s else { continue };
+            row.push(cell(final_best, 3));
+            row.push(cell(chosen_best, 3));
+            if let Some(c) = criterion {
+                let never = c.unreached;
                 row.push(format!(
                     "{}{}",
-                    cell(&c["generation"], 0),
+                    cell(&c.generation, 0),
                     if never > 0 { format!("; {never} seeds never") } else { String::new() }
                 ));
             }
         }
-        for s in stages.iter().filter(|s| s["kind"] == "test") {
-            row.push(cell(&s["fitness"], 3));
+        for s in stages {
+            if let StageFigures::Test { fitness, .. } = s {
+                row.push(cell(fitness, 3));
+            }
         }
         let _ = writeln!(md, "| {} |", row.join(" | "));
     }
@@ -472,14 +472,16 @@ fn sweep_table(
     md
 }
 
-pub(crate) fn read_json<T: serde::de::DeserializeOwned>(
+/// The `summary.json` of test stage `stage` of seed `seed` of experiment
+/// (or point) directory `out`, which the seed's run must have written.
+pub(crate) fn seed_test_summary(
+    out: &Path,
+    seed: u64,
+    stage: &str,
     unsealed: crate::files::Unsealed<'_>,
-    path: &Path,
-) -> Result<T, Error> {
-    let bytes =
-        crate::files::read_checked(path, rundir::REWRITE, unsealed)?.ok_or_else(|| missing(path))?.bytes;
-    serde_json::from_slice(&bytes)
-        .map_err(|e| Error::new(ErrorKind::Corrupt, format!("error: cannot read `{}`: {e}", path.display())))
+) -> Result<TestSummary, Error> {
+    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), stage);
+    rundir::read_test_summary(&dir, unsealed)?.ok_or_else(|| missing(&rundir::summary_path(&dir)))
 }
 
 /// A file that a seed's run must have written.
@@ -491,7 +493,7 @@ pub(crate) fn missing(path: &Path) -> Error {
 }
 
 /// Builds the Markdown summary and the multi-seed fitness picture.
-/// Returns the Markdown and, per stage, its figures as JSON (`summary.json`).
+/// Returns the Markdown and, per stage, its figures (`summary.json`).
 fn summarise(
     program: &Program,
     stages: &[usize],
@@ -500,7 +502,7 @@ fn summarise(
     seeds: &[u64],
     criteria: &[(String, f32)],
     unsealed: crate::files::Unsealed<'_>,
-) -> Result<(String, Vec<serde_json::Value>), Error> {
+) -> Result<(String, Vec<StageFigures>), Error> {
     let mut json = Vec::new();
     let mut md = String::new();
     let _ = writeln!(md, "# {title} over {} seeds ({:?})\n", seeds.len(), seeds);
@@ -554,14 +556,19 @@ fn summarise(
                         if unreached > 0 { format!("; {unreached} seeds never") } else { String::new() }
                     ),
                 };
-                json.push(serde_json::json!({
-                    "stage": stage.name, "kind": "evolve", "generations": evo.generations,
-                    "final_best": spread(&best), "chosen_best": spread(&chosen), "final_mean": spread(&mean),
-                    "best_ever": spread(&ever),
-                    "criterion": criterion.map(|c| serde_json::json!({
-                        "fitness": c, "generation": spread(&reach), "unreached": unreached,
-                    })),
-                }));
+                json.push(StageFigures::Evolve {
+                    stage: stage.name.clone(),
+                    generations: evo.generations,
+                    final_best: spread(&best),
+                    chosen_best: spread(&chosen),
+                    final_mean: spread(&mean),
+                    best_ever: spread(&ever),
+                    criterion: criterion.map(|c| rundir::CriterionFigures {
+                        fitness: f64::from(c),
+                        generation: spread(&reach),
+                        unreached,
+                    }),
+                });
                 let _ = writeln!(
                     md,
                     "| {} | {} | {} | {} | {} | {} | {} |",
@@ -584,9 +591,11 @@ fn summarise(
                         stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
                     perf.extend(learners.map(|(_, p)| *p as f64));
                 }
-                json.push(serde_json::json!({
-                    "stage": stage.name, "kind": "train", "actions": actions, "performance": spread(&perf),
-                }));
+                json.push(StageFigures::Train {
+                    stage: stage.name.clone(),
+                    actions: *actions,
+                    performance: spread(&perf),
+                });
                 let _ = writeln!(
                     md,
                     "| {} | training, {actions} actions | performance at the end {} | - | - | - | - |",
@@ -599,18 +608,20 @@ fn summarise(
                 let mut grips = Vec::new();
                 let mut rel = Vec::new();
                 for &seed in seeds {
-                    let v: serde_json::Value = read_json(
-                        unsealed,
-                        &rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name).join("summary.json"),
-                    )?;
-                    fit.push(v["fitness"].as_f64().unwrap_or(f64::NAN));
-                    grips.push(v["grips"].as_f64().unwrap_or(f64::NAN));
-                    rel.push(v["releases_outside"].as_f64().unwrap_or(f64::NAN));
+                    let v = seed_test_summary(out, seed, &stage.name, unsealed)?;
+                    fit.push(v.fitness);
+                    grips.push(f64::from(v.grips));
+                    rel.push(f64::from(v.releases_outside));
                 }
-                json.push(serde_json::json!({
-                    "stage": stage.name, "kind": "test", "actions": actions, "lives": lives, "learning": learning,
-                    "fitness": spread(&fit), "grips": spread(&grips), "releases_outside": spread(&rel),
-                }));
+                json.push(StageFigures::Test {
+                    stage: stage.name.clone(),
+                    actions: *actions,
+                    lives: *lives,
+                    learning: *learning,
+                    fitness: spread(&fit),
+                    grips: spread(&grips),
+                    releases_outside: spread(&rel),
+                });
                 let length = match lives {
                     1 => format!("{actions} actions"),
                     _ => {
@@ -633,7 +644,7 @@ fn summarise(
     if let Some(first) = histories.iter().filter(|h| !h.is_empty()).max_by_key(|h| h.len()) {
         let starts = report::fitness_points(first).1;
         plot::multi_seed_fitness(
-            &out.join("fitness-seeds"),
+            &rundir::picture_path(out, rundir::Picture::FitnessSeeds),
             &format!("{}: fitness over {} seeds (median, min-max)", title.trim_end_matches(','), seeds.len()),
             &runs,
             &starts,

@@ -12,7 +12,7 @@ use shaping_runtime::sim::Sim;
 use shaping_runtime::controller::EpisodeResult;
 
 use crate::error::Error;
-use crate::files::{create_dir, write_sealed};
+use crate::files::create_dir;
 use crate::run::{Event, Observer};
 use crate::{animation, episode, html, load, report, run, rundir};
 
@@ -239,7 +239,7 @@ pub fn replay(
     )?;
     let Chosen { program, index, genome, training_seed } = chosen;
     let stage = &program.stages[index];
-    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("replay"));
+    let out = args.out.clone().unwrap_or_else(|| rundir::replay_dir(&run_dir, &stage.name));
     rundir::check_replay_out(&out)?;
     let (actions, learning) = match &stage.run {
         StageRun::Evolve(e) => (e.actions, true),
@@ -267,9 +267,9 @@ pub fn replay(
     // A team's world is the one its robots started in.
     let scene = if others.is_empty() { Sim::new(&stage.world, seed).scene() } else { team_scene };
     report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
-    write_sealed(&out, &[("episode.json", rundir::compact_json(&ep)?.as_bytes())])?;
+    rundir::write_episode(&out, &ep)?;
     rundir::write_program(&out, &program)?;
-    write_sealed(&out, &[("genome", &rundir::genome_bytes(&genome))])?;
+    rundir::write_genome_file(&out, &genome)?;
     let report = if args.report { Some(html::write(&out, None)?) } else { None };
     let mut animations = Vec::new();
     if args.gif.is_some() || args.mp4.is_some() {

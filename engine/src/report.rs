@@ -15,48 +15,8 @@ use shaping_runtime::sim::{ObjectState, Scene};
 
 use crate::episode::{Episode, EpisodeColumns, Frame, OtherRobot};
 use crate::error::Error;
-use crate::files::write_atomic;
 use crate::plot;
-
-/// `generations.csv`: one row per generation of the stage and its ancestors.
-/// A stage with variants adds a column `best_variant_NAME` per variant
-/// (`variants`, the stage's, in declaration order): the best individual's
-/// fitness in that variant, empty where the generation did not draw it (or
-/// in a row of an ancestor without those variants).
-pub fn generations_csv(history: &[GenStats], variants: &[String]) -> String {
-    let mut s = String::from(
-        "stage,generation,stage_generation,best,mean,worst,best_index,best_recharges,best_grips,best_releases_outside",
-    );
-    for v in variants {
-        let _ = write!(s, ",best_variant_{v}");
-    }
-    s.push('\n');
-    for h in history {
-        let _ = write!(
-            s,
-            "{},{},{},{:.6},{:.6},{:.6},{},{},{},{}",
-            h.stage,
-            h.generation,
-            h.stage_generation,
-            h.best,
-            h.mean,
-            h.worst,
-            h.best_index,
-            h.best_recharges,
-            h.best_grips,
-            h.best_releases_outside
-        );
-        let mine = h.best_variants.len() == variants.len();
-        for i in 0..variants.len() {
-            match h.best_variants.get(i).copied().flatten().filter(|_| mine) {
-                Some(f) => _ = write!(s, ",{f:.6}"),
-                None => s.push(','),
-            }
-        }
-        s.push('\n');
-    }
-    s
-}
+use crate::rundir::{self, Picture};
 
 /// The names of a stage's variants (none without variants).
 pub fn variant_names(stage: &shaping_runtime::program::Stage) -> Vec<String> {
@@ -84,7 +44,7 @@ pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(),
         return Ok(());
     }
     let (points, starts) = fitness_points(history);
-    plot::fitness_curves(&dir.join("fitness"), title, &points, &starts, false)
+    plot::fitness_curves(&rundir::picture_path(dir, Picture::Fitness), title, &points, &starts, false)
         .map_err(|e| Error::io(format!("error: {e}")))
 }
 
@@ -418,7 +378,7 @@ pub fn episode_files_until(
     path: Option<(Range<usize>, &str)>,
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
-    write_atomic(&dir.join("trace.csv"), team_trace_csv(trace, others, stage, episode).as_bytes())?;
+    rundir::write_trace(dir, &team_trace_csv(trace, others, stage, episode))?;
     if trace.rows.is_empty() {
         return Ok(());
     }
@@ -465,8 +425,12 @@ fn pictures(
         battery: trace.rows.iter().map(|r| r.battery).collect(),
         holding: trace.rows.iter().map(|r| r.holding).collect(),
     };
-    plot::activation_trace(&dir.join("activations"), &format!("{title}: module activations"), &act)
-        .map_err(to_err)?;
+    plot::activation_trace(
+        &rundir::picture_path(dir, Picture::Activations),
+        &format!("{title}: module activations"),
+        &act,
+    )
+    .map_err(to_err)?;
     check()?;
 
     // The performance indicator the controller keeps: the rolling mean of the
@@ -480,7 +444,7 @@ fn pictures(
     if !series.is_empty() {
         let window = stage.modules.iter().find_map(|m| m.learning.as_ref().map(|l| l.window)).unwrap_or(30);
         plot::rolling_reinforcement(
-            &dir.join("reinforcement"),
+            &rundir::picture_path(dir, Picture::Reinforcement),
             &format!("{title}: performance (rolling mean of the last {window} reinforcements)"),
             &series,
             1,
@@ -499,7 +463,7 @@ fn pictures(
         None => (trajectory_scene(scene, trace, others), format!("{title}: trajectory")),
     };
     scene.roles = stage.roles.iter().map(|r| (r.name.clone(), r.robots)).collect();
-    plot::trajectory(&dir.join("trajectory"), &what, &scene).map_err(to_err)
+    plot::trajectory(&rundir::picture_path(dir, Picture::Trajectory), &what, &scene).map_err(to_err)
 }
 
 /// Modules that learn (or at least receive reinforcement), with their index.

@@ -2,6 +2,7 @@
 //! stages, evolution with resume and fingerprint checks, test stages; the
 //! files of each stage, and what the caller is told as it goes.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -14,8 +15,8 @@ use shaping_runtime::sim::Scene;
 
 use crate::episode::{self, Part};
 use crate::error::{Error, ErrorKind, Result};
-use crate::files::{create_dir, unsealed_warning, write_sealed, DirLock, Unsealed};
-use crate::rundir::{self, compact_json, to_json};
+use crate::files::{create_dir, unsealed_warning, DirLock, Unsealed};
+use crate::rundir::{self, TestSummary};
 use crate::sweep::Assignment;
 use crate::{html, report, RECORDED_TRAINING_ACTIONS};
 
@@ -60,7 +61,7 @@ pub enum Event<'a> {
     /// A test stage is done: its `summary.json`, and the totals of each world.
     Tested {
         stage: &'a str,
-        summary: &'a Value,
+        summary: &'a TestSummary,
         lives: u32,
         before: &'a EpisodeResult,
         after: &'a EpisodeResult,
@@ -188,7 +189,7 @@ pub struct RunOutcome {
 pub enum StageOutcome {
     Train { stage: String, actions: u32, performance: Vec<f32> },
     Evolve { stage: String, generations: u32, best: f32, genome: Genome },
-    Test { stage: String, summary: Value },
+    Test { stage: String, summary: Box<TestSummary> },
 }
 
 impl StageOutcome {
@@ -547,7 +548,7 @@ fn misdescribed<'a>(
     let mut found = Vec::new();
     for (i, st) in program.stages.iter().enumerate() {
         let dir = rundir::stage_dir(out, &st.name);
-        if stages.contains(&i) || !holds_results(&dir) {
+        if stages.contains(&i) || !rundir::holds_results(&dir) {
             continue;
         }
         let Some((j, _)) = previous.stage(&st.name) else { continue };
@@ -565,13 +566,6 @@ fn misdescribed<'a>(
         found.push(Misdescribed { stage: &st.name, what: what.join("; "), parts: parts.max(1), dir });
     }
     found
-}
-
-/// A stage directory holds results of a run (not only a replay's).
-fn holds_results(dir: &Path) -> bool {
-    ["checkpoint.json", "trained.json", "best.genome", "summary.json", "episode.json"]
-        .iter()
-        .any(|f| dir.join(f).exists())
 }
 
 /// What a run resumes from, read once by [`precheck`]: per stage, its
@@ -734,7 +728,8 @@ impl Runner<'_> {
                         learning: *learning,
                     };
                     let summary = self.test_stage(&test, &dir)?;
-                    results.push(StageOutcome::Test { stage: stage.name.clone(), summary });
+                    results
+                        .push(StageOutcome::Test { stage: stage.name.clone(), summary: Box::new(summary) });
                 }
                 StageRun::Train { .. } => unreachable!("training stages run above"),
             }
@@ -774,7 +769,7 @@ fn best_episode(
             dir.display()
         )));
     };
-    write_sealed(dir, &[("episode.json", compact_json(&recorded.episode)?.as_bytes())])
+    rundir::write_episode(dir, &recorded.episode)
 }
 
 /// Warns through `observer` that `path` was read without a seal.
@@ -914,9 +909,7 @@ impl Runner<'_> {
                     return Err(fail(e, &cp));
                 }
             };
-            let csv = report::generations_csv(&cp.history, &report::variant_names(stage));
-            let checkpoint = rundir::checkpoint_bytes(&cp)?;
-            write_sealed(dir, &[("checkpoint.json", &checkpoint), ("generations.csv", csv.as_bytes())])?;
+            rundir::write_generation(dir, &cp, &report::variant_names(stage))?;
             self.observer.event(Event::Generation { stage: &stage.name, stats: &stats });
             if stats.crowded_episodes > 0 && !warned {
                 // Said at once (a long run may be stopped), and again with the
@@ -971,9 +964,7 @@ impl Runner<'_> {
         }
         let (genome, fitness) = evolve::best_of(&cp)
             .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
-        let csv = report::generations_csv(&cp.history, &report::variant_names(stage));
-        let best = rundir::genome_bytes(&genome);
-        write_sealed(dir, &[("best.genome", &best), ("generations.csv", csv.as_bytes())])?;
+        rundir::write_evolved(dir, &genome, &cp, &report::variant_names(stage))?;
         report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
         self.observer.event(Event::Evolved {
             stage: &stage.name,
@@ -1161,7 +1152,7 @@ struct TestRun<'a> {
 impl Runner<'_> {
     /// Runs test stage `t` and writes its files into `dir` (all of them or,
     /// when stopped or failing on the way, none); returns its summary.
-    fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<Value> {
+    fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<TestSummary> {
         let stage = &t.program.stages[t.index];
         let stop = self.interrupt;
         let (actions, lives, learning) = (t.actions, t.lives, t.learning);
@@ -1222,7 +1213,7 @@ fn test_files(
     lives: u32,
     learning: bool,
     stop: Option<&AtomicBool>,
-) -> Result<serde_json::Value, Error> {
+) -> Result<TestSummary, Error> {
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let check = || if stopped() { Err(Error::io(report::STOPPED)) } else { Ok(()) };
     // The change, and the other lives' starts lightly (unlabelled marks).
@@ -1250,83 +1241,91 @@ fn test_files(
         &stopped,
     )?;
     check()?;
-    write_sealed(dir, &[("episode.json", compact_json(&ba.episode)?.as_bytes())])?;
+    rundir::write_episode(dir, &ba.episode)?;
     check()?;
-    write_sealed(dir, &[("best.genome", &rundir::genome_bytes(&outcome.genome))])?;
-    let perf = |r: &EpisodeResult| {
-        serde_json::json!({
-            "actions": r.actions, "fitness": r.fitness, "grips": r.grips,
-            "releases_outside": r.releases_outside, "recharges": r.recharges, "collisions": r.collisions,
-        })
+    rundir::write_best_genome(dir, &outcome.genome)?;
+    let perf = |r: &EpisodeResult| rundir::WorldTotals {
+        actions: r.actions,
+        fitness: f64::from(r.fitness),
+        grips: r.grips,
+        releases_outside: r.releases_outside,
+        recharges: r.recharges,
+        collisions: r.collisions,
     };
     let (b, a) = (lives_total(&ba.before), lives_total(&ba.after));
     let counts = |v: &[EpisodeResult]| v.iter().map(|r| r.actions).collect::<Vec<u32>>();
     // Per variant: its lives (k mod the number of variants) and their mean fitness.
-    let variants = |st: &Stage, v: &[EpisodeResult]| -> Option<Value> {
+    let variants = |st: &Stage, v: &[EpisodeResult]| -> Option<Vec<rundir::VariantLives>> {
         let vars = st.variants.as_ref()?;
         let n = vars.list.len().max(1);
-        let rows: Vec<Value> = vars
+        let rows = vars
             .list
             .iter()
             .enumerate()
             .map(|(i, x)| {
                 let mine: Vec<EpisodeResult> = v.iter().skip(i).step_by(n).cloned().collect();
-                serde_json::json!({"variant": x.name, "lives": mine.len(), "fitness": lives_total(&mine).fitness})
+                let fitness = f64::from(lives_total(&mine).fitness);
+                rundir::VariantLives { variant: x.name.clone(), lives: mine.len(), fitness }
             })
             .collect();
-        Some(Value::Array(rows))
+        Some(rows)
     };
-    let mut summary = serde_json::json!({
-        "stage": stage.name, "learning": learning, "seed": outcome.seed,
-        "parent": parent_stage.name, "parent_fitness": outcome.parent_fitness,
-        "fitness": a.fitness, "grips": a.grips, "releases_outside": a.releases_outside,
-        "before": perf(&b), "after": perf(&a),
-        "lives": lives, "before_lives": counts(&ba.before), "after_lives": counts(&ba.after),
-        "reinforcement_mean": reinforcement_means(stage, &ba.trace, ba.switch),
-        "reinforcement_counts": reinforcement_counts(stage, ba),
-    });
-    if let Some(v) = variants(parent_stage, &ba.before) {
-        summary["before_variants"] = v;
-    }
-    if let Some(v) = variants(stage, &ba.after) {
-        summary["after_variants"] = v;
-    }
     // Only when a world was too crowded to place apart: the lives that
     // overlap and their overlapping placements (absent: none).
     let crowding = lives_crowding(ba);
-    if crowding.crowded > 0 {
-        summary["crowded_lives"] = serde_json::json!(crowding.crowded);
-        summary["placement_failures"] = serde_json::json!(crowding.placements);
-    }
+    let crowded = crowding.crowded > 0;
+    let summary = TestSummary {
+        stage: stage.name.clone(),
+        learning,
+        seed: outcome.seed,
+        parent: parent_stage.name.clone(),
+        parent_fitness: f64::from(outcome.parent_fitness),
+        fitness: f64::from(a.fitness),
+        grips: a.grips,
+        releases_outside: a.releases_outside,
+        before: perf(&b),
+        after: perf(&a),
+        lives,
+        before_lives: counts(&ba.before),
+        after_lives: counts(&ba.after),
+        reinforcement_mean: reinforcement_means(stage, &ba.trace, ba.switch),
+        reinforcement_counts: reinforcement_counts(stage, ba),
+        before_variants: variants(parent_stage, &ba.before),
+        after_variants: variants(stage, &ba.after),
+        crowded_lives: crowded.then_some(crowding.crowded),
+        placement_failures: crowded.then_some(crowding.placements),
+    };
     check()?;
-    write_sealed(dir, &[("summary.json", to_json(&summary)?.as_bytes())])?;
+    rundir::write_test_summary(dir, &summary)?;
     Ok(summary)
 }
 
 /// Mean reinforcement of each learning module over the lives before the
 /// world changed, the first 100 actions after it, and the rest after it.
-fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json::Value {
+fn reinforcement_means(
+    stage: &Stage,
+    trace: &Trace,
+    switch: u32,
+) -> BTreeMap<String, rundir::ReinforcementMeans> {
+    // A mean that is not a number is written `null`, as none is.
     let mean = |v: &[f32]| {
         let xs: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
-        if xs.is_empty() {
-            serde_json::Value::Null
-        } else {
-            serde_json::json!(xs.iter().sum::<f32>() / xs.len() as f32)
-        }
+        let m = xs.iter().sum::<f32>() / xs.len() as f32;
+        (!xs.is_empty() && m.is_finite()).then_some(f64::from(m))
     };
-    let mut out = serde_json::Map::new();
+    let mut out = BTreeMap::new();
     for (i, name) in report::learning_modules(stage) {
         let sig = report::reinforcement_signals(trace, i);
         let s = (switch as usize).min(sig.len());
         let early = (s + 100).min(sig.len());
-        out.insert(
-            name,
-            serde_json::json!({
-                "before": mean(&sig[..s]), "after_first_100": mean(&sig[s..early]), "after_rest": mean(&sig[early..]),
-            }),
-        );
+        let means = rundir::ReinforcementMeans {
+            before: mean(&sig[..s]),
+            after_first_100: mean(&sig[s..early]),
+            after_rest: mean(&sig[early..]),
+        };
+        out.insert(name, means);
     }
-    serde_json::Value::Object(out)
+    out
 }
 
 /// Each learning module's reinforcement signals counted life by life:
@@ -1334,8 +1333,8 @@ fn reinforcement_means(stage: &Stage, trace: &Trace, switch: u32) -> serde_json:
 /// one number per life of each world (rewards are positive signals,
 /// punishments negative ones), so that a module's mean signal over any
 /// lives can be computed from `summary.json` alone.
-fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> serde_json::Value {
-    let mut out = serde_json::Map::new();
+fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> BTreeMap<String, rundir::ReinforcementCounts> {
+    let mut out = BTreeMap::new();
     for (i, name) in report::learning_modules(stage) {
         let sig = report::reinforcement_signals(&ba.trace, i);
         let mut at = 0usize;
@@ -1348,13 +1347,13 @@ fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> serde_json::Value {
                 punishments.push(life.iter().filter(|&&x| x < 0.0).count());
                 at = end;
             }
-            serde_json::json!({ "rewards": rewards, "punishments": punishments })
+            rundir::Signals { rewards, punishments }
         };
         let before = world(&ba.before);
         let after = world(&ba.after);
-        out.insert(name, serde_json::json!({ "before": before, "after": after }));
+        out.insert(name, rundir::ReinforcementCounts { before, after });
     }
-    serde_json::Value::Object(out)
+    out
 }
 
 impl Runner<'_> {
@@ -1397,8 +1396,7 @@ impl Runner<'_> {
             .map_err(|e| Error::io(format!("error: {e}")))?;
         let (trace, ep) = (&rec.trace, &rec.episode);
         report::episode_files(dir, &stage.name, stage, trace, &rec.others, ep, &rec.scene, &[], None)?;
-        let bytes = rundir::trained_bytes(&trained)?;
-        write_sealed(dir, &[("episode.json", compact_json(ep)?.as_bytes()), ("trained.json", &bytes)])?;
+        rundir::write_trained_episode(dir, ep, &trained)?;
         self.observer.event(Event::Trained { stage, trained: &trained, recorded, reused: false, dir });
         Ok(trained)
     }

@@ -28,8 +28,45 @@ use shaping_runtime::evolve::{self, Checkpoint, Trained};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
+use crate::episode::Episode;
 use crate::error::{Error, ErrorKind, Result};
 use crate::files::{read_bytes, read_checked, seal, unseal, write_atomic, write_sealed, Sealed, Unsealed};
+
+mod generations;
+mod summary;
+
+pub use generations::{generations_csv, parse_generations, GenRow, Generations};
+
+pub use summary::{
+    nan_if_null, CriterionFigures, DriveSummary, ExperimentSummary, PointSummary, ReinforcementCounts,
+    ReinforcementMeans, Signals, StageFigures, SweepSet, TestSummary, VariantLives, WorldTotals,
+    SUMMARY_FORMAT,
+};
+
+/// The names of the files of a run, experiment, sweep, replay and drive
+/// directory: here and nowhere else (the paths below join them; others
+/// name them in messages).
+pub mod names {
+    pub const PROGRAM: &str = "program.json";
+    pub const SOURCE: &str = "source.json";
+    pub const REPORT: &str = "report.html";
+    pub const CHECKPOINT: &str = "checkpoint.json";
+    pub const TRAINED: &str = "trained.json";
+    pub const BEST_GENOME: &str = "best.genome";
+    pub const GENERATIONS: &str = "generations.csv";
+    pub const SUMMARY: &str = "summary.json";
+    pub const SUMMARY_MD: &str = "summary.md";
+    pub const EPISODE: &str = "episode.json";
+    pub const TRACE: &str = "trace.csv";
+    /// A replay's (and a drive's) genome, beside its `program.json`.
+    pub const GENOME: &str = "genome";
+    /// The default directories of a replay and a drive in a stage's.
+    pub const REPLAY: &str = "replay";
+    pub const DRIVE: &str = "drive";
+    /// An experiment's directory beside a file's default run directory.
+    pub const EXPERIMENT: &str = "experiment";
+}
+use names::*;
 
 /// A stage's directory in run directory `out`.
 pub fn stage_dir(out: &Path, stage: &str) -> PathBuf {
@@ -58,7 +95,13 @@ pub fn create_stage_dir(dir: &Path) -> Result<()> {
 /// The files only a run writes into its directories: one of them in a
 /// directory makes it a run's (or a stage's, an experiment's).
 const RUN_FILES: &[&str] =
-    &["checkpoint.json", "trained.json", "generations.csv", "best.genome", "summary.json", ".lock"];
+    &[CHECKPOINT, TRAINED, GENERATIONS, BEST_GENOME, SUMMARY, crate::files::DirLock::FILE];
+
+/// A stage directory holds results of a run (not only a replay's): one of
+/// the files a stage's run writes.
+pub fn holds_results(dir: &Path) -> bool {
+    [CHECKPOINT, TRAINED, BEST_GENOME, SUMMARY, EPISODE].iter().any(|f| dir.join(f).exists())
+}
 
 /// Refuses a replay's output directory `out` that is a run's: a stage
 /// directory (a replay would replace its `episode.json` and `trace.csv`), a
@@ -98,12 +141,12 @@ pub fn check_output_dir(out: &Path, who: &str, sub: &str) -> Result<()> {
     if !meta.is_dir() {
         return Ok(());
     }
-    let replay = out.join("genome").exists() && out.join("episode.json").exists();
+    let replay = genome_file_path(out).exists() && episode_path(out).exists();
     if program_path(out).exists() && !replay {
         return Err(refuse("a run directory (it holds `program.json`)".into()));
     }
     // A drive's or a replay's own directory holds a `summary.json` too.
-    let own = |f: &&&str| replay && **f == "summary.json";
+    let own = |f: &&&str| replay && **f == SUMMARY;
     if let Some(file) = RUN_FILES.iter().filter(|f| !own(f)).find(|f| out.join(f).exists()) {
         return Err(refuse(format!("a directory of a run (it holds `{file}`)")));
     }
@@ -112,17 +155,97 @@ pub fn check_output_dir(out: &Path, who: &str, sub: &str) -> Result<()> {
 
 /// `STAGE/checkpoint.json`.
 pub fn checkpoint_path(dir: &Path) -> PathBuf {
-    dir.join("checkpoint.json")
+    dir.join(CHECKPOINT)
 }
 
 /// `STAGE/trained.json`.
 pub fn trained_path(dir: &Path) -> PathBuf {
-    dir.join("trained.json")
+    dir.join(TRAINED)
 }
 
 /// `STAGE/best.genome`.
 pub fn best_genome_path(dir: &Path) -> PathBuf {
-    dir.join("best.genome")
+    dir.join(BEST_GENOME)
+}
+
+/// `STAGE/generations.csv`.
+pub fn generations_path(dir: &Path) -> PathBuf {
+    dir.join(GENERATIONS)
+}
+
+/// `summary.json`: a test stage's (`STAGE/`), an experiment's or a sweep
+/// point's, a sweep's, a drive's.
+pub fn summary_path(dir: &Path) -> PathBuf {
+    dir.join(SUMMARY)
+}
+
+/// `summary.md` of an experiment, a sweep point or a sweep.
+pub fn summary_md_path(dir: &Path) -> PathBuf {
+    dir.join(SUMMARY_MD)
+}
+
+/// `episode.json` of a stage, a replay or a drive.
+pub fn episode_path(dir: &Path) -> PathBuf {
+    dir.join(EPISODE)
+}
+
+/// `trace.csv` of a stage, a replay or a drive.
+pub fn trace_path(dir: &Path) -> PathBuf {
+    dir.join(TRACE)
+}
+
+/// `genome` of a replay's or a drive's directory.
+pub fn genome_file_path(dir: &Path) -> PathBuf {
+    dir.join(GENOME)
+}
+
+/// `report.html` of any directory a report is written for.
+pub fn report_path(dir: &Path) -> PathBuf {
+    dir.join(REPORT)
+}
+
+/// The pictures of a directory, each written as `NAME.svg` and `NAME.png`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Picture {
+    /// An evolved stage's fitness per generation.
+    Fitness,
+    /// An episode's module activations.
+    Activations,
+    /// An episode's reinforcement of learning modules.
+    Reinforcement,
+    /// An episode's path over its world.
+    Trajectory,
+    /// An experiment's (or a sweep point's) fitness over its seeds.
+    FitnessSeeds,
+    /// A sweep's figures per point.
+    Sweep,
+}
+
+/// A picture's path without its extension (see [`Picture`]).
+pub fn picture_path(dir: &Path, picture: Picture) -> PathBuf {
+    dir.join(match picture {
+        Picture::Fitness => "fitness",
+        Picture::Activations => "activations",
+        Picture::Reinforcement => "reinforcement",
+        Picture::Trajectory => "trajectory",
+        Picture::FitnessSeeds => "fitness-seeds",
+        Picture::Sweep => "sweep",
+    })
+}
+
+/// The default directory of a replay of `stage` of run `run`.
+pub fn replay_dir(run: &Path, stage: &str) -> PathBuf {
+    stage_dir(run, stage).join(REPLAY)
+}
+
+/// The default directory of a drive of `stage` of run `run`.
+pub fn drive_dir(run: &Path, stage: &str) -> PathBuf {
+    stage_dir(run, stage).join(DRIVE)
+}
+
+/// The default directory of an experiment beside run directory `run`.
+pub fn experiment_dir(run: &Path) -> PathBuf {
+    run.join(EXPERIMENT)
 }
 
 /// The run directory of seed `seed` in an experiment's (or a sweep point's)
@@ -205,9 +328,9 @@ fn parse_sealed<T: DeserializeOwned>(
     serde_json::from_str(&body).map_err(|e| corrupt(e.to_string()))
 }
 
-const CHECKPOINT: (&str, &str) =
+const CHECKPOINT_WORDS: (&str, &str) =
     ("the checkpoint", "move it away or pass `--fresh` to start the stage again");
-const TRAINED: (&str, &str) = ("the trained weights", "delete it or pass `--fresh`");
+const TRAINED_WORDS: (&str, &str) = ("the trained weights", "delete it or pass `--fresh`");
 
 /// A stage's checkpoint, if there is one (a damaged one is an error); one
 /// written before checksums is read without a word (see
@@ -219,21 +342,21 @@ pub fn read_checkpoint(dir: &Path) -> Result<Option<Checkpoint>> {
 /// [`read_checkpoint`], telling `unsealed` of a checkpoint written before
 /// checksums (no checksum and no seal), for a warning.
 pub fn read_checkpoint_with(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Checkpoint>> {
-    read_sealed(&checkpoint_path(dir), CHECKPOINT.0, CHECKPOINT.1, unsealed)
+    read_sealed(&checkpoint_path(dir), CHECKPOINT_WORDS.0, CHECKPOINT_WORDS.1, unsealed)
 }
 
 /// A checkpoint from the bytes of a `checkpoint.json` (`name` names it in
 /// errors; one without its checksum is refused); whether it fits a program
 /// is [`evolve::resume`]'s to say.
 pub fn parse_checkpoint(bytes: &[u8], name: &str) -> Result<Checkpoint> {
-    parse_sealed(bytes, Path::new(name), CHECKPOINT.0, CHECKPOINT.1, Legacy::Refuse)
+    parse_sealed(bytes, Path::new(name), CHECKPOINT_WORDS.0, CHECKPOINT_WORDS.1, Legacy::Refuse)
 }
 
 /// Trained weights from the bytes of a `trained.json` (`name` names it in
 /// errors; one without its checksum is refused); whether they fit a
 /// program is [`evolve::train::check`]'s to say.
 pub fn parse_trained(bytes: &[u8], name: &str) -> Result<Trained> {
-    parse_sealed(bytes, Path::new(name), TRAINED.0, TRAINED.1, Legacy::Refuse)
+    parse_sealed(bytes, Path::new(name), TRAINED_WORDS.0, TRAINED_WORDS.1, Legacy::Refuse)
 }
 
 /// The bytes of a stage's checkpoint as written: sealed ([`seal`]).
@@ -243,7 +366,7 @@ pub fn checkpoint_bytes(cp: &Checkpoint) -> Result<Vec<u8>> {
 
 /// Writes a stage's checkpoint, sealed.
 pub fn write_checkpoint(dir: &Path, cp: &Checkpoint) -> Result<()> {
-    write_sealed(dir, &[("checkpoint.json", &checkpoint_bytes(cp)?)])
+    write_sealed(dir, &[(CHECKPOINT, &checkpoint_bytes(cp)?)])
 }
 
 /// A training stage's learned weights, if saved (a damaged file is an
@@ -254,7 +377,7 @@ pub fn read_trained(dir: &Path) -> Result<Option<Trained>> {
 
 /// [`read_trained`], telling `unsealed` of a file written before checksums.
 pub fn read_trained_with(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Trained>> {
-    read_sealed(&trained_path(dir), TRAINED.0, TRAINED.1, unsealed)
+    read_sealed(&trained_path(dir), TRAINED_WORDS.0, TRAINED_WORDS.1, unsealed)
 }
 
 /// The bytes of `trained.json`: sealed.
@@ -264,7 +387,7 @@ pub fn trained_bytes(trained: &Trained) -> Result<Vec<u8>> {
 
 /// Writes a training stage's learned weights, sealed.
 pub fn write_trained(dir: &Path, trained: &Trained) -> Result<()> {
-    write_sealed(dir, &[("trained.json", &trained_bytes(trained)?)])
+    write_sealed(dir, &[(TRAINED, &trained_bytes(trained)?)])
 }
 
 /// The bytes of a genome file.
@@ -274,7 +397,142 @@ pub fn genome_bytes(genome: &Genome) -> Vec<u8> {
 
 /// Writes `best.genome`, sealed.
 pub fn write_best_genome(dir: &Path, genome: &Genome) -> Result<()> {
-    write_sealed(dir, &[("best.genome", &genome_bytes(genome))])
+    write_sealed(dir, &[(BEST_GENOME, &genome_bytes(genome))])
+}
+
+/// Writes an evolved stage's checkpoint and its `generations.csv` (of its
+/// history), sealed together: after each generation.
+pub fn write_generation(dir: &Path, cp: &Checkpoint, variants: &[String]) -> Result<()> {
+    let csv = generations_csv(&cp.history, variants);
+    write_sealed(dir, &[(CHECKPOINT, &checkpoint_bytes(cp)?), (GENERATIONS, csv.as_bytes())])
+}
+
+/// Writes an evolved stage's chosen best (`best.genome`) and its
+/// `generations.csv`, sealed together: at the stage's end.
+pub fn write_evolved(dir: &Path, genome: &Genome, cp: &Checkpoint, variants: &[String]) -> Result<()> {
+    let csv = generations_csv(&cp.history, variants);
+    write_sealed(dir, &[(BEST_GENOME, &genome_bytes(genome)), (GENERATIONS, csv.as_bytes())])
+}
+
+/// Writes `episode.json`, sealed (compact JSON).
+pub fn write_episode(dir: &Path, episode: &Episode) -> Result<()> {
+    write_sealed(dir, &[(EPISODE, compact_json(episode)?.as_bytes())])
+}
+
+/// Writes a training stage's `episode.json` and `trained.json`, sealed together.
+pub fn write_trained_episode(dir: &Path, episode: &Episode, trained: &Trained) -> Result<()> {
+    write_sealed(dir, &[(EPISODE, compact_json(episode)?.as_bytes()), (TRAINED, &trained_bytes(trained)?)])
+}
+
+/// Writes a replay's `genome`, sealed.
+pub fn write_genome_file(dir: &Path, genome: &Genome) -> Result<()> {
+    write_sealed(dir, &[(GENOME, &genome_bytes(genome))])
+}
+
+/// Writes a drive's `episode.json` and `genome`, sealed together.
+pub fn write_driven(dir: &Path, episode: &Episode, genome: &Genome) -> Result<()> {
+    write_sealed(dir, &[(EPISODE, compact_json(episode)?.as_bytes()), (GENOME, &genome_bytes(genome))])
+}
+
+/// Writes `trace.csv` (not sealed: a drive writes it as the robot drives).
+pub fn write_trace(dir: &Path, csv: &str) -> Result<()> {
+    write_atomic(&trace_path(dir), csv.as_bytes())
+}
+
+/// A summary's bytes: through a `serde_json::Value`, whose sorted maps give
+/// the keys the order the files have always had (see [`summary`]).
+fn summary_text<T: Serialize>(summary: &T) -> Result<String> {
+    let value = serde_json::to_value(summary)
+        .map_err(|e| Error::io(format!("error: cannot serialise a summary: {e}")))?;
+    to_json(&value)
+}
+
+/// A summary from the bytes of `path`, checked against its seal (`None`:
+/// no file): one whose `"format"` is newer than [`SUMMARY_FORMAT`] is
+/// refused naming the version; a damaged or missing key is an error
+/// naming the file and the key (`what` says which summary it should be).
+fn read_summary<T: DeserializeOwned>(path: &Path, what: &str, unsealed: Unsealed<'_>) -> Result<Option<T>> {
+    let Some(file) = read_checked(path, REWRITE, unsealed)? else { return Ok(None) };
+    let bad = |why: String| {
+        Error::new(ErrorKind::Corrupt, format!("error: `{}` is not {what}: {why}", path.display()))
+    };
+    let value: serde_json::Value = serde_json::from_slice(&file.bytes).map_err(|e| bad(e.to_string()))?;
+    if !value.is_object() {
+        return Err(bad("it is not a JSON object".into()));
+    }
+    match value.get("format").map(|f| f.as_u64()) {
+        None => {}
+        Some(Some(n)) if n <= u64::from(SUMMARY_FORMAT) => {}
+        Some(Some(n)) => {
+            return Err(Error::new(
+                ErrorKind::Corrupt,
+                format!(
+                    "error: `{}` has summary format {n}, this shaping reads format {SUMMARY_FORMAT} and before;                      a newer shaping wrote it",
+                    path.display()
+                ),
+            ))
+        }
+        Some(None) => return Err(bad("`format` is not a whole number".into())),
+    }
+    serde_json::from_value(value).map(Some).map_err(|e| bad(e.to_string()))
+}
+
+/// Writes a test stage's `summary.json`, sealed.
+pub fn write_test_summary(dir: &Path, summary: &TestSummary) -> Result<()> {
+    write_sealed(dir, &[(SUMMARY, summary_text(summary)?.as_bytes())])
+}
+
+/// A test stage's `summary.json` (`None`: the stage has not run); one
+/// with `lives` 0 is refused.
+pub fn read_test_summary(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<TestSummary>> {
+    let path = summary_path(dir);
+    let summary: Option<TestSummary> = read_summary(&path, "a test stage's summary", unsealed)?;
+    if summary.as_ref().is_some_and(|s| s.lives == 0) {
+        return Err(Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: `{}` is not a test stage's summary: `lives` is not a whole number of 1 or more",
+                path.display()
+            ),
+        ));
+    }
+    Ok(summary)
+}
+
+/// Writes an experiment's (or a sweep's) `summary.json`, sealed.
+pub fn write_experiment_summary(dir: &Path, summary: &ExperimentSummary) -> Result<()> {
+    write_sealed(dir, &[(SUMMARY, format!("{}\n", summary_text(summary)?).as_bytes())])
+}
+
+/// An experiment's (or a sweep's) `summary.json` in `dir` (`None`: none).
+pub fn read_experiment_summary(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<ExperimentSummary>> {
+    read_summary(&summary_path(dir), "an experiment's summary", unsealed)
+}
+
+/// Writes a drive's `summary.json`, sealed.
+pub fn write_drive_summary(dir: &Path, summary: &DriveSummary) -> Result<()> {
+    write_sealed(dir, &[(SUMMARY, summary_text(summary)?.as_bytes())])
+}
+
+/// A drive's `summary.json` in `dir` (`None`: none).
+pub fn read_drive_summary(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<DriveSummary>> {
+    read_summary(&summary_path(dir), "a drive's summary", unsealed)
+}
+
+/// A stage's `generations.csv` (`None`: the stage has not run; a damaged
+/// file is an error naming it, the line and the column).
+pub fn read_generations(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Generations>> {
+    let path = generations_path(dir);
+    let Some(file) = read_checked(&path, REWRITE, unsealed)? else { return Ok(None) };
+    let text = String::from_utf8(file.bytes).map_err(|_| {
+        Error::new(ErrorKind::Corrupt, format!("error: `{}` is not UTF-8 text", path.display()))
+    })?;
+    parse_generations(&text, &path).map(Some)
+}
+
+/// Writes `summary.md` of an experiment, a sweep point or a sweep.
+pub fn write_summary_md(dir: &Path, md: &str) -> Result<()> {
+    write_atomic(&summary_md_path(dir), md.as_bytes())
 }
 
 /// What to do with a damaged file a run derived (a genome, statistics, an
@@ -392,7 +650,7 @@ pub fn checked_best_with(
 
 /// `program.json` of a run directory (the program as it ran).
 pub fn program_path(out: &Path) -> PathBuf {
-    out.join("program.json")
+    out.join(PROGRAM)
 }
 
 /// Writes `program.json`.
@@ -405,13 +663,13 @@ pub fn write_program(out: &Path, program: &Program) -> Result<()> {
 /// no program to compare with).
 pub fn read_program(out: &Path) -> Option<Program> {
     let bytes = std::fs::read(program_path(out)).ok()?;
-    crate::load::parse_built(&bytes, "program.json").ok()
+    crate::load::parse_built(&bytes, PROGRAM).ok()
 }
 
 /// `source.json` of a run directory: the name of the file (`khepera.bat`)
 /// its program was compiled from, the program the directory belongs to.
 pub fn source_path(out: &Path) -> PathBuf {
-    out.join("source.json")
+    out.join(SOURCE)
 }
 
 /// The contents of `source.json`.

@@ -42,7 +42,7 @@ pub fn median(values: &[f64]) -> Option<f64> {
 }
 
 /// A closed interval of values.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Interval {
     pub low: f64,
     pub high: f64,
@@ -103,7 +103,7 @@ fn percentile(v: &[f64], q: f64) -> f64 {
 }
 
 /// How a p-value was computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Method {
     /// The exact distribution of U (no ties, and a sample of at most 8).
     #[serde(rename = "exact")]
@@ -294,7 +294,7 @@ fn a12_counts(a: &[f64], b: &[f64]) -> Option<(u128, u128)> {
 }
 
 /// The size of an A12, in Vargha and Delaney's (2000) words.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Magnitude {
     Negligible,

@@ -1236,7 +1236,7 @@ impl Run {
             .filter(|s| rundir::stage_dir(&out, &s.name).is_dir())
             .map(|s| s.name.clone())
             .collect();
-        let report = out.join("report.html");
+        let report = rundir::report_path(&out);
         let report = report.is_file().then_some(report);
         Ok(Run { out, seed: None, stages, report })
     }
@@ -1283,42 +1283,53 @@ impl Run {
     /// with variants) `best_variant_NAME` floats (NaN where the generation
     /// did not draw the variant), the others integers.
     fn generations<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyDict>> {
-        let path = self.stage_dir(stage)?.join("generations.csv");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
-        let mut lines = text.lines();
-        let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-        let rows: Vec<Vec<&str>> = lines.filter(|l| !l.is_empty()).map(|l| l.split(',').collect()).collect();
+        let dir = self.stage_dir(stage)?;
+        let g =
+            rundir::read_generations(&dir, &|_| {}).map_err(|e| shaping_error(py, &e))?.ok_or_else(|| {
+                let path = rundir::generations_path(&dir);
+                ShapingError::new_err(format!(
+                    "error: cannot read `{}`: there is no such file",
+                    path.display()
+                ))
+            })?;
+        let rows = &g.rows;
         let out = PyDict::new(py);
-        for (c, name) in header.iter().enumerate() {
-            let cells: Vec<&str> = rows.iter().map(|r| r.get(c).copied().unwrap_or("")).collect();
-            let bad =
-                || ShapingError::new_err(format!("error: `{}`: column `{name}` is damaged", path.display()));
-            match *name {
-                "stage" => {
-                    out.set_item(name, py.import("numpy")?.call_method1("array", (cells,))?)?;
-                }
-                "best" | "mean" | "worst" => {
-                    let v: Vec<f64> =
-                        cells.iter().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad())?;
-                    out.set_item(name, PyArray1::from_vec(py, v))?;
-                }
-                // The best's fitness in each variant: empty (NaN) where its
-                // generation did not draw the variant.
-                _ if name.starts_with("best_variant_") => {
-                    let v: Vec<f64> = cells
-                        .iter()
-                        .map(|s| if s.is_empty() { Ok(f64::NAN) } else { s.parse() })
-                        .collect::<Result<_, _>>()
-                        .map_err(|_| bad())?;
-                    out.set_item(name, PyArray1::from_vec(py, v))?;
-                }
-                _ => {
-                    let v: Vec<i64> =
-                        cells.iter().map(|s| s.parse()).collect::<Result<_, _>>().map_err(|_| bad())?;
-                    out.set_item(name, PyArray1::from_vec(py, v))?;
-                }
+        let stages: Vec<&str> = rows.iter().map(|r| r.stage.as_str()).collect();
+        out.set_item("stage", py.import("numpy")?.call_method1("array", (stages,))?)?;
+        let ints = |f: fn(&rundir::GenRow) -> Option<u64>| -> Option<Vec<i64>> {
+            rows.iter().map(|r| f(r).map(|n| n as i64)).collect()
+        };
+        let floats = |f: fn(&rundir::GenRow) -> Option<f32>| -> Option<Vec<f64>> {
+            rows.iter().map(|r| f(r).map(f64::from)).collect()
+        };
+        // The columns in the file's order; those a file written before
+        // them lacks are left out.
+        let columns: [(&str, Option<Vec<i64>>, Option<Vec<f64>>); 9] = [
+            ("generation", ints(|r| Some(u64::from(r.generation))), None),
+            ("stage_generation", ints(|r| Some(u64::from(r.stage_generation))), None),
+            ("best", None, floats(|r| Some(r.best))),
+            ("mean", None, floats(|r| Some(r.mean))),
+            ("worst", None, floats(|r| r.worst)),
+            ("best_index", ints(|r| r.best_index), None),
+            ("best_recharges", ints(|r| r.best_recharges), None),
+            ("best_grips", ints(|r| r.best_grips), None),
+            ("best_releases_outside", ints(|r| r.best_releases_outside), None),
+        ];
+        for (name, int, float) in columns {
+            if let Some(v) = int {
+                out.set_item(name, PyArray1::from_vec(py, v))?;
+            } else if let Some(v) = float {
+                out.set_item(name, PyArray1::from_vec(py, v))?;
             }
+        }
+        // The best's fitness in each variant: NaN where its generation did
+        // not draw the variant.
+        for (k, variant) in g.variants.iter().enumerate() {
+            let v: Vec<f64> = rows
+                .iter()
+                .map(|r| r.best_variants.get(k).copied().flatten().map_or(f64::NAN, f64::from))
+                .collect();
+            out.set_item(format!("best_variant_{variant}"), PyArray1::from_vec(py, v))?;
         }
         Ok(out)
     }
@@ -1592,9 +1603,16 @@ impl Experiment {
     /// range, mean and standard deviation over the seeds.
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let path = self.out.join("summary.json");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
+        let summary = rundir::read_experiment_summary(&self.out, &|_| {})
+            .map_err(|e| shaping_error(py, &e))?
+            .ok_or_else(|| {
+                let path = rundir::summary_path(&self.out);
+                ShapingError::new_err(format!(
+                    "error: cannot read `{}`: there is no such file",
+                    path.display()
+                ))
+            })?;
+        let text = serde_json::to_value(&summary).map(|v| v.to_string()).unwrap_or_default();
         py.import("json")?.call_method1("loads", (text,))
     }
 

@@ -15,7 +15,6 @@ use crate::load::create_dir;
 use crate::out::outln;
 use crate::CliError;
 use shaping_engine::episode::{self, Part, Recorder};
-use shaping_engine::files::write_sealed;
 use shaping_engine::{replay, report};
 
 use crate::run;
@@ -83,7 +82,7 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let replay::Chosen { program, index, genome, training_seed } = chosen;
     let stage = &program.stages[index];
     check_robot_world(stage)?;
-    let out = args.out.clone().unwrap_or_else(|| run_dir.join(&stage.name).join("drive"));
+    let out = args.out.clone().unwrap_or_else(|| shaping_engine::rundir::drive_dir(&run_dir, &stage.name));
     shaping_engine::rundir::check_output_dir(&out, "`drive`", "drive")?;
     // The life length and learning the stage declares, as in `replay`.
     let declared = EvalOptions::of(stage);
@@ -116,7 +115,7 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     // The trace is written as the robot drives: a process killed (even with
     // SIGKILL) keeps every action but the last few.
     create_dir(&out)?;
-    let mut written = report::TraceWriter::create(&out.join("trace.csv"), stage)?;
+    let mut written = report::TraceWriter::create(&shaping_engine::rundir::trace_path(&out), stage)?;
     let started = Instant::now();
     let mut trace = Trace::default();
     let mut frames = Vec::new();
@@ -145,22 +144,28 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let ep = episode::episode(stage, seed, learning, &trace, &parts);
     report::episode_pictures(&out, &stage.name, stage, &trace, &scene)?;
     // Sealed, as a replay's are (`trace.csv` is written as the robot drives).
-    let episode = serde_json::to_string(&ep).unwrap_or_default();
-    let genome_file = shaping_engine::rundir::genome_bytes(&genome);
-    write_sealed(&out, &[("episode.json", episode.as_bytes()), ("genome", &genome_file)])?;
+    shaping_engine::rundir::write_driven(&out, &ep, &genome)?;
     let done = trace.rows.len();
     let rate = if elapsed > 0.0 { done as f64 / elapsed } else { 0.0 };
-    let summary = serde_json::json!({
-        "stage": stage.name, "seed": seed, "port": args.port.display().to_string(), "baud": args.baud,
-        "period_ms": period.as_millis() as u64, "actions": done, "seconds": elapsed,
-        "actions_per_second": rate, "requests": requests, "bytes": bytes,
-        "fitness": result.as_ref().map(|r| r.fitness), "grips": result.as_ref().map(|r| r.grips),
-        "releases_outside": result.as_ref().map(|r| r.releases_outside),
-        "recharges": result.as_ref().map(|r| r.recharges), "collisions": result.as_ref().map(|r| r.collisions),
-        "error": error.as_ref().map(|e| e.to_string()),
-    });
-    let summary_file = serde_json::to_string_pretty(&summary).unwrap_or_default();
-    write_sealed(&out, &[("summary.json", summary_file.as_bytes())])?;
+    let summary = shaping_engine::rundir::DriveSummary {
+        stage: stage.name.clone(),
+        seed,
+        port: args.port.display().to_string(),
+        baud: args.baud,
+        period_ms: period.as_millis() as u64,
+        actions: done,
+        seconds: elapsed,
+        actions_per_second: rate,
+        requests,
+        bytes,
+        fitness: result.as_ref().map(|r| f64::from(r.fitness)),
+        grips: result.as_ref().map(|r| r.grips),
+        releases_outside: result.as_ref().map(|r| r.releases_outside),
+        recharges: result.as_ref().map(|r| r.recharges),
+        collisions: result.as_ref().map(|r| r.collisions),
+        error: error.as_ref().map(|e| e.to_string()),
+    };
+    shaping_engine::rundir::write_drive_summary(&out, &summary)?;
     if let Some(err) = &error {
         eprintln!("stopped after {done} actions; what ran is in {}", out.display());
         return Err(CliError::io(failure(err, &stopped)));

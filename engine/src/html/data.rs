@@ -16,6 +16,7 @@ use crate::episode::{Episode, EPISODE_FORMAT};
 use crate::error::Error;
 use crate::experiment::spread;
 use crate::files::{read_checked, Unsealed};
+use crate::rundir::{ExperimentSummary, GenRow, PointSummary, StageFigures};
 use crate::{load, rundir};
 
 /// Version of the data embedded in a report.
@@ -139,50 +140,6 @@ pub struct FitnessSeries {
     pub best_max: Vec<f32>,
     /// Experiment only: how many seeds have this generation.
     pub seeds: Vec<u32>,
-}
-
-/// One row of `generations.csv`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GenRow {
-    pub stage: String,
-    pub generation: u32,
-    pub stage_generation: u32,
-    pub best: f32,
-    pub mean: f32,
-}
-
-/// Parses `generations.csv` (columns found by name).
-pub fn parse_generations(text: &str, path: &Path) -> Result<Vec<GenRow>, Error> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').map(str::trim).collect();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| {
-            Error::io(format!("error: `{}` has no column `{name}` in its header", path.display()))
-        })
-    };
-    let (cs, cg, csg, cb, cm) =
-        (col("stage")?, col("generation")?, col("stage_generation")?, col("best")?, col("mean")?);
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let bad = |what: &str| Error::io(format!("error: `{}` line {}: {what}", path.display(), i + 2));
-        let cell = |c: usize| cells.get(c).copied().ok_or_else(|| bad(&format!("has {} cells", cells.len())));
-        let int =
-            |c: usize| cell(c)?.parse::<u32>().map_err(|_| bad(&format!("`{}` is not a count", cells[c])));
-        let num =
-            |c: usize| cell(c)?.parse::<f32>().map_err(|_| bad(&format!("`{}` is not a number", cells[c])));
-        rows.push(GenRow {
-            stage: cell(cs)?.to_string(),
-            generation: int(cg)?,
-            stage_generation: int(csg)?,
-            best: num(cb)?,
-            mean: num(cm)?,
-        });
-    }
-    Ok(rows)
 }
 
 /// The bytes of `path` as the run wrote them: checked against its seal
@@ -615,12 +572,11 @@ pub fn stage_view(program: &Program, index: usize, genome: Option<(&Genome, Stri
 fn run_fitness(program: &Program, run: &Path, u: Unsealed<'_>) -> Result<Vec<Vec<GenRow>>, Error> {
     let mut out = vec![Vec::new(); program.stages.len()];
     for (i, st) in program.stages.iter().enumerate() {
-        let path = run.join(&st.name).join("generations.csv");
-        if !matches!(st.run, StageRun::Evolve(_)) || !path.exists() {
+        if !matches!(st.run, StageRun::Evolve(_)) {
             continue;
         }
-        let rows = parse_generations(&read_text(&path, u)?, &path)?;
-        out[i] = rows.into_iter().filter(|r| r.stage == st.name).collect();
+        let Some(g) = rundir::read_generations(&rundir::stage_dir(run, &st.name), u)? else { continue };
+        out[i] = g.rows.into_iter().filter(|r| r.stage == st.name).collect();
     }
     Ok(out)
 }
@@ -654,39 +610,6 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
     s
 }
 
-/// A test stage's `summary.json` (`None` when there is none); one without
-/// what the page shows (the lives, and per world the fitness and events)
-/// is an error naming the file and what is missing.
-fn read_summary(path: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let bad = |what: String| {
-        Error::io(format!("error: `{}` is not a test stage's summary: {what}", path.display()))
-    };
-    let v: serde_json::Value = serde_json::from_str(&read_text(path, u)?).map_err(|e| bad(e.to_string()))?;
-    if !v.is_object() {
-        return Err(bad("it is not a JSON object".into()));
-    }
-    // Runs before `N lives of` wrote no `lives`: one life.
-    if v.get("lives").is_some_and(|n| n.as_u64().is_none_or(|n| n == 0)) {
-        return Err(bad("`lives` is not a whole number of 1 or more".into()));
-    }
-    for world in ["before", "after"] {
-        let w = &v[world];
-        // A fitness that was not a number is written as `null`.
-        if !(w["fitness"].is_number() || w.get("fitness").is_some_and(serde_json::Value::is_null)) {
-            return Err(bad(format!("no `{world}.fitness`")));
-        }
-        for count in ["actions", "grips", "releases_outside", "recharges"] {
-            if w[count].as_u64().is_none() {
-                return Err(bad(format!("no `{world}.{count}` (a whole number)")));
-            }
-        }
-    }
-    Ok(Some(v))
-}
-
 /// The stages of one run directory, with genomes, results and episodes.
 fn run_stages(
     program: &Program,
@@ -697,18 +620,18 @@ fn run_stages(
     let mut views = Vec::new();
     let mut episodes = Vec::new();
     for (i, st) in program.stages.iter().enumerate() {
-        let dir = run.join(&st.name);
+        let dir = rundir::stage_dir(run, &st.name);
         if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
             continue;
         }
-        let genome = read_genome(&dir.join("best.genome"), st, u)?;
+        let genome = read_genome(&rundir::best_genome_path(&dir), st, u)?;
         let cp = rundir::read_checkpoint_with(&dir, u)?;
         if let (Some(g), Some(cp), StageRun::Evolve(_)) = (&genome, &cp, &st.run) {
             // The best the checkpoint beside it holds (a `best.genome`
             // changed after the run wrote it is an error naming it).
             rundir::check_best(&dir, g, cp)?;
         }
-        let src = format!("{}/best.genome", st.name);
+        let src = format!("{}/{}", st.name, rundir::names::BEST_GENOME);
         let mut view = stage_view(program, i, genome.as_ref().map(|g| (g, src)));
         // The seed the stage ran with is its checkpoint's (`--seed`, an
         // experiment's seed), not necessarily the one the file declares.
@@ -716,26 +639,25 @@ fn run_stages(
             view.run = run_text(st, Some(cp.seed));
             view.crowded = crowded_generations(st, cp);
         }
-        view.results = read_summary(&dir.join("summary.json"), u)?;
-        if let Some(r) = &view.results {
-            if let (Some(n), Some(p)) = (r["crowded_lives"].as_u64(), r["placement_failures"].as_u64()) {
-                let lives = 2 * r["lives"].as_u64().unwrap_or(1);
-                view.crowded = Some(crowded_text(n, lives, p, "lives"));
+        if let Some(r) = rundir::read_test_summary(&dir, u)? {
+            if let (Some(n), Some(p)) = (r.crowded_lives, r.placement_failures) {
+                view.crowded = Some(crowded_text(n, 2 * u64::from(r.lives), p, "lives"));
             }
+            view.results = Some(to_value(&r)?);
         }
         if matches!(st.run, StageRun::Train { .. }) {
             view.crowded = crowded_training(&dir, u)?;
         }
         if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
             let pst = &program.stages[a];
-            let pdir = run.join(&pst.name);
+            let pdir = rundir::stage_dir(run, &pst.name);
             if let Some(cp) = rundir::read_checkpoint_with(&pdir, u)? {
-                let parent_best = read_genome(&pdir.join("best.genome"), pst, u)?;
+                let parent_best = read_genome(&rundir::best_genome_path(&pdir), pst, u)?;
                 provenance(program, i, a, g, &cp, parent_best.as_ref(), &mut view);
             }
         }
         views.push(view);
-        let ep = dir.join("episode.json");
+        let ep = rundir::episode_path(&dir);
         if ep.exists() {
             episodes.push(read_episode(&ep, u)?);
         }
@@ -889,8 +811,7 @@ fn series_of(program: &Program, fitness: &[Vec<GenRow>], only: Option<usize>) ->
 /// its `summary.json` covers, when there is one (a directory may hold other
 /// seeds' runs, from earlier experiments), else every `seed-N` on disk.
 fn seed_dirs(dir: &Path, u: Unsealed<'_>) -> Result<Vec<(u64, PathBuf)>, Error> {
-    let covered: Option<Vec<u64>> = summary_json(dir, u)?
-        .and_then(|v| v["seeds"].as_array().map(|a| a.iter().filter_map(|s| s.as_u64()).collect()));
+    let covered: Option<Vec<u64>> = summary_json(dir, u)?.map(|s| s.seeds);
     let mut seeds: Vec<(u64, PathBuf)> = std::fs::read_dir(dir)
         .into_iter()
         .flatten()
@@ -899,19 +820,22 @@ fn seed_dirs(dir: &Path, u: Unsealed<'_>) -> Result<Vec<(u64, PathBuf)>, Error> 
             let name = e.file_name().to_string_lossy().into_owned();
             let seed = name.strip_prefix("seed-")?.parse::<u64>().ok()?;
             let covered = covered.as_ref().is_none_or(|c| c.contains(&seed));
-            (covered && e.path().join("program.json").exists()).then(|| (seed, e.path()))
+            (covered && rundir::program_path(&e.path()).exists()).then(|| (seed, e.path()))
         })
         .collect();
     seeds.sort();
     Ok(seeds)
 }
 
-/// An experiment's (or a sweep's) `summary.json` in `dir`, if there is one
-/// that is JSON (a damaged one is an error naming it).
-fn summary_json(dir: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
-    let path = dir.join("summary.json");
-    let Some(file) = read_checked(&path, rundir::REWRITE, u)? else { return Ok(None) };
-    Ok(serde_json::from_slice(&file.bytes).ok())
+/// An experiment's (or a sweep's) `summary.json` in `dir`, if there is
+/// one (a damaged one, or one of a newer format, is an error naming it).
+fn summary_json(dir: &Path, u: Unsealed<'_>) -> Result<Option<ExperimentSummary>, Error> {
+    rundir::read_experiment_summary(dir, u)
+}
+
+/// A summary as the report's data holds it.
+fn to_value<T: serde::Serialize>(summary: &T) -> Result<serde_json::Value, Error> {
+    serde_json::to_value(summary).map_err(|e| Error::io(format!("error: cannot serialise a summary: {e}")))
 }
 
 fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
@@ -934,33 +858,34 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
 
 /// The `summary.json` of a sweep in `dir`, if there is one (with points in
 /// directories of their own).
-fn sweep_summary(dir: &Path, u: Unsealed<'_>) -> Result<Option<serde_json::Value>, Error> {
-    let Some(v) = summary_json(dir, u)? else { return Ok(None) };
-    let Some(points) = v["points"].as_array() else { return Ok(None) };
-    let sweep = !points.is_empty() && points.iter().all(|p| p["dir"].as_str().is_some_and(|d| d != "."));
-    Ok(sweep.then_some(v))
+fn sweep_summary(dir: &Path, u: Unsealed<'_>) -> Result<Option<ExperimentSummary>, Error> {
+    Ok(summary_json(dir, u)?.filter(ExperimentSummary::is_sweep))
 }
 
 /// A sweep's directory: the experiment report of its best point (by the
 /// median chosen best of the last evolved stage), listing every point.
-fn sweep(dir: &Path, summary: serde_json::Value, u: Unsealed<'_>) -> Result<ReportData, Error> {
-    let points = summary["points"].as_array().cloned().unwrap_or_default();
-    let score = |p: &serde_json::Value| {
-        p["stages"]
-            .as_array()
-            .and_then(|s| s.iter().rev().find(|x| x["kind"] == "evolve"))
-            .and_then(|x| x["chosen_best"]["median"].as_f64())
+fn sweep(dir: &Path, summary: ExperimentSummary, u: Unsealed<'_>) -> Result<ReportData, Error> {
+    let score = |p: &PointSummary| {
+        p.stages
+            .iter()
+            .rev()
+            .find_map(|x| match x {
+                StageFigures::Evolve { chosen_best, .. } => Some(chosen_best.map(|c| c.median)),
+                _ => None,
+            })
+            .flatten()
+            .filter(|m| m.is_finite())
             .unwrap_or(f64::NEG_INFINITY)
     };
     // The first of the best, so ties go to the earlier point.
-    let best = points.iter().fold(None::<&serde_json::Value>, |b, p| match b {
+    let best = summary.points.iter().fold(None::<&PointSummary>, |b, p| match b {
         Some(b) if score(b) >= score(p) => Some(b),
         _ => Some(p),
     });
     let Some(best) = best else {
         return Err(Error::io(format!("error: the sweep in `{}` has no points", dir.display())));
     };
-    let point_dir = dir.join(best["dir"].as_str().unwrap_or_default());
+    let point_dir = dir.join(&best.dir);
     let seeds = seed_dirs(&point_dir, u)?;
     if seeds.is_empty() {
         return Err(Error::io(format!("error: the point `{}` has no seed directories", point_dir.display())));
@@ -968,10 +893,10 @@ fn sweep(dir: &Path, summary: serde_json::Value, u: Unsealed<'_>) -> Result<Repo
     let mut data = experiment(&point_dir, &seeds, u)?;
     data.kind = "sweep";
     data.source = dir.display().to_string();
-    let name = best["name"].as_str().unwrap_or_default().to_string();
+    let name = best.name.clone();
     data.episodes_note = format!("the best point, {name}: {}", data.episodes_note);
     data.sweep_point = Some(name);
-    data.sweep = Some(summary);
+    data.sweep = Some(to_value(&summary)?);
     Ok(data)
 }
 
@@ -989,12 +914,12 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
     if !dir.is_dir() {
         return Err(Error::io(format!("error: `{}` is not a directory", dir.display())));
     }
-    let here = dir.join("program.json");
+    let here = rundir::program_path(dir);
     if here.exists() {
         let program = load::load_built(&here)?;
-        if dir.join("episode.json").exists() {
+        if rundir::episode_path(dir).exists() {
             // A replay: one episode of one stage.
-            let ep = read_episode(&dir.join("episode.json"), u)?;
+            let ep = read_episode(&rundir::episode_path(dir), u)?;
             let (index, _) = program.stage(&ep.stage).ok_or_else(|| {
                 Error::io(format!(
                     "error: `{}` replays stage `{}`, which `{}` does not have",
@@ -1004,9 +929,13 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
                 ))
             })?;
             let st = &program.stages[index];
-            let genome = read_genome(&dir.join("genome"), st, u)?;
+            let genome = read_genome(&rundir::genome_file_path(dir), st, u)?;
             let mut data = base("replay", &program, dir);
-            data.stages.push(stage_view(&program, index, genome.as_ref().map(|g| (g, "genome".to_string()))));
+            data.stages.push(stage_view(
+                &program,
+                index,
+                genome.as_ref().map(|g| (g, rundir::names::GENOME.to_string())),
+            ));
             data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
             data.episodes.push(ep);
             return Ok(data);
@@ -1028,11 +957,9 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
             None => None,
         };
         if let (Some(summary), Some(name)) = (summary, name) {
-            let listed =
-                summary["points"].as_array().is_some_and(|p| p.iter().any(|x| x["dir"] == name.as_str()));
-            if listed {
+            if summary.points.iter().any(|x| x.dir == name) {
                 data.sweep_point = Some(name);
-                data.sweep = Some(summary);
+                data.sweep = Some(to_value(&summary)?);
             }
         }
         return Ok(data);
@@ -1041,10 +968,10 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
         return sweep(dir, summary, u);
     }
     // A stage directory inside a run.
-    let parent = dir.parent().filter(|p| p.join("program.json").exists());
+    let parent = dir.parent().filter(|p| rundir::program_path(p).exists());
     let name = dir.file_name().map(|n| n.to_string_lossy().into_owned());
     if let (Some(run), Some(name)) = (parent, name) {
-        let program = load::load_built(&run.join("program.json"))?;
+        let program = load::load_built(&rundir::program_path(run))?;
         if let Some((index, _)) = program.stage(&name) {
             let mut data = base("stage", &program, dir);
             let fitness = run_fitness(&program, run, u)?;
@@ -1061,7 +988,7 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
 }
 
 fn experiment(dir: &Path, seeds: &[(u64, PathBuf)], u: Unsealed<'_>) -> Result<ReportData, Error> {
-    let program = load::load_built(&seeds[0].1.join("program.json"))?;
+    let program = load::load_built(&rundir::program_path(&seeds[0].1))?;
     let mut per_seed = Vec::new();
     for (_, run) in seeds {
         per_seed.push(run_fitness(&program, run, u)?);

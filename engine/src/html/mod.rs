@@ -19,9 +19,6 @@ const TEMPLATE: &str = include_str!("page.html");
 const STYLE: &str = include_str!("page.css");
 const SCRIPT: &str = include_str!("page.js");
 
-/// The file name runs and replays write.
-pub const FILE_NAME: &str = "report.html";
-
 fn escape_html(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
@@ -69,7 +66,7 @@ pub fn write_with(dir: &Path, out: Option<&Path>, unsealed: Unsealed<'_>) -> Res
     }
     let data = data::collect_with(dir, unsealed)?;
     let html = page(&data)?;
-    let path = out.map_or_else(|| dir.join(FILE_NAME), Path::to_path_buf);
+    let path = out.map_or_else(|| crate::rundir::report_path(dir), Path::to_path_buf);
     write_atomic(&path, html.as_bytes())?;
     Ok(path)
 }
@@ -83,7 +80,7 @@ fn replaceable(out: &Path) -> Result<(), Error> {
         return Err(Error::io(format!(
             "error: `{}` is a directory; give `-o` the file to write (e.g. `{}`)",
             out.display(),
-            out.join(FILE_NAME).display()
+            crate::rundir::report_path(out).display()
         )));
     }
     let mut head = Vec::new();

@@ -8,10 +8,11 @@ use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Param, Program, StageRun};
 
-use super::data::{self, parse_generations, seed_series, stage_view, GenRow, ReportData};
+use super::data::{self, seed_series, stage_view, ReportData};
 use super::{embedded_json, page};
 use crate::episode::{run_recorded, Episode};
 use crate::run::{before_after, BeforeAfter};
+use crate::rundir::{parse_generations, GenRow};
 
 fn program() -> Program {
     let src = include_str!("../../../tests/cli/report.bat");
@@ -221,14 +222,17 @@ fn generations_csv_is_parsed_by_column_name_and_bad_lines_are_named() {
     let text = "stage,generation,stage_generation,best,mean,worst,best_index\n\
                 a,0,0,0.5,0.25,0.1,3\n\
                 b,1,0,0.75,0.5,0.2,1\n";
-    let rows = parse_generations(text, Path::new("g.csv")).unwrap();
-    assert_eq!(
-        rows,
-        [
-            GenRow { stage: "a".into(), generation: 0, stage_generation: 0, best: 0.5, mean: 0.25 },
-            GenRow { stage: "b".into(), generation: 1, stage_generation: 0, best: 0.75, mean: 0.5 },
-        ]
-    );
+    let rows = parse_generations(text, Path::new("g.csv")).unwrap().rows;
+    let row = |stage: &str, generation, best, mean, worst, index| GenRow {
+        stage: stage.into(),
+        generation,
+        best,
+        mean,
+        worst: Some(worst),
+        best_index: Some(index),
+        ..GenRow::default()
+    };
+    assert_eq!(rows, [row("a", 0, 0.5, 0.25, 0.1, 3), row("b", 1, 0.75, 0.5, 0.2, 1)]);
     let bad =
         parse_generations("stage,generation,stage_generation,best,mean\na,0,0,x,1\n", Path::new("g.csv"));
     let msg = bad.unwrap_err().to_string();
@@ -245,6 +249,7 @@ fn seed_series_are_medians_with_the_range_of_the_best() {
         stage_generation: g,
         best,
         mean,
+        ..GenRow::default()
     };
     let seeds = vec![
         vec![row(0, 0.1, 0.0), row(1, 0.4, 0.2)],
