@@ -713,6 +713,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_summary_of_a_newer_format_or_with_a_key_missing_is_refused_naming_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = summary_path(dir.path());
+        std::fs::write(&path, r#"{"format": 2, "file": "x"}"#).unwrap();
+        let err = read_experiment_summary(dir.path(), &|_| {}).unwrap_err();
+        assert!(
+            err.message().contains("summary format 2") && err.message().contains("summary.json"),
+            "{err}"
+        );
+        std::fs::write(&path, r#"{"file": "x", "seeds": [1]}"#).unwrap();
+        let err = read_experiment_summary(dir.path(), &|_| {}).unwrap_err();
+        assert!(
+            err.message().contains("missing field `sets`") && err.message().contains("summary.json"),
+            "{err}"
+        );
+    }
+
+    #[test]
     fn a_checkpoint_changed_by_one_digit_is_refused_as_corrupt() {
         let dir = tempfile::tempdir().unwrap();
         let trained = Trained {

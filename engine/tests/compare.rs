@@ -185,16 +185,14 @@ fn compare_refuses_different_stages_single_seeds_and_missing_measures() {
     s.as_object_mut().unwrap().remove("grips");
     std::fs::write(&summary, serde_json::to_string(&s).unwrap()).unwrap();
     // An edited file is refused as damaged (its seal); one without a seal
-    // (written before seals) is read, and then its missing measure named.
+    // (written before seals) is read, and then its missing key named with
+    // the file (the typed summary: no measure silently becomes NaN).
     let e = err(&opts(&[&x, &y]));
     assert!(e.contains("summary.json` is corrupt"), "{e}");
     std::fs::remove_file(y.join("seed-4/bigger/.seals")).unwrap();
     let e = err(&opts(&[&x, &y]));
     assert_eq!(
         e,
-        format!(
-            "error: measure `grips` of stage `bigger` is missing in `{}` (1 of 2 seeds), which other directories have",
-            y.display()
-        )
+        format!("error: `{}` is not a test stage's summary: missing field `grips`", summary.display())
     );
 }

@@ -1304,7 +1304,7 @@ impl Run {
         };
         // The columns in the file's order; those a file written before
         // them lacks are left out.
-        let columns: [(&str, Option<Vec<i64>>, Option<Vec<f64>>); 9] = [
+        let columns = [
             ("generation", ints(|r| Some(u64::from(r.generation))), None),
             ("stage_generation", ints(|r| Some(u64::from(r.stage_generation))), None),
             ("best", None, floats(|r| Some(r.best))),
