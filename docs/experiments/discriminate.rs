@@ -261,13 +261,8 @@ fn fit(kind: &str, s: &[Sample], seed: u64) -> Rule {
 
 const KINDS: [&str; 3] = ["linear", "hidden 4", "quadratic"];
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    match v.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => v[n / 2],
-        n => (v[n / 2 - 1] + v[n / 2]) / 2.0,
-    }
+fn median(v: Vec<f64>) -> f64 {
+    shaping_engine::stats::median(&v).unwrap_or(f64::NAN)
 }
 
 fn summary(v: &[u32]) -> String {

@@ -70,17 +70,8 @@ fn parse_args() -> Result<Args, String> {
     Ok(a)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
+fn median(v: Vec<f64>) -> f64 {
+    shaping_engine::stats::median(&v).unwrap_or(f64::NAN)
 }
 
 fn run() -> Result<(), String> {

@@ -250,14 +250,9 @@ fn picture(file: &str, arena: [f32; 2], radius: f32, paths: &[Vec<[f32; 2]>]) ->
     root.present().map_err(err)
 }
 
-fn median(v: &mut [f32]) -> f32 {
-    v.sort_by(f32::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        (v[n / 2 - 1] + v[n / 2]) / 2.0
-    }
+fn median(v: &[f32]) -> f32 {
+    let v: Vec<f64> = v.iter().map(|&x| f64::from(x)).collect();
+    shaping_engine::stats::median(&v).unwrap_or(f64::NAN) as f32
 }
 
 /// The medians of a set of lives (spreads and shares) and the mean of
@@ -270,7 +265,7 @@ struct Summary {
 }
 
 fn summarise(lives: &[Life]) -> Summary {
-    let med = |f: &dyn Fn(&Life) -> f32| median(&mut lives.iter().map(f).collect::<Vec<_>>());
+    let med = |f: &dyn Fn(&Life) -> f32| median(&lives.iter().map(f).collect::<Vec<_>>());
     Summary {
         spread: [med(&|l| l.spread[0]), med(&|l| l.spread[1])],
         near: [med(&|l| l.near[0]), med(&|l| l.near[1])],
@@ -298,7 +293,8 @@ impl Summary {
 
 /// `name: median M, min A, max B, over N` of `v`.
 fn over_seeds(name: &str, mut v: Vec<f32>) {
-    let m = median(&mut v);
+    v.sort_by(f32::total_cmp);
+    let m = median(&v);
     println!("{name}: median {m:.2}, min {:.2}, max {:.2}, over {} seeds", v[0], v[v.len() - 1], v.len());
 }
 

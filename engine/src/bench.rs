@@ -86,9 +86,9 @@ pub const SIM_ROBOT_STEPS: u64 = 200_000;
 pub const EPISODES: u64 = 200;
 pub const EPISODE_ACTIONS: u32 = 300;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    v[v.len() / 2]
+/// The engine's one median ([`crate::stats::median`]) of the runs' rates.
+fn median(v: Vec<f64>) -> f64 {
+    crate::stats::median(&v).unwrap_or(f64::NAN)
 }
 
 fn share(part: u64, whole: u64) -> f64 {

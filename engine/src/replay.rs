@@ -133,7 +133,7 @@ pub fn choose(
         // Nothing is evolved: the empty genome is the only individual.
         None if stage.layout.bits == 0 && run.is_none() => Genome::zeros(0),
         None => {
-            let source = run::evolved_ancestor(&program, index).unwrap_or(index);
+            let source = program.evolved_at_or_above(index).unwrap_or(index);
             let dir = rundir::stage_dir(&run_dir, &program.stages[source].name);
             let path = rundir::best_genome_path(&dir);
             if !path.exists() {

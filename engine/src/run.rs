@@ -243,8 +243,7 @@ pub fn run_seed(program: &Program, seed: Option<u64>) -> u64 {
 /// stages whose weights they use, in program order.
 pub fn chain(program: &Program, target: usize) -> Vec<usize> {
     let mut need = vec![false; program.stages.len()];
-    let mut cur = Some(target);
-    while let Some(i) = cur {
+    for i in program.lineage(target) {
         need[i] = true;
         for (_, p) in program.stages[i].modules.iter().flat_map(|m| m.network_params()) {
             if let Param::Trained { stage, .. } = *p {
@@ -253,21 +252,8 @@ pub fn chain(program: &Program, target: usize) -> Vec<usize> {
                 }
             }
         }
-        cur = program.stages[i].parent;
     }
     (0..program.stages.len()).filter(|&i| need[i]).collect()
-}
-
-/// The nearest evolved stage at or above `index` (itself if evolved), if any.
-pub fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
-    let mut cur = Some(index);
-    while let Some(i) = cur {
-        if let StageRun::Evolve(_) = program.stages[i].run {
-            return Some(i);
-        }
-        cur = program.stages[i].parent;
-    }
-    None
 }
 
 /// Episodes whose world could not be placed apart: some placement (an
@@ -785,7 +771,7 @@ fn evolved_parent<'a>(
     index: usize,
     finals: &'a [Option<Checkpoint>],
 ) -> Result<Option<&'a Checkpoint>> {
-    let Some(p) = program.stages[index].parent.and_then(|p| evolved_ancestor(program, p)) else {
+    let Some(p) = program.evolved_above(index) else {
         return Ok(None);
     };
     finals[p].as_ref().map(Some).ok_or_else(|| {

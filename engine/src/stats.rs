@@ -25,7 +25,7 @@ fn sorted(values: &[f64]) -> Vec<f64> {
 
 /// The median of sorted values: the middle value of an odd count, the mean
 /// of the two middle values of an even count.
-fn median_of_sorted(v: &[f64]) -> Option<f64> {
+pub(crate) fn median_of_sorted(v: &[f64]) -> Option<f64> {
     let n = v.len();
     match n {
         0 => None,

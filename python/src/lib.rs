@@ -885,7 +885,7 @@ fn frozen_template(
         }
         (None, Some(dir)) => {
             let mut genome = Genome::zeros(bits);
-            let Some(parent) = st.parent.and_then(|p| engine_run::evolved_ancestor(program, p)) else {
+            let Some(parent) = program.evolved_above(index) else {
                 return Ok(genome);
             };
             let pst = &program.stages[parent];

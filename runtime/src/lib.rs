@@ -26,6 +26,7 @@ pub mod program;
 pub mod robot;
 pub mod sim;
 pub mod state;
+#[cfg(any(test, feature = "testkit"))]
 pub mod testkit;
 pub mod validate;
 pub mod world;

@@ -859,6 +859,27 @@ impl Program {
     pub fn stage(&self, name: &str) -> Option<(usize, &Stage)> {
         self.stages.iter().enumerate().find(|(_, s)| s.name == name)
     }
+
+    /// Stage `index` and the stages it extends, nearest first: the one walk
+    /// up the program's `parent` links. It ends early at a parent out of
+    /// range or not before its child (a malformed chain, which
+    /// [`Program::validate`] refuses), so it never loops.
+    pub fn lineage(&self, index: usize) -> impl Iterator<Item = usize> + '_ {
+        let first = Some(index).filter(|&i| i < self.stages.len());
+        std::iter::successors(first, move |&child| self.stages[child].parent.filter(|&p| p < child))
+    }
+
+    /// The nearest evolved stage among stage `index` and those it extends
+    /// (itself if it evolves; test stages skipped).
+    pub fn evolved_at_or_above(&self, index: usize) -> Option<usize> {
+        self.lineage(index).find(|&i| matches!(self.stages[i].run, StageRun::Evolve(_)))
+    }
+
+    /// The nearest evolved stage among those stage `index` extends (not
+    /// itself): the stage whose best or population it starts from.
+    pub fn evolved_above(&self, index: usize) -> Option<usize> {
+        self.lineage(index).skip(1).find(|&i| matches!(self.stages[i].run, StageRun::Evolve(_)))
+    }
 }
 
 impl Program {

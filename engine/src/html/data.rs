@@ -648,7 +648,9 @@ fn run_stages(
         if matches!(st.run, StageRun::Train { .. }) {
             view.crowded = crowded_training(&dir, u)?;
         }
-        if let (Some(g), Some(a)) = (&genome, evolved_ancestor(program, i)) {
+        // An evolved stage's frozen genes come from the nearest evolved ancestor.
+        let ancestor = matches!(st.run, StageRun::Evolve(_)).then(|| program.evolved_above(i)).flatten();
+        if let (Some(g), Some(a)) = (&genome, ancestor) {
             let pst = &program.stages[a];
             let pdir = rundir::stage_dir(run, &pst.name);
             if let Some(cp) = rundir::read_checkpoint_with(&pdir, u)? {
@@ -695,25 +697,6 @@ fn crowded_training(dir: &Path, u: Unsealed<'_>) -> Result<Option<String>, Error
     let Some(t) = rundir::read_trained_with(dir, u)? else { return Ok(None) };
     let p = u64::from(t.result.placement_failures);
     Ok((p > 0).then(|| crowded_words("in its training life", p)))
-}
-
-/// The nearest ancestor of evolved stage `index` that evolved (test stages
-/// skipped): the stage whose final population this one started from.
-fn evolved_ancestor(program: &Program, index: usize) -> Option<usize> {
-    if !matches!(program.stages[index].run, StageRun::Evolve(_)) {
-        return None;
-    }
-    let mut cur = program.stages[index].parent;
-    let mut steps = 0;
-    while let Some(p) = cur {
-        let st = program.stages.get(p)?;
-        if matches!(st.run, StageRun::Evolve(_)) {
-            return Some(p);
-        }
-        steps += 1;
-        cur = st.parent.filter(|_| steps < program.stages.len());
-    }
-    None
 }
 
 /// Says where the frozen genes of `best` (the best individual of stage

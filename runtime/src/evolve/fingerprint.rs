@@ -126,28 +126,16 @@ pub fn stage_print(program: &Program, index: usize) -> StagePrint {
     }
 }
 
-/// The evolved stages stage `index` extends, nearest first (test stages are
-/// skipped: an evolved stage starts from the nearest evolved ancestor).
-fn evolved_ancestors(program: &Program, index: usize) -> Vec<usize> {
-    let mut out = Vec::new();
-    let mut child = index;
-    let mut current = program.stages.get(index).and_then(|s| s.parent);
-    // `p < child` keeps a malformed parent chain from looping.
-    while let Some(p) = current.filter(|&p| p < child) {
-        let Some(st) = program.stages.get(p) else { break };
-        if let StageRun::Evolve(_) = st.run {
-            out.push(p);
-        }
-        child = p;
-        current = st.parent;
-    }
-    out
-}
-
 /// The fingerprint of a result of stage `index`: the stage, then the evolved
 /// stages it extends, nearest first.
 pub fn fingerprint(program: &Program, index: usize) -> Fingerprint {
-    std::iter::once(index).chain(evolved_ancestors(program, index)).map(|i| stage_print(program, i)).collect()
+    // The stage, then the evolved stages it extends, nearest first (an
+    // evolved stage starts from the nearest evolved ancestor).
+    let evolved = |&i: &usize| matches!(program.stages[i].run, StageRun::Evolve(_));
+    std::iter::once(index)
+        .chain(program.lineage(index).skip(1).filter(evolved))
+        .map(|i| stage_print(program, i))
+        .collect()
 }
 
 /// One number for a fingerprint, its own `generations` left out (they may

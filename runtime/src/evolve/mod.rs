@@ -820,25 +820,22 @@ fn get_stage(program: &Program, index: usize) -> Result<&Stage, EvolveError> {
     program.stages.get(index).ok_or(EvolveError::StageIndex { index, count: program.stages.len() })
 }
 
-/// The nearest evolved stage among `stage`'s ancestors (test stages skipped).
+/// The nearest evolved stage among `stage`'s ancestors (test stages
+/// skipped; [`Program::evolved_above`]), or why the chain is malformed.
 fn evolved_ancestor(program: &Program, stage: usize) -> Result<Option<usize>, EvolveError> {
-    let mut child = stage;
-    let mut current = get_stage(program, stage)?.parent;
-    while let Some(p) = current {
-        let pst = get_stage(program, p)?;
-        if p >= child {
-            return Err(EvolveError::ParentOrder {
-                stage: program.stages[child].name.clone(),
-                parent: pst.name.clone(),
-            });
-        }
-        if let StageRun::Evolve(_) = pst.run {
-            return Ok(Some(p));
-        }
-        child = p;
-        current = pst.parent;
+    get_stage(program, stage)?;
+    if let Some(p) = program.evolved_above(stage) {
+        return Ok(Some(p));
     }
-    Ok(None)
+    // The walk ends early at a malformed link: name it.
+    let last = program.lineage(stage).last().unwrap_or(stage);
+    match program.stages[last].parent {
+        Some(p) if p >= last => Err(EvolveError::ParentOrder {
+            stage: program.stages[last].name.clone(),
+            parent: get_stage(program, p)?.name.clone(),
+        }),
+        _ => Ok(None),
+    }
 }
 
 /// The child's layout must start with the parent's genes (same place, size and
