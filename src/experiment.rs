@@ -6,7 +6,8 @@ use shaping_engine::run::Runner;
 
 use crate::cluster::Coordinator;
 use crate::out::out;
-use crate::run::{interrupt_flag, Terminal};
+use crate::run::interrupt_flag;
+use crate::terminal::Terminal;
 use crate::CliError;
 
 /// Runs every seed of every point, then the summaries. Under MPI (`cluster`

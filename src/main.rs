@@ -11,6 +11,7 @@ mod replay;
 mod robot;
 mod run;
 mod signals;
+mod terminal;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

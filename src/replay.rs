@@ -3,7 +3,7 @@
 use shaping_engine::replay::{self, ReplayOptions};
 
 use crate::out::outln;
-use crate::run::Terminal;
+use crate::terminal::Terminal;
 use crate::{load, CliError, ErrorFormat};
 
 pub fn replay(args: ReplayOptions, error_format: ErrorFormat) -> Result<(), CliError> {

@@ -478,7 +478,7 @@ impl Diagnostics {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Suggestion {
     /// Write `with` instead of the word at `span` (a "did you mean").
-    Replace { span: crate::syntax::Span, with: String },
+    Replace { span: crate::span::Span, with: String },
     /// Declare this hardware (`actuator arm lift`) in the robot.
     Declare { line: String },
 }
@@ -498,7 +498,7 @@ impl Error {
         if let Some(with) = quoted(DID_YOU_MEAN) {
             let mut labels = self.labels()?;
             let l = labels.find(|l| l.primary()).or_else(|| self.labels()?.next())?;
-            let span = crate::syntax::Span { start: l.offset(), end: l.offset() + l.len() };
+            let span = crate::span::Span { start: l.offset(), end: l.offset() + l.len() };
             return Some(Suggestion::Replace { span, with });
         }
         if help.starts_with("declare") {
@@ -531,7 +531,7 @@ impl Suggestion {
             .map(|(_, w)| {
                 let start = span.start + (w.as_ptr() as usize - text.as_ptr() as usize);
                 Suggestion::Replace {
-                    span: crate::syntax::Span { start, end: start + w.len() },
+                    span: crate::span::Span { start, end: start + w.len() },
                     with: with.clone(),
                 }
             })

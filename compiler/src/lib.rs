@@ -20,6 +20,7 @@ pub mod fmt;
 pub mod ide;
 pub mod layout;
 pub mod lower;
+pub mod span;
 pub mod syntax;
 
 pub use diag::{Diagnostics, Error};

@@ -12,8 +12,11 @@ use shaping_runtime::evolve::{Checkpoint, GenStats};
 use shaping_runtime::program::{Program, StageRun};
 
 use crate::error::{Error, ErrorKind};
-use crate::stats::{self, Interval, Magnitude, Method};
+use crate::stats;
 use crate::{load, rundir};
+
+// The comparison's figures are part of `summary.json`'s schema (`rundir`).
+pub use crate::rundir::{GroupFigures, MeasureTests, PairTest, Tests};
 
 /// One stage's measures over the seeds of a group: each measure's value per
 /// seed, in the seeds' order (NaN: missing from the seed's files).
@@ -66,7 +69,7 @@ pub fn read_measures(
                 for &seed in seeds {
                     let sdir = rundir::stage_dir(&rundir::seed_dir(dir, seed), &stage.name);
                     let cp: Checkpoint = rundir::read_checkpoint(&sdir)?
-                        .ok_or_else(|| crate::experiment::missing(&rundir::checkpoint_path(&sdir)))?;
+                        .ok_or_else(|| rundir::missing(&rundir::checkpoint_path(&sdir)))?;
                     let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
                     // The last generation's columns of `generations.csv`.
                     let last = |f: fn(&GenStats) -> f64| own.last().map_or(f64::NAN, |l| f(l));
@@ -99,7 +102,7 @@ pub fn read_measures(
             StageRun::Test { .. } => {
                 let mut v: [Vec<f64>; 3] = Default::default();
                 for &seed in seeds {
-                    let s = crate::experiment::seed_test_summary(dir, seed, &stage.name, &|_| {})?;
+                    let s = rundir::seed_test_summary(dir, seed, &stage.name, &|_| {})?;
                     for (k, x) in
                         [s.fitness, f64::from(s.grips), f64::from(s.releases_outside)].into_iter().enumerate()
                     {
@@ -113,57 +116,6 @@ pub fn read_measures(
         }
     }
     Ok(out)
-}
-
-/// One group's figures of a measure.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct GroupFigures {
-    /// The seeds with a value.
-    pub seeds: usize,
-    pub median: Option<f64>,
-    /// The bootstrap 95% interval of the median.
-    pub interval: Option<Interval>,
-}
-
-/// The test of a pair of groups (`a` against `b`, numbered from 1).
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct PairTest {
-    pub a: usize,
-    pub b: usize,
-    /// Mann-Whitney's U of `a`.
-    pub u: Option<f64>,
-    pub p_value: Option<f64>,
-    /// Holm-corrected over the pairs of the measure (more than two groups only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub p_holm: Option<f64>,
-    /// The probability that a seed of `a` has the larger value (ties half).
-    pub a12: Option<f64>,
-    pub size: Option<Magnitude>,
-    pub method: Option<Method>,
-    /// Why there is no test (a side with fewer than 2 seeds).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub no_test: Option<String>,
-}
-
-/// One measure of one stage, over the groups.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MeasureTests {
-    pub stage: String,
-    pub measure: String,
-    pub groups: Vec<GroupFigures>,
-    pub pairs: Vec<PairTest>,
-}
-
-/// The comparison of groups: what `summary.json` keeps under `tests` and
-/// `shaping compare` prints.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Tests {
-    /// The groups' names, numbered from 1 in the pairs.
-    pub groups: Vec<String>,
-    /// How the figures were computed, in words.
-    pub method: String,
-    pub holm: bool,
-    pub measures: Vec<MeasureTests>,
 }
 
 /// What [`Tests::method`] says: how the intervals are computed and, when
@@ -426,7 +378,7 @@ pub fn compare(opts: &CompareOptions) -> Result<Tests, Error> {
             }
             stages = vec![i];
         }
-        let criteria = crate::experiment::criteria(&program, &opts.criterion)?;
+        let criteria = criteria(&program, &opts.criterion)?;
         if let Some((c, _)) =
             criteria.iter().find(|(c, _)| !stages.iter().any(|&i| program.stages[i].name == *c))
         {
@@ -502,6 +454,28 @@ fn check_measures(groups: &[(String, Vec<StageMeasures>)]) -> Result<(), Error> 
         }
     }
     Ok(())
+}
+
+/// Parses `STAGE=VALUE` criteria (`navigation=0.7`).
+pub(crate) fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Error> {
+    args.iter()
+        .map(|c| {
+            let (stage, value) = c.split_once('=').ok_or_else(|| {
+                Error::new(ErrorKind::Invalid, format!("error: criterion `{c}` is not of the form STAGE=FITNESS"))
+            })?;
+            load::stage_index(program, Some(stage))?;
+            let v: f32 = value
+                .parse()
+                .map_err(|_| Error::new(ErrorKind::Invalid, format!("error: criterion `{c}`: `{value}` is not a number")))?;
+            // `nan`, `inf` and numbers beyond f32 parse, but no fitness reaches them.
+            if !v.is_finite() {
+                return Err(Error::new(ErrorKind::Invalid, format!(
+                    "error: criterion `{c}`: `{value}` is not a finite number (a fitness to reach, e.g. `{stage}=0.5`)"
+                )));
+            }
+            Ok((stage.to_string(), v))
+        })
+        .collect()
 }
 
 #[cfg(test)]

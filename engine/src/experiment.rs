@@ -12,7 +12,9 @@ use shaping_runtime::program::{Program, StageRun};
 use crate::error::{Error, ErrorKind};
 use crate::files::DirLock;
 use crate::load;
-use crate::rundir::{self, StageFigures, TestSummary};
+use crate::rundir::{self, StageFigures};
+// A figure over seeds is part of `summary.json`'s schema (`rundir`).
+pub use crate::rundir::{spread, Spread};
 use crate::sweep::{self, Assignment, Set};
 use crate::{compare, plot, report, run};
 
@@ -35,36 +37,6 @@ pub struct ExperimentOptions {
     pub no_report: bool,
 }
 
-/// Median, minimum and maximum; mean and standard deviation (the sample's,
-/// 0 for one value).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Spread {
-    #[serde(deserialize_with = "rundir::nan_if_null")]
-    pub median: f64,
-    #[serde(deserialize_with = "rundir::nan_if_null")]
-    pub min: f64,
-    #[serde(deserialize_with = "rundir::nan_if_null")]
-    pub max: f64,
-    #[serde(deserialize_with = "rundir::nan_if_null")]
-    pub mean: f64,
-    #[serde(deserialize_with = "rundir::nan_if_null")]
-    pub sd: f64,
-}
-
-pub fn spread(values: &[f64]) -> Option<Spread> {
-    if values.is_empty() {
-        return None;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    let median = crate::stats::median_of_sorted(&v)?;
-    let mean = v.iter().sum::<f64>() / n as f64;
-    let sd =
-        if n > 1 { (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt() } else { 0.0 };
-    Some(Spread { median, min: v[0], max: v[n - 1], mean, sd })
-}
-
 fn fmt_spread(s: Option<Spread>, digits: usize) -> String {
     match s {
         Some(s) => format!(
@@ -78,28 +50,6 @@ fn fmt_spread(s: Option<Spread>, digits: usize) -> String {
         ),
         None => "-".into(),
     }
-}
-
-/// Parses `STAGE=VALUE` criteria (`navigation=0.7`).
-pub(crate) fn criteria(program: &Program, args: &[String]) -> Result<Vec<(String, f32)>, Error> {
-    args.iter()
-        .map(|c| {
-            let (stage, value) = c.split_once('=').ok_or_else(|| {
-                Error::new(ErrorKind::Invalid, format!("error: criterion `{c}` is not of the form STAGE=FITNESS"))
-            })?;
-            load::stage_index(program, Some(stage))?;
-            let v: f32 = value
-                .parse()
-                .map_err(|_| Error::new(ErrorKind::Invalid, format!("error: criterion `{c}`: `{value}` is not a number")))?;
-            // `nan`, `inf` and numbers beyond f32 parse, but no fitness reaches them.
-            if !v.is_finite() {
-                return Err(Error::new(ErrorKind::Invalid, format!(
-                    "error: criterion `{c}`: `{value}` is not a finite number (a fitness to reach, e.g. `{stage}=0.5`)"
-                )));
-            }
-            Ok((stage.to_string(), v))
-        })
-        .collect()
 }
 
 /// What an experiment runs, checked before anything runs (on every rank
@@ -122,7 +72,7 @@ pub type Task = (u32, u64);
 impl Plan {
     /// Checks `args` against `program` (the file's, compiled once).
     pub fn new(program: Program, args: ExperimentOptions) -> Result<Plan, Error> {
-        let criteria = criteria(&program, &args.criterion)?;
+        let criteria = compare::criteria(&program, &args.criterion)?;
         if args.seeds == 0 {
             return Err(Error::new(ErrorKind::Invalid, "error: `--seeds` must be at least 1"));
         }
@@ -472,26 +422,6 @@ fn sweep_table(
     md
 }
 
-/// The `summary.json` of test stage `stage` of seed `seed` of experiment
-/// (or point) directory `out`, which the seed's run must have written.
-pub(crate) fn seed_test_summary(
-    out: &Path,
-    seed: u64,
-    stage: &str,
-    unsealed: crate::files::Unsealed<'_>,
-) -> Result<TestSummary, Error> {
-    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), stage);
-    rundir::read_test_summary(&dir, unsealed)?.ok_or_else(|| missing(&rundir::summary_path(&dir)))
-}
-
-/// A file that a seed's run must have written.
-pub(crate) fn missing(path: &Path) -> Error {
-    Error::new(
-        ErrorKind::Io,
-        format!("error: cannot read `{}`: the seed's run did not write it", path.display()),
-    )
-}
-
 /// Builds the Markdown summary and the multi-seed fitness picture.
 /// Returns the Markdown and, per stage, its figures (`summary.json`).
 fn summarise(
@@ -526,7 +456,7 @@ fn summarise(
                 for &seed in seeds {
                     let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
                     let cp: Checkpoint = rundir::read_checkpoint_with(&dir, unsealed)?
-                        .ok_or_else(|| missing(&rundir::checkpoint_path(&dir)))?;
+                        .ok_or_else(|| rundir::missing(&rundir::checkpoint_path(&dir)))?;
                     let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
                     if let Some(last) = own.last() {
                         best.push(last.best as f64);
@@ -586,7 +516,7 @@ fn summarise(
                 for &seed in seeds {
                     let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
                     let t = rundir::read_trained_with(&dir, unsealed)?
-                        .ok_or_else(|| missing(&rundir::trained_path(&dir)))?;
+                        .ok_or_else(|| rundir::missing(&rundir::trained_path(&dir)))?;
                     let learners =
                         stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
                     perf.extend(learners.map(|(_, p)| *p as f64));
@@ -608,7 +538,7 @@ fn summarise(
                 let mut grips = Vec::new();
                 let mut rel = Vec::new();
                 for &seed in seeds {
-                    let v = seed_test_summary(out, seed, &stage.name, unsealed)?;
+                    let v = rundir::seed_test_summary(out, seed, &stage.name, unsealed)?;
                     fit.push(v.fitness);
                     grips.push(f64::from(v.grips));
                     rel.push(f64::from(v.releases_outside));

@@ -38,9 +38,9 @@ mod summary;
 pub use generations::{generations_csv, parse_generations, GenRow, Generations};
 
 pub use summary::{
-    nan_if_null, CriterionFigures, DriveSummary, ExperimentSummary, PointSummary, ReinforcementCounts,
-    ReinforcementMeans, Signals, StageFigures, SweepSet, TestSummary, VariantLives, WorldTotals,
-    SUMMARY_FORMAT,
+    nan_if_null, spread, CriterionFigures, DriveSummary, ExperimentSummary, GroupFigures, MeasureTests,
+    PairTest, PointSummary, ReinforcementCounts, ReinforcementMeans, Signals, Spread, StageFigures, SweepSet,
+    TestSummary, Tests, VariantLives, WorldTotals, SUMMARY_FORMAT,
 };
 
 /// The names of the files of a run, experiment, sweep, replay and drive
@@ -706,6 +706,21 @@ pub fn write_source(out: &Path, file: Option<&str>) -> Result<()> {
             _ => Ok(()),
         },
     }
+}
+
+/// The `summary.json` of test stage `stage` of seed `seed` of experiment
+/// (or point) directory `out`, which the seed's run must have written.
+pub fn seed_test_summary(out: &Path, seed: u64, stage: &str, unsealed: Unsealed<'_>) -> Result<TestSummary> {
+    let dir = stage_dir(&seed_dir(out, seed), stage);
+    read_test_summary(&dir, unsealed)?.ok_or_else(|| missing(&summary_path(&dir)))
+}
+
+/// A file that a seed's run must have written.
+pub fn missing(path: &Path) -> Error {
+    Error::new(
+        ErrorKind::Io,
+        format!("error: cannot read `{}`: the seed's run did not write it", path.display()),
+    )
 }
 
 #[cfg(test)]

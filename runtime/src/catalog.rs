@@ -199,3 +199,38 @@ pub fn channel_bearing(channel: usize) -> Option<f32> {
         _ => None,
     }
 }
+
+// ------------------------------------------------------------ state slots
+
+/// Number of state slots an expression can read (`robot.x` ...,
+/// `distance_to(NAME)`, `team.spread`, `team.grouped`, `team.largest`).
+pub const STATE_SLOTS: usize = ST_LARGEST + 1;
+/// The team's spread (`team.spread`): the mean distance of its robots'
+/// centres to the team's centre (their mean), mm, after the last action
+/// all of them did (0 for one robot). After the targets, so the slots
+/// before it keep their numbers.
+pub const ST_SPREAD: usize = ST_TARGETS + MAX_TARGETS;
+/// The share of the team's robots whose body is within [`crate::state::NEIGHBOUR_GAP`]
+/// of another robot's (`team.grouped`; 0 for one robot).
+pub const ST_GROUPED: usize = ST_SPREAD + 1;
+/// The share of the team's robots in its largest group (`team.largest`):
+/// robots joined by bodies within [`crate::state::NEIGHBOUR_GAP`] of each other, and
+/// the robots joined to those (1 for one robot).
+pub const ST_LARGEST: usize = ST_SPREAD + 2;
+/// The first slot of the distances to the stage's targets
+/// (`Stage::targets`): slot `ST_TARGETS + i` is target `i`'s.
+pub const ST_TARGETS: usize = 6;
+/// The most named items one stage's expressions measure the distance to.
+pub const MAX_TARGETS: usize = 8;
+/// The body centre, mm from the arena's south-west corner.
+pub const ST_X: usize = 0;
+pub const ST_Y: usize = 1;
+/// The heading, radians counter-clockwise from east, in `-pi..=pi`.
+pub const ST_HEADING: usize = 2;
+/// The distance the body centre travelled in this life so far, mm.
+pub const ST_DISTANCE: usize = 3;
+/// The actions done in the life so far (0 before the first; 1 in the
+/// expressions evaluated after it).
+pub const ST_TIME: usize = 4;
+/// The squares of [`crate::state::SQUARE_MM`] the body centre has been in during this life.
+pub const ST_SQUARES: usize = 5;

@@ -6,8 +6,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::catalog::{ACT_SLOTS, CHANNELS};
-use crate::state::STATE_SLOTS;
+use crate::catalog::{ACT_SLOTS, CHANNELS, STATE_SLOTS};
 
 /// Deepest stack an expression may need; the compiler rejects deeper ones.
 pub const MAX_STACK: usize = 32;

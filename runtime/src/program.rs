@@ -49,7 +49,7 @@ pub struct Stage {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub variants: Option<Variants>,
     /// The items a fitness measures the distance to (`distance_to(goal)`):
-    /// state slot [`crate::state::ST_TARGETS`]` + i` reads target `i`, found
+    /// state slot [`crate::catalog::ST_TARGETS`]` + i` reads target `i`, found
     /// by kind and name in the world of each episode (a variant's included).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub targets: Vec<Target>,
@@ -879,14 +879,6 @@ impl Program {
     /// itself): the stage whose best or population it starts from.
     pub fn evolved_above(&self, index: usize) -> Option<usize> {
         self.lineage(index).skip(1).find(|&i| matches!(self.stages[i].run, StageRun::Evolve(_)))
-    }
-}
-
-impl Program {
-    /// The one validation of a program (see [`crate::validate`]): what the
-    /// runtime needs before it may index and compute with it.
-    pub fn validate(&self) -> Result<(), crate::validate::Invalid> {
-        crate::validate::program(self)
     }
 }
 

@@ -290,10 +290,10 @@ pub fn stage(s: &Stage) -> R {
 /// The variants: 1 to [`crate::limits::MAX_VARIANTS`] of them, named once
 /// each, a draw of 1 to their number, each world valid and with the arena
 /// and body of the stage's; every target of the stage (at most
-/// [`crate::state::MAX_TARGETS`]) found in every world.
+/// [`catalog::MAX_TARGETS`]) found in every world.
 fn variants(at: &At, s: &Stage) -> R {
-    at.field("targets").ensure(s.targets.len() <= crate::state::MAX_TARGETS, || {
-        format!("{} targets, more than {}", s.targets.len(), crate::state::MAX_TARGETS)
+    at.field("targets").ensure(s.targets.len() <= catalog::MAX_TARGETS, || {
+        format!("{} targets, more than {}", s.targets.len(), catalog::MAX_TARGETS)
     })?;
     let found = |at: &At, w: &World| -> R {
         for (i, t) in s.targets.iter().enumerate() {
@@ -741,9 +741,9 @@ fn expr(at: &At, e: &Expr) -> R {
             Op::Act(a) => {
                 at.ensure((a as usize) < ACT_SLOTS, || format!("actuator slot {a} does not exist"))?
             }
-            Op::State(v) => at.ensure((v as usize) < crate::state::STATE_SLOTS, || {
-                format!("state slot {v} does not exist")
-            })?,
+            Op::State(v) => {
+                at.ensure((v as usize) < catalog::STATE_SLOTS, || format!("state slot {v} does not exist"))?
+            }
             Op::Const(v) => at.finite(v)?,
             _ => {}
         }
@@ -862,5 +862,13 @@ fn run(at: &At, s: &Stage) -> R {
                 )
             })
         }
+    }
+}
+
+impl Program {
+    /// The one validation of a program (this module): what the
+    /// runtime needs before it may index and compute with it.
+    pub fn validate(&self) -> Result<(), Invalid> {
+        program(self)
     }
 }

@@ -17,7 +17,8 @@ use crate::CliError;
 use shaping_engine::episode::{self, Part, Recorder};
 use shaping_engine::{replay, report};
 
-use crate::run;
+use crate::terminal::Terminal;
+use shaping_engine::run;
 
 pub struct DriveArgs {
     pub file: PathBuf,
@@ -67,7 +68,7 @@ pub fn failure(err: &RobotError, stopped: &Result<(), RobotError>) -> String {
 
 pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let program = crate::load::load_program(&args.file, args.error_format)?;
-    let terminal = run::Terminal::new(true, false);
+    let terminal = Terminal::new(true, false);
     // A run made with `--set`: its own program, as `replay` takes it.
     let run_dir = args.run.clone().unwrap_or_else(|| run::default_out(&args.file));
     let program = replay::with_run_settings(program, &run_dir, &[], &terminal);

@@ -183,7 +183,7 @@ mod pty {
                 .ok_or_else(|| CliError::io("error: the program has no stages"))?,
         };
         let stage = &program.stages[index];
-        let seed = args.seed.unwrap_or_else(|| crate::run::run_seed(&program, None));
+        let seed = args.seed.unwrap_or_else(|| shaping_engine::run::run_seed(&program, None));
         let mut emu = Emulator::new(&stage.world, seed);
         let flag = interrupt_flag()?;
         let (master, _slave, link) = create_pty(&args.port)?;

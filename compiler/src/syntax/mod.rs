@@ -5,7 +5,6 @@ mod brackets;
 pub mod lex;
 mod parser;
 mod recover;
-pub mod span;
 
+pub use crate::span::{self, Span};
 pub use parser::{parse, parse_for_check, parse_recovering, RESERVED};
-pub use span::Span;

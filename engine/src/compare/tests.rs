@@ -2,6 +2,7 @@
 //! `stats/tests.rs` for the script: `ten_vs_ten`, `textbook_shier`).
 
 use super::*;
+use crate::stats::{Interval, Magnitude, Method};
 
 fn group(name: &str, chosen: &[f64]) -> (String, Vec<StageMeasures>) {
     let m = StageMeasures {

@@ -14,7 +14,6 @@ use shaping_runtime::program::{
 
 use crate::episode::{Episode, EPISODE_FORMAT};
 use crate::error::Error;
-use crate::experiment::spread;
 use crate::files::{read_checked, Unsealed};
 use crate::rundir::{ExperimentSummary, GenRow, PointSummary, StageFigures};
 use crate::{load, rundir};
@@ -599,7 +598,7 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
         let rows: Vec<&GenRow> = seeds.iter().filter_map(|r| r.get(k)).collect();
         let best: Vec<f64> = rows.iter().map(|r| r.best as f64).collect();
         let mean: Vec<f64> = rows.iter().map(|r| r.mean as f64).collect();
-        let (Some(b), Some(m)) = (spread(&best), spread(&mean)) else { continue };
+        let (Some(b), Some(m)) = (rundir::spread(&best), rundir::spread(&mean)) else { continue };
         s.generation.push(rows[0].generation);
         s.best.push(b.median as f32);
         s.mean.push(m.median as f32);

@@ -19,8 +19,7 @@ use std::collections::BTreeMap;
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::compare::Tests;
-use crate::experiment::Spread;
+use crate::stats::{Interval, Magnitude, Method};
 
 /// The version of every kind of `summary.json` this shaping writes and reads.
 pub const SUMMARY_FORMAT: u32 = 1;
@@ -28,6 +27,38 @@ pub const SUMMARY_FORMAT: u32 = 1;
 /// A figure written `null` when it was not a number: read back as NaN.
 pub fn nan_if_null<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// Median, minimum and maximum; mean and standard deviation (the sample's,
+/// 0 for one value).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Spread {
+    #[serde(deserialize_with = "nan_if_null")]
+    pub median: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub min: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub max: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub mean: f64,
+    #[serde(deserialize_with = "nan_if_null")]
+    pub sd: f64,
+}
+
+/// The [`Spread`] of `values` (`None` without any): the one median
+/// ([`crate::stats::median`]'s definition) of all of them, NaN sorted last.
+pub fn spread(values: &[f64]) -> Option<Spread> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(|a, b| a.total_cmp(b));
+    let n = v.len();
+    let median = crate::stats::median_of_sorted(&v)?;
+    let mean = v.iter().sum::<f64>() / n as f64;
+    let sd =
+        if n > 1 { (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt() } else { 0.0 };
+    Some(Spread { median, min: v[0], max: v[n - 1], mean, sd })
 }
 
 fn one() -> u32 {
@@ -238,4 +269,58 @@ pub struct DriveSummary {
     pub collisions: Option<u32>,
     /// What stopped the drive, if anything did.
     pub error: Option<String>,
+}
+
+// ------------------------------------------------ the tests of a comparison
+// (`shaping compare`, a sweep's `tests`: computed in `compare`)
+
+/// One group's figures of a measure.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct GroupFigures {
+    /// The seeds with a value.
+    pub seeds: usize,
+    pub median: Option<f64>,
+    /// The bootstrap 95% interval of the median.
+    pub interval: Option<Interval>,
+}
+
+/// The test of a pair of groups (`a` against `b`, numbered from 1).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PairTest {
+    pub a: usize,
+    pub b: usize,
+    /// Mann-Whitney's U of `a`.
+    pub u: Option<f64>,
+    pub p_value: Option<f64>,
+    /// Holm-corrected over the pairs of the measure (more than two groups only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub p_holm: Option<f64>,
+    /// The probability that a seed of `a` has the larger value (ties half).
+    pub a12: Option<f64>,
+    pub size: Option<Magnitude>,
+    pub method: Option<Method>,
+    /// Why there is no test (a side with fewer than 2 seeds).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub no_test: Option<String>,
+}
+
+/// One measure of one stage, over the groups.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeasureTests {
+    pub stage: String,
+    pub measure: String,
+    pub groups: Vec<GroupFigures>,
+    pub pairs: Vec<PairTest>,
+}
+
+/// The comparison of groups: what `summary.json` keeps under `tests` and
+/// `shaping compare` prints.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Tests {
+    /// The groups' names, numbered from 1 in the pairs.
+    pub groups: Vec<String>,
+    /// How the figures were computed, in words.
+    pub method: String,
+    pub holm: bool,
+    pub measures: Vec<MeasureTests>,
 }
