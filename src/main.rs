@@ -406,34 +406,9 @@ fn dispatch(command: Command) -> Result<(), CliError> {
         Command::Fmt { files, check, error_format } => fmt::fmt(&files, check, error_format),
         // Served by `main`, for the protocol's exit status.
         Command::Lsp => Ok(()),
-        Command::Explain { code } => match shaping_compiler::explain::explain(&code) {
-            Some(e) => out!("{}", shaping_compiler::explain::render(e)),
-            None => Err(CliError::new(
-                shaping_engine::ErrorKind::Invalid,
-                format!(
-                    "error: no diagnostic has the code `{code}` (the codes are S0001 to S{:04})",
-                    shaping_compiler::explain::EXPLANATIONS.len()
-                ),
-            )),
-        },
+        Command::Explain { code } => explain(&code),
         Command::Layout { file, stage, format, error_format } => {
-            let program = load::load_program(&file, error_format)?;
-            let index = load::stage_index(&program, stage.as_deref())?;
-            match format {
-                LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index))?,
-                LayoutFormat::Json => {
-                    let st = &program.stages[index];
-                    let layout = serde_json::json!({
-                        "stage": st.name,
-                        "bits": st.layout.bits,
-                        "genes": shaping_compiler::layout_rows(&program, index),
-                    });
-                    let json = serde_json::to_string_pretty(&layout)
-                        .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
-                    outln!("{json}")?;
-                }
-            }
-            Ok(())
+            layout(&file, stage.as_deref(), format, error_format)
         }
         Command::Graph { file, stage, error_format } => {
             let program = load::load_program(&file, error_format)?;
@@ -459,6 +434,7 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             error_format,
         } => {
             let robot = robot.map(|dev| robot::RobotRun::new(dev, baud, period, timeout)).transpose()?;
+            let sets = single_values(sets, "run")?;
             // One robot: its individuals are evaluated one after another.
             let jobs = if robot.is_some() { Some(1) } else { jobs };
             let args = run::RunArgs {
@@ -473,21 +449,9 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                 no_report,
                 error_format,
                 robot,
-                sets: single_values(sets, "run")?,
+                sets,
             };
-            #[cfg(feature = "mpi")]
-            if cluster::launcher().is_some() {
-                if args.robot.is_some() {
-                    return Err(CliError::io(
-                        "error: `--robot` evaluates on one robot; run it without `mpirun`",
-                    ));
-                }
-                return cluster::with_mpi(jobs, rank_timeout, quiet || json, None, |c| {
-                    run::run(args, Some(c))
-                });
-            }
-            let _ = rank_timeout;
-            run::run(args, None)
+            run_here_or_on_ranks(args, rank_timeout)
         }
         Command::Drive {
             file,
@@ -591,37 +555,12 @@ fn dispatch(command: Command) -> Result<(), CliError> {
                     no_report,
                 },
             )?;
-            #[cfg(feature = "mpi")]
-            if cluster::launcher().is_some() {
-                let task = |task, threads| experiment::run_task(&plan, task, Some(threads), true, None);
-                return cluster::with_mpi(jobs, rank_timeout, false, Some(&task), |c| {
-                    experiment::experiment(&plan, jobs, Some(c))
-                });
-            }
-            let _ = rank_timeout;
-            experiment::experiment(&plan, jobs, None)
+            experiment_here_or_on_ranks(&plan, jobs, rank_timeout)
         }
         Command::Compare { dirs, criterion, stage, json } => {
-            let opts = shaping_engine::compare::CompareOptions { dirs, criterion, stage };
-            let tests = shaping_engine::compare::compare(&opts)?;
-            if json {
-                let text = serde_json::to_string_pretty(&tests)
-                    .map_err(|e| CliError::io(format!("error: cannot serialise the comparison: {e}")))?;
-                return print_text(&text);
-            }
-            print_text(&shaping_engine::compare::markdown(&tests, "# Comparison"))
+            compare(shaping_engine::compare::CompareOptions { dirs, criterion, stage }, json)
         }
-        Command::Report { dir, output } => {
-            let unsealed = std::cell::RefCell::new(Vec::new());
-            let path =
-                html::write_with(&dir, output.as_deref(), &|p| unsealed.borrow_mut().push(p.to_path_buf()))?;
-            if let Some(w) = shaping_engine::files::unsealed_warning(&unsealed.borrow()) {
-                eprintln!("{w}");
-            }
-            let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-            eprintln!("wrote {} ({} kB)", path.display(), size.div_ceil(1000));
-            Ok(())
-        }
+        Command::Report { dir, output } => report(&dir, output.as_deref()),
         Command::Bench { file, stage, runs, sets, error_format } => bench::bench(bench::BenchArgs {
             file,
             stage,
@@ -629,23 +568,125 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             sets: single_values(sets, "bench")?,
             error_format,
         }),
-        Command::Build { file, output, error_format } => {
-            if load::same_entry(&file, &output) {
-                return Err(CliError::io(format!(
-                    "error: `{}` is the file being built; give `-o` another file (e.g. `{}`)",
-                    output.display(),
-                    file.with_extension("json").display()
-                )));
-            }
-            load::replaceable_program(&output)?;
-            let program = load::load_program(&file, error_format)?;
-            let json = serde_json::to_string_pretty(&program)
-                .map_err(|e| CliError::io(format!("error: cannot serialise the program: {e}")))?;
-            load::write_atomic(&output, json.as_bytes())?;
-            eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
-            Ok(())
+        Command::Build { file, output, error_format } => build(&file, &output, error_format),
+    }
+}
+
+/// `shaping explain CODE`.
+fn explain(code: &str) -> Result<(), CliError> {
+    match shaping_compiler::explain::explain(code) {
+        Some(e) => out!("{}", shaping_compiler::explain::render(e)),
+        None => Err(CliError::new(
+            shaping_engine::ErrorKind::Invalid,
+            format!(
+                "error: no diagnostic has the code `{code}` (the codes are S0001 to S{:04})",
+                shaping_compiler::explain::EXPLANATIONS.len()
+            ),
+        )),
+    }
+}
+
+/// `shaping layout FILE [--stage S] [--format text|json]`.
+fn layout(
+    file: &std::path::Path,
+    stage: Option<&str>,
+    format: LayoutFormat,
+    error_format: ErrorFormat,
+) -> Result<(), CliError> {
+    let program = load::load_program(file, error_format)?;
+    let index = load::stage_index(&program, stage)?;
+    match format {
+        LayoutFormat::Text => print_text(&shaping_compiler::render_layout(&program, index)),
+        LayoutFormat::Json => {
+            let st = &program.stages[index];
+            let layout = serde_json::json!({
+                "stage": st.name,
+                "bits": st.layout.bits,
+                "genes": shaping_compiler::layout_rows(&program, index),
+            });
+            let json = serde_json::to_string_pretty(&layout)
+                .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
+            outln!("{json}")
         }
     }
+}
+
+/// `shaping run`: in this process, or over the ranks when an MPI launcher
+/// started it (a build with MPI).
+fn run_here_or_on_ranks(args: run::RunArgs, rank_timeout: u64) -> Result<(), CliError> {
+    #[cfg(feature = "mpi")]
+    if cluster::launcher().is_some() {
+        if args.robot.is_some() {
+            return Err(CliError::io("error: `--robot` evaluates on one robot; run it without `mpirun`"));
+        }
+        let (jobs, quiet) = (args.jobs, args.quiet || args.json);
+        return cluster::with_mpi(jobs, rank_timeout, quiet, None, |c| run::run(args, Some(c)));
+    }
+    let _ = rank_timeout;
+    run::run(args, None)
+}
+
+/// `shaping experiment`: in this process, or over the ranks when an MPI
+/// launcher started it (a build with MPI).
+fn experiment_here_or_on_ranks(
+    plan: &shaping_engine::experiment::Plan,
+    jobs: Option<usize>,
+    rank_timeout: u64,
+) -> Result<(), CliError> {
+    #[cfg(feature = "mpi")]
+    if cluster::launcher().is_some() {
+        let task = |task, threads| experiment::run_task(plan, task, Some(threads), true, None);
+        return cluster::with_mpi(jobs, rank_timeout, false, Some(&task), |c| {
+            experiment::experiment(plan, jobs, Some(c))
+        });
+    }
+    let _ = rank_timeout;
+    experiment::experiment(plan, jobs, None)
+}
+
+/// `shaping compare DIR DIR...`: Markdown, or JSON with `--json`.
+fn compare(opts: shaping_engine::compare::CompareOptions, json: bool) -> Result<(), CliError> {
+    let tests = shaping_engine::compare::compare(&opts)?;
+    if json {
+        let text = serde_json::to_string_pretty(&tests)
+            .map_err(|e| CliError::io(format!("error: cannot serialise the comparison: {e}")))?;
+        return print_text(&text);
+    }
+    print_text(&shaping_engine::compare::markdown(&tests, "# Comparison"))
+}
+
+/// `shaping report DIR [-o FILE]`.
+fn report(dir: &std::path::Path, output: Option<&std::path::Path>) -> Result<(), CliError> {
+    let unsealed = std::cell::RefCell::new(Vec::new());
+    let path = html::write_with(dir, output, &|p| unsealed.borrow_mut().push(p.to_path_buf()))?;
+    if let Some(w) = shaping_engine::files::unsealed_warning(&unsealed.borrow()) {
+        eprintln!("{w}");
+    }
+    let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    eprintln!("wrote {} ({} kB)", path.display(), size.div_ceil(1000));
+    Ok(())
+}
+
+/// `shaping build FILE -o program.json`.
+fn build(
+    file: &std::path::Path,
+    output: &std::path::Path,
+    error_format: ErrorFormat,
+) -> Result<(), CliError> {
+    if load::same_entry(file, output) {
+        return Err(CliError::io(format!(
+            "error: `{}` is the file being built; give `-o` another file (e.g. `{}`)",
+            output.display(),
+            file.with_extension("json").display()
+        )));
+    }
+    load::replaceable_program(output)?;
+    let program = load::load_program(file, error_format)?;
+    let json = serde_json::to_string_pretty(&program)
+        .map_err(|e| CliError::io(format!("error: cannot serialise the program: {e}")))?;
+    load::write_atomic(output, json.as_bytes())?;
+    eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
+    Ok(())
 }
 
 /// A build without MPI support started by an MPI launcher with several

@@ -799,30 +799,7 @@ impl Runner<'_> {
             unreachable!("evolve_stage is called for evolved stages")
         };
         let path = rundir::checkpoint_path(dir);
-        let mut cp = match existing {
-            Some(mut cp) => {
-                if cp.seed != seed {
-                    return Err(other_seed(&path, cp.seed, seed));
-                }
-                evolve::resume(program, index, &mut cp).map_err(|e| stale(&path, &e))?;
-                self.observer.event(Event::Resumed {
-                    stage: &stage.name,
-                    generation: cp.generation,
-                    generations: evo.generations,
-                    finished: evolve::is_finished(program, &cp) && cp.validated,
-                    checkpoint: &path,
-                });
-                cp
-            }
-            None => evolve::start_stage(program, index, seed, parent)
-                .map_err(|e| Error::io(format!("error: {e}")))?,
-        };
-        // Every individual would silently score 0 on a stage the controller
-        // cannot run (e.g. weights of a training stage that was not bound).
-        let probe = Genome::zeros(stage.layout.bits as usize);
-        shaping_runtime::controller::validate(stage, &probe).map_err(|e| {
-            Error::new(ErrorKind::Invalid, format!("error: stage `{}` cannot run: {e}", stage.name))
-        })?;
+        let mut cp = self.start_or_resume(program, index, seed, parent, &path, existing)?;
         self.observer.event(Event::EvolveStart {
             stage: &stage.name,
             generations: evo.generations,
@@ -839,30 +816,7 @@ impl Runner<'_> {
                 return f;
             }
             if self.stopped() && matches!(e, evolve::EvolveError::Inconsistent { .. }) {
-                return interrupted(if evolve::is_finished(program, cp) {
-                    format!(
-                        "interrupted: stage `{}` stopped while choosing its best, which is dropped; its generations \
-                         are saved in `{}`, and the same command resumes it",
-                        stage.name,
-                        path.display()
-                    )
-                } else if cp.generation == 0 {
-                    format!(
-                        "interrupted: stage `{}` stopped in its first generation, which is dropped; nothing of the \
-                         stage was saved, and the same command runs it",
-                        stage.name
-                    )
-                } else {
-                    format!(
-                        "interrupted: stage `{}` stopped in generation {} of {}, which is dropped; the {} before it \
-                         are saved in `{}`, and the same command resumes it",
-                        stage.name,
-                        cp.generation + 1,
-                        evo.generations,
-                        cp.generation,
-                        path.display()
-                    )
-                });
+                return dropped(program, cp, &path);
             }
             Error::new(ErrorKind::Evaluation, format!("error: {e}"))
         };
@@ -901,14 +855,7 @@ impl Runner<'_> {
                 // Said at once (a long run may be stopped), and again with the
                 // totals at the end of the stage.
                 warned = true;
-                self.observer.event(Event::Warning(format!(
-                    "warning: the world of stage `{}` is too crowded: in generation {}, {} of {} episodes placed \
-                     objects (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
-                    stage.name,
-                    stats.stage_generation,
-                    stats.crowded_episodes,
-                    u64::from(evo.population) * u64::from(evo.evaluations.max(1))
-                )));
+                self.observer.event(Event::Warning(crowded_generation(&stage.name, evo, &stats)));
             }
             if self.stopped() && !evolve::is_finished(program, &cp) {
                 self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: false });
@@ -961,6 +908,95 @@ impl Runner<'_> {
         });
         Ok(cp)
     }
+
+    /// Evolved stage `index`'s checkpoint to go on from: `existing`
+    /// resumed (the same seed, fitting the program), or a new start from
+    /// `parent`'s population; and the stage checked runnable, since every
+    /// individual would silently score 0 on a stage the controller cannot
+    /// run (e.g. weights of a training stage that was not bound).
+    fn start_or_resume(
+        &self,
+        program: &Program,
+        index: usize,
+        seed: u64,
+        parent: Option<&Checkpoint>,
+        path: &Path,
+        existing: Option<Checkpoint>,
+    ) -> Result<Checkpoint> {
+        let stage = &program.stages[index];
+        let cp = match existing {
+            Some(mut cp) => {
+                if cp.seed != seed {
+                    return Err(other_seed(path, cp.seed, seed));
+                }
+                evolve::resume(program, index, &mut cp).map_err(|e| stale(path, &e))?;
+                if let StageRun::Evolve(evo) = &stage.run {
+                    self.observer.event(Event::Resumed {
+                        stage: &stage.name,
+                        generation: cp.generation,
+                        generations: evo.generations,
+                        finished: evolve::is_finished(program, &cp) && cp.validated,
+                        checkpoint: path,
+                    });
+                }
+                cp
+            }
+            None => evolve::start_stage(program, index, seed, parent)
+                .map_err(|e| Error::io(format!("error: {e}")))?,
+        };
+        let probe = Genome::zeros(stage.layout.bits as usize);
+        shaping_runtime::controller::validate(stage, &probe).map_err(|e| {
+            Error::new(ErrorKind::Invalid, format!("error: stage `{}` cannot run: {e}", stage.name))
+        })?;
+        Ok(cp)
+    }
+}
+
+/// A generation (or the choice of the best) of the stage of `cp` given up
+/// for Ctrl-C: dropped whole, and where the same command goes on.
+fn dropped(program: &Program, cp: &Checkpoint, path: &Path) -> Error {
+    let stage = &program.stages[cp.stage];
+    let generations = match &stage.run {
+        StageRun::Evolve(evo) => evo.generations,
+        _ => cp.generation,
+    };
+    interrupted(if evolve::is_finished(program, cp) {
+        format!(
+            "interrupted: stage `{}` stopped while choosing its best, which is dropped; its generations \
+             are saved in `{}`, and the same command resumes it",
+            stage.name,
+            path.display()
+        )
+    } else if cp.generation == 0 {
+        format!(
+            "interrupted: stage `{}` stopped in its first generation, which is dropped; nothing of the \
+             stage was saved, and the same command runs it",
+            stage.name
+        )
+    } else {
+        format!(
+            "interrupted: stage `{}` stopped in generation {} of {}, which is dropped; the {} before it \
+             are saved in `{}`, and the same command resumes it",
+            stage.name,
+            cp.generation + 1,
+            generations,
+            cp.generation,
+            path.display()
+        )
+    })
+}
+
+/// The warning of the first generation of stage `name` with crowded
+/// episodes.
+fn crowded_generation(name: &str, evo: &shaping_runtime::program::Evolution, stats: &GenStats) -> String {
+    format!(
+        "warning: the world of stage `{}` is too crowded: in generation {}, {} of {} episodes placed \
+         objects (or the robot) overlapping; the run goes on, and the end of the stage gives the count",
+        name,
+        stats.stage_generation,
+        stats.crowded_episodes,
+        u64::from(evo.population) * u64::from(evo.evaluations.max(1))
+    )
 }
 
 /// The crowded episodes of evolved stage `name`: its generations in the
