@@ -383,6 +383,64 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    /// `place ... at (X, Y)` where the body would cross the arena's walls.
+    #[error("the placement{name} puts the body (radius {radius} mm) across the arena's walls ({width} x {depth} mm)")]
+    #[diagnostic(code(S0033), help("keep the place at least {radius} mm from every wall of the arena; coordinates are mm east and north of its south-west corner"))]
+    PlaceOutside {
+        #[label("the robot does not fit here")]
+        span: SourceSpan,
+        name: String,
+        radius: f32,
+        width: f32,
+        depth: f32,
+    },
+
+    /// `place ... at (X, Y)` where the body would overlap an inner wall or
+    /// a cylinder.
+    #[error("the placement{name} puts the body inside {what}")]
+    #[diagnostic(code(S0034), help("move the place so that the body (radius {radius} mm) clears {what}"))]
+    PlaceBlocked {
+        #[label(primary, "the body overlaps it here")]
+        span: SourceSpan,
+        #[label("declared here")]
+        other: Option<SourceSpan>,
+        name: String,
+        what: String,
+        radius: f32,
+    },
+
+    /// `place` in a world of a team: every robot would be put on one spot.
+    #[error(
+        "the placement{name} would put the {robots} robots of the team on one spot, on top of each other"
+    )]
+    #[diagnostic(code(S0035), help("a placement moves the world's one robot; keep `place` for worlds without `robots N` (or with `robots 1`)"))]
+    PlaceTeam {
+        #[label(primary, "every robot is put here")]
+        span: SourceSpan,
+        #[label("{robots} robots")]
+        robots_span: Option<SourceSpan>,
+        name: String,
+        robots: u32,
+    },
+
+    /// `place ... after N actions` in a stage whose lives end before.
+    #[error("the placement{name} comes after action {after}, but stage `{stage}`'s lives last {life} actions: it never happens")]
+    #[diagnostic(
+        code(S0036),
+        help("place the robot after fewer actions (at most {last}), or give the stage longer lives")
+    )]
+    PlaceAfterLife {
+        #[label(primary, "never reached")]
+        span: SourceSpan,
+        #[label("the lives' length")]
+        life_span: Option<SourceSpan>,
+        name: String,
+        stage: String,
+        after: u32,
+        life: u32,
+        last: u32,
+    },
 }
 
 impl Error {

@@ -259,6 +259,34 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: concat!(robot!(), "stage s {\n  world { lamp sun at (200mm, 300mm) }\n  variants mean { near { lamp sun at (100mm, 100mm) } far { } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage dim extends s {\n  world changes { lamp sun at (200mm, 300mm) intensity 0.5 }\n  test best for 2 lives of 300 actions\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { lamp sun at (200mm, 300mm) }\n  variants mean { near { lamp sun at (100mm, 100mm) } far { } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\nstage dim extends s {\n  world changes { lamp sun at (200mm, 300mm) intensity 0.5 }\n  variants mean { near { lamp sun at (100mm, 100mm) intensity 0.5 } far { } }\n  test best for 2 lives of 300 actions\n}\n"),
     },
+    Explanation {
+        code: "S0033",
+        title: "a placement where the body crosses the arena's walls",
+        text: "`place [NAME] at (X, Y) heading A after N actions` puts the robot's centre at (X, Y) during the life. The body (the Khepera's radius is 27.5 mm) must lie inside the arena: X between the radius and the arena's width less the radius, Y likewise with its depth. Coordinates are mm east and north of the arena's south-west corner.",
+        wrong: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (390mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (300mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0034",
+        title: "a placement inside a wall or a cylinder",
+        text: "A placement puts the robot's body where it says, without moving it there: a place where the body would overlap an inner wall or a cylinder would leave it stuck inside an obstacle. Move the place so that the body (its radius from the centre) clears every wall and cylinder of the world (and of every variant that has the placement).",
+        wrong: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (210mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (300mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0035",
+        title: "a placement in the world of a team",
+        text: "A placement moves the world's robot to one pose. In a world of a team (`robots N` with N above 1) every robot would be put on that one spot, on top of each other; a placement is for a world with one robot.",
+        wrong: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    robots 3\n    place cue_read at (300mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (300mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+    },
+    Explanation {
+        code: "S0036",
+        title: "a placement after the life's last action",
+        text: "`place ... after N actions` happens after the life's Nth action, before the next one. A stage whose lives last N actions or fewer (`evolve { actions N }`, `test best for N actions`, `train for N actions`) never reaches it, so the placement would silently do nothing: place the robot after fewer actions, or make the lives longer.",
+        wrong: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (300mm, 100mm) heading 90 after 60 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world {\n    arena 400mm x 400mm\n    wall divider from (200mm, 0mm) to (200mm, 300mm)\n    place cue_read at (300mm, 100mm) heading 90 after 20 actions\n  }\n  evolve { actions 60 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+    },
 ];
 
 /// The explanation of a code (`S0006`, any case).

@@ -278,6 +278,9 @@ pub struct Items {
     /// Where the robot starts; `None`: anywhere free, at a random heading.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub start: Option<Start>,
+    /// Where the robot is put during the life (`place ... after N actions`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub places: Vec<Placement>,
 }
 
 impl Items {
@@ -327,6 +330,19 @@ pub struct LampSwitch {
     pub on: bool,
     /// After this many actions of the life (at least 1).
     pub at: u32,
+}
+
+/// `place [NAME] at (X, Y) heading A after N actions`: after the life's
+/// `N`th action the robot is put at `at`, facing `heading` (radians,
+/// counter-clockwise from east), wherever it was: what it did since the
+/// start leaves nothing in its pose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Placement {
+    pub name: Option<String>,
+    pub at: [f32; 2],
+    pub heading: f32,
+    /// After this many actions of the life (at least 1).
+    pub after: u32,
 }
 
 /// A rectangle of the floor with a grey level (what a ground sensor reads

@@ -16,7 +16,7 @@ use crate::catalog::{self, ACT_SLOTS, CHANNELS};
 use crate::expr::{Expr, Op};
 use crate::limits::*;
 use crate::program::*;
-use crate::world::{crowded, Blocker, Crowded};
+use crate::world::{blocker, crowded, Blocker, Crowded};
 
 /// Why a program was refused: the stage (when the problem is in one), the
 /// field (a path like `modules[1] (avoid).activation.params[3]`) and what is
@@ -445,6 +445,15 @@ fn world(at: &At, w: &World) -> R {
         Blocker::Wall(i) => format!("inner wall {i}"),
         Blocker::Cylinder(i) => format!("cylinder {i}"),
     };
+    for (i, p) in w.items.places.iter().enumerate() {
+        let at = at.field("items").field("places").index(i);
+        at.ensure(w.robots == 1, || {
+            format!("a team of {} robots would all be placed at one spot, on top of each other", w.robots)
+        })?;
+        if let Some(b) = blocker(&w.items, p.at, w.body.radius) {
+            at.err(format!("the placement puts the body inside {}", item(b)))?;
+        }
+    }
     match crowded(w) {
         None => Ok(()),
         Some(Crowded::Objects { need, room }) => at.field("objects").err(format!(
@@ -489,6 +498,20 @@ fn items(at: &At, it: &Items, arena: [f32; 2], radius: f32) -> R {
     named("cylinders", &mut it.cylinders.iter().map(|c| &c.name))?;
     named("lamps", &mut it.lamps.iter().map(|l| &l.name))?;
     named("zones", &mut it.zones.iter().map(|z| &z.name))?;
+    named("places", &mut it.places.iter().map(|p| &p.name))?;
+    at.field("places").ensure(it.places.len() <= MAX_ITEMS, || {
+        format!("{} places, more than the limit of {MAX_ITEMS}", it.places.len())
+    })?;
+    let fits = |p: [f32; 2]| {
+        p[0] >= radius && p[1] >= radius && p[0] <= arena[0] - radius && p[1] <= arena[1] - radius
+    };
+    for (i, p) in it.places.iter().enumerate() {
+        let at = at.field("places").index(i);
+        point(&at.field("at"), p.at)?;
+        at.field("heading").within(p.heading, -1e4, 1e4)?;
+        at.field("after").count(p.after, 1, crate::limits::MAX_ACTIONS)?;
+        at.ensure(fits(p.at), || "the placement leaves the body outside the arena".into())?;
+    }
     for (i, w) in it.walls.iter().enumerate() {
         let at = at.field("walls").index(i);
         point(&at.field("from"), w.from)?;

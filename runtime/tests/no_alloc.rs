@@ -10,7 +10,7 @@ use rand_chacha::ChaCha8Rng;
 use shaping_runtime::catalog::CHANNELS;
 use shaping_runtime::controller::{run_episode, EpisodeOptions};
 use shaping_runtime::program::{
-    Behavior, Cylinder, InnerWall, Items, Lamp, Network, Param, Stage, Start, Zone,
+    Behavior, Cylinder, InnerWall, Items, Lamp, Network, Param, Placement, Stage, Start, Zone,
 };
 use shaping_runtime::sim::{Command, Sim};
 use shaping_runtime::testkit;
@@ -50,6 +50,7 @@ fn with_items() -> Stage {
         lamps: vec![Lamp { name: None, at: [300.0, 100.0], height: 100.0, intensity: 1.0, switch: None }],
         zones: vec![Zone { name: None, from: [0.0, 0.0], to: [120.0, 120.0], grey: 0.0, charger: true }],
         start: Some(Start { from: [150.0, 300.0], to: [250.0, 400.0], heading: None }),
+        places: vec![Placement { name: None, at: [200.0, 300.0], heading: 0.0, after: 50 }],
     };
     for m in &mut stage.modules {
         if let Behavior::Neural(nb) = &mut m.behavior {

@@ -305,6 +305,49 @@ fn a_lamp_switches_after_the_declared_action() {
     assert!(sim.scene().dark_lamps.is_empty());
 }
 
+#[test]
+fn a_placement_puts_the_robot_after_the_declared_action() {
+    use shaping_runtime::program::Placement;
+    let north = std::f32::consts::FRAC_PI_2;
+    let place = Placement { name: None, at: [300.0, 400.0], heading: 0.0, after: 3 };
+    let mut sim = Sim::new(&world(Items { places: vec![place], ..Items::default() }), 1);
+    assert!(sim.set_pose(Pose { x: 100.0, y: 100.0, theta: north }));
+    for _ in 0..2 {
+        sim.step(&forward());
+    }
+    let before = sim.pose();
+    assert!(before.y > 100.0 && before.x == 100.0, "{before:?}");
+    sim.step(&forward());
+    // After the third action: at the place, facing east, whatever it did.
+    assert_eq!(sim.pose(), Pose { x: 300.0, y: 400.0, theta: 0.0 });
+    assert_eq!(sim.placement_failures(), 0);
+    sim.step(&forward());
+    let after = sim.pose();
+    assert!(after.x > 300.0 && (after.y - 400.0).abs() < 1e-3, "{after:?}");
+}
+
+#[test]
+fn validation_refuses_a_placement_outside_in_a_wall_or_for_a_team() {
+    use shaping_runtime::program::Placement;
+    let check = |items: Items, robots: u32| {
+        let mut s = shaping_runtime::testkit::navigation();
+        s.world = World { robots, ..world(items) };
+        shaping_runtime::validate::stage(&s).err().map(|e| e.to_string())
+    };
+    let at = |x: f32, y: f32| Items {
+        walls: vec![InnerWall { name: None, from: [200.0, 0.0], to: [200.0, 300.0] }],
+        places: vec![Placement { name: None, at: [x, y], heading: 0.0, after: 5 }],
+        ..Items::default()
+    };
+    assert_eq!(check(at(300.0, 100.0), 1), None);
+    let e = check(at(390.0, 100.0), 1).unwrap();
+    assert!(e.contains("outside the arena"), "{e}");
+    let e = check(at(210.0, 100.0), 1).unwrap();
+    assert!(e.contains("inside inner wall 0"), "{e}");
+    let e = check(at(300.0, 100.0), 2).unwrap();
+    assert!(e.contains("on top of each other"), "{e}");
+}
+
 /// The per-sensor code gives the same bits on the AVX2 path (where the CPU
 /// has it) as on the portable one: percepts and poses of whole lives in a
 /// world with every kind of surface and light (inner walls, cylinders,

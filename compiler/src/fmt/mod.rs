@@ -759,6 +759,13 @@ impl F<'_> {
                 }
                 t
             }
+            WorldItem::Place { name, at, heading, after, .. } => format!(
+                "place{} at {} heading {} after {}",
+                self.item_name(name),
+                self.point(at),
+                self.qty(heading),
+                self.qty(after)
+            ),
             WorldItem::Body { preset, items, span } => {
                 let head = preset.as_ref().map_or("body".to_string(), |p| format!("body {}", p.text));
                 if !self.lx.tokens_in(*span).iter().any(|t| self.text(t.span) == "{") {

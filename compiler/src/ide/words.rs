@@ -205,6 +205,8 @@ const LIST: &[Word] = &[
     w("lamp", C, WORLD | CLAUSE, "`lamp [NAME] at (X, Y) [height H] [intensity K]`: a lamp", ITEMS),
     w("zone", C, WORLD, "`zone [NAME] from (X, Y) to (X, Y) [grey G] [charger]`: a rectangle of the floor", ITEMS),
     w("start", C, WORLD, "`start at (X, Y) [heading A]`: where the robot starts", ITEMS),
+    w("place", C, WORLD, "`place [NAME] at (X, Y) heading A after N actions`: after the life's Nth action the robot is put there, wherever it was", ITEMS),
+    w("after", C, CLAUSE, "`after N actions`: when a `place` puts the robot", ITEMS),
     w("diameter", C, CLAUSE, "`diameter D`: of objects or a cylinder", WORLD_S),
     w("physical", C, CLAUSE, "objects that block the robot", WORLD_S),
     w("virtual", C, CLAUSE, "objects that only add sensor readings", WORLD_S),

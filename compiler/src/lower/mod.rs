@@ -1080,6 +1080,8 @@ impl<'a> Lower<'a> {
         self.check_team(&st.world, decl.span);
         self.variants_decl(&mut st, decl);
         self.run(&mut st, decl, parent.is_some());
+        let (life, life_span) = life(&st.run, decl);
+        self.check_place_life(&st.world, decl.span, &sname, life, life_span);
         let hw = Hw {
             stage: sname.clone(),
             sensors: st.sensors.clone(),
@@ -1176,6 +1178,22 @@ impl<'a> Lower<'a> {
         self.check_lamp(&st, &stage, s);
         (st, stage)
     }
+}
+
+/// The length of a stage's lives (actions), and where `decl` sets it
+/// (`actions` of `evolve`, a `test` or `train` clause), if it does.
+fn life(run: &StageRun, decl: &ast::StageDecl) -> (u32, Option<Span>) {
+    use ast::StageItem as I;
+    let span = decl.items.iter().rev().find_map(|i| match i {
+        I::Evolve(settings, _) => settings.iter().rev().find(|s| s.name.text == "actions").map(|s| s.span),
+        I::Test { span, .. } | I::Train { span, .. } => Some(*span),
+        _ => None,
+    });
+    let life = match run {
+        StageRun::Evolve(e) => e.actions,
+        StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions,
+    };
+    (life, span)
 }
 
 impl Lower<'_> {

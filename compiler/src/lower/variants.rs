@@ -166,6 +166,8 @@ impl Lower<'_> {
             self.check_items(&ws, d.span);
             self.check_crowded(&ws, d.span);
             self.check_team(&ws, d.span);
+            let (life, _) = super::life(&st.run, decl);
+            self.check_place_life(&ws, d.span, sname, life, None);
             let mut world = ws.world;
             world.arena = st.world.world.arena;
             world.body = st.world.world.body.clone();

@@ -267,6 +267,23 @@ impl Lower<'_> {
                     ws.world.items.start = Some(Start { from, to, heading });
                     ws.spans.insert("start", *span);
                 }
+                W::Place { name, at, heading, after, span } => {
+                    let at = self.point(at, "the place");
+                    let h = self.heading(heading).map(|d| d.to_radians());
+                    let n = self.count_in(after, "the action a placement follows", 1, MAX_ACTIONS.into());
+                    let (Some(at), Some(heading), Some(n)) = (at, h, n) else {
+                        refuse(ws, "place", name.as_ref());
+                        continue;
+                    };
+                    let p = Placement {
+                        name: name.as_ref().map(|n| n.text.clone()),
+                        at,
+                        heading,
+                        after: n as u32,
+                    };
+                    let place = self.place(ws, block, stage, "place", name.as_ref(), *span);
+                    put(&mut ws.world.items.places, place, p);
+                }
             }
         }
     }
@@ -294,6 +311,7 @@ impl Lower<'_> {
             "wall" => ws.world.items.walls.iter().map(|x| x.name.as_deref()).collect(),
             "cylinder" => ws.world.items.cylinders.iter().map(|x| x.name.as_deref()).collect(),
             "lamp" => ws.world.items.lamps.iter().map(|x| x.name.as_deref()).collect(),
+            "place" => ws.world.items.places.iter().map(|x| x.name.as_deref()).collect(),
             _ => ws.world.items.zones.iter().map(|x| x.name.as_deref()).collect(),
         };
         let spans = ws.item_spans.entry(kind).or_default();
@@ -413,11 +431,59 @@ impl Lower<'_> {
                 );
             }
         }
+        let r = ws.world.body.radius;
+        for (p, sp) in items.places.iter().zip(spans("place")) {
+            if !here(&sp) {
+                continue;
+            }
+            let name = item_name(&p.name);
+            let fits = p.at[0] >= r && p.at[1] >= r && p.at[0] <= w - r && p.at[1] <= d - r;
+            if !fits {
+                self.errors.push(Error::PlaceOutside {
+                    span: sp.into(),
+                    name,
+                    radius: r,
+                    width: w,
+                    depth: d,
+                });
+                continue;
+            }
+            let (what, other) = match blocker(items, p.at, r) {
+                None => continue,
+                Some(Blocker::Wall(i)) => {
+                    (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied())
+                }
+                Some(Blocker::Cylinder(i)) => (
+                    format!("the cylinder{}", item_name(&items.cylinders[i].name)),
+                    spans("cylinder").get(i).copied(),
+                ),
+            };
+            self.errors.push(Error::PlaceBlocked {
+                span: sp.into(),
+                other: other.map(Into::into),
+                name,
+                what,
+                radius: r,
+            });
+        }
+        if ws.world.robots > 1 {
+            let robots_span = ws.spans.get("robots").copied();
+            let robots_here = robots_span.is_some_and(|sp| here(&sp));
+            if let Some((p, sp)) =
+                items.places.iter().zip(spans("place")).find(|(_, sp)| robots_here || here(sp))
+            {
+                self.errors.push(Error::PlaceTeam {
+                    span: sp.into(),
+                    robots_span: robots_span.map(Into::into),
+                    name: item_name(&p.name),
+                    robots: ws.world.robots,
+                });
+            }
+        }
         let (Some(s), Some(sp)) = (&items.start, ws.spans.get("start")) else { return };
         if !here(sp) {
             return;
         }
-        let r = ws.world.body.radius;
         let fits = |p: [f32; 2]| p[0] >= r && p[1] >= r && p[0] <= w - r && p[1] <= d - r;
         if !(fits(s.from) && fits(s.to)) {
             self.value_error(
@@ -448,6 +514,36 @@ impl Lower<'_> {
             label: "the body overlaps it here".into(),
             other_label: "declared here".into(),
         });
+    }
+
+    /// Placements after the life's last action (`life` actions, set at
+    /// `life_span` when this stage sets it): they never happen. Reported
+    /// for the placements declared in `decl` (a stage or a variant), and
+    /// for all of them when the stage sets the life.
+    pub(super) fn check_place_life(
+        &mut self,
+        ws: &WorldSt,
+        decl: Span,
+        stage: &str,
+        life: u32,
+        life_span: Option<Span>,
+    ) {
+        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
+        let spans = ws.item_spans.get("place").cloned().unwrap_or_default();
+        for (p, sp) in ws.world.items.places.iter().zip(spans) {
+            if p.after < life || !(here(&sp) || life_span.is_some_and(|l| here(&l))) {
+                continue;
+            }
+            self.errors.push(Error::PlaceAfterLife {
+                span: sp.into(),
+                life_span: life_span.map(Into::into),
+                name: item_name(&p.name),
+                stage: stage.to_string(),
+                after: p.after,
+                life,
+                last: life.saturating_sub(1),
+            });
+        }
     }
 
     /// A world whose objects or robot can never be placed, whatever the

@@ -272,6 +272,14 @@ pub enum WorldItem {
         heading: Option<Quantity>,
         span: Span,
     },
+    /// `place [NAME] at (X, Y) heading A after N actions`
+    Place {
+        name: Option<Name>,
+        at: Point,
+        heading: Quantity,
+        after: Quantity,
+        span: Span,
+    },
 }
 
 /// `(X, Y)` in a world item.
@@ -301,6 +309,7 @@ impl WorldItem {
             WorldItem::Lamp { name: n, .. } => ("lamp", name(n)),
             WorldItem::Zone { name: n, .. } => ("zone", name(n)),
             WorldItem::Start { .. } => ("start", None),
+            WorldItem::Place { name: n, .. } => ("place", name(n)),
         }
     }
 
@@ -317,7 +326,8 @@ impl WorldItem {
             | WorldItem::Cylinder { span, .. }
             | WorldItem::Lamp { span, .. }
             | WorldItem::Zone { span, .. }
-            | WorldItem::Start { span, .. } => *span,
+            | WorldItem::Start { span, .. }
+            | WorldItem::Place { span, .. } => *span,
         }
     }
 }

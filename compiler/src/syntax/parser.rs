@@ -317,6 +317,8 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::lamp_item | Rule::k_lamp => "`lamp`",
         Rule::zone | Rule::k_zone => "`zone`",
         Rule::start | Rule::k_start => "`start`",
+        Rule::place | Rule::k_place => "`place`",
+        Rule::place_after | Rule::k_after => "`after N actions`",
         Rule::item_name => "a name",
         Rule::k_from => "`from`",
         Rule::k_at => "`at`",
@@ -526,12 +528,13 @@ pub(super) fn syntax_error_shifted(src: &str, e: pest::error::Error<Rule>, shift
 }
 
 /// The forms of the world items placed by a point.
-const PLACED_ITEMS: [(&str, &str); 5] = [
+const PLACED_ITEMS: [(&str, &str); 6] = [
     ("lamp", "lamp [NAME] at (X, Y) [height H] [intensity K]"),
     ("cylinder", "cylinder [NAME] at (X, Y) diameter D"),
     ("wall", "wall [NAME] from (X, Y) to (X, Y)"),
     ("zone", "zone [NAME] from (X, Y) to (X, Y) [grey G] [charger]"),
     ("start", "start at (X, Y) [heading A]` or `start from (X, Y) to (X, Y) [heading A]"),
+    ("place", "place [NAME] at (X, Y) heading A after N actions"),
 ];
 
 /// A world item without its position (`lamp sun intensity 0.5`), where the
@@ -1334,13 +1337,14 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 }
                 items.push(WorldItem::Body { preset, items: body, span: csp });
             }
-            Rule::inner_wall | Rule::cylinder | Rule::lamp_item | Rule::zone | Rule::start => {
+            Rule::inner_wall | Rule::cylinder | Rule::lamp_item | Rule::zone | Rule::start | Rule::place => {
                 let rule = c.as_rule();
                 let mut name_ = None;
                 let mut points = Vec::new();
                 let (mut diameter, mut height, mut intensity, mut grey, mut heading) =
                     (None, None, None, None, None);
                 let mut switch = None;
+                let mut after = None;
                 let mut charger = false;
                 for o in c.into_inner() {
                     match o.as_rule() {
@@ -1363,6 +1367,9 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                         Rule::zone_grey => grey = o.into_inner().next().map(quantity),
                         Rule::zone_charger => charger = true,
                         Rule::heading => heading = o.into_inner().next().map(quantity),
+                        Rule::place_after => {
+                            after = o.into_inner().find(|q| q.as_rule() == Rule::quantity).map(quantity)
+                        }
                         _ => {}
                     }
                 }
@@ -1390,6 +1397,13 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                         to: second.unwrap_or(p0),
                         grey,
                         charger,
+                        span: csp,
+                    },
+                    Rule::place => WorldItem::Place {
+                        name: name_,
+                        at: first,
+                        heading: heading.unwrap_or(q0.clone()),
+                        after: after.unwrap_or(q0),
                         span: csp,
                     },
                     _ => WorldItem::Start { from: first, to: second, heading, span: csp },

@@ -75,10 +75,14 @@ fn kind(e: &Error) -> &'static str {
         Error::NotASensor { .. } => "NotASensor",
         Error::NoLamp { .. } => "NoLamp",
         Error::VariantUndoesChange { .. } => "VariantUndoesChange",
+        Error::PlaceOutside { .. } => "PlaceOutside",
+        Error::PlaceBlocked { .. } => "PlaceBlocked",
+        Error::PlaceTeam { .. } => "PlaceTeam",
+        Error::PlaceAfterLife { .. } => "PlaceAfterLife",
     }
 }
 
-const KINDS: [&str; 32] = [
+const KINDS: [&str; 36] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -111,6 +115,10 @@ const KINDS: [&str; 32] = [
     "NotASensor",
     "NoLamp",
     "VariantUndoesChange",
+    "PlaceOutside",
+    "PlaceBlocked",
+    "PlaceTeam",
+    "PlaceAfterLife",
 ];
 
 #[test]

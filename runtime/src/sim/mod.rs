@@ -180,8 +180,11 @@ pub struct Sim {
     lamps: Vec<Lamp>,
     /// Some declared lamp switches on or off during the life.
     switches: bool,
-    /// Actions done (the clock of the lamps' switches).
+    /// Actions done (the clock of the lamps' switches and the placements).
     actions: u32,
+    /// Where the robot is put after the life's Nth action (`place`), in
+    /// the order declared.
+    places: Vec<(u32, Pose)>,
     /// Inner walls or cylinders may shade a sensor from a lamp.
     shades: bool,
     zones: Vec<FloorZone>,
@@ -536,6 +539,14 @@ impl Sim {
             cylinders,
             switches: lamps.iter().any(|l: &Lamp| l.switch.is_some()),
             actions: 0,
+            places: items
+                .places
+                .iter()
+                .map(|p| {
+                    let at = pt(p.at);
+                    (p.after, Pose { x: at.x, y: at.y, theta: finite_or(p.heading, 0.0) })
+                })
+                .collect(),
             lamps,
             zones,
             ground: std::array::from_fn(|k| body.ground.get(k).map_or(Point2::origin(), |&p| pt(p))),
@@ -1026,7 +1037,23 @@ impl Sim {
                 }
             }
         }
+        if !self.places.is_empty() {
+            self.place_after(self.actions);
+        }
         out
+    }
+
+    /// The placements due after `done` actions: the robot is put there
+    /// (a place overlapping a physical object on the floor counts as a
+    /// placement failure, [`Sim::placement_failures`]; walls and cylinders
+    /// the compiler keeps clear).
+    fn place_after(&mut self, done: u32) {
+        let due: Option<Pose> = self.places.iter().rev().find(|(at, _)| *at == done).map(|(_, p)| *p);
+        if let Some(pose) = due {
+            let free = self.free(&Point2::new(pose.x, pose.y));
+            self.placement_failures = self.placement_failures.saturating_add(u32::from(!free));
+            self.set_pose_unchecked(pose);
+        }
     }
 
     /// Actions done in this world so far.
