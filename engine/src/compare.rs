@@ -209,7 +209,7 @@ pub fn tests(groups: &[(String, Vec<StageMeasures>)]) -> Tests {
 }
 
 /// Digits a measure's values are shown with.
-fn digits(measure: &str) -> usize {
+pub(crate) fn digits(measure: &str) -> usize {
     match measure {
         // A median of an even count may fall halfway.
         "generation_reaching_criterion" | "evaluations_reaching_criterion" => 1,
@@ -219,7 +219,7 @@ fn digits(measure: &str) -> usize {
     }
 }
 
-fn p_text(p: f64) -> String {
+pub(crate) fn p_text(p: f64) -> String {
     if p >= 0.001 {
         format!("{p:.4}")
     } else {

@@ -127,6 +127,64 @@ fn a_sweeps_tests_are_compares_of_its_points() {
     );
 }
 
+/// The report's page shows the statistics of `summary.json` (the same
+/// numbers, not computed again): a sweep's page each pair's p-value, Holm's
+/// and A12, a plain experiment's page its medians with their intervals.
+#[test]
+fn the_report_shows_the_summarys_tests() {
+    let d = tempfile::tempdir().unwrap();
+    let sets = vec![parse_set("first.evolve.mutation=0.01,0.2,0.5").unwrap()];
+    experiment(tiny(), ExperimentOptions { sets, no_report: false, ..tiny_experiment(d.path(), 3) }).unwrap();
+    let summary = read_json(&d.path().join("summary.json"));
+    let tests: Tests = serde_json::from_value(summary["tests"].clone()).unwrap();
+    let p_text = |p: f64| if p >= 0.001 { format!("{p:.4}") } else { format!("{p:.1e}") };
+    let point = d.path().join(summary["points"][1]["dir"].as_str().unwrap());
+    for page in [d.path().join("report.html"), point.join("report.html")] {
+        let html = std::fs::read_to_string(&page).unwrap();
+        let at = html.find("<section id=\"sec-stats\"").unwrap_or_else(|| panic!("{}", page.display()));
+        let end = at + html[at..].find("</section>").unwrap();
+        let section = &html[at..end];
+        assert!(section.contains("Holm-corrected"), "{section}");
+        assert!(section.contains("<code>first.evolve.mutation=0.5</code>"), "{section}");
+        for m in &tests.measures {
+            for p in &m.pairs {
+                let row = format!(
+                    "<tr><td>{}</td><td>{}</td><td>{} vs {}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{:.3}</td>",
+                    m.stage,
+                    m.measure.replace('_', " "),
+                    p.a,
+                    p.b,
+                    p.u.unwrap(),
+                    p_text(p.p_value.unwrap()),
+                    p_text(p.p_holm.unwrap()),
+                    p.a12.unwrap()
+                );
+                assert!(section.contains(&row), "{row}\n{section}");
+            }
+            let g = &m.groups[1];
+            let (x, ci) = (g.median.unwrap(), g.interval.unwrap());
+            let cell = format!("<td class=\"num\">{x:.3} [{:.3}, {:.3}] ({})</td>", ci.low, ci.high, g.seeds);
+            assert!(m.measure.contains("criterion") || section.contains(&cell), "{cell}\n{section}");
+        }
+    }
+    // One experiment: its medians and intervals, no pairs.
+    let one = d.path().join("one");
+    experiment(tiny(), ExperimentOptions { no_report: false, ..tiny_experiment(&one, 3) }).unwrap();
+    let html = std::fs::read_to_string(one.join("report.html")).unwrap();
+    let tests: Tests = serde_json::from_value(read_json(&one.join("summary.json"))["tests"].clone()).unwrap();
+    let m = &tests.measures[0];
+    let (x, ci) = (m.groups[0].median.unwrap(), m.groups[0].interval.unwrap());
+    let row = format!(
+        "<tr><td>{}</td><td>{}</td><td class=\"num\">{x:.3} [{:.3}, {:.3}] (3)</td></tr>",
+        m.stage,
+        m.measure.replace('_', " "),
+        ci.low,
+        ci.high
+    );
+    assert!(html.contains(&row), "{row}");
+    assert!(html.contains("id=\"stats-medians\"") && !html.contains("id=\"stats-tests\""));
+}
+
 #[test]
 fn compare_refuses_different_stages_single_seeds_and_missing_measures() {
     let d = tempfile::tempdir().unwrap();

@@ -1616,6 +1616,59 @@ impl Experiment {
         py.import("json")?.call_method1("loads", (text,))
     }
 
+    /// The statistics of `summary.json` (its `tests`), per stage and
+    /// measure: each group's median over the seeds with its bootstrap 95%
+    /// interval. A group is the experiment, or a point of a sweep.
+    fn medians<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let t = self.tests_of_summary()?;
+        let out = PyList::empty(py);
+        for m in &t.measures {
+            for (g, figures) in t.groups.iter().zip(&m.groups) {
+                let d = PyDict::new(py);
+                d.set_item("stage", &m.stage)?;
+                d.set_item("measure", &m.measure)?;
+                d.set_item("group", g)?;
+                d.set_item("seeds", figures.seeds)?;
+                d.set_item("median", figures.median)?;
+                d.set_item("low", figures.interval.map(|i| i.low))?;
+                d.set_item("high", figures.interval.map(|i| i.high))?;
+                out.append(d)?;
+            }
+        }
+        Ok(out)
+    }
+
+    /// The tests of `summary.json` between the points of a sweep, per stage,
+    /// measure and pair: Mann-Whitney's U and `p_value`, `p_holm` (Holm's
+    /// correction over the measure's pairs with more than two points, else
+    /// None), Vargha-Delaney's `a12` (the probability that a seed of `a`
+    /// has the larger value), its `size` and the test's `method`; without a
+    /// test (a side with fewer than 2 seeds) these are None and `no_test`
+    /// says why. Empty for an experiment of one point.
+    fn tests<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let t = self.tests_of_summary()?;
+        let out = PyList::empty(py);
+        let name = |i: usize| t.groups.get(i.wrapping_sub(1)).cloned().unwrap_or_default();
+        for m in &t.measures {
+            for p in &m.pairs {
+                let d = PyDict::new(py);
+                d.set_item("stage", &m.stage)?;
+                d.set_item("measure", &m.measure)?;
+                d.set_item("a", name(p.a))?;
+                d.set_item("b", name(p.b))?;
+                d.set_item("u", p.u)?;
+                d.set_item("p_value", p.p_value)?;
+                d.set_item("p_holm", p.p_holm)?;
+                d.set_item("a12", p.a12)?;
+                d.set_item("size", p.size.map(|s| s.words()))?;
+                d.set_item("method", p.method.map(|m| m.words()))?;
+                d.set_item("no_test", p.no_test.as_deref())?;
+                out.append(d)?;
+            }
+        }
+        Ok(out)
+    }
+
     /// The reports written (`report.html` of each point, and of the sweep).
     #[getter]
     fn reports(&self) -> Vec<PathBuf> {
@@ -1624,6 +1677,23 @@ impl Experiment {
 
     fn __repr__(&self) -> String {
         format!("<Experiment {}: {} runs, seeds {:?}>", self.out.display(), self.runs.len(), self.seeds)
+    }
+}
+
+impl Experiment {
+    /// The `tests` of `summary.json`, as the experiment wrote them.
+    fn tests_of_summary(&self) -> PyResult<shaping_engine::compare::Tests> {
+        let path = self.out.join("summary.json");
+        let text = std::fs::read_to_string(&path)
+            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| ShapingError::new_err(format!("error: `{}` is not JSON: {e}", path.display())))?;
+        serde_json::from_value(value.get("tests").cloned().unwrap_or_default()).map_err(|e| {
+            ShapingError::new_err(format!(
+                "error: `{}` has no statistics (`tests`) of this version: {e}; run the experiment again",
+                path.display()
+            ))
+        })
     }
 }
 

@@ -491,6 +491,42 @@ def test_experiment_writes_what_the_cli_writes(tmp_path):
         )
 
 
+def test_experiment_gives_the_summarys_medians_and_tests(tmp_path):
+    """`medians()` and `tests()` are summary.json's `tests` as records: a
+    sweep of three points has each pair's p-value, Holm's and A12."""
+    exp = shaping.experiment(
+        TINY,
+        seeds=3,
+        out=tmp_path / "sweep",
+        set={"first.evolve.mutation": [0.01, 0.2, 0.5]},
+        report=False,
+    )
+    tests = exp.tests()
+    names = ["first.evolve.mutation=0.01", "first.evolve.mutation=0.2", "first.evolve.mutation=0.5"]
+    stored = exp.summary["tests"]
+    assert stored["groups"] == names and stored["holm"] is True
+    pairs = [(m, p) for m in stored["measures"] for p in m["pairs"]]
+    assert len(tests) == len(pairs) > 0
+    for t, (m, p) in zip(tests, pairs):
+        assert (t["stage"], t["measure"]) == (m["stage"], m["measure"])
+        assert (t["a"], t["b"]) == (names[p["a"] - 1], names[p["b"] - 1])
+        for key in ["u", "p_value", "p_holm", "a12", "size", "method"]:
+            assert t[key] == p[key], key
+        assert 0 <= t["p_value"] <= t["p_holm"] <= 1 and 0 <= t["a12"] <= 1
+        assert t["no_test"] is None
+    assert {(t["a"], t["b"]) for t in tests} == {(names[0], names[1]), (names[0], names[2]), (names[1], names[2])}
+    medians = exp.medians()
+    assert len(medians) == 3 * len(stored["measures"])
+    chosen = [r for r in medians if (r["stage"], r["measure"]) == ("second", "chosen_best")]
+    assert [r["group"] for r in chosen] == names
+    for r in chosen:
+        assert r["seeds"] == 3 and r["low"] <= r["median"] <= r["high"]
+    # One experiment: its medians, no pairs.
+    one = shaping.experiment(TINY, seeds=2, out=tmp_path / "one", report=False)
+    assert one.tests() == []
+    assert {r["group"] for r in one.medians()} == {"tiny"}
+
+
 def test_experiment_sweeps_a_list_of_values(tmp_path):
     exp = shaping.experiment(
         TINY,

@@ -49,6 +49,11 @@ pub struct ReportData {
     /// The name of the point shown (its settings).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sweep_point: Option<String>,
+    /// An experiment's or a sweep's statistics: the `tests` of its
+    /// `summary.json`, as the experiment computed them (the page shows
+    /// them; a summary written before them has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tests: Option<crate::compare::Tests>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -835,6 +840,7 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         episodes: Vec::new(),
         sweep: None,
         sweep_point: None,
+        tests: None,
     }
 }
 
@@ -878,6 +884,7 @@ fn sweep(dir: &Path, summary: ExperimentSummary, u: Unsealed<'_>) -> Result<Repo
     let name = best.name.clone();
     data.episodes_note = format!("the best point, {name}: {}", data.episodes_note);
     data.sweep_point = Some(name);
+    data.tests = Some(summary.tests.clone());
     data.sweep = Some(to_value(&summary)?);
     Ok(data)
 }
@@ -941,9 +948,12 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
         if let (Some(summary), Some(name)) = (summary, name) {
             if summary.points.iter().any(|x| x.dir == name) {
                 data.sweep_point = Some(name);
+                data.tests = Some(summary.tests.clone());
                 data.sweep = Some(to_value(&summary)?);
+                return Ok(data);
             }
         }
+        data.tests = summary_json(dir, u)?.map(|s| s.tests);
         return Ok(data);
     }
     if let Some(summary) = sweep_summary(dir, u)? {

@@ -4,6 +4,7 @@
 //! Nothing is fetched when the page opens.
 
 pub mod data;
+mod stats;
 
 #[cfg(test)]
 mod tests;
@@ -35,12 +36,19 @@ pub fn embedded_json(data: &ReportData) -> Result<String, Error> {
 pub fn page(data: &ReportData) -> Result<String, Error> {
     let title = escape_html(&format!("{} · shaping report", data.title));
     let json = embedded_json(data)?;
-    // The data go in last, so nothing in them is taken for a placeholder.
-    let mut out = String::with_capacity(TEMPLATE.len() + STYLE.len() + SCRIPT.len() + json.len());
+    let stats = data.tests.as_ref().map(stats::section).unwrap_or_default();
+    // Each mark is looked for in the rest of the template only, so nothing
+    // in the values is taken for a placeholder.
+    let mut out =
+        String::with_capacity(TEMPLATE.len() + STYLE.len() + SCRIPT.len() + json.len() + stats.len());
     let mut rest = TEMPLATE;
-    for (mark, value) in
-        [("{{title}}", title.as_str()), ("{{style}}", STYLE), ("{{data}}", &json), ("{{script}}", SCRIPT)]
-    {
+    for (mark, value) in [
+        ("{{title}}", title.as_str()),
+        ("{{style}}", STYLE),
+        ("{{stats}}", &stats),
+        ("{{data}}", &json),
+        ("{{script}}", SCRIPT),
+    ] {
         let Some(at) = rest.find(mark) else {
             return Err(Error::io(format!("error: the report template has no `{mark}`")));
         };

@@ -855,8 +855,14 @@
     });
   }
 
+  // ------------------------------------------------------------------ statistics
+  // The tables are in the page (summary.json's tests); link them when there.
+  function initStats() {
+    if (document.getElementById('sec-stats')) $('nav-stats').hidden = false;
+  }
+
   // ------------------------------------------------------------------ start
-  for (const [name, f] of [['sweep', initSweep], ['replay', initReplay], ['fitness', initFitness], ['architecture', initArchitecture], ['genome', initGenome]]) {
+  for (const [name, f] of [['sweep', initSweep], ['stats', initStats], ['replay', initReplay], ['fitness', initFitness], ['architecture', initArchitecture], ['genome', initGenome]]) {
     try { f(); } catch (e) { showError(name + ': ' + (e && e.stack ? e.stack : e)); }
   }
   document.body.dataset.ready = '1';

@@ -285,6 +285,7 @@ fn sample_data(title: &str) -> ReportData {
         episodes: vec![ep],
         sweep: None,
         sweep_point: None,
+        tests: None,
     }
 }
 
@@ -310,7 +311,7 @@ fn the_page_embeds_the_data_intact_even_when_it_holds_markup() {
     assert_eq!(back["episodes"][0]["actions"]["x"].as_array().unwrap().len(), 50);
     // The title element is escaped too, and every placeholder is filled.
     assert!(html.contains("<title>evil&lt;/script&gt;"));
-    for mark in ["{{title}}", "{{style}}", "{{data}}", "{{script}}"] {
+    for mark in ["{{title}}", "{{style}}", "{{stats}}", "{{data}}", "{{script}}"] {
         assert!(!html.contains(mark), "{mark} left in the page");
     }
     // Exactly the page's own two scripts: the data and the code.
@@ -439,4 +440,33 @@ fn frozen_genes_are_traced_to_the_parents_final_population() {
     let mut v = stage_view(&p, col, Some((&stranger, "collect/best.genome".into())));
     data::provenance(&p, col, nav, &stranger, &cp, None, &mut v);
     assert!(v.frozen_from.unwrap().contains("match no individual"));
+}
+
+/// The statistics section is the summary's tests, escaped; a page without
+/// tests has none.
+#[test]
+fn the_statistics_section_escapes_names_and_is_absent_without_tests() {
+    let measures = |v: &[f64]| {
+        vec![crate::compare::StageMeasures {
+            stage: "s".into(),
+            kind: "test",
+            measures: vec![("after_fitness", v.to_vec())],
+        }]
+    };
+    let t = crate::compare::tests(&[
+        ("<b>a</b>".into(), measures(&[0.1, 0.2, 0.3])),
+        ("b".into(), measures(&[0.5, 0.6, 0.7])),
+    ]);
+    let pair = &t.measures[0].pairs[0];
+    let (p, a12) = (pair.p_value.unwrap(), pair.a12.unwrap());
+    let mut data = sample_data("x");
+    assert!(!page(&data).unwrap().contains("<section id=\"sec-stats\""));
+    data.tests = Some(t);
+    let html = page(&data).unwrap();
+    assert!(html.contains("<code>&lt;b&gt;a&lt;/b&gt;</code>") && !html.contains("<b>a</b>"));
+    assert!(
+        html.contains(&format!("<td class=\"num\">{p:.4}</td><td class=\"num\">{a12:.3}</td>")),
+        "{p} {a12}"
+    );
+    assert!(!html.contains("Holm"));
 }

@@ -213,6 +213,19 @@ class Experiment:
     @property
     def summary_text(self) -> str:
         """The summary the command line prints."""
+    def medians(self) -> list[dict[str, Any]]:
+        """The statistics of ``summary.json`` (``tests``): per stage, measure and
+        group (the experiment, or a point of a sweep), a record with ``stage``,
+        ``measure``, ``group``, ``seeds``, ``median`` and its bootstrap 95%
+        interval ``low`` .. ``high``."""
+    def tests(self) -> list[dict[str, Any]]:
+        """The tests of ``summary.json`` between a sweep's points: per stage,
+        measure and pair of points ``a`` and ``b``, a record with ``u``,
+        ``p_value`` (two-sided Mann-Whitney U), ``p_holm`` (Holm's correction,
+        with more than two points; else None), ``a12`` (Vargha-Delaney: the
+        probability that a seed of ``a`` has the larger value), ``size``,
+        ``method`` and ``no_test`` (why there is no test, else None). Empty for
+        an experiment of one point."""
     @property
     def reports(self) -> list[str]: ...
 
