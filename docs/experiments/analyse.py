@@ -455,10 +455,10 @@ fin = [history("charger", s, "s")[-1] for s in SEEDS]
 print(f"  best_recharges per seed: {' '.join(map(str, ch))}; median {statistics.median(ch)}; final best {spread(fin, 1)}")
 
 print("\n== the T-maze (examples/t-maze.bat): share of 100 fresh lives in the cued arm, per seed")
-for net in ["recurrent", "feedforward"]:
+for net, run in [("recurrent", "t-maze"), ("feedforward", "t-maze-ff")]:
     shares, per = [], []
     for s in SEEDS:
-        with open(f"{R}/t-maze/seed-{s}/{net}_test/summary.json") as f:
+        with open(f"{R}/{run}/seed-{s}/maze_test/summary.json") as f:
             d = json.load(f)
         shares.append(d["fitness"])
         per.append("/".join(f"{v['fitness']:.2f}" for v in d["after_variants"]))

@@ -90,9 +90,17 @@ print(next(b for b in blocks if "1 per recharge" in b), end="")
 PY
 grep -q 'uses charger' $R/charger.bat
 $B experiment $R/charger.bat --seeds $SEEDS --out $R/charger --fresh > /dev/null
-# The cue-then-choose T-maze: a recurrent network and the feed-forward
-# control, each best tested on 100 fresh lives in the task's two variants.
+# The cue-then-choose T-maze: the cue read in a start box, then the robot
+# placed at the foot of the stem; the recurrent network (t-maze.bat) and
+# the feed-forward control (the same file without the context), each best
+# tested on 100 fresh lives in the task's two variants, and the test
+# between them (printed).
+sed 's#hidden 6 recurrent  outputs#hidden 6  outputs#' examples/t-maze.bat > $R/t-maze-ff.bat
+grep -q 'behavior neural { hidden 6  outputs linear' $R/t-maze-ff.bat
+[ "$(grep -c 'recurrent  outputs' $R/t-maze-ff.bat)" = 0 ]
 $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/null
+$B experiment $R/t-maze-ff.bat --seeds $SEEDS --out $R/t-maze-ff --fresh > /dev/null
+$B compare $R/t-maze $R/t-maze-ff --stage maze_test
 
 # Teams (EXPERIMENTS.md, "Teams: aggregation and cooperative collect"):
 # aggregation.bat's 10 robots, and team-collect.bat's 4 robots with 16

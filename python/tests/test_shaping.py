@@ -650,12 +650,12 @@ def test_genes_encode_refuses_nan_and_rounds_halves_as_the_runtime():
 
 
 def test_generations_of_a_stage_with_variants(tmp_path):
-    """examples/t-maze.bat's `recurrent` has four variants: their columns
+    """examples/t-maze.bat's `maze` has four variants: their columns
     are floats; with `draw 2`, a generation leaves two out (NaN)."""
     tmaze = ROOT / "examples" / "t-maze.bat"
-    run = shaping.run(tmaze, out=tmp_path / "all", stage="recurrent", set={"recurrent.evolve.generations": 2},
+    run = shaping.run(tmaze, out=tmp_path / "all", stage="maze", set={"maze.evolve.generations": 2},
                       report=False)
-    g = run.generations("recurrent")
+    g = run.generations("maze")
     assert len(g["best"]) == 2
     names = ["left", "right", "left_seen", "right_seen"]
     for v in names:
@@ -666,9 +666,9 @@ def test_generations_of_a_stage_with_variants(tmp_path):
     assert source.count("variants mean {") >= 1
     drawn = tmp_path / "drawn.bat"
     drawn.write_text(source.replace("variants mean {", "variants mean draw 2 {", 1))
-    run = shaping.run(drawn, out=tmp_path / "drawn", stage="recurrent",
-                      set={"recurrent.evolve.generations": 3}, report=False)
-    g = run.generations("recurrent")
+    run = shaping.run(drawn, out=tmp_path / "drawn", stage="maze",
+                      set={"maze.evolve.generations": 3}, report=False)
+    g = run.generations("maze")
     columns = np.array([g[f"best_variant_{v}"] for v in names])
     assert columns.shape == (4, 3)
     # Each generation draws two of the four: two numbers and two NaN.
