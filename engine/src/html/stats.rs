@@ -28,9 +28,8 @@ pub fn section(t: &Tests) -> String {
         .collect();
     let _ = writeln!(
         h,
-        "<p class=\"muted\" id=\"stats-note\">{} {}: {}. Figures: {}.</p>",
-        if t.groups.len() == 1 { "Group" } else { "Groups" },
-        if t.groups.len() == 1 { "" } else { "(numbered in the pairs)" },
+        "<p class=\"muted\" id=\"stats-note\">{}: {}. Figures: {}.</p>",
+        if t.groups.len() == 1 { "Group" } else { "Groups (numbered in the pairs)" },
         groups.join(", "),
         escape_html(&t.method)
     );

@@ -464,6 +464,7 @@ fn the_statistics_section_escapes_names_and_is_absent_without_tests() {
     data.tests = Some(t);
     let html = page(&data).unwrap();
     assert!(html.contains("<code>&lt;b&gt;a&lt;/b&gt;</code>") && !html.contains("<b>a</b>"));
+    assert!(html.contains("Groups (numbered in the pairs): 1 <code>"));
     assert!(
         html.contains(&format!("<td class=\"num\">{p:.4}</td><td class=\"num\">{a12:.3}</td>")),
         "{p} {a12}"
