@@ -35,3 +35,13 @@ stage in_a_variant extends s {
     right { place junction at (300mm, 250mm) heading 0 after 80 actions }
   }
 }
+stage with_variants extends s {
+  test best for 2 lives of 60 actions
+  variants mean {
+    left { place junction at (300mm, 250mm) heading 180 after 40 actions }
+    right { }
+  }
+}
+stage shorter extends with_variants {
+  test best for 2 lives of 30 actions
+}

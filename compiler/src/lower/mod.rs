@@ -1081,7 +1081,8 @@ impl<'a> Lower<'a> {
         self.variants_decl(&mut st, decl);
         self.run(&mut st, decl, parent.is_some());
         let (life, life_span) = life(&st.run, decl);
-        self.check_place_life(&st.world, decl.span, &sname, life, life_span);
+        let in_stage = |sp: Span| decl.span.start <= sp.start && sp.end <= decl.span.end;
+        self.check_place_life(&st.world, &sname, life, life_span, &|sp| in_stage(sp) || life_span.is_some());
         let hw = Hw {
             stage: sname.clone(),
             sensors: st.sensors.clone(),

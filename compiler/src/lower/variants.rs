@@ -146,6 +146,7 @@ impl Lower<'_> {
         // Errors of the variants themselves are reported where declared.
         let saved = self.errors.len();
         let mut list = Vec::with_capacity(v.decls.len());
+        let mut placed = Vec::new();
         for d in &v.decls {
             for item in &d.world.items {
                 if matches!(item, ast::WorldItem::Arena { .. } | ast::WorldItem::Body { .. }) {
@@ -166,8 +167,9 @@ impl Lower<'_> {
             self.check_items(&ws, d.span);
             self.check_crowded(&ws, d.span);
             self.check_team(&ws, d.span);
-            let (life, _) = super::life(&st.run, decl);
-            self.check_place_life(&ws, d.span, sname, life, None);
+            if !ws.world.items.places.is_empty() {
+                placed.push((ws.clone(), d.span));
+            }
             let mut world = ws.world;
             world.arena = st.world.world.arena;
             world.body = st.world.world.body.clone();
@@ -176,6 +178,15 @@ impl Lower<'_> {
         if !here {
             self.errors.truncate(saved);
             self.variants_undo_changes(v, st, sname, decl);
+        }
+        // A variant's placements after the life's end: where the variant is
+        // declared, and again in a stage that sets a shorter life.
+        let (life, life_span) = super::life(&st.run, decl);
+        for (ws, vspan) in &placed {
+            let in_variant = |sp: Span| vspan.start <= sp.start && sp.end <= vspan.end;
+            self.check_place_life(ws, sname, life, life_span, &|sp| {
+                in_variant(sp) && (here || life_span.is_some())
+            });
         }
         (!list.is_empty()).then_some(Variants { aggregate: v.aggregate, draw: v.draw, list })
     }

@@ -518,20 +518,20 @@ impl Lower<'_> {
 
     /// Placements after the life's last action (`life` actions, set at
     /// `life_span` when this stage sets it): they never happen. Reported
-    /// for the placements declared in `decl` (a stage or a variant), and
-    /// for all of them when the stage sets the life.
+    /// for the placements whose span `report` accepts (those declared in
+    /// the stage or variant at hand, and all of them when the stage sets
+    /// the life), so that each is reported once.
     pub(super) fn check_place_life(
         &mut self,
         ws: &WorldSt,
-        decl: Span,
         stage: &str,
         life: u32,
         life_span: Option<Span>,
+        report: &dyn Fn(Span) -> bool,
     ) {
-        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
         let spans = ws.item_spans.get("place").cloned().unwrap_or_default();
         for (p, sp) in ws.world.items.places.iter().zip(spans) {
-            if p.after < life || !(here(&sp) || life_span.is_some_and(|l| here(&l))) {
+            if p.after < life || !report(sp) {
                 continue;
             }
             self.errors.push(Error::PlaceAfterLife {
