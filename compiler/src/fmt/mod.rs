@@ -666,7 +666,13 @@ impl F<'_> {
                 self.item(v.span, self.block(head, v.span, items))
             }
             StageItem::Role(r) => {
-                let head = format!("role {} robots {}", r.name.text, self.qty(&r.robots));
+                let head = match &r.robots {
+                    Some(q) if !r.adds => format!("role {} robots {}", r.name.text, self.qty(q)),
+                    _ => format!("role {} adds", r.name.text),
+                };
+                if !r.body {
+                    return self.item(r.span, Doc::Text(head));
+                }
                 let items = r.items.iter().map(|x| self.stage_item(x)).collect();
                 self.item(r.span, self.block(head, r.span, items))
             }

@@ -130,21 +130,39 @@ pub enum StageItem {
     Role(RoleDecl),
 }
 
-/// `role NAME robots N { MODULES LINKS }`: a role of a heterogeneous team.
+/// `role NAME robots N { MODULES LINKS FITNESS }`: a role of a
+/// heterogeneous team; in a stage that extends a stage with roles, also
+/// `role NAME adds { ... }` (modules and links added to a role) and `role
+/// NAME robots N` without braces (how many robots play a role).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoleDecl {
     pub name: Name,
-    /// How many robots play it.
-    pub robots: Quantity,
-    /// Its modules and links (`StageItem::Module`, `LinksAll` and `Link`).
+    /// How many robots play it (`None`: `role NAME adds { ... }`).
+    pub robots: Option<Quantity>,
+    /// `adds { ... }`: what a later stage adds to an existing role.
+    pub adds: bool,
+    /// Braces were written (`role NAME robots N` alone has none).
+    pub body: bool,
+    /// Its modules, links and fitness (`StageItem::Module`, `LinksAll`,
+    /// `Link` and `Fitness`).
     pub items: Vec<StageItem>,
     pub span: Span,
+    /// The head: `role NAME robots N` or `role NAME adds`.
+    pub head: Span,
 }
 
 impl RoleDecl {
-    /// The head `role NAME robots N`, up to its count.
+    /// The head `role NAME robots N` (up to its count) or `role NAME adds`.
     pub fn head(&self) -> Span {
-        Span { start: self.span.start, end: self.robots.span.end.max(self.span.start) }
+        self.head
+    }
+
+    /// The fitness declarations of the role.
+    pub fn fitness(&self) -> impl Iterator<Item = &FitnessDecl> {
+        self.items.iter().filter_map(|i| match i {
+            StageItem::Fitness(f) => Some(f),
+            _ => None,
+        })
     }
 
     /// The modules the role declares.

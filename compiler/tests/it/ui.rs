@@ -75,10 +75,16 @@ fn kind(e: &Error) -> &'static str {
         Error::NotASensor { .. } => "NotASensor",
         Error::NoLamp { .. } => "NoLamp",
         Error::VariantUndoesChange { .. } => "VariantUndoesChange",
+        Error::UnknownRole { .. } => "UnknownRole",
+        Error::RoleModuleExists { .. } => "RoleModuleExists",
+        Error::LinkAcrossRoles { .. } => "LinkAcrossRoles",
+        Error::RoleInTest { .. } => "RoleInTest",
+        Error::RoleFitnessReadsOther { .. } => "RoleFitnessReadsOther",
+        Error::RoleFitnessAlone { .. } => "RoleFitnessAlone",
     }
 }
 
-const KINDS: [&str; 32] = [
+const KINDS: [&str; 38] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -111,6 +117,12 @@ const KINDS: [&str; 32] = [
     "NotASensor",
     "NoLamp",
     "VariantUndoesChange",
+    "UnknownRole",
+    "RoleModuleExists",
+    "LinkAcrossRoles",
+    "RoleInTest",
+    "RoleFitnessReadsOther",
+    "RoleFitnessAlone",
 ];
 
 #[test]
