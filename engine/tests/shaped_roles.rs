@@ -83,3 +83,30 @@ fn a_shaped_teams_role_robots_are_swept_with_set() {
     assert!(outcome.is_ok(), "{:?}", outcome.err().map(|e| e.to_string()));
     assert!(dir.path().join("check/summary.json").exists());
 }
+
+/// A role's fitness replaces the stage's for its robots only; the team's
+/// aggregate (`team sum`) is over every robot, as the stage says.
+#[test]
+fn a_roles_fitness_is_its_robots_and_the_team_aggregates_every_robot() {
+    use shaping_runtime::controller::{run_team_episode, EpisodeOptions};
+    let src = "robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s {
+  world { arena 800mm x 800mm }
+  fitness per action 0.5, team sum
+  role a robots 2 { module m { sense ir  behavior forward } }
+  role b robots 1 {
+    module n { sense ir  behavior stop }
+    fitness per action 1, at end 3
+  }
+}
+";
+    let program = shaping_compiler::compile(src, "roles-fitness.bat").unwrap();
+    let stage = &program.stages[0];
+    assert!(stage.roles[0].fitness.is_none());
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let opts = EpisodeOptions { actions: 10, learning: false, seed: 1 };
+    let res = run_team_episode(stage, &genome, &opts, None).unwrap();
+    let robots: Vec<f32> = res.robots.iter().map(|r| r.fitness).collect();
+    assert_eq!(robots, [5.0, 5.0, 13.0]);
+    assert_eq!(res.team.fitness, 23.0);
+}

@@ -291,7 +291,7 @@ fn context(text: &str, offset: usize) -> Context {
         ("learn", _) => return Context::Only(&["crbp"]),
         ("links", _) if matches!(block, Some("stage" | "role")) => return Context::Only(&["all"]),
         ("role", _) => return Context::Nothing,
-        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots"]),
+        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots", "adds"]),
         ("all", "links") => return Context::Only(&["evolvable", "fixed"]),
         ("test", _) => return Context::Only(&["best"]),
         ("best", _) | ("train", _) => return Context::Only(&["for"]),

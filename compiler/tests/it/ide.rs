@@ -42,14 +42,15 @@ fn completion_in_a_role_offers_its_words_and_its_modules() {
     for w in ["module", "links", "link"] {
         assert!(words.contains(&w), "{w} in {words:?}");
     }
-    assert!(!words.contains(&"fitness"), "{words:?}");
-    // In a stage: `role`; after `role NAME`: `robots`.
+    // A role's robots may have a fitness of their own.
+    assert!(words.contains(&"fitness"), "{words:?}");
+    // In a stage: `role`; after `role NAME`: `robots` (and, in a later stage, `adds`).
     let text = SRC.replace("  fitness per action wheels[0]\n", "  fitness per action wheels[0]\n  \n");
     let offset = text.find("  \n").unwrap() + 2;
     assert!(labels(&ide::complete(&text, offset)).contains(&"role"));
     let text = SRC.replace("role anchor robots 1", "role anchor ");
     let offset = text.find("role anchor ").unwrap() + 12;
-    assert_eq!(labels(&ide::complete(&text, offset)), ["robots"]);
+    assert_eq!(labels(&ide::complete(&text, offset)), ["robots", "adds"]);
 }
 
 #[test]
