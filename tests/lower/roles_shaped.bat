@@ -33,6 +33,7 @@ stage escort extends avoid {
 }
 
 stage check extends escort {
+  world changes { arena 700mm x 700mm  role anchor robots 1 }
   role seeker robots 3
   test best for 40 actions
 }

@@ -705,6 +705,9 @@ impl F<'_> {
             WorldItem::Battery(q, _) => format!("battery {}", self.qty(q)),
             WorldItem::Recharge(q, _) => format!("recharge {}", self.qty(q)),
             WorldItem::Robots(q, _) => format!("robots {}", self.qty(q)),
+            WorldItem::RoleRobots { name, robots, .. } => {
+                format!("role {} robots {}", name.text, self.qty(robots))
+            }
             WorldItem::Objects { count, diameter, virtual_, .. } => {
                 let mut t = "objects".to_string();
                 if let Some(c) = count {

@@ -1072,7 +1072,17 @@ impl<'a> Lower<'a> {
         let role_decls = self.role_heads(&mut st, decl);
         let (roles, heads) = (st.roles.clone(), st.role_heads.clone());
         // A later stage that adds a role or changes a role's robots changes the team here.
-        let changed = decl.extends.as_ref().and(decl.roles().find(|r| r.robots.is_some())).map(|r| r.head());
+        let in_world = decl.items.iter().find_map(|i| match i {
+            I::World(w) => w.items.iter().find_map(|x| match x {
+                ast::WorldItem::RoleRobots { span, .. } => Some(*span),
+                _ => None,
+            }),
+            _ => None,
+        });
+        let changed = decl
+            .extends
+            .as_ref()
+            .and(decl.roles().find(|r| r.robots.is_some()).map(|r| r.head()).or(in_world));
         self.role_robots(
             &mut st.world,
             &roles,

@@ -38,7 +38,9 @@ impl Lower<'_> {
     /// index in `st.roles` of the role whose modules it lowers (`None`: it
     /// lowers none, or was refused).
     pub(super) fn role_heads(&mut self, st: &mut StageSt, decl: &ast::StageDecl) -> Vec<Option<usize>> {
-        let roles: Vec<&ast::RoleDecl> = decl.roles().collect();
+        // A `world changes`' `role NAME robots N`s, after the stage's roles.
+        let world_roles = self.world_roles(st, decl);
+        let roles: Vec<&ast::RoleDecl> = decl.roles().chain(&world_roles).collect();
         let Some(first) = roles.first() else { return Vec::new() };
         if let Some(e) = &decl.extends {
             if st.roles.is_empty() {
@@ -111,6 +113,84 @@ impl Lower<'_> {
         self.check_robot_limit(st, first.head(), &decl.name.text);
         st.role_heads = heads;
         lowered
+    }
+
+    /// The `role NAME robots N` items of `decl`'s `world changes`, as the
+    /// stage's own `role NAME robots N`: in a stage that extends a stage
+    /// with roles only. Elsewhere (a stage without inherited roles, a
+    /// `world` or `world adds`, a variant) they are refused.
+    fn world_roles(&mut self, st: &StageSt, decl: &ast::StageDecl) -> Vec<ast::RoleDecl> {
+        let later = decl.extends.is_some() && !st.roles.is_empty();
+        let mut out = Vec::new();
+        let refuse = |lw: &mut Self, span: Span, message: String, help: String| {
+            lw.errors.push(Error::RolesNotHere {
+                span: span.into(),
+                other: None,
+                message,
+                label: "a role's robots".into(),
+                other_label: String::new(),
+                help,
+            });
+        };
+        for item in &decl.items {
+            match item {
+                ast::StageItem::World(w) => {
+                    for x in &w.items {
+                        let ast::WorldItem::RoleRobots { name, robots, span } = x else { continue };
+                        if !later {
+                            let message = match &decl.extends {
+                                None => format!(
+                                    "the world of stage `{}` says how many robots play role `{}`, but the stage declares its roles",
+                                    decl.name.text, name.text
+                                ),
+                                Some(p) => format!(
+                                    "the world of stage `{}` changes the robots of role `{}`, but the team of stage `{}` has no roles",
+                                    decl.name.text, name.text, p.text
+                                ),
+                            };
+                            refuse(
+                                self,
+                                *span,
+                                message,
+                                format!("a stage that declares its roles gives their robots in them (`role {} robots N {{ ... }}`); a later stage changes them, in its `world changes` or among its items", name.text),
+                            );
+                        } else if w.mode != ast::WorldMode::Changes {
+                            refuse(
+                                self,
+                                *span,
+                                format!("stage `{}` changes the robots of role `{}` outside `world changes`", decl.name.text, name.text),
+                                format!("write it in `world changes {{ role {} robots N }}`, or among the stage's items", name.text),
+                            );
+                        } else {
+                            out.push(ast::RoleDecl {
+                                name: name.clone(),
+                                robots: Some(robots.clone()),
+                                adds: false,
+                                body: false,
+                                items: Vec::new(),
+                                span: *span,
+                                head: *span,
+                            });
+                        }
+                    }
+                }
+                ast::StageItem::Variants(v) => {
+                    for d in &v.variants {
+                        for x in &d.world.items {
+                            let ast::WorldItem::RoleRobots { name, span, .. } = x else { continue };
+                            refuse(
+                                self,
+                                *span,
+                                format!("variant `{}` changes the robots of role `{}`", d.name.text, name.text),
+                                format!("every variant's world has the stage's roles: change the role's robots for the stage, with `role {} robots N` among its items or in its `world changes`", name.text),
+                            );
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
     }
 
     /// More robots in the roles than the limit: an error at `at`.

@@ -243,6 +243,13 @@ pub enum WorldItem {
     Recharge(Quantity, Span),
     /// `robots N`: a team of N clones.
     Robots(Quantity, Span),
+    /// `role NAME robots N` in a later stage's `world changes`: how many
+    /// robots play role NAME (lowered with the stage's roles).
+    RoleRobots {
+        name: Name,
+        robots: Quantity,
+        span: Span,
+    },
     Objects {
         count: Option<Quantity>,
         diameter: Option<Quantity>,
@@ -312,6 +319,7 @@ impl WorldItem {
             WorldItem::Battery(..) => ("battery", None),
             WorldItem::Recharge(..) => ("recharge", None),
             WorldItem::Robots(..) => ("robots", None),
+            WorldItem::RoleRobots { name: n, .. } => ("role", Some(n.text.as_str())),
             WorldItem::Objects { .. } => ("objects", None),
             WorldItem::Body { .. } => ("body", None),
             WorldItem::Wall { name: n, .. } => ("wall", name(n)),
@@ -329,6 +337,7 @@ impl WorldItem {
             | WorldItem::Battery(_, span)
             | WorldItem::Recharge(_, span)
             | WorldItem::Robots(_, span)
+            | WorldItem::RoleRobots { span, .. }
             | WorldItem::Objects { span, .. }
             | WorldItem::Body { span, .. }
             | WorldItem::Wall { span, .. }

@@ -1338,6 +1338,12 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                     items.push(WorldItem::Robots(quantity(q), csp));
                 }
             }
+            Rule::role_robots => {
+                let mut ri = c.into_inner().filter(|p| matches!(p.as_rule(), Rule::ident | Rule::quantity));
+                if let (Some(n), Some(q)) = (ri.next(), ri.next()) {
+                    items.push(WorldItem::RoleRobots { name: name(n), robots: quantity(q), span: csp });
+                }
+            }
             Rule::objects => {
                 let mut count = None;
                 let mut diameter = None;
