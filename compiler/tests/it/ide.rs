@@ -96,3 +96,27 @@ fn a_module_named_in_a_role_is_defined_in_that_role() {
     let def = ide::definition(SRC, at("module brain", 1, 8)).expect("a definition");
     assert_eq!(def.start, at("module brain", 1, 7));
 }
+
+/// A later stage's roles: a link in `role NAME adds { }` completes the
+/// role's modules, inherited ones included; a hover on a module of a role
+/// added later describes that role's (decl order is not the team's).
+#[test]
+fn a_later_stages_roles_complete_and_hover_their_own_modules() {
+    let later = format!(
+        "{SRC}stage more extends team {{
+  role anchor robots 2
+  role scout robots 1 {{ module brain {{ sense ir[1]  behavior forward }} }}
+  role seeker adds {{
+    module dodge {{ sense ir[2]  behavior back }}
+    link 
+  }}
+}}
+"
+    );
+    let offset = later.find("link \n").unwrap() + 5;
+    let got = ide::complete(&later, offset);
+    assert_eq!(labels(&got), ["brain", "flee", "dodge"]);
+    let scout = later.find("module brain { sense ir[1]").unwrap() + 8;
+    let (_, md) = ide::hover(&later.replace("    link \n", ""), scout).expect("hover");
+    assert!(md.contains("role `scout`") && md.contains("scout.brain"), "{md}");
+}
