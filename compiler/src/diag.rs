@@ -387,7 +387,7 @@ pub enum Error {
     /// A later stage names a role its team does not have (`role NAME adds
     /// { ... }`, `role NAME robots N`).
     #[error("{message}")]
-    #[diagnostic(code(S0033))]
+    #[diagnostic(code(S0037))]
     UnknownRole {
         #[label("{label}")]
         span: SourceSpan,
@@ -399,7 +399,7 @@ pub enum Error {
 
     /// `role NAME adds { module M ... }` where role NAME has a module M.
     #[error("role `{role}` already has a module `{module}`")]
-    #[diagnostic(code(S0034))]
+    #[diagnostic(code(S0038))]
     RoleModuleExists {
         #[label(primary, "declared again here")]
         span: SourceSpan,
@@ -414,7 +414,7 @@ pub enum Error {
 
     /// A link of a role that names a module of another role.
     #[error("`{module}` is a module of role `{other}`, not of role `{role}`: a link joins two modules of one role")]
-    #[diagnostic(code(S0035))]
+    #[diagnostic(code(S0039))]
     LinkAcrossRoles {
         #[label("a module of role `{other}`")]
         span: SourceSpan,
@@ -427,7 +427,7 @@ pub enum Error {
 
     /// A role added by a test stage: no evolution gives its genes.
     #[error("test stage `{stage}` adds role `{role}`, whose genes no stage evolves")]
-    #[diagnostic(code(S0036))]
+    #[diagnostic(code(S0040))]
     RoleInTest {
         #[label(primary, "a new role")]
         span: SourceSpan,
@@ -442,7 +442,7 @@ pub enum Error {
     /// A role's fitness reads an actuator that only other roles' modules
     /// command: for this role's robots it never changes.
     #[error("the fitness of role `{role}` reads `{actuator}`, which only the modules of {others} command")]
-    #[diagnostic(code(S0037))]
+    #[diagnostic(code(S0041))]
     RoleFitnessReadsOther {
         #[label("role `{role}`'s modules never command it")]
         span: SourceSpan,
@@ -456,7 +456,7 @@ pub enum Error {
     /// A warning: a role's fitness in a team of one role, which replaces
     /// the stage's fitness for every robot.
     #[error("role `{role}` has a fitness of its own, but it is the team's only role")]
-    #[diagnostic(code(S0038), severity(Warning))]
+    #[diagnostic(code(S0042), severity(Warning))]
     RoleFitnessAlone {
         #[label("the fitness of every robot")]
         span: SourceSpan,
