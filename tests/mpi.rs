@@ -93,6 +93,20 @@ fn any_number_of_ranks_writes_the_single_process_files() {
     }
 }
 
+/// A team shaped stage by stage (roles that grow, a role added later, a
+/// role's own fitness, robots changed by the file): on 3 ranks, the single
+/// process's files.
+#[test]
+fn a_shaped_team_on_three_ranks_writes_the_single_process_files() {
+    let dir = scratch("shaped-roles");
+    let file = root().join("tests/lower/roles_shaped.bat");
+    let one = dir.join("one");
+    ok(single().arg("run").arg(&file).arg("--out").arg(&one).arg("--quiet"));
+    let three = dir.join("three");
+    ok(mpirun(3).arg("run").arg(&file).arg("--out").arg(&three));
+    assert_same_files(&one, &three);
+}
+
 /// `shaping experiment tiny.bat --seeds 2 EXTRA... --out OUT`, on one process
 /// and on 3 ranks: the files must be the same; returns rank 0's stderr and
 /// the directory of the 3 ranks.

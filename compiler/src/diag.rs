@@ -441,6 +441,87 @@ pub enum Error {
         life: u32,
         last: u32,
     },
+
+    /// A later stage names a role its team does not have (`role NAME adds
+    /// { ... }`, `role NAME robots N`).
+    #[error("{message}")]
+    #[diagnostic(code(S0037))]
+    UnknownRole {
+        #[label("{label}")]
+        span: SourceSpan,
+        message: String,
+        label: String,
+        #[help]
+        help: Option<String>,
+    },
+
+    /// `role NAME adds { module M ... }` where role NAME has a module M.
+    #[error("role `{role}` already has a module `{module}`")]
+    #[diagnostic(code(S0038))]
+    RoleModuleExists {
+        #[label(primary, "declared again here")]
+        span: SourceSpan,
+        #[label("declared by stage `{by}`")]
+        first: SourceSpan,
+        role: String,
+        module: String,
+        by: String,
+        #[help]
+        help: String,
+    },
+
+    /// A link of a role that names a module of another role.
+    #[error("`{module}` is a module of role `{other}`, not of role `{role}`: a link joins two modules of one role")]
+    #[diagnostic(code(S0039))]
+    LinkAcrossRoles {
+        #[label("a module of role `{other}`")]
+        span: SourceSpan,
+        module: String,
+        role: String,
+        other: String,
+        #[help]
+        help: String,
+    },
+
+    /// A role added by a test stage: no evolution gives its genes.
+    #[error("test stage `{stage}` adds role `{role}`, whose genes no stage evolves")]
+    #[diagnostic(code(S0040))]
+    RoleInTest {
+        #[label(primary, "a new role")]
+        span: SourceSpan,
+        #[label("tests here")]
+        test: Option<SourceSpan>,
+        stage: String,
+        role: String,
+        #[help]
+        help: String,
+    },
+
+    /// A role's fitness reads an actuator that only other roles' modules
+    /// command: for this role's robots it never changes.
+    #[error("the fitness of role `{role}` reads `{actuator}`, which only the modules of {others} command")]
+    #[diagnostic(code(S0041))]
+    RoleFitnessReadsOther {
+        #[label("role `{role}`'s modules never command it")]
+        span: SourceSpan,
+        role: String,
+        actuator: String,
+        others: String,
+        #[help]
+        help: String,
+    },
+
+    /// A warning: a role's fitness in a team of one role, which replaces
+    /// the stage's fitness for every robot.
+    #[error("role `{role}` has a fitness of its own, but it is the team's only role")]
+    #[diagnostic(code(S0042), severity(Warning))]
+    RoleFitnessAlone {
+        #[label("the fitness of every robot")]
+        span: SourceSpan,
+        role: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

@@ -264,8 +264,35 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         let last = robot + u64::from(role.robots) - 1;
         let robots =
             if role.robots == 1 { format!("robot {robot}") } else { format!("robots {robot}..{last}") };
-        let names: Vec<&str> = st.modules[mods].iter().map(|m| m.name.as_str()).collect();
-        let _ = writeln!(out, "role `{}`: {robots}, modules {}, {genes} genes", role.name, names.join(", "));
+        let names: Vec<&str> = st.modules[mods.clone()].iter().map(|m| m.name.as_str()).collect();
+        // Which genes each earlier stage froze, and how many evolve here.
+        let mut frozen: Vec<(u16, usize)> = Vec::new();
+        for g in st.layout.genes.iter().filter(|g| g.frozen && mods.contains(&(g.module as usize))) {
+            match frozen.iter_mut().find(|(s, _)| *s == g.stage) {
+                Some((_, k)) => *k += 1,
+                None => frozen.push((g.stage, 1)),
+            }
+        }
+        let by: Vec<String> = frozen
+            .iter()
+            .map(|&(s, k)| {
+                let name = program.stages.get(s as usize).map_or("?", |x| x.name.as_str());
+                format!("{k} of stage `{name}`")
+            })
+            .collect();
+        let evolvable = genes - frozen.iter().map(|(_, k)| k).sum::<usize>();
+        let state = match (by.is_empty(), evolvable) {
+            (true, _) => String::new(),
+            (false, 0) => format!(" (frozen: {})", by.join(", ")),
+            (false, e) => format!(" (frozen: {}; evolvable: {e})", by.join(", ")),
+        };
+        let own = if role.fitness.is_some() { ", its own fitness" } else { "" };
+        let _ = writeln!(
+            out,
+            "role `{}`: {robots}, modules {}, {genes} genes{state}{own}",
+            role.name,
+            names.join(", ")
+        );
         robot = last + 1;
     }
     // Parameters that are not genes: what training stages learned.

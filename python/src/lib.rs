@@ -408,10 +408,11 @@ impl Program {
     }
 
     /// The roles of `stage`'s heterogeneous team, in order, one dict per
-    /// role: `name`, `robots` (robot 0 plays the first role) and `modules`,
+    /// role: `name`, `robots` (robot 0 plays the first role), `modules`,
     /// the indices of its modules (a gene of `layout` whose `team_role` is
-    /// the role's name is the role's). Empty for a team of clones or one
-    /// robot.
+    /// the role's name is the role's), and `own_fitness`, whether the role
+    /// declares the fitness of its robots. Empty for a team of clones or
+    /// one robot.
     fn roles<'py>(&self, py: Python<'py>, stage: &str) -> PyResult<Bound<'py, PyAny>> {
         let st = &self.program.stages[stage_index(&self.program, stage)?];
         let roles: Vec<serde_json::Value> = st
@@ -420,7 +421,12 @@ impl Program {
             .enumerate()
             .map(|(r, role)| {
                 let modules: Vec<usize> = st.role_modules(r).collect();
-                serde_json::json!({ "name": role.name, "robots": role.robots, "modules": modules })
+                serde_json::json!({
+                    "name": role.name,
+                    "robots": role.robots,
+                    "modules": modules,
+                    "own_fitness": role.fitness.is_some(),
+                })
             })
             .collect();
         json_to_py(py, &serde_json::Value::Array(roles))

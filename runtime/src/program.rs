@@ -70,6 +70,11 @@ pub struct Role {
     pub robots: u32,
     /// How many modules of [`Stage::modules`] are its own.
     pub modules: u16,
+    /// The fitness of its robots, replacing the stage's (`fitness` inside
+    /// the role); `None`: the stage's. The team's aggregate is the stage's
+    /// (`Stage::fitness.team`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fitness: Option<Fitness>,
 }
 
 /// The conditions an individual is evaluated in: named variants of the
@@ -193,6 +198,11 @@ impl Stage {
         let start: usize = self.roles.iter().take(r).map(|x| x.modules as usize).sum();
         let len = self.roles.get(r).map_or(0, |x| x.modules as usize);
         start.min(self.modules.len())..(start + len).min(self.modules.len())
+    }
+
+    /// The fitness of role `r`'s robots: the role's own, else the stage's.
+    pub fn role_fitness(&self, r: usize) -> &Fitness {
+        self.roles.get(r).and_then(|x| x.fitness.as_ref()).unwrap_or(&self.fitness)
     }
 
     /// Module `i`'s name as outputs and settings write it: `ROLE.MODULE` in

@@ -146,6 +146,10 @@ fn reads(stage: &Stage, slot: impl Fn(usize) -> bool) -> bool {
     let mut exprs: Vec<&Expr> = Vec::new();
     exprs.extend(&stage.fitness.per_action);
     exprs.extend(&stage.fitness.at_end);
+    for f in stage.roles.iter().filter_map(|r| r.fitness.as_ref()) {
+        exprs.extend(&f.per_action);
+        exprs.extend(&f.at_end);
+    }
     for m in &stage.modules {
         exprs.extend(&m.reinforce);
         if let Behavior::Script(s) = &m.behavior {

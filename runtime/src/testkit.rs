@@ -434,8 +434,8 @@ pub fn two_roles(edit: impl Fn(&mut Stage)) -> Stage {
     ];
     st.links = vec![Link { from: 0, to: 1, weight: EVOLVABLE }];
     st.roles = vec![
-        Role { name: "movers".into(), robots: 2, modules: 2 },
-        Role { name: "sitters".into(), robots: 1, modules: 1 },
+        Role { name: "movers".into(), robots: 2, modules: 2, fitness: None },
+        Role { name: "sitters".into(), robots: 1, modules: 1, fitness: None },
     ];
     edit(&mut st);
     lay_out(&mut st, 0, GeneSpec::default());

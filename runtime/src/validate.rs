@@ -341,16 +341,30 @@ fn extension(p: &Program, i: usize) -> R {
             at.field("layout.genes").ensure(genes.len() >= n && s.layout.bits >= parent.bits, || {
                 format!("{} genes, fewer than the {n} of the stage it extends", genes.len())
             })?;
-            let (pr, pm) = (&p.stages[j].roles, p.stages[j].modules.len());
-            let same_roles = s.roles.len() == pr.len()
-                && s.roles.iter().zip(pr).all(|(a, b)| a.name == b.name && a.modules == b.modules);
-            at.field("roles").ensure(same_roles && (pr.is_empty() || s.modules.len() == pm), || {
-                "a stage with roles extends no stage, and a stage that extends it has its roles and modules (and adds none)".into()
+            let ps = &p.stages[j];
+            let pr = &ps.roles;
+            // A stage with roles extends no stage; one that extends it keeps
+            // its roles, in order, each with at least its modules, and may
+            // add roles after them.
+            let kept_roles = s.roles.len() >= pr.len()
+                && s.roles.iter().zip(pr).all(|(a, b)| a.name == b.name && a.modules >= b.modules)
+                && (s.roles.is_empty() || !pr.is_empty());
+            at.field("roles").ensure(kept_roles, || {
+                "a stage with roles extends no stage, and a stage that extends it keeps its roles and their modules".into()
             })?;
+            // A module keeps its name and role; with roles, a role's
+            // added modules may move the later roles' (their index).
+            let label = |st: &Stage, m: u16| {
+                if st.roles.is_empty() {
+                    format!("#{m}")
+                } else {
+                    st.module_label(m as usize)
+                }
+            };
             for (k, (c, q)) in genes.iter().zip(&parent.genes).enumerate() {
                 at.field("layout.genes").index(k).ensure(
-                    (c.offset, c.bits, c.lo, c.hi, c.stage, c.module)
-                        == (q.offset, q.bits, q.lo, q.hi, q.stage, q.module),
+                    (c.offset, c.bits, c.lo, c.hi, c.stage, label(s, c.module))
+                        == (q.offset, q.bits, q.lo, q.hi, q.stage, label(ps, q.module)),
                     || "differs from the gene of the stage it extends".into(),
                 )?;
             }
@@ -804,6 +818,9 @@ fn roles(at: &At, s: &Stage) -> R {
             format!("`{}` names two roles", role.name)
         })?;
         at.field("robots").count(role.robots, 1, MAX_ROBOTS)?;
+        if let Some(f) = &role.fitness {
+            fitness(&at.field("fitness"), f)?;
+        }
         at.field("modules").count(u32::from(role.modules), 1, MAX_MODULES as u32)?;
         let evolved = matches!(s.run, StageRun::Evolve(_));
         let mine = s.role_modules(r);

@@ -1,5 +1,6 @@
 // Roles belong to a stage that extends no stage and evolves or tests; a
-// stage that extends a stage with roles keeps them and declares no module.
+// stage that extends a stage with roles keeps them and adds modules and
+// links in a role only (it may add a role).
 robot r { sensor ir[8] proximity  actuator wheels[2] speed }
 stage practice {
   train for 100 actions

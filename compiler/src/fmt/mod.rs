@@ -666,7 +666,13 @@ impl F<'_> {
                 self.item(v.span, self.block(head, v.span, items))
             }
             StageItem::Role(r) => {
-                let head = format!("role {} robots {}", r.name.text, self.qty(&r.robots));
+                let head = match &r.robots {
+                    Some(q) if !r.adds => format!("role {} robots {}", r.name.text, self.qty(q)),
+                    _ => format!("role {} adds", r.name.text),
+                };
+                if !r.body {
+                    return self.item(r.span, Doc::Text(head));
+                }
                 let items = r.items.iter().map(|x| self.stage_item(x)).collect();
                 self.item(r.span, self.block(head, r.span, items))
             }
@@ -699,6 +705,9 @@ impl F<'_> {
             WorldItem::Battery(q, _) => format!("battery {}", self.qty(q)),
             WorldItem::Recharge(q, _) => format!("recharge {}", self.qty(q)),
             WorldItem::Robots(q, _) => format!("robots {}", self.qty(q)),
+            WorldItem::RoleRobots { name, robots, .. } => {
+                format!("role {} robots {}", name.text, self.qty(robots))
+            }
             WorldItem::Objects { count, diameter, virtual_, .. } => {
                 let mut t = "objects".to_string();
                 if let Some(c) = count {

@@ -291,7 +291,7 @@ fn context(text: &str, offset: usize) -> Context {
         ("learn", _) => return Context::Only(&["crbp"]),
         ("links", _) if matches!(block, Some("stage" | "role")) => return Context::Only(&["all"]),
         ("role", _) => return Context::Nothing,
-        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots"]),
+        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots", "adds"]),
         ("all", "links") => return Context::Only(&["evolvable", "fixed"]),
         ("test", _) => return Context::Only(&["best"]),
         ("best", _) | ("train", _) => return Context::Only(&["for"]),
@@ -451,8 +451,15 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
     let role = here.and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end));
     let modules = |stages: &[&ast::StageDecl]| -> Vec<String> {
         let mut names: Vec<String> = Vec::new();
+        // A role's modules: those of the role of that name in this stage
+        // and the stages it extends (`role NAME adds { ... }` adds to them).
         let declared: Vec<&ast::ModuleDecl> = match role {
-            Some(r) => r.modules().collect(),
+            Some(r) => stages
+                .iter()
+                .rev()
+                .flat_map(|s| s.roles().filter(|x| x.name.text == r.name.text))
+                .flat_map(|x| x.modules())
+                .collect(),
             None => stages.iter().rev().flat_map(|s| s.all_modules()).collect(),
         };
         for m in declared {
@@ -656,8 +663,9 @@ pub fn hover(text: &str, offset: usize) -> Option<(Span, String)> {
                 };
                 // In a stage with roles, the module of the role at the
                 // cursor (two roles may each have a module of this name).
-                let role_at =
-                    here.and_then(|s| s.roles().position(|r| r.span.start <= offset && offset <= r.span.end));
+                let role_at = here
+                    .and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end))
+                    .and_then(|d| st.roles.iter().position(|x| x.name == d.name.text));
                 let in_role = role_at
                     .filter(|_| !st.roles.is_empty())
                     .and_then(|r| st.role_modules(r).find(|&k| st.modules[k].name == word));

@@ -13,12 +13,13 @@ use crate::syntax::Span;
 impl Lower<'_> {
     pub(super) fn links(&mut self, st: &mut StageSt, decl: &ast::StageDecl, s: u16) {
         let (modules, links) = (&st.modules, &mut st.links);
-        self.links_of(modules, links, &decl.name.text, &decl.items, s, &[]);
+        self.links_of(modules, links, &decl.name.text, &decl.items, s, None);
     }
 
     /// The links of `items` (a stage's, or a role's) between `modules`,
-    /// into `links`. `others` are the modules of the stage's other roles,
-    /// with their role's name: a link to one of them is named so.
+    /// into `links`. For a role, `role` is its name and the modules of the
+    /// stage's other roles, with their role's name: a link to one of them
+    /// is refused as such.
     pub(super) fn links_of(
         &mut self,
         modules: &[ModuleSt],
@@ -26,25 +27,34 @@ impl Lower<'_> {
         stage: &str,
         items: &[ast::StageItem],
         s: u16,
-        others: &[(String, String)],
+        role: Option<(&str, &[(String, String)])>,
     ) {
+        let (role, others) = role.unwrap_or(("", &[]));
         use ast::StageItem as I;
         let names: Vec<String> = modules.iter().map(|m| m.name.clone()).collect();
         let lookup = |lw: &mut Lower, n: &ast::Name| -> Option<u16> {
             if let Some(i) = names.iter().position(|m| *m == n.text) {
                 return Some(i as u16);
             }
-            let other = others.iter().find(|(m, _)| *m == n.text);
-            let help = match (other, lw.module_origin.get(&n.text)) {
-                (Some((_, role)), _) => Some(format!(
-                    "`{}` is a module of role `{role}`: a link joins two modules of one role",
-                    n.text
-                )),
-                (None, Some(origin)) => Some(format!(
+            if let Some((_, other)) = others.iter().find(|(m, _)| *m == n.text) {
+                lw.errors.push(Error::LinkAcrossRoles {
+                    span: n.span.into(),
+                    module: n.text.clone(),
+                    role: role.to_string(),
+                    other: other.clone(),
+                    help: format!(
+                        "each robot runs its role's modules only, so a link joins two modules of one role: link `{}` to a module of role `{role}`, or give role `{role}` a module of its own",
+                        n.text
+                    ),
+                });
+                return None;
+            }
+            let help = match lw.module_origin.get(&n.text) {
+                Some(origin) => Some(format!(
                     "`{}` is declared by stage `{origin}`, which does not come before this one",
                     n.text
                 )),
-                (None, None) => did_you_mean(&n.text, names.iter().map(String::as_str)),
+                None => did_you_mean(&n.text, names.iter().map(String::as_str)),
             };
             lw.errors.push(Error::Unknown {
                 span: n.span.into(),

@@ -1069,15 +1069,36 @@ impl<'a> Lower<'a> {
             }
         }
         let inherited_roles = !st.roles.is_empty();
-        self.role_heads(&mut st, decl);
+        let role_decls = self.role_heads(&mut st, decl);
         let (roles, heads) = (st.roles.clone(), st.role_heads.clone());
-        self.role_robots(&mut st.world, &roles, &heads, decl.span, format!("the world of stage `{sname}`"));
+        // A later stage that adds a role or changes a role's robots changes the team here.
+        let in_world = decl.items.iter().find_map(|i| match i {
+            I::World(w) => w.items.iter().find_map(|x| match x {
+                ast::WorldItem::RoleRobots { span, .. } => Some(*span),
+                _ => None,
+            }),
+            _ => None,
+        });
+        let changed = decl
+            .extends
+            .as_ref()
+            .and(decl.roles().find(|r| r.robots.is_some()).map(|r| r.head()).or(in_world));
+        self.role_robots(
+            &mut st.world,
+            &roles,
+            &heads,
+            decl.span,
+            format!("the world of stage `{sname}`"),
+            changed,
+        );
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span, decl.span);
         self.check_ground(&st, s, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
+        let before_team = self.errors.len();
         self.check_team(&st.world, decl.span);
+        self.role_team_help(&st.roles, before_team);
         self.variants_decl(&mut st, decl);
         self.run(&mut st, decl, parent.is_some());
         let (life, life_span) = life(&st.run, decl);
@@ -1095,7 +1116,7 @@ impl<'a> Lower<'a> {
         let role_stage = !st.roles.is_empty();
         let own_roles = self.check_role_items(&st, decl, inherited_roles);
         if own_roles {
-            self.role_modules(&hw, &mut st, decl, s);
+            self.role_modules(&hw, &mut st, decl, s, &role_decls);
         }
         let mut declared_here: HashMap<String, Span> = HashMap::new();
         for item in &decl.items {
@@ -1159,7 +1180,11 @@ impl<'a> Lower<'a> {
                 self.fitness(&hw, &mut st, f);
             }
         }
-        if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared && !st.fitness_reported {
+        self.role_fitness(&hw, &mut st, decl, &role_decls);
+        // Where every role has a fitness of its own, the stage needs none.
+        let roles_fit = !st.roles.is_empty() && st.roles.iter().all(|r| r.fitness.is_some());
+        if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared && !st.fitness_reported && !roles_fit
+        {
             st.fitness_reported = true;
             self.value_error(
                 decl.name.span,

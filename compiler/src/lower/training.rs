@@ -121,7 +121,7 @@ impl Lower<'_> {
     pub(super) fn check_evolved_genes(&mut self, st: &StageSt, decl: &ast::StageDecl, s: u16, since: usize) {
         if !matches!(st.run, StageRun::Evolve(_))
             || st.genes.iter().any(|g| g.stage == s)
-            || decl.roles().next().is_some()
+            || (decl.extends.is_none() && decl.roles().next().is_some())
             || self.errors[since..].iter().any(|e| !e.is_warning())
         {
             return;
@@ -136,7 +136,7 @@ impl Lower<'_> {
             (None, None) => (decl.name.span, "evolves (it has no `test` or `train`)".to_string()),
         };
         let help = match &decl.extends {
-            Some(_) if !st.roles.is_empty() => "a stage that extends a stage with roles keeps their genes, frozen, and adds none: make it a test stage (`test best for N actions`) to run the team in this world".to_string(),
+            Some(_) if !st.roles.is_empty() => format!("a stage that extends a stage with roles keeps their genes, frozen: give it genes of its own (modules added to a role, `role {} adds {{ module ... }}`, or a new role), or make it a test stage (`test best for N actions`) to run the team in this world", st.roles.first().map_or("ROLE", |r| r.name.as_str())),
             Some(p) => format!("give it genes of its own (a new module, or new evolvable links: `link FROM -> TO evolvable`), or make it a test stage (`test best for N actions`) that runs the best of stage `{}` in this world", p.text),
             None => super::roles::EVOLVABLE_HELP.to_string(),
         };

@@ -162,7 +162,7 @@ impl Lower<'_> {
             let label = format!("{sname}`, variant `{}", d.name.text);
             self.world(&mut ws, &d.world, &label);
             let what = format!("variant `{}` of stage `{sname}`", d.name.text);
-            self.role_robots(&mut ws, &st.roles, &st.role_heads, d.span, what);
+            self.role_robots(&mut ws, &st.roles, &st.role_heads, d.span, what, None);
             self.check_charger(&ws);
             self.check_items(&ws, d.span);
             self.check_crowded(&ws, d.span);

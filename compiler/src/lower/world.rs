@@ -162,6 +162,8 @@ impl Lower<'_> {
                         ws.spans.insert("robots", *span);
                     }
                 }
+                // A role's robots: lowered with the stage's roles (`roles.rs`).
+                W::RoleRobots { .. } => {}
                 W::Objects { count, diameter, virtual_, span } => {
                     let mut o = ws.world.objects.clone().unwrap_or(Objects {
                         count: 8,

@@ -130,21 +130,39 @@ pub enum StageItem {
     Role(RoleDecl),
 }
 
-/// `role NAME robots N { MODULES LINKS }`: a role of a heterogeneous team.
+/// `role NAME robots N { MODULES LINKS FITNESS }`: a role of a
+/// heterogeneous team; in a stage that extends a stage with roles, also
+/// `role NAME adds { ... }` (modules and links added to a role) and `role
+/// NAME robots N` without braces (how many robots play a role).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoleDecl {
     pub name: Name,
-    /// How many robots play it.
-    pub robots: Quantity,
-    /// Its modules and links (`StageItem::Module`, `LinksAll` and `Link`).
+    /// How many robots play it (`None`: `role NAME adds { ... }`).
+    pub robots: Option<Quantity>,
+    /// `adds { ... }`: what a later stage adds to an existing role.
+    pub adds: bool,
+    /// Braces were written (`role NAME robots N` alone has none).
+    pub body: bool,
+    /// Its modules, links and fitness (`StageItem::Module`, `LinksAll`,
+    /// `Link` and `Fitness`).
     pub items: Vec<StageItem>,
     pub span: Span,
+    /// The head: `role NAME robots N` or `role NAME adds`.
+    pub head: Span,
 }
 
 impl RoleDecl {
-    /// The head `role NAME robots N`, up to its count.
+    /// The head `role NAME robots N` (up to its count) or `role NAME adds`.
     pub fn head(&self) -> Span {
-        Span { start: self.span.start, end: self.robots.span.end.max(self.span.start) }
+        self.head
+    }
+
+    /// The fitness declarations of the role.
+    pub fn fitness(&self) -> impl Iterator<Item = &FitnessDecl> {
+        self.items.iter().filter_map(|i| match i {
+            StageItem::Fitness(f) => Some(f),
+            _ => None,
+        })
     }
 
     /// The modules the role declares.
@@ -225,6 +243,13 @@ pub enum WorldItem {
     Recharge(Quantity, Span),
     /// `robots N`: a team of N clones.
     Robots(Quantity, Span),
+    /// `role NAME robots N` in a later stage's `world changes`: how many
+    /// robots play role NAME (lowered with the stage's roles).
+    RoleRobots {
+        name: Name,
+        robots: Quantity,
+        span: Span,
+    },
     Objects {
         count: Option<Quantity>,
         diameter: Option<Quantity>,
@@ -302,6 +327,7 @@ impl WorldItem {
             WorldItem::Battery(..) => ("battery", None),
             WorldItem::Recharge(..) => ("recharge", None),
             WorldItem::Robots(..) => ("robots", None),
+            WorldItem::RoleRobots { name: n, .. } => ("role", Some(n.text.as_str())),
             WorldItem::Objects { .. } => ("objects", None),
             WorldItem::Body { .. } => ("body", None),
             WorldItem::Wall { name: n, .. } => ("wall", name(n)),
@@ -320,6 +346,7 @@ impl WorldItem {
             | WorldItem::Battery(_, span)
             | WorldItem::Recharge(_, span)
             | WorldItem::Robots(_, span)
+            | WorldItem::RoleRobots { span, .. }
             | WorldItem::Objects { span, .. }
             | WorldItem::Body { span, .. }
             | WorldItem::Wall { span, .. }

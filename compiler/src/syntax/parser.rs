@@ -390,6 +390,8 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::learn_when | Rule::k_always => "`always` or `when`",
         Rule::window => "`over`",
         Rule::role | Rule::k_role => "`role`",
+        Rule::role_adds | Rule::k_adds => "`adds`",
+        Rule::role_body => "`{`",
         Rule::links_all => "`links`",
         Rule::link => "`link`",
         Rule::k_all => "`all`",
@@ -850,14 +852,41 @@ impl Builder {
                         .filter(|p| p.as_rule() != Rule::k_role && p.as_rule() != Rule::k_robots);
                     let blank = Name { text: String::new(), span: csp };
                     let role_name = ri.next().map(name).unwrap_or(blank);
-                    let robots =
-                        ri.next().map(quantity).unwrap_or(Quantity { value: 1.0, unit: None, span: csp });
-                    let role_items = ri.filter_map(|p| self.role_item(p)).collect();
+                    let (mut robots, mut adds, mut body) = (None, false, None);
+                    let mut head_end = role_name.span.end;
+                    for p in ri {
+                        match p.as_rule() {
+                            Rule::quantity => {
+                                let q = quantity(p);
+                                head_end = q.span.end;
+                                robots = Some(q);
+                            }
+                            Rule::role_adds => {
+                                adds = true;
+                                for q in p.into_inner() {
+                                    match q.as_rule() {
+                                        Rule::k_adds => head_end = span(&q).end,
+                                        Rule::role_body => body = Some(q),
+                                        _ => {}
+                                    }
+                                }
+                            }
+                            Rule::role_body => body = Some(p),
+                            _ => {}
+                        }
+                    }
+                    let has_body = body.is_some();
+                    let role_items = body
+                        .map(|b| b.into_inner().filter_map(|p| self.role_item(p)).collect())
+                        .unwrap_or_default();
                     items.push(StageItem::Role(RoleDecl {
                         name: role_name,
                         robots,
+                        adds,
+                        body: has_body,
                         items: role_items,
                         span: csp,
+                        head: Span { start: csp.start, end: head_end.max(csp.start) },
                     }));
                 }
                 Rule::module | Rule::links_all | Rule::link => items.extend(self.role_item(c)),
@@ -872,6 +901,7 @@ impl Builder {
         let csp = span(&c);
         match c.as_rule() {
             Rule::module => Some(StageItem::Module(self.module(c))),
+            Rule::fitness => Some(StageItem::Fitness(self.fitness(c))),
             Rule::links_all => {
                 let kind = c.into_inner().nth(1).map(link_kind).unwrap_or(LinkKind::Evolvable(None));
                 Some(StageItem::LinksAll(kind, csp))
@@ -1309,6 +1339,12 @@ fn world(p: Pair<Rule>) -> WorldBlock {
             Rule::robots => {
                 if let Some(q) = c.into_inner().nth(1) {
                     items.push(WorldItem::Robots(quantity(q), csp));
+                }
+            }
+            Rule::role_robots => {
+                let mut ri = c.into_inner().filter(|p| matches!(p.as_rule(), Rule::ident | Rule::quantity));
+                if let (Some(n), Some(q)) = (ri.next(), ri.next()) {
+                    items.push(WorldItem::RoleRobots { name: name(n), robots: quantity(q), span: csp });
                 }
             }
             Rule::objects => {

@@ -311,16 +311,18 @@ const ROLE_ITEM_HEAD: &str = "stage _ { role _ robots 1 {";
 /// caller blanks the role whole).
 fn role_items(src: &str, tokens: &[Token], (s, e): (usize, usize), masked: &mut [u8]) -> Option<Vec<Error>> {
     let toks = &tokens[first_token(tokens, s)..first_token(tokens, e)];
-    // `role NAME robots N {`
-    if toks.get(4).and_then(|t| punct(src, t)) != Some(b'{') {
-        return None;
-    }
-    let body = toks[4].span.end;
+    // `role NAME robots N {` or `role NAME adds {`
+    let open = match (word(src, toks.get(2)), toks.get(3).and_then(|t| punct(src, t))) {
+        (Some("adds"), Some(b'{')) => 3,
+        _ if toks.get(4).and_then(|t| punct(src, t)) == Some(b'{') => 4,
+        _ => return None,
+    };
+    let body = toks[open].span.end;
     let mut pieces: Vec<(usize, usize)> = Vec::new();
     let mut start = body;
     let mut depth = 0i64;
     let mut close = None;
-    for (j, t) in toks.iter().enumerate().skip(5) {
+    for (j, t) in toks.iter().enumerate().skip(open + 1) {
         if starts_item(src, toks, j) {
             if t.span.start > start {
                 pieces.push((start, t.span.start));

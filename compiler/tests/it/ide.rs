@@ -42,14 +42,15 @@ fn completion_in_a_role_offers_its_words_and_its_modules() {
     for w in ["module", "links", "link"] {
         assert!(words.contains(&w), "{w} in {words:?}");
     }
-    assert!(!words.contains(&"fitness"), "{words:?}");
-    // In a stage: `role`; after `role NAME`: `robots`.
+    // A role's robots may have a fitness of their own.
+    assert!(words.contains(&"fitness"), "{words:?}");
+    // In a stage: `role`; after `role NAME`: `robots` (and, in a later stage, `adds`).
     let text = SRC.replace("  fitness per action wheels[0]\n", "  fitness per action wheels[0]\n  \n");
     let offset = text.find("  \n").unwrap() + 2;
     assert!(labels(&ide::complete(&text, offset)).contains(&"role"));
     let text = SRC.replace("role anchor robots 1", "role anchor ");
     let offset = text.find("role anchor ").unwrap() + 12;
-    assert_eq!(labels(&ide::complete(&text, offset)), ["robots"]);
+    assert_eq!(labels(&ide::complete(&text, offset)), ["robots", "adds"]);
 }
 
 #[test]
@@ -94,4 +95,28 @@ fn a_module_named_in_a_role_is_defined_in_that_role() {
     // `brain` declared in role `anchor`: itself.
     let def = ide::definition(SRC, at("module brain", 1, 8)).expect("a definition");
     assert_eq!(def.start, at("module brain", 1, 7));
+}
+
+/// A later stage's roles: a link in `role NAME adds { }` completes the
+/// role's modules, inherited ones included; a hover on a module of a role
+/// added later describes that role's (decl order is not the team's).
+#[test]
+fn a_later_stages_roles_complete_and_hover_their_own_modules() {
+    let later = format!(
+        "{SRC}stage more extends team {{
+  role anchor robots 2
+  role scout robots 1 {{ module brain {{ sense ir[1]  behavior forward }} }}
+  role seeker adds {{
+    module dodge {{ sense ir[2]  behavior back }}
+    link 
+  }}
+}}
+"
+    );
+    let offset = later.find("link \n").unwrap() + 5;
+    let got = ide::complete(&later, offset);
+    assert_eq!(labels(&got), ["brain", "flee", "dodge"]);
+    let scout = later.find("module brain { sense ir[1]").unwrap() + 8;
+    let (_, md) = ide::hover(&later.replace("    link \n", ""), scout).expect("hover");
+    assert!(md.contains("role `scout`") && md.contains("scout.brain"), "{md}");
 }

@@ -10,7 +10,7 @@ fn roles_src() -> String {
 }
 
 fn role(name: &str, robots: u32, modules: u16) -> Role {
-    Role { name: name.into(), robots, modules }
+    Role { name: name.into(), robots, modules, fitness: None }
 }
 
 #[test]

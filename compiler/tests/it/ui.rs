@@ -79,10 +79,16 @@ fn kind(e: &Error) -> &'static str {
         Error::PlaceBlocked { .. } => "PlaceBlocked",
         Error::PlaceTeam { .. } => "PlaceTeam",
         Error::PlaceAfterLife { .. } => "PlaceAfterLife",
+        Error::UnknownRole { .. } => "UnknownRole",
+        Error::RoleModuleExists { .. } => "RoleModuleExists",
+        Error::LinkAcrossRoles { .. } => "LinkAcrossRoles",
+        Error::RoleInTest { .. } => "RoleInTest",
+        Error::RoleFitnessReadsOther { .. } => "RoleFitnessReadsOther",
+        Error::RoleFitnessAlone { .. } => "RoleFitnessAlone",
     }
 }
 
-const KINDS: [&str; 36] = [
+const KINDS: [&str; 42] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -119,6 +125,12 @@ const KINDS: [&str; 36] = [
     "PlaceBlocked",
     "PlaceTeam",
     "PlaceAfterLife",
+    "UnknownRole",
+    "RoleModuleExists",
+    "LinkAcrossRoles",
+    "RoleInTest",
+    "RoleFitnessReadsOther",
+    "RoleFitnessAlone",
 ];
 
 #[test]

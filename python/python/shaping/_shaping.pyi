@@ -88,7 +88,7 @@ class Program:
     def layout(self, stage: str) -> list[dict[str, Any]]:
         """The genes of ``stage``: the rows of ``shaping layout --format json``."""
     def roles(self, stage: str) -> list[dict[str, Any]]:
-        """The roles of ``stage``'s heterogeneous team: ``name``, ``robots`` and ``modules`` (module indices; [] without roles)."""
+        """The roles of ``stage``'s heterogeneous team: ``name``, ``robots``, ``modules`` (module indices) and ``own_fitness`` (the role declares its robots' fitness); [] without roles."""
     def layout_text(self, stage: str) -> str:
         """The table ``shaping layout`` prints."""
     def evaluator(

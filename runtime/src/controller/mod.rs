@@ -332,6 +332,8 @@ pub struct ActionReport {
 #[derive(Clone, Debug)]
 pub struct Controller<'s> {
     stage: &'s Stage,
+    /// The fitness of its robot: its role's ([`Stage::role_fitness`]).
+    role_fitness: &'s crate::program::Fitness,
     /// The modules it runs: the stage's, or its role's ([`Controller::for_role`]).
     modules: &'s [crate::program::Module],
     mods: Vec<Mod<'s>>,
@@ -478,8 +480,9 @@ impl<'s> Controller<'s> {
             forced: None,
             forbidden: vec![false; n],
             holding: false,
-            fitness: stage.fitness.per_action.as_ref().map(FastExpr::new),
-            at_end: stage.fitness.at_end.as_ref().map(FastExpr::new),
+            role_fitness: stage.role_fitness(role),
+            fitness: stage.role_fitness(role).per_action.as_ref().map(FastExpr::new),
+            at_end: stage.role_fitness(role).at_end.as_ref().map(FastExpr::new),
             odo: Odometer::default(),
             state: [0.0; STATE_SLOTS],
             team: [0.0, 0.0, 1.0],
@@ -905,7 +908,10 @@ impl<'s> Controller<'s> {
             let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
             fitness += f64::from(e.eval(&env));
         }
-        add_bonuses(self.stage, &res, &mut fitness);
+        let counts = [res.grips, res.releases_outside, res.recharges, res.collisions];
+        for points in fitness_bonus_points(self.role_fitness, counts) {
+            fitness += points as f64;
+        }
         res.fitness = fitness as f32;
         res.placement_failures = sim.placement_failures();
         res.descriptors = self.descriptors(sim);
@@ -1014,7 +1020,16 @@ pub fn add_bonuses(stage: &Stage, res: &EpisodeResult, fitness: &mut f64) {
 /// Each bonus of `stage`'s fitness for the event counts `[grips, releases
 /// outside, recharges, collisions]`: its points times its event's count.
 pub fn bonus_points(stage: &Stage, counts: [u32; 4]) -> impl Iterator<Item = f32> + '_ {
-    stage.fitness.bonuses.iter().map(move |b| {
+    fitness_bonus_points(&stage.fitness, counts)
+}
+
+/// Each bonus of `fitness` for the event counts `[grips, releases
+/// outside, recharges, collisions]`: its points times its event's count.
+pub fn fitness_bonus_points(
+    fitness: &crate::program::Fitness,
+    counts: [u32; 4],
+) -> impl Iterator<Item = f32> + '_ {
+    fitness.bonuses.iter().map(move |b| {
         let n = match b.event {
             Event::Grip => counts[0],
             Event::ReleaseOutside => counts[1],
