@@ -87,27 +87,7 @@ impl Lower<'_> {
                     )),
                 });
             }
-            let robots = match &r.robots {
-                Some(q) => self.count_in(q, "the robots of a role", 1, MAX_ROBOTS.into()).unwrap_or(1),
-                None => 1,
-            };
-            if r.modules().next().is_none() && !r.adds {
-                self.errors.push(Error::EmptyRole {
-                    span: r.head().into(),
-                    role: r.name.text.clone(),
-                    help: format!(
-                        "declare the modules its robots run inside its braces: `role {} robots N {{ module NAME {{ ... }} }}`",
-                        r.name.text
-                    ),
-                });
-            }
-            lowered.push(Some(st.roles.len()));
-            st.roles.push(Role {
-                name: r.name.text.clone(),
-                robots: robots as u32,
-                modules: 0,
-                fitness: None,
-            });
+            lowered.push(Some(self.new_role(st, r)));
             heads.push(r.head());
         }
         self.check_robot_limit(st, first.head(), &decl.name.text);
@@ -119,6 +99,30 @@ impl Lower<'_> {
     /// stage's own `role NAME robots N`: in a stage that extends a stage
     /// with roles only. Elsewhere (a stage without inherited roles, a
     /// `world` or `world adds`, a variant) they are refused.
+    /// A role declared with its robots and modules (`role NAME robots N {
+    /// ... }`, in a first stage or added by a later one) appended to the
+    /// stage's roles, its modules lowered later; its index. A role without
+    /// modules is an error (a first stage's `adds` is one already).
+    fn new_role(&mut self, st: &mut StageSt, r: &ast::RoleDecl) -> usize {
+        let robots = r
+            .robots
+            .as_ref()
+            .and_then(|q| self.count_in(q, "the robots of a role", 1, MAX_ROBOTS.into()))
+            .unwrap_or(1);
+        if r.modules().next().is_none() && !r.adds {
+            self.errors.push(Error::EmptyRole {
+                span: r.head().into(),
+                role: r.name.text.clone(),
+                help: format!(
+                    "declare the modules its robots run inside its braces: `role {} robots N {{ module NAME {{ ... }} }}`",
+                    r.name.text
+                ),
+            });
+        }
+        st.roles.push(Role { name: r.name.text.clone(), robots: robots as u32, modules: 0, fitness: None });
+        st.roles.len() - 1
+    }
+
     fn world_roles(&mut self, st: &StageSt, decl: &ast::StageDecl) -> Vec<ast::RoleDecl> {
         let later = decl.extends.is_some() && !st.roles.is_empty();
         let mut out = Vec::new();
@@ -302,28 +306,7 @@ impl Lower<'_> {
                 lowered.push(None);
                 continue;
             }
-            let robots = r
-                .robots
-                .as_ref()
-                .and_then(|q| self.count_in(q, "the robots of a role", 1, MAX_ROBOTS.into()))
-                .unwrap_or(1);
-            if r.modules().next().is_none() {
-                self.errors.push(Error::EmptyRole {
-                    span: r.head().into(),
-                    role: r.name.text.clone(),
-                    help: format!(
-                        "declare the modules its robots run inside its braces: `role {} robots N {{ module NAME {{ ... }} }}`",
-                        r.name.text
-                    ),
-                });
-            }
-            lowered.push(Some(st.roles.len()));
-            st.roles.push(Role {
-                name: r.name.text.clone(),
-                robots: robots as u32,
-                modules: 0,
-                fitness: None,
-            });
+            lowered.push(Some(self.new_role(st, r)));
             st.role_heads.push(r.head());
             changed = changed.or(Some(r.head()));
         }
