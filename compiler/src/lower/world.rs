@@ -20,273 +20,312 @@ pub(crate) const BODY_SETTINGS: [&str; 6] =
 
 impl Lower<'_> {
     pub(super) fn world(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str) {
-        use ast::WorldItem as W;
         // Settings that are not lists: once per block.
         let mut seen: HashMap<&'static str, Span> = HashMap::new();
         for item in &block.items {
-            let single = match item {
-                W::Arena { .. } => Some("arena"),
-                W::Charger { .. } => Some("charger"),
-                W::Battery(..) => Some("battery"),
-                W::Recharge(..) => Some("recharge"),
-                W::Robots(..) => Some("robots"),
-                W::Objects { .. } => Some("objects"),
-                W::Body { .. } => Some("body"),
-                W::Start { .. } => Some("start"),
-                _ => None,
+            if self.world_item_fits(ws, block, stage, item, &mut seen) {
+                self.world_item(ws, block, stage, item);
+            }
+        }
+    }
+
+    /// Whether `item` may be lowered into the world so far: a setting that
+    /// is not a list once per block (`seen`), an `adds` of what the world
+    /// lacks and a `changes` of what it has; each mistake reported.
+    fn world_item_fits(
+        &mut self,
+        ws: &WorldSt,
+        block: &ast::WorldBlock,
+        stage: &str,
+        item: &ast::WorldItem,
+        seen: &mut HashMap<&'static str, Span>,
+    ) -> bool {
+        use ast::WorldItem as W;
+        let single = match item {
+            W::Arena { .. } => Some("arena"),
+            W::Charger { .. } => Some("charger"),
+            W::Battery(..) => Some("battery"),
+            W::Recharge(..) => Some("recharge"),
+            W::Robots(..) => Some("robots"),
+            W::Objects { .. } => Some("objects"),
+            W::Body { .. } => Some("body"),
+            W::Start { .. } => Some("start"),
+            _ => None,
+        };
+        if let Some(key) = single {
+            if let Some(first) = seen.get(key) {
+                self.errors.push(Error::Duplicate {
+                    span: item.span().into(),
+                    first: (*first).into(),
+                    what: "world setting",
+                    name: key.into(),
+                });
+                return false;
+            }
+            seen.insert(key, item.span());
+        }
+        let key = match item {
+            W::Charger { .. } => Some("charger"),
+            W::Battery(..) | W::Recharge(..) => Some("battery"),
+            W::Objects { .. } => Some("objects"),
+            W::Start { .. } => Some("start"),
+            _ => None,
+        };
+        if let Some(key) = key {
+            let exists = match key {
+                "charger" => ws.world.charger.is_some(),
+                "battery" => ws.world.battery.is_some(),
+                "start" => ws.world.items.start.is_some(),
+                _ => ws.world.objects.is_some(),
             };
-            if let Some(key) = single {
-                if let Some(first) = seen.get(key) {
-                    self.errors.push(Error::Duplicate {
+            match block.mode {
+                ast::WorldMode::Adds if exists && !matches!(item, W::Recharge(..)) => {
+                    let other = ws.spans.get(key).copied().unwrap_or(item.span());
+                    self.errors.push(Error::Conflict {
                         span: item.span().into(),
-                        first: (*first).into(),
-                        what: "world setting",
-                        name: key.into(),
+                        other: other.into(),
+                        message: format!(
+                            "stage `{stage}` adds {}, but its world has one already",
+                            key_desc(key)
+                        ),
+                        label: "added here".into(),
+                        other_label: "already declared here".into(),
                     });
-                    continue;
+                    return false;
                 }
-                seen.insert(key, item.span());
+                ast::WorldMode::Changes if !exists && !matches!(item, W::Recharge(..)) => {
+                    self.value_error(
+                        item.span(),
+                        format!("stage `{stage}` changes {}, but its world has none", key_desc(key)),
+                        "nothing to change",
+                        Some("use `world adds { ... }` to add them".into()),
+                    );
+                    return false;
+                }
+                _ => {}
             }
-            let key = match item {
-                W::Charger { .. } => Some("charger"),
-                W::Battery(..) | W::Recharge(..) => Some("battery"),
-                W::Objects { .. } => Some("objects"),
-                W::Start { .. } => Some("start"),
-                _ => None,
-            };
-            if let Some(key) = key {
-                let exists = match key {
-                    "charger" => ws.world.charger.is_some(),
-                    "battery" => ws.world.battery.is_some(),
-                    "start" => ws.world.items.start.is_some(),
-                    _ => ws.world.objects.is_some(),
-                };
-                match block.mode {
-                    ast::WorldMode::Adds if exists && !matches!(item, W::Recharge(..)) => {
-                        let other = ws.spans.get(key).copied().unwrap_or(item.span());
-                        self.errors.push(Error::Conflict {
-                            span: item.span().into(),
-                            other: other.into(),
-                            message: format!(
-                                "stage `{stage}` adds {}, but its world has one already",
-                                key_desc(key)
-                            ),
-                            label: "added here".into(),
-                            other_label: "already declared here".into(),
+        }
+        true
+    }
+
+    /// Lowers one item of a world block into the world.
+    fn world_item(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str, item: &ast::WorldItem) {
+        use ast::WorldItem as W;
+        match item {
+            W::Wall { .. }
+            | W::Cylinder { .. }
+            | W::Lamp { .. }
+            | W::Zone { .. }
+            | W::Start { .. }
+            | W::Place { .. } => self.world_list_item(ws, block, stage, item),
+            _ => self.world_setting(ws, block, item),
+        }
+    }
+
+    /// Lowers a setting of a world block (its arena, charger, battery,
+    /// robots, objects, body): one of each per world.
+    fn world_setting(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, item: &ast::WorldItem) {
+        use ast::WorldItem as W;
+        match item {
+            W::Arena { width, depth, span } => {
+                let w = self.length(width, "the arena width");
+                let d = self.length(depth, "the arena depth");
+                if let (Some(w), Some(d)) = (w, d) {
+                    ws.world.arena = [w, d];
+                    ws.spans.insert("arena", *span);
+                    ws.arena_bare = width.unit.is_none() && depth.unit.is_none();
+                }
+            }
+            W::Charger { length, wall, lamp, span } => {
+                let len = self.length(length, "the charger length");
+                let w = match wall.text.as_str() {
+                    "north" => Some(Wall::North),
+                    "south" => Some(Wall::South),
+                    "east" => Some(Wall::East),
+                    "west" => Some(Wall::West),
+                    _ => {
+                        self.errors.push(Error::Unknown {
+                            span: wall.span.into(),
+                            what: "wall",
+                            name: wall.text.clone(),
+                            help: did_you_mean(&wall.text, ["north", "south", "east", "west"])
+                                .or_else(|| Some("the walls are `north`, `south`, `east` and `west`".into())),
                         });
-                        continue;
+                        None
                     }
-                    ast::WorldMode::Changes if !exists && !matches!(item, W::Recharge(..)) => {
-                        self.value_error(
-                            item.span(),
-                            format!("stage `{stage}` changes {}, but its world has none", key_desc(key)),
-                            "nothing to change",
-                            Some("use `world adds { ... }` to add them".into()),
-                        );
-                        continue;
-                    }
-                    _ => {}
+                };
+                let lamp_height = match lamp {
+                    None => Some(None),
+                    Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
+                    Some(Some(q)) => self.length(q, "the lamp height").map(Some),
+                };
+                if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
+                    ws.world.charger = Some(Charger { wall, length, lamp_height });
+                    ws.spans.insert("charger", *span);
                 }
             }
-            match item {
-                W::Arena { width, depth, span } => {
-                    let w = self.length(width, "the arena width");
-                    let d = self.length(depth, "the arena depth");
-                    if let (Some(w), Some(d)) = (w, d) {
-                        ws.world.arena = [w, d];
-                        ws.spans.insert("arena", *span);
-                        ws.arena_bare = width.unit.is_none() && depth.unit.is_none();
-                    }
+            W::Battery(q, span) => {
+                if let Some(c) = self.count(q, "the battery capacity", 1) {
+                    let recharge = ws.world.battery.as_ref().map(|b| b.recharge).unwrap_or(DEFAULT_RECHARGE);
+                    ws.world.battery = Some(Battery { capacity: c as u32, recharge });
+                    ws.spans.insert("battery", *span);
                 }
-                W::Charger { length, wall, lamp, span } => {
-                    let len = self.length(length, "the charger length");
-                    let w = match wall.text.as_str() {
-                        "north" => Some(Wall::North),
-                        "south" => Some(Wall::South),
-                        "east" => Some(Wall::East),
-                        "west" => Some(Wall::West),
-                        _ => {
-                            self.errors.push(Error::Unknown {
-                                span: wall.span.into(),
-                                what: "wall",
-                                name: wall.text.clone(),
-                                help: did_you_mean(&wall.text, ["north", "south", "east", "west"]).or_else(
-                                    || Some("the walls are `north`, `south`, `east` and `west`".into()),
-                                ),
-                            });
-                            None
-                        }
-                    };
-                    let lamp_height = match lamp {
-                        None => Some(None),
-                        Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
-                        Some(Some(q)) => self.length(q, "the lamp height").map(Some),
-                    };
-                    if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
-                        ws.world.charger = Some(Charger { wall, length, lamp_height });
-                        ws.spans.insert("charger", *span);
-                    }
-                }
-                W::Battery(q, span) => {
-                    if let Some(c) = self.count(q, "the battery capacity", 1) {
-                        let recharge =
-                            ws.world.battery.as_ref().map(|b| b.recharge).unwrap_or(DEFAULT_RECHARGE);
-                        ws.world.battery = Some(Battery { capacity: c as u32, recharge });
-                        ws.spans.insert("battery", *span);
-                    }
-                }
-                W::Recharge(q, span) => {
-                    if let Some(c) = self.count(q, "the recharge time", 1) {
-                        match ws.world.battery.as_mut() {
-                            Some(b) => b.recharge = c as u32,
-                            None => {
-                                // `recharge` before `battery` in the same block.
-                                let has_battery = block.items.iter().any(|i| matches!(i, W::Battery(..)));
-                                if has_battery {
-                                    ws.world.battery = Some(Battery { capacity: 200, recharge: c as u32 });
-                                } else {
-                                    self.value_error(
-                                        *span,
-                                        "the world recharges a battery it does not have".into(),
-                                        "no battery",
-                                        Some("declare `battery N actions` too".into()),
-                                    );
-                                }
+            }
+            W::Recharge(q, span) => {
+                if let Some(c) = self.count(q, "the recharge time", 1) {
+                    match ws.world.battery.as_mut() {
+                        Some(b) => b.recharge = c as u32,
+                        None => {
+                            // `recharge` before `battery` in the same block.
+                            let has_battery = block.items.iter().any(|i| matches!(i, W::Battery(..)));
+                            if has_battery {
+                                ws.world.battery = Some(Battery { capacity: 200, recharge: c as u32 });
+                            } else {
+                                self.value_error(
+                                    *span,
+                                    "the world recharges a battery it does not have".into(),
+                                    "no battery",
+                                    Some("declare `battery N actions` too".into()),
+                                );
                             }
                         }
                     }
                 }
-                W::Robots(q, span) => {
-                    if let Some(n) = self.count_in(q, "the number of robots", 1, MAX_ROBOTS.into()) {
-                        ws.world.robots = n as u32;
-                        ws.spans.insert("robots", *span);
-                    }
-                }
-                // A role's robots: lowered with the stage's roles (`roles.rs`).
-                W::RoleRobots { .. } => {}
-                W::Objects { count, diameter, virtual_, span } => {
-                    let mut o = ws.world.objects.clone().unwrap_or(Objects {
-                        count: 8,
-                        diameter: 25.0,
-                        virtual_: false,
-                    });
-                    if let Some(c) = count
-                        .as_ref()
-                        .and_then(|q| self.count_in(q, "the number of objects", 0, MAX_OBJECTS.into()))
-                    {
-                        o.count = c as u32;
-                    }
-                    if let Some(d) = diameter.as_ref().and_then(|q| self.length(q, "the object diameter")) {
-                        o.diameter = d;
-                    }
-                    if let Some(v) = virtual_ {
-                        o.virtual_ = *v;
-                    }
-                    ws.world.objects = Some(o);
-                    ws.spans.insert("objects", *span);
-                }
-                W::Body { preset, items, span } => {
-                    self.body(ws, preset.as_ref(), items, *span);
-                    ws.spans.insert("body", *span);
-                }
-                W::Wall { name, from, to, span } => {
-                    let (a, b) = (self.point(from, "a wall's end"), self.point(to, "a wall's end"));
-                    let (Some(from), Some(to)) = (a, b) else {
-                        refuse(ws, "wall", name.as_ref());
-                        continue;
-                    };
-                    let wall = InnerWall { name: name.as_ref().map(|n| n.text.clone()), from, to };
-                    let place = self.place(ws, block, stage, "wall", name.as_ref(), *span);
-                    put(&mut ws.world.items.walls, place, wall);
-                }
-                W::Cylinder { name, at, diameter, span } => {
-                    let at = self.point(at, "a cylinder's centre");
-                    let d = self.length(diameter, "the cylinder diameter");
-                    let (Some(at), Some(diameter)) = (at, d) else {
-                        refuse(ws, "cylinder", name.as_ref());
-                        continue;
-                    };
-                    let cyl = Cylinder { name: name.as_ref().map(|n| n.text.clone()), at, diameter };
-                    let place = self.place(ws, block, stage, "cylinder", name.as_ref(), *span);
-                    put(&mut ws.world.items.cylinders, place, cyl);
-                }
-                W::Lamp { name, at, height, intensity, switch, span } => {
-                    let at = self.point(at, "a lamp's position");
-                    let h = match height {
-                        Some(q) => self.length(q, "the lamp height"),
-                        None => Some(DEFAULT_LAMP_HEIGHT),
-                    };
-                    let k = match intensity {
-                        Some(q) => self.plain(q, "the lamp intensity", 0.0, 1e6),
-                        None => Some(1.0),
-                    };
-                    let sw = match switch {
-                        Some((on, q)) => self
-                            .count_in(q, "the action a lamp switches at", 1, MAX_ACTIONS.into())
-                            .map(|n| Some(LampSwitch { on: *on, at: n as u32 })),
-                        None => Some(None),
-                    };
-                    let (Some(at), Some(height), Some(intensity), Some(switch)) = (at, h, k, sw) else {
-                        refuse(ws, "lamp", name.as_ref());
-                        continue;
-                    };
-                    let lamp =
-                        Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity, switch };
-                    let place = self.place(ws, block, stage, "lamp", name.as_ref(), *span);
-                    put(&mut ws.world.items.lamps, place, lamp);
-                }
-                W::Zone { name, from, to, grey, charger, span } => {
-                    let (a, b) = (self.point(from, "a zone's corner"), self.point(to, "a zone's corner"));
-                    let g = match grey {
-                        Some(q) => self.plain(q, "the grey level", 0.0, 1.0),
-                        None => Some(0.0),
-                    };
-                    let (Some(from), Some(to), Some(grey)) = (a, b, g) else {
-                        refuse(ws, "zone", name.as_ref());
-                        continue;
-                    };
-                    let zone = Zone {
-                        name: name.as_ref().map(|n| n.text.clone()),
-                        from,
-                        to,
-                        grey,
-                        charger: *charger,
-                    };
-                    let place = self.place(ws, block, stage, "zone", name.as_ref(), *span);
-                    put(&mut ws.world.items.zones, place, zone);
-                }
-                W::Start { from, to, heading, span } => {
-                    let a = self.point(from, "the start position");
-                    let b = match to {
-                        Some(p) => self.point(p, "the start region's corner"),
-                        None => a,
-                    };
-                    let h = match heading {
-                        Some(q) => self.heading(q).map(|d| Some(d.to_radians())),
-                        None => Some(None),
-                    };
-                    let (Some(from), Some(to), Some(heading)) = (a, b, h) else { continue };
-                    ws.world.items.start = Some(Start { from, to, heading });
-                    ws.spans.insert("start", *span);
-                }
-                W::Place { name, at, heading, after, span } => {
-                    let at = self.point(at, "the place");
-                    let h = self.heading(heading).map(|d| d.to_radians());
-                    let n = self.count_in(after, "the action a placement follows", 1, MAX_ACTIONS.into());
-                    let (Some(at), Some(heading), Some(n)) = (at, h, n) else {
-                        refuse(ws, "place", name.as_ref());
-                        continue;
-                    };
-                    let p = Placement {
-                        name: name.as_ref().map(|n| n.text.clone()),
-                        at,
-                        heading,
-                        after: n as u32,
-                    };
-                    let place = self.place(ws, block, stage, "place", name.as_ref(), *span);
-                    put(&mut ws.world.items.places, place, p);
+            }
+            W::Robots(q, span) => {
+                if let Some(n) = self.count_in(q, "the number of robots", 1, MAX_ROBOTS.into()) {
+                    ws.world.robots = n as u32;
+                    ws.spans.insert("robots", *span);
                 }
             }
+            // A role's robots: lowered with the stage's roles (`roles.rs`).
+            W::RoleRobots { .. } => {}
+            W::Objects { count, diameter, virtual_, span } => {
+                let mut o =
+                    ws.world.objects.clone().unwrap_or(Objects { count: 8, diameter: 25.0, virtual_: false });
+                if let Some(c) = count
+                    .as_ref()
+                    .and_then(|q| self.count_in(q, "the number of objects", 0, MAX_OBJECTS.into()))
+                {
+                    o.count = c as u32;
+                }
+                if let Some(d) = diameter.as_ref().and_then(|q| self.length(q, "the object diameter")) {
+                    o.diameter = d;
+                }
+                if let Some(v) = virtual_ {
+                    o.virtual_ = *v;
+                }
+                ws.world.objects = Some(o);
+                ws.spans.insert("objects", *span);
+            }
+            W::Body { preset, items, span } => {
+                self.body(ws, preset.as_ref(), items, *span);
+                ws.spans.insert("body", *span);
+            }
+            _ => {}
+        }
+    }
+
+    /// Lowers a list item of a world block (a wall, cylinder, lamp, zone,
+    /// the start or a placement), named or not, added or changed.
+    fn world_list_item(
+        &mut self,
+        ws: &mut WorldSt,
+        block: &ast::WorldBlock,
+        stage: &str,
+        item: &ast::WorldItem,
+    ) {
+        use ast::WorldItem as W;
+        match item {
+            W::Wall { name, from, to, span } => {
+                let (a, b) = (self.point(from, "a wall's end"), self.point(to, "a wall's end"));
+                let (Some(from), Some(to)) = (a, b) else {
+                    refuse(ws, "wall", name.as_ref());
+                    return;
+                };
+                let wall = InnerWall { name: name.as_ref().map(|n| n.text.clone()), from, to };
+                let place = self.place(ws, block, stage, "wall", name.as_ref(), *span);
+                put(&mut ws.world.items.walls, place, wall);
+            }
+            W::Cylinder { name, at, diameter, span } => {
+                let at = self.point(at, "a cylinder's centre");
+                let d = self.length(diameter, "the cylinder diameter");
+                let (Some(at), Some(diameter)) = (at, d) else {
+                    refuse(ws, "cylinder", name.as_ref());
+                    return;
+                };
+                let cyl = Cylinder { name: name.as_ref().map(|n| n.text.clone()), at, diameter };
+                let place = self.place(ws, block, stage, "cylinder", name.as_ref(), *span);
+                put(&mut ws.world.items.cylinders, place, cyl);
+            }
+            W::Lamp { name, at, height, intensity, switch, span } => {
+                let at = self.point(at, "a lamp's position");
+                let h = match height {
+                    Some(q) => self.length(q, "the lamp height"),
+                    None => Some(DEFAULT_LAMP_HEIGHT),
+                };
+                let k = match intensity {
+                    Some(q) => self.plain(q, "the lamp intensity", 0.0, 1e6),
+                    None => Some(1.0),
+                };
+                let sw = match switch {
+                    Some((on, q)) => self
+                        .count_in(q, "the action a lamp switches at", 1, MAX_ACTIONS.into())
+                        .map(|n| Some(LampSwitch { on: *on, at: n as u32 })),
+                    None => Some(None),
+                };
+                let (Some(at), Some(height), Some(intensity), Some(switch)) = (at, h, k, sw) else {
+                    refuse(ws, "lamp", name.as_ref());
+                    return;
+                };
+                let lamp =
+                    Lamp { name: name.as_ref().map(|n| n.text.clone()), at, height, intensity, switch };
+                let place = self.place(ws, block, stage, "lamp", name.as_ref(), *span);
+                put(&mut ws.world.items.lamps, place, lamp);
+            }
+            W::Zone { name, from, to, grey, charger, span } => {
+                let (a, b) = (self.point(from, "a zone's corner"), self.point(to, "a zone's corner"));
+                let g = match grey {
+                    Some(q) => self.plain(q, "the grey level", 0.0, 1.0),
+                    None => Some(0.0),
+                };
+                let (Some(from), Some(to), Some(grey)) = (a, b, g) else {
+                    refuse(ws, "zone", name.as_ref());
+                    return;
+                };
+                let zone =
+                    Zone { name: name.as_ref().map(|n| n.text.clone()), from, to, grey, charger: *charger };
+                let place = self.place(ws, block, stage, "zone", name.as_ref(), *span);
+                put(&mut ws.world.items.zones, place, zone);
+            }
+            W::Start { from, to, heading, span } => {
+                let a = self.point(from, "the start position");
+                let b = match to {
+                    Some(p) => self.point(p, "the start region's corner"),
+                    None => a,
+                };
+                let h = match heading {
+                    Some(q) => self.heading(q).map(|d| Some(d.to_radians())),
+                    None => Some(None),
+                };
+                let (Some(from), Some(to), Some(heading)) = (a, b, h) else { return };
+                ws.world.items.start = Some(Start { from, to, heading });
+                ws.spans.insert("start", *span);
+            }
+            W::Place { name, at, heading, after, span } => {
+                let at = self.point(at, "the place");
+                let h = self.heading(heading).map(|d| d.to_radians());
+                let n = self.count_in(after, "the action a placement follows", 1, MAX_ACTIONS.into());
+                let (Some(at), Some(heading), Some(n)) = (at, h, n) else {
+                    refuse(ws, "place", name.as_ref());
+                    return;
+                };
+                let p =
+                    Placement { name: name.as_ref().map(|n| n.text.clone()), at, heading, after: n as u32 };
+                let place = self.place(ws, block, stage, "place", name.as_ref(), *span);
+                put(&mut ws.world.items.places, place, p);
+            }
+            _ => {}
         }
     }
 
