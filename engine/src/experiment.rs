@@ -444,131 +444,18 @@ fn summarise(
     let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     let mut histories: Vec<Vec<GenStats>> = vec![Vec::new(); seeds.len()];
     for stage in stages.iter().map(|&i| &program.stages[i]) {
-        match &stage.run {
+        let (figures, row) = match &stage.run {
             StageRun::Evolve(evo) => {
-                let mut chosen = Vec::new();
-                let mut best = Vec::new();
-                let mut mean = Vec::new();
-                let mut ever = Vec::new();
-                let mut reach = Vec::new();
-                let mut unreached = 0;
                 let criterion = criteria.iter().find(|(s, _)| *s == stage.name).map(|c| c.1);
-                for &seed in seeds {
-                    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
-                    let cp: Checkpoint = rundir::read_checkpoint_with(&dir, unsealed)?
-                        .ok_or_else(|| rundir::missing(&rundir::checkpoint_path(&dir)))?;
-                    let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
-                    if let Some(last) = own.last() {
-                        best.push(last.best as f64);
-                        mean.push(last.mean as f64);
-                    }
-                    if let Some((_, f)) = shaping_runtime::evolve::best_of(&cp) {
-                        chosen.push(f as f64);
-                    }
-                    ever.push(own.iter().map(|h| h.best as f64).fold(f64::NEG_INFINITY, f64::max));
-                    if let Some(c) = criterion {
-                        match own.iter().find(|h| h.best >= c) {
-                            Some(h) => reach.push(h.stage_generation as f64 + 1.0),
-                            None => unreached += 1,
-                        }
-                    }
-                    // Per seed, keep the longest history (the deepest evolved stage's).
-                    let slot = seeds.iter().position(|&s| s == seed).unwrap_or(0);
-                    if cp.history.len() > histories[slot].len() {
-                        histories[slot] = cp.history;
-                    }
-                }
-                let reach_text = match criterion {
-                    None => "-".to_string(),
-                    Some(c) => format!(
-                        "{} to reach {c}{}",
-                        fmt_spread(spread(&reach), 0),
-                        if unreached > 0 { format!("; {unreached} seeds never") } else { String::new() }
-                    ),
-                };
-                json.push(StageFigures::Evolve {
-                    stage: stage.name.clone(),
-                    generations: evo.generations,
-                    final_best: spread(&best),
-                    chosen_best: spread(&chosen),
-                    final_mean: spread(&mean),
-                    best_ever: spread(&ever),
-                    criterion: criterion.map(|c| rundir::CriterionFigures {
-                        fitness: f64::from(c),
-                        generation: spread(&reach),
-                        unreached,
-                    }),
-                });
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | {} | {} | {} | {} |",
-                    stage.name,
-                    evo.generations,
-                    fmt_spread(spread(&best), 3),
-                    fmt_spread(spread(&chosen), 3),
-                    fmt_spread(spread(&mean), 3),
-                    fmt_spread(spread(&ever), 3),
-                    reach_text
-                );
+                evolved_figures(stage, evo, out, seeds, criterion, unsealed, &mut histories)?
             }
-            StageRun::Train { actions } => {
-                let mut perf = Vec::new();
-                for &seed in seeds {
-                    let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
-                    let t = rundir::read_trained_with(&dir, unsealed)?
-                        .ok_or_else(|| rundir::missing(&rundir::trained_path(&dir)))?;
-                    let learners =
-                        stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
-                    perf.extend(learners.map(|(_, p)| *p as f64));
-                }
-                json.push(StageFigures::Train {
-                    stage: stage.name.clone(),
-                    actions: *actions,
-                    performance: spread(&perf),
-                });
-                let _ = writeln!(
-                    md,
-                    "| {} | training, {actions} actions | performance at the end {} | - | - | - | - |",
-                    stage.name,
-                    fmt_spread(spread(&perf), 2),
-                );
-            }
+            StageRun::Train { actions } => trained_figures(stage, *actions, out, seeds, unsealed)?,
             StageRun::Test { actions, lives, learning } => {
-                let mut fit = Vec::new();
-                let mut grips = Vec::new();
-                let mut rel = Vec::new();
-                for &seed in seeds {
-                    let v = rundir::seed_test_summary(out, seed, &stage.name, unsealed)?;
-                    fit.push(v.fitness);
-                    grips.push(f64::from(v.grips));
-                    rel.push(f64::from(v.releases_outside));
-                }
-                json.push(StageFigures::Test {
-                    stage: stage.name.clone(),
-                    actions: *actions,
-                    lives: *lives,
-                    learning: *learning,
-                    fitness: spread(&fit),
-                    grips: spread(&grips),
-                    releases_outside: spread(&rel),
-                });
-                let length = match lives {
-                    1 => format!("{actions} actions"),
-                    _ => {
-                        format!("{lives} lives of {actions} actions (fitness: mean per life; events: totals)")
-                    }
-                };
-                let _ = writeln!(
-                    md,
-                    "| {} | test, {length}, learning {} | fitness {} | - | grips {} | released outside {} | - |",
-                    stage.name,
-                    if *learning { "on" } else { "off" },
-                    fmt_spread(spread(&fit), 3),
-                    fmt_spread(spread(&grips), 1),
-                    fmt_spread(spread(&rel), 1),
-                );
+                tested_figures(stage, (*actions, *lives, *learning), out, seeds, unsealed)?
             }
-        }
+        };
+        json.push(figures);
+        md.push_str(&row);
     }
     let runs: Vec<Vec<plot::GenPoint>> = histories.iter().map(|h| report::fitness_points(h).0).collect();
     if let Some(first) = histories.iter().filter(|h| !h.is_empty()).max_by_key(|h| h.len()) {
@@ -586,4 +473,155 @@ fn summarise(
         "\nPicture: `fitness-seeds.svg` / `fitness-seeds.png` (median best and mean, min-max band)."
     );
     Ok((md, json))
+}
+
+/// An evolved stage's figures over the seeds (its row of `summary.md` and
+/// its `summary.json` part); each seed's history kept in `histories` if
+/// it is the longest so far (the deepest evolved stage's).
+fn evolved_figures(
+    stage: &shaping_runtime::program::Stage,
+    evo: &shaping_runtime::program::Evolution,
+    out: &Path,
+    seeds: &[u64],
+    criterion: Option<f32>,
+    unsealed: crate::files::Unsealed<'_>,
+    histories: &mut [Vec<GenStats>],
+) -> Result<(StageFigures, String), Error> {
+    let mut md = String::new();
+    let mut chosen = Vec::new();
+    let mut best = Vec::new();
+    let mut mean = Vec::new();
+    let mut ever = Vec::new();
+    let mut reach = Vec::new();
+    let mut unreached = 0;
+    for &seed in seeds {
+        let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
+        let cp: Checkpoint = rundir::read_checkpoint_with(&dir, unsealed)?
+            .ok_or_else(|| rundir::missing(&rundir::checkpoint_path(&dir)))?;
+        let own: Vec<&GenStats> = cp.history.iter().filter(|h| h.stage == stage.name).collect();
+        if let Some(last) = own.last() {
+            best.push(last.best as f64);
+            mean.push(last.mean as f64);
+        }
+        if let Some((_, f)) = shaping_runtime::evolve::best_of(&cp) {
+            chosen.push(f as f64);
+        }
+        ever.push(own.iter().map(|h| h.best as f64).fold(f64::NEG_INFINITY, f64::max));
+        if let Some(c) = criterion {
+            match own.iter().find(|h| h.best >= c) {
+                Some(h) => reach.push(h.stage_generation as f64 + 1.0),
+                None => unreached += 1,
+            }
+        }
+        // Per seed, keep the longest history (the deepest evolved stage's).
+        let slot = seeds.iter().position(|&s| s == seed).unwrap_or(0);
+        if cp.history.len() > histories[slot].len() {
+            histories[slot] = cp.history;
+        }
+    }
+    let reach_text = match criterion {
+        None => "-".to_string(),
+        Some(c) => format!(
+            "{} to reach {c}{}",
+            fmt_spread(spread(&reach), 0),
+            if unreached > 0 { format!("; {unreached} seeds never") } else { String::new() }
+        ),
+    };
+    let figures = StageFigures::Evolve {
+        stage: stage.name.clone(),
+        generations: evo.generations,
+        final_best: spread(&best),
+        chosen_best: spread(&chosen),
+        final_mean: spread(&mean),
+        best_ever: spread(&ever),
+        criterion: criterion.map(|c| rundir::CriterionFigures {
+            fitness: f64::from(c),
+            generation: spread(&reach),
+            unreached,
+        }),
+    };
+    let _ = writeln!(
+        md,
+        "| {} | {} | {} | {} | {} | {} | {} |",
+        stage.name,
+        evo.generations,
+        fmt_spread(spread(&best), 3),
+        fmt_spread(spread(&chosen), 3),
+        fmt_spread(spread(&mean), 3),
+        fmt_spread(spread(&ever), 3),
+        reach_text
+    );
+    Ok((figures, md))
+}
+
+/// A training stage's figures over the seeds: its learning modules' performance.
+fn trained_figures(
+    stage: &shaping_runtime::program::Stage,
+    actions: u32,
+    out: &Path,
+    seeds: &[u64],
+    unsealed: crate::files::Unsealed<'_>,
+) -> Result<(StageFigures, String), Error> {
+    let mut md = String::new();
+    let mut perf = Vec::new();
+    for &seed in seeds {
+        let dir = rundir::stage_dir(&rundir::seed_dir(out, seed), &stage.name);
+        let t = rundir::read_trained_with(&dir, unsealed)?
+            .ok_or_else(|| rundir::missing(&rundir::trained_path(&dir)))?;
+        let learners = stage.modules.iter().zip(&t.performance).filter(|(m, _)| m.learning.is_some());
+        perf.extend(learners.map(|(_, p)| *p as f64));
+    }
+    let figures = StageFigures::Train { stage: stage.name.clone(), actions, performance: spread(&perf) };
+    let _ = writeln!(
+        md,
+        "| {} | training, {actions} actions | performance at the end {} | - | - | - | - |",
+        stage.name,
+        fmt_spread(spread(&perf), 2),
+    );
+    Ok((figures, md))
+}
+
+/// A test stage's figures over the seeds: its fitness and events.
+fn tested_figures(
+    stage: &shaping_runtime::program::Stage,
+    (actions, lives, learning): (u32, u32, bool),
+    out: &Path,
+    seeds: &[u64],
+    unsealed: crate::files::Unsealed<'_>,
+) -> Result<(StageFigures, String), Error> {
+    let mut md = String::new();
+    let mut fit = Vec::new();
+    let mut grips = Vec::new();
+    let mut rel = Vec::new();
+    for &seed in seeds {
+        let v = rundir::seed_test_summary(out, seed, &stage.name, unsealed)?;
+        fit.push(v.fitness);
+        grips.push(f64::from(v.grips));
+        rel.push(f64::from(v.releases_outside));
+    }
+    let figures = StageFigures::Test {
+        stage: stage.name.clone(),
+        actions,
+        lives,
+        learning,
+        fitness: spread(&fit),
+        grips: spread(&grips),
+        releases_outside: spread(&rel),
+    };
+    let length = match lives {
+        1 => format!("{actions} actions"),
+        _ => {
+            format!("{lives} lives of {actions} actions (fitness: mean per life; events: totals)")
+        }
+    };
+    let _ = writeln!(
+        md,
+        "| {} | test, {length}, learning {} | fitness {} | - | grips {} | released outside {} | - |",
+        stage.name,
+        if learning { "on" } else { "off" },
+        fmt_spread(spread(&fit), 3),
+        fmt_spread(spread(&grips), 1),
+        fmt_spread(spread(&rel), 1),
+    );
+    Ok((figures, md))
 }
