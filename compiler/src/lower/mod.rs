@@ -653,61 +653,7 @@ impl<'a> Lower<'a> {
                 }
             }
         }
-        // Cycles: walk up from every stage.
-        let mut in_cycle = vec![false; file.stages.len()];
-        for i in 0..file.stages.len() {
-            let mut path = vec![i];
-            let mut cur = i;
-            while let Some(p) = parent[cur] {
-                if let Some(pos) = path.iter().position(|&x| x == p) {
-                    let cycle = &path[pos..];
-                    if cycle.iter().all(|&c| !in_cycle[c]) {
-                        let mut members = cycle.to_vec();
-                        members.sort_unstable();
-                        for &c in &members {
-                            in_cycle[c] = true;
-                        }
-                        let first = members[0];
-                        let text: Vec<String> = {
-                            let mut order = vec![first];
-                            let mut c = first;
-                            while let Some(p) = parent[c] {
-                                if p == first {
-                                    break;
-                                }
-                                order.push(p);
-                                c = p;
-                            }
-                            order.push(first);
-                            order.iter().map(|&c| format!("`{}`", file.stages[c].name.text)).collect()
-                        };
-                        let span_of = |c: usize| {
-                            file.stages[c]
-                                .extends
-                                .as_ref()
-                                .map(|e| e.span)
-                                .unwrap_or(file.stages[c].name.span)
-                        };
-                        self.errors.push(Error::Cycle {
-                            span: span_of(first).into(),
-                            cycle: text.join(" extends "),
-                            others: members[1..]
-                                .iter()
-                                .map(|&c| {
-                                    miette::LabeledSpan::new_with_span(
-                                        Some("and this one".into()),
-                                        span_of(c),
-                                    )
-                                })
-                                .collect(),
-                        });
-                    }
-                    break;
-                }
-                path.push(p);
-                cur = p;
-            }
-        }
+        let in_cycle = self.stage_cycles(&parent);
         // Dependency order, stable by declaration: parents first, and the
         // stages whose weights a stage uses (`weights trained STAGE`). Uses
         // that depend on each other cannot all be met: then the first stage
@@ -774,48 +720,115 @@ impl<'a> Lower<'a> {
                     );
                 }
             }
-            let trains = decl.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }));
-            if let (StageRun::Train { .. }, true) = (&stage.run, trains) {
-                if !stage.layout.genes.is_empty() {
-                    self.value_error(
-                        decl.name.span,
-                        format!(
-                            "training stage `{}` evolves nothing, but declares {} genes",
-                            decl.name.text,
-                            stage.layout.genes.len()
-                        ),
-                        "has genes",
-                        Some(
-                            "declare its activation weights, behavior weights and links `fixed` or `random`"
-                                .into(),
-                        ),
-                    );
-                }
-                let shapes = stage
-                    .modules
-                    .iter()
-                    .map(|m| {
-                        let shape = match &m.behavior {
-                            Behavior::Neural(nb) => TrainedShape::Network((
-                                nb.net.inputs,
-                                nb.net.hidden,
-                                nb.net.outputs,
-                                nb.net.recurrent,
-                            )),
-                            // A script has a step: none is the placeholder of a failed behavior.
-                            Behavior::Script(sc) if sc.steps.is_empty() => TrainedShape::Failed,
-                            Behavior::Script(_) => TrainedShape::Script,
-                        };
-                        let a = &m.activation;
-                        (m.name.clone(), shape, (a.inputs, a.hidden, a.outputs, a.recurrent))
-                    })
-                    .collect();
-                self.trained.insert(decl.name.text.clone(), (s, shapes));
-            }
+            self.check_training(decl, &stage, s);
             states.push(state);
             stages.push(stage);
         }
         Program { format: FORMAT_VERSION, name, stages }
+    }
+
+    /// The stages in a cycle of `extends` (walking up from every stage),
+    /// each cycle reported once.
+    fn stage_cycles(&mut self, parent: &[Option<usize>]) -> Vec<bool> {
+        let file = self.file;
+        let mut in_cycle = vec![false; file.stages.len()];
+        for i in 0..file.stages.len() {
+            let mut path = vec![i];
+            let mut cur = i;
+            while let Some(p) = parent[cur] {
+                if let Some(pos) = path.iter().position(|&x| x == p) {
+                    let cycle = &path[pos..];
+                    if cycle.iter().all(|&c| !in_cycle[c]) {
+                        let mut members = cycle.to_vec();
+                        members.sort_unstable();
+                        for &c in &members {
+                            in_cycle[c] = true;
+                        }
+                        let first = members[0];
+                        let text: Vec<String> = {
+                            let mut order = vec![first];
+                            let mut c = first;
+                            while let Some(p) = parent[c] {
+                                if p == first {
+                                    break;
+                                }
+                                order.push(p);
+                                c = p;
+                            }
+                            order.push(first);
+                            order.iter().map(|&c| format!("`{}`", file.stages[c].name.text)).collect()
+                        };
+                        let span_of = |c: usize| {
+                            file.stages[c]
+                                .extends
+                                .as_ref()
+                                .map(|e| e.span)
+                                .unwrap_or(file.stages[c].name.span)
+                        };
+                        self.errors.push(Error::Cycle {
+                            span: span_of(first).into(),
+                            cycle: text.join(" extends "),
+                            others: members[1..]
+                                .iter()
+                                .map(|&c| {
+                                    miette::LabeledSpan::new_with_span(
+                                        Some("and this one".into()),
+                                        span_of(c),
+                                    )
+                                })
+                                .collect(),
+                        });
+                    }
+                    break;
+                }
+                path.push(p);
+                cur = p;
+            }
+        }
+        in_cycle
+    }
+
+    /// A training stage (`train ...`): it must have no genes, and its
+    /// modules' shapes are kept for the stages that use its weights.
+    fn check_training(&mut self, decl: &ast::StageDecl, stage: &Stage, s: u16) {
+        let trains = decl.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }));
+        if let (StageRun::Train { .. }, true) = (&stage.run, trains) {
+            if !stage.layout.genes.is_empty() {
+                self.value_error(
+                    decl.name.span,
+                    format!(
+                        "training stage `{}` evolves nothing, but declares {} genes",
+                        decl.name.text,
+                        stage.layout.genes.len()
+                    ),
+                    "has genes",
+                    Some(
+                        "declare its activation weights, behavior weights and links `fixed` or `random`"
+                            .into(),
+                    ),
+                );
+            }
+            let shapes = stage
+                .modules
+                .iter()
+                .map(|m| {
+                    let shape = match &m.behavior {
+                        Behavior::Neural(nb) => TrainedShape::Network((
+                            nb.net.inputs,
+                            nb.net.hidden,
+                            nb.net.outputs,
+                            nb.net.recurrent,
+                        )),
+                        // A script has a step: none is the placeholder of a failed behavior.
+                        Behavior::Script(sc) if sc.steps.is_empty() => TrainedShape::Failed,
+                        Behavior::Script(_) => TrainedShape::Script,
+                    };
+                    let a = &m.activation;
+                    (m.name.clone(), shape, (a.inputs, a.hidden, a.outputs, a.recurrent))
+                })
+                .collect();
+            self.trained.insert(decl.name.text.clone(), (s, shapes));
+        }
     }
 
     fn root_state(&mut self, s: u16) -> StageSt {
