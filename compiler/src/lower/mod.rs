@@ -1169,7 +1169,31 @@ impl<'a> Lower<'a> {
         if !role_stage {
             self.links(&mut st, decl, s);
         }
-        // Fitness.
+        self.stage_fitness(&hw, &mut st, decl, &role_decls);
+        st.targets = std::mem::take(&mut self.targets);
+        self.allocate(&mut st, s);
+        self.check_role_genes(&st, decl);
+        self.check_evolved_genes(&st, decl, s, errors_before);
+        self.check_genome_size(&st, decl);
+        let mut stage = assemble(&st, &sname, s, parent);
+        stage.variants = self.variant_worlds(&st, &sname, decl);
+        self.check_team_clause(&stage, decl);
+        self.check_lamp(&st, &stage, s);
+        (st, stage)
+    }
+
+    /// A stage's fitness (its own, replaced or added to) and its roles';
+    /// an evolved stage without any is an error. The stage's targets are
+    /// `self.targets` while its fitness terms are read.
+    fn stage_fitness(
+        &mut self,
+        hw: &Hw,
+        st: &mut StageSt,
+        decl: &ast::StageDecl,
+        role_decls: &[Option<usize>],
+    ) {
+        use ast::StageItem as I;
+        let sname = &decl.name.text;
         // A `fitness` without `adds` replaces the fitness: after another
         // `fitness` of the same stage, it would silently drop that one.
         let mut first_fitness: Option<Span> = None;
@@ -1190,10 +1214,10 @@ impl<'a> Lower<'a> {
                     continue;
                 }
                 first_fitness = first_fitness.or(Some(f.span));
-                self.fitness(&hw, &mut st, f);
+                self.fitness(hw, st, f);
             }
         }
-        self.role_fitness(&hw, &mut st, decl, &role_decls);
+        self.role_fitness(hw, st, decl, role_decls);
         // Where every role has a fitness of its own, the stage needs none.
         let roles_fit = !st.roles.is_empty() && st.roles.iter().all(|r| r.fitness.is_some());
         if matches!(st.run, StageRun::Evolve(_)) && !st.fitness_declared && !st.fitness_reported && !roles_fit
@@ -1206,16 +1230,6 @@ impl<'a> Lower<'a> {
                 Some("add `fitness per action EXPR` or declare a `test` stage".into()),
             );
         }
-        st.targets = std::mem::take(&mut self.targets);
-        self.allocate(&mut st, s);
-        self.check_role_genes(&st, decl);
-        self.check_evolved_genes(&st, decl, s, errors_before);
-        self.check_genome_size(&st, decl);
-        let mut stage = assemble(&st, &sname, s, parent);
-        stage.variants = self.variant_worlds(&st, &sname, decl);
-        self.check_team_clause(&stage, decl);
-        self.check_lamp(&st, &stage, s);
-        (st, stage)
     }
 }
 
