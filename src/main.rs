@@ -415,6 +415,30 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             let index = load::stage_index(&program, stage.as_deref())?;
             print_text(&shaping_compiler::render_graph(&program, index))
         }
+        Command::Compare { dirs, criterion, stage, json } => {
+            compare(shaping_engine::compare::CompareOptions { dirs, criterion, stage }, json)
+        }
+        Command::Report { dir, output } => report(&dir, output.as_deref()),
+        Command::Bench { file, stage, runs, sets, error_format } => bench::bench(bench::BenchArgs {
+            file,
+            stage,
+            runs,
+            sets: single_values(sets, "bench")?,
+            error_format,
+        }),
+        Command::Build { file, output, error_format } => build(&file, &output, error_format),
+        run @ (Command::Run { .. }
+        | Command::Drive { .. }
+        | Command::Emulate { .. }
+        | Command::Replay { .. }
+        | Command::Experiment { .. }) => run_command(run),
+    }
+}
+
+/// The commands that run programs: `run`, `drive`, `emulate`, `replay`,
+/// `experiment` (`dispatch` gives no other).
+fn run_command(command: Command) -> Result<(), CliError> {
+    match command {
         Command::Run {
             file,
             stage,
@@ -557,18 +581,10 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             )?;
             experiment_here_or_on_ranks(&plan, jobs, rank_timeout)
         }
-        Command::Compare { dirs, criterion, stage, json } => {
-            compare(shaping_engine::compare::CompareOptions { dirs, criterion, stage }, json)
-        }
-        Command::Report { dir, output } => report(&dir, output.as_deref()),
-        Command::Bench { file, stage, runs, sets, error_format } => bench::bench(bench::BenchArgs {
-            file,
-            stage,
-            runs,
-            sets: single_values(sets, "bench")?,
-            error_format,
-        }),
-        Command::Build { file, output, error_format } => build(&file, &output, error_format),
+        _ => Err(CliError::new(
+            shaping_engine::ErrorKind::Invalid,
+            "error: internal error: a command that runs no program was taken for one",
+        )),
     }
 }
 
