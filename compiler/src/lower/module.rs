@@ -16,20 +16,7 @@ pub(crate) const ACTIONS: [&str; 8] =
 impl Lower<'_> {
     /// Declares a new module, or changes an inherited one.
     pub(super) fn module(&mut self, hw: &Hw, modules: &mut Vec<ModuleSt>, m: &ast::ModuleDecl, s: u16) {
-        // Repeated clauses.
-        let mut seen: std::collections::HashMap<&str, &ModuleItem> = std::collections::HashMap::new();
-        for item in &m.items {
-            if let Some(first) = seen.get(item.keyword()).copied() {
-                self.errors.push(Error::Duplicate {
-                    span: item.span().into(),
-                    first: first.span().into(),
-                    what: "clause",
-                    name: item.keyword().into(),
-                });
-            } else {
-                seen.insert(item.keyword(), item);
-            }
-        }
+        self.repeated_clauses(m);
         let existing = modules.iter().position(|x| x.name == m.name.text);
         let mut st = match existing {
             Some(i) => modules[i].clone(),
@@ -125,7 +112,41 @@ impl Lower<'_> {
                 }
             };
         }
-        // Behavior, learning, reinforcement: may change in later stages.
+        self.module_behavior(hw, &mut st, m, s);
+        if st.behavior.is_none() && !m.items.iter().any(|i| matches!(i, ModuleItem::Behavior(_))) {
+            self.value_error(
+                m.name.span,
+                format!("module `{}` has no behavior", m.name.text),
+                "no `behavior` clause",
+                Some("add `behavior STEP`, `behavior script { ... }` or `behavior neural { ... }`".into()),
+            );
+        }
+        match existing {
+            Some(i) => modules[i] = st,
+            None => modules.push(st),
+        }
+    }
+
+    /// A module's clauses given twice (each reported).
+    fn repeated_clauses(&mut self, m: &ast::ModuleDecl) {
+        let mut seen: std::collections::HashMap<&str, &ModuleItem> = std::collections::HashMap::new();
+        for item in &m.items {
+            if let Some(first) = seen.get(item.keyword()).copied() {
+                self.errors.push(Error::Duplicate {
+                    span: item.span().into(),
+                    first: first.span().into(),
+                    what: "clause",
+                    name: item.keyword().into(),
+                });
+            } else {
+                seen.insert(item.keyword(), item);
+            }
+        }
+    }
+
+    /// A module's behavior, learning and reinforcement: what a later stage
+    /// may change.
+    fn module_behavior(&mut self, hw: &Hw, st: &mut ModuleSt, m: &ast::ModuleDecl, s: u16) {
         let sense_span = st.inputs_span;
         let inputs = st.inputs.clone();
         for item in &m.items {
@@ -162,18 +183,6 @@ impl Lower<'_> {
                 }
                 _ => {}
             }
-        }
-        if st.behavior.is_none() && !m.items.iter().any(|i| matches!(i, ModuleItem::Behavior(_))) {
-            self.value_error(
-                m.name.span,
-                format!("module `{}` has no behavior", m.name.text),
-                "no `behavior` clause",
-                Some("add `behavior STEP`, `behavior script { ... }` or `behavior neural { ... }`".into()),
-            );
-        }
-        match existing {
-            Some(i) => modules[i] = st,
-            None => modules.push(st),
         }
     }
 
