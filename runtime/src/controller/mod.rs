@@ -753,46 +753,7 @@ impl<'s> Controller<'s> {
             self.reinf[winner] = r;
             module.perf.push(r);
             if learn {
-                if let Some(l) = &module.learning {
-                    let rate = if r > 0.0 { l.rate_reward } else { l.rate_punish };
-                    match l.target {
-                        LearnTarget::Activation => {
-                            let t = if r > 0.0 { 1.0 } else { 0.0 };
-                            if let Gen::Script(_) = module.gen {
-                                // The reinforcement judges the decision that
-                                // started the script, not the percept where a
-                                // later `reinforce` step delivered it.
-                                let (p, link) = (module.decided, module.decided_link);
-                                module.activation.forward(&p, link);
-                                module.activation.train(&p, |_| t, rate, l.error);
-                            } else {
-                                module.activation.train(&self.now, |_| t, rate, l.error);
-                            }
-                            if let Some(b) = &mut self.block {
-                                b.load(winner, &module.activation);
-                            }
-                        }
-                        LearnTarget::Behavior => {
-                            if let Gen::Neural { net, bits, .. } = &mut module.gen {
-                                let bits = &*bits;
-                                let reward = r > 0.0;
-                                net.train(
-                                    &self.now,
-                                    |o| {
-                                        let b = bits[o] as f32;
-                                        if reward {
-                                            b
-                                        } else {
-                                            1.0 - b
-                                        }
-                                    },
-                                    rate,
-                                    l.error,
-                                );
-                            }
-                        }
-                    }
-                }
+                crbp(module, winner, &mut self.block, &self.now, r);
             }
         }
         let fitness = self.fitness.as_ref().map_or(0.0, |e| e.eval(&env));
@@ -1143,4 +1104,59 @@ fn check_genome(stage: &Stage, genome: &Genome) -> Result<(), ControllerError> {
         return Err(ControllerError::GenomeTooShort { have: genome.bits.len(), need });
     }
     Ok(())
+}
+
+/// Step 7, CRBP: the winner `module` (index `winner`) learns from the
+/// reinforcement `r` (not 0) of the action just done, its activation
+/// network towards 1 on reward and 0 on punishment (a script's for the
+/// percept that started it), or its behavior network towards the outputs
+/// it gave (reward) or their complements (punishment); `block` keeps the
+/// activations' copy in step.
+fn crbp(
+    module: &mut Mod<'_>,
+    winner: usize,
+    block: &mut Option<block::Block>,
+    now: &[f32; CHANNELS],
+    r: f32,
+) {
+    if let Some(l) = &module.learning {
+        let rate = if r > 0.0 { l.rate_reward } else { l.rate_punish };
+        match l.target {
+            LearnTarget::Activation => {
+                let t = if r > 0.0 { 1.0 } else { 0.0 };
+                if let Gen::Script(_) = module.gen {
+                    // The reinforcement judges the decision that
+                    // started the script, not the percept where a
+                    // later `reinforce` step delivered it.
+                    let (p, link) = (module.decided, module.decided_link);
+                    module.activation.forward(&p, link);
+                    module.activation.train(&p, |_| t, rate, l.error);
+                } else {
+                    module.activation.train(now, |_| t, rate, l.error);
+                }
+                if let Some(b) = block {
+                    b.load(winner, &module.activation);
+                }
+            }
+            LearnTarget::Behavior => {
+                if let Gen::Neural { net, bits, .. } = &mut module.gen {
+                    let bits = &*bits;
+                    let reward = r > 0.0;
+                    net.train(
+                        now,
+                        |o| {
+                            let b = bits[o] as f32;
+                            if reward {
+                                b
+                            } else {
+                                1.0 - b
+                            }
+                        },
+                        rate,
+                        l.error,
+                    );
+                }
+            }
+        }
+    }
 }
