@@ -15,8 +15,8 @@ use crate::error::{Error, ErrorKind};
 use crate::stats;
 use crate::{load, rundir};
 
-// The comparison's figures are part of `summary.json`'s schema (`rundir`).
-pub use crate::rundir::{GroupFigures, MeasureTests, PairTest, Tests};
+// The comparison's figures are part of `summary.json`'s schema.
+use crate::rundir::{GroupFigures, MeasureTests, PairTest, Tests};
 
 /// One stage's measures over the seeds of a group: each measure's value per
 /// seed, in the seeds' order (NaN: missing from the seed's files).

@@ -13,8 +13,7 @@ use crate::error::{Error, ErrorKind};
 use crate::files::DirLock;
 use crate::load;
 use crate::rundir::{self, StageFigures};
-// A figure over seeds is part of `summary.json`'s schema (`rundir`).
-pub use crate::rundir::{spread, Spread};
+use crate::rundir::{spread, Spread};
 use crate::sweep::{self, Assignment, Set};
 use crate::{compare, plot, report, run};
 

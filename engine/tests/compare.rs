@@ -7,8 +7,9 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use common::{experiment, load, root, tiny, tiny_experiment};
-use shaping_engine::compare::{compare, CompareOptions, Tests};
+use shaping_engine::compare::{compare, CompareOptions};
 use shaping_engine::experiment::ExperimentOptions;
+use shaping_engine::rundir::Tests;
 use shaping_engine::stats;
 use shaping_engine::sweep::parse_set;
 

@@ -1688,7 +1688,7 @@ impl Experiment {
 
 impl Experiment {
     /// The `tests` of `summary.json`, as the experiment wrote them.
-    fn tests_of_summary(&self) -> PyResult<shaping_engine::compare::Tests> {
+    fn tests_of_summary(&self) -> PyResult<shaping_engine::rundir::Tests> {
         let path = self.out.join("summary.json");
         let text = std::fs::read_to_string(&path)
             .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;

@@ -53,7 +53,7 @@ pub struct ReportData {
     /// `summary.json`, as the experiment computed them (the page shows
     /// them; a summary written before them has none).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub tests: Option<crate::compare::Tests>,
+    pub tests: Option<crate::rundir::Tests>,
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -6,7 +6,8 @@
 use std::fmt::Write as _;
 
 use super::escape_html;
-use crate::compare::{digits, p_text, Tests};
+use crate::compare::{digits, p_text};
+use crate::rundir::Tests;
 
 /// The section `Statistics` for `t`: per stage and measure, each group's
 /// median with its bootstrap 95% interval and, with two groups or more,
