@@ -107,7 +107,7 @@ pub fn evaluate_unless(
             return None;
         }
         let Some(world) = worlds.stage(e) else {
-            return Some(Described { evaluation: Evaluation::unknown_variant(), ..Described::default() });
+            return Some(Described { evaluation: Evaluation::not_run(), ..Described::default() });
         };
         let (r, d) = episode(world, genome, &EpisodeOptions { actions, learning: true, seed: e.seed });
         sum += f64::from(r.fitness);

@@ -194,7 +194,7 @@ impl Evaluate for RobotRun {
 
 impl RobotRun {
     fn evaluate_one(&self, stage: &Stage, actions: u32, genome: &Genome, seed: u64) -> Evaluation {
-        let nan = Evaluation { fitness: f32::NAN, ..Evaluation::default() };
+        let nan = Evaluation::not_run();
         let mut st = self.lock();
         if st.error.is_some() {
             return nan;

@@ -50,11 +50,11 @@ pub fn evaluator_until<'s>(
 ) -> impl Fn(&Genome, Episode) -> Evaluation + Sync + 's {
     let worlds = VariantStages::of(stage);
     move |genome: &Genome, episode: Episode| {
-        let Some(stage) = worlds.stage(episode) else { return Evaluation::unknown_variant() };
+        let Some(stage) = worlds.stage(episode) else { return Evaluation::not_run() };
         let opts = EpisodeOptions { actions: opts.actions, learning: opts.learning, seed: episode.seed };
         match controller::run_episode_until(stage, genome, &opts, &stop) {
             Some(r) => Evaluation::of_episode(r),
-            None => Evaluation { fitness: f32::NAN, ..Evaluation::default() },
+            None => Evaluation::not_run(),
         }
     }
 }

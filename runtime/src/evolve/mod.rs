@@ -122,9 +122,10 @@ pub struct Evaluation {
 }
 
 impl Evaluation {
-    /// The result of an episode in a variant its stage does not declare:
-    /// nothing ran, and its fitness is NaN.
-    pub fn unknown_variant() -> Evaluation {
+    /// The result of an episode that did not run or was given up (a
+    /// variant its stage does not declare, Ctrl-C, a lost robot): its
+    /// fitness is NaN, so no generation keeps it.
+    pub fn not_run() -> Evaluation {
         Evaluation { fitness: f32::NAN, ..Evaluation::default() }
     }
 
