@@ -522,6 +522,64 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    /// A range-and-bearing range of 0, or longer than the arena's diagonal.
+    #[error("{message}")]
+    #[diagnostic(code(S0043))]
+    RabRange {
+        #[label("this range")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
+
+    /// A `signal` sensor whose elements are not whole sectors of the
+    /// values robots broadcast.
+    #[error("{message}")]
+    #[diagnostic(code(S0044))]
+    SignalChannels {
+        #[label("this sensor")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
+
+    /// A warning: a broadcast actuator that no robot can hear.
+    #[error("{message}")]
+    #[diagnostic(code(S0045), severity(Warning))]
+    Unheard {
+        #[label("broadcast here")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
+
+    /// A `signal(...)` step with the wrong number of values, or a value
+    /// outside 0..1.
+    #[error("{message}")]
+    #[diagnostic(code(S0046))]
+    SignalValues {
+        #[label("this step")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
+
+    /// A warning: range-and-bearing settings of a body whose robot has
+    /// no range-and-bearing hardware.
+    #[error("{message}")]
+    #[diagnostic(code(S0047), severity(Warning))]
+    RabUnused {
+        #[label("no robot uses it")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

@@ -21,6 +21,13 @@ pub struct Explanation {
 }
 
 /// The robot of most examples.
+/// A robot with a range-and-bearing board: 8 sectors, 8 heard, one broadcast value.
+macro_rules! robot_rab {
+    () => {
+        "robot r { sensor ir[8] proximity  sensor rab[8] range_bearing  sensor heard[8] signal  actuator wheels[2] speed  actuator signal broadcast }\n"
+    };
+}
+
 macro_rules! robot {
     () => {
         "robot r { sensor ir[8] proximity  actuator wheels[2] speed }\n"
@@ -328,6 +335,41 @@ pub const EXPLANATIONS: &[Explanation] = &[
         text: "A role's fitness replaces the stage's for the role's robots; in a team of one role, every robot plays it, so it is simply the stage's fitness, written where a reader looks for what distinguishes a role. The file compiles; declare the fitness as the stage's (outside the role).",
         wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0]\n  role only robots 2 {\n    module m { sense ir  behavior forward }\n    fitness per action wheels[1]\n  }\n}\n"),
         right: concat!(robot!(), "stage s {\n  fitness per action wheels[1]\n  role only robots 2 { module m { sense ir  behavior forward } }\n}\n"),
+    },
+    Explanation {
+        code: "S0043",
+        title: "a range-and-bearing range of 0 or beyond the arena",
+        text: "`rab_range` (in a world's `body`) is how far, body surface to body surface, a robot perceives and hears the others with its range-and-bearing board. A range of 0 perceives nothing; a range longer than the arena's diagonal perceives every robot wherever it is, so its sectors read only where the others are, never whether they are near. Give a distance within the arena: the default is 300 mm.",
+        wrong: concat!(robot_rab!(), "stage s {\n  world { arena 400mm x 400mm  robots 2  body { rab_range 900mm } }\n  fitness per action wheels[0]\n  module m { sense rab  behavior toward(rab) }\n}\n"),
+        right: concat!(robot_rab!(), "stage s {\n  world { arena 400mm x 400mm  robots 2  body { rab_range 300mm } }\n  fitness per action wheels[0]\n  module m { sense rab  behavior toward(rab) }\n}\n"),
+    },
+    Explanation {
+        code: "S0044",
+        title: "a signal sensor that is not whole sectors of the values broadcast",
+        text: "A `signal` sensor reads, for each value the robots broadcast (the `broadcast` actuator's count) and each sector of the range-and-bearing board (the `range_bearing` sensor's count, 8 without one), the strongest value heard there: element `k * SECTORS + s` is value `k` in sector `s`. So it has a multiple of the sectors as elements, at most sectors times values, and needs a `broadcast` actuator: without one, nothing is ever heard.",
+        wrong: concat!("robot r { sensor ir[8] proximity  sensor rab[4] range_bearing  sensor heard[6] signal  actuator wheels[2] speed  actuator signal broadcast }\n", "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense heard  behavior toward(heard) }\n}\n"),
+        right: concat!("robot r { sensor ir[8] proximity  sensor rab[4] range_bearing  sensor heard[4] signal  actuator wheels[2] speed  actuator signal broadcast }\n", "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense heard  behavior toward(heard) }\n}\n"),
+    },
+    Explanation {
+        code: "S0045",
+        title: "a broadcast that no robot hears (a warning)",
+        text: "A `broadcast` actuator sets values that the other robots within range hear at the next action, through a `signal` sensor. A robot without a `signal` sensor hears nothing, and in a team of clones no robot has one, so the values are set for nobody. The file compiles; give the robot a `signal` sensor, or leave the actuator out.",
+        wrong: concat!("robot r { sensor ir[8] proximity  actuator wheels[2] speed  actuator signal broadcast }\n", "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior script { signal(1); forward } }\n}\n"),
+        right: concat!(robot_rab!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior script { signal(1); forward } }\n}\n"),
+    },
+    Explanation {
+        code: "S0046",
+        title: "a signal step with the wrong values",
+        text: "`NAME(V, ...)` with the name of a `broadcast` actuator sets every value it broadcasts, each 0 (silent) to 1: as many numbers as the actuator's count (`actuator signal[2] broadcast` takes `signal(1, 0)`). The step takes no time and the values stay until set again, so it has no `for` or `until`.",
+        wrong: concat!(robot_rab!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior script { signal(2, 0); forward } }\n}\n"),
+        right: concat!(robot_rab!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior script { signal(1); forward } }\n}\n"),
+    },
+    Explanation {
+        code: "S0047",
+        title: "range-and-bearing settings without the board (a warning)",
+        text: "`rab_range`, `rab_noise`, `rab_bearing_noise` and `rab_occlusion` set the range-and-bearing board of a body, which a robot has only when it declares a `range_bearing` or `signal` sensor or a `broadcast` actuator. Without one, the settings change nothing. The file compiles; declare the hardware, or leave the settings out.",
+        wrong: concat!(robot!(), "stage s {\n  world { robots 2  body { rab_range 200mm } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+        right: concat!(robot!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
     },
 ];
 

@@ -98,6 +98,8 @@ fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
                 SensorKind::Optical => Source::Barrier,
                 SensorKind::Ground => Source::Floor,
                 SensorKind::LampDistance => Source::LampDistance,
+                // Not recorded in `episode.json` yet: no column.
+                SensorKind::RangeBearing | SensorKind::Signal => continue,
             };
             out.push((format!("{}[{i}]", s.name), source));
         }
@@ -107,6 +109,7 @@ fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
             ActuatorKind::Speed => &[Source::Wheel(0), Source::Wheel(1)],
             ActuatorKind::Lift => &[Source::Arm],
             ActuatorKind::Grip => &[Source::Claw],
+            ActuatorKind::Broadcast => &[],
         };
         out.extend(sources.iter().enumerate().map(|(i, &src)| (format!("{}[{i}]", a.name), src)));
     }

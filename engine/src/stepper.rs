@@ -30,7 +30,7 @@ use std::sync::Arc;
 use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use shaping_runtime::catalog::{ActuatorKind, ACT_SLOTS, CHANNELS};
+use shaping_runtime::catalog::{ActuatorKind, ACT_SLOTS, CHANNELS, SIGNALS};
 use shaping_runtime::controller::{bonus_points, record_command, FastExpr};
 use shaping_runtime::expr::Env;
 use shaping_runtime::program::Stage;
@@ -51,6 +51,8 @@ pub enum Control {
     Claw,
     /// Above 0.5: ask the charger to recharge.
     Charge,
+    /// A broadcast value, 0..1.
+    Signal(usize),
 }
 
 impl Control {
@@ -99,6 +101,11 @@ impl Spaces {
                 }
                 ActuatorKind::Lift => named(Control::Arm, a.name.clone()),
                 ActuatorKind::Grip => named(Control::Claw, a.name.clone()),
+                ActuatorKind::Broadcast => {
+                    for k in 0..stage.world.body.rab.as_ref().map_or(1, |r| usize::from(r.signals)) {
+                        named(Control::Signal(k), format!("{}[{k}]", a.name));
+                    }
+                }
             }
         }
         if stage.world.charger.is_some() {
@@ -134,6 +141,7 @@ impl Spaces {
                 Control::Arm => cmd.arm = Some(v > 0.5),
                 Control::Claw => cmd.claw = Some(v > 0.5),
                 Control::Charge => cmd.charge = v > 0.5,
+                Control::Signal(k) => cmd.signal.get_or_insert([0.0; SIGNALS])[k] = v,
             }
         }
         Ok(cmd)

@@ -42,6 +42,7 @@ fn commands() -> Vec<Command> {
                 arm: if rng.random::<f32>() < 0.05 { Some(rng.random()) } else { None },
                 claw: if rng.random::<f32>() < 0.05 { Some(rng.random()) } else { None },
                 charge: rng.random::<f32>() < 0.1,
+                signal: None,
             }
         })
         .collect()

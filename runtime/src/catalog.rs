@@ -10,9 +10,10 @@
 use serde::{Deserialize, Serialize};
 
 /// Number of percept channels the simulator fills each action.
-pub const CHANNELS: usize = 23;
-/// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`, arm, claw).
-pub const ACT_SLOTS: usize = 4;
+pub const CHANNELS: usize = CH_HEARD + RAB_SECTORS * SIGNALS;
+/// Number of actuator slots visible to expressions (`wheels[0]`, `wheels[1]`,
+/// arm, claw, then the broadcast values).
+pub const ACT_SLOTS: usize = ACT_SIGNAL + SIGNALS;
 
 /// Channel index of the first proximity (IR) sensor.
 pub const CH_IR: usize = 0;
@@ -28,6 +29,16 @@ pub const CH_FLOOR: usize = 18;
 pub const GROUND_SENSORS: usize = 4;
 /// Channel index of the distance to the nearest lamp.
 pub const CH_LAMP_DISTANCE: usize = CH_FLOOR + GROUND_SENSORS;
+/// Channel index of the range-and-bearing sensor's first sector.
+pub const CH_RAB: usize = CH_LAMP_DISTANCE + 1;
+/// Most sectors of the range-and-bearing sensor.
+pub const RAB_SECTORS: usize = 8;
+/// Channel index of the first heard signal (`signal` sensor): with `S`
+/// sectors, signal `k`'s strongest value in sector `s` is channel
+/// `CH_HEARD + k * S + s`.
+pub const CH_HEARD: usize = CH_RAB + RAB_SECTORS;
+/// Most values a robot broadcasts (`broadcast` actuator).
+pub const SIGNALS: usize = 4;
 
 /// Actuator slot of the left wheel's commanded speed (normalised to -1..1).
 pub const ACT_LEFT: usize = 0;
@@ -37,6 +48,8 @@ pub const ACT_RIGHT: usize = 1;
 pub const ACT_ARM: usize = 2;
 /// Actuator slot of the claw (0 open, 1 closed).
 pub const ACT_CLAW: usize = 3;
+/// Actuator slot of the first broadcast value (0..1).
+pub const ACT_SIGNAL: usize = 4;
 
 /// Bearings of the 8 Khepera IR / ambient sensors, in degrees, counter-clockwise
 /// from the robot's heading (K-Team order: 0 = left 90, ..., 5 = right 90,
@@ -59,6 +72,12 @@ pub enum SensorKind {
     /// The distance from the body centre to the nearest lamp, 0 .. 1 (1 m
     /// or more, or no lamp): the simulator's knowledge, for fitness terms.
     LampDistance,
+    /// Range and bearing: per sector around the body, the nearest other
+    /// robot's proximity, 0 (none within range) .. 1 (touching).
+    RangeBearing,
+    /// What the other robots broadcast: per signal and sector, the
+    /// strongest value heard from the robots within range there (0: none).
+    Signal,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -69,6 +88,9 @@ pub enum ActuatorKind {
     Lift,
     /// Gripper claw, `open` or `closed`.
     Grip,
+    /// One to four values, 0..1, that the robots within range-and-bearing
+    /// range hear at the next action.
+    Broadcast,
 }
 
 /// One row of the sensor catalog.
@@ -99,7 +121,7 @@ pub struct ActuatorInfo {
     pub doc: &'static str,
 }
 
-pub const SENSORS: [SensorInfo; 6] = [
+pub const SENSORS: [SensorInfo; 8] = [
     SensorInfo {
         kind: SensorKind::Proximity,
         keyword: "proximity",
@@ -142,9 +164,23 @@ pub const SENSORS: [SensorInfo; 6] = [
         channel: CH_LAMP_DISTANCE,
         doc: "distance to the nearest lamp in m, 0 .. 1 (1 m or more, or no lamp); simulated only",
     },
+    SensorInfo {
+        kind: SensorKind::RangeBearing,
+        keyword: "range_bearing",
+        max_count: RAB_SECTORS,
+        channel: CH_RAB,
+        doc: "range and bearing: per sector, the nearest other robot's proximity, 0 none in range .. 1 touching",
+    },
+    SensorInfo {
+        kind: SensorKind::Signal,
+        keyword: "signal",
+        max_count: RAB_SECTORS * SIGNALS,
+        channel: CH_HEARD,
+        doc: "signals heard: per broadcast value and sector, the strongest value heard there, 0..1",
+    },
 ];
 
-pub const ACTUATORS: [ActuatorInfo; 3] = [
+pub const ACTUATORS: [ActuatorInfo; 4] = [
     ActuatorInfo {
         kind: ActuatorKind::Speed,
         keyword: "speed",
@@ -168,6 +204,14 @@ pub const ACTUATORS: [ActuatorInfo; 3] = [
         slot: ACT_CLAW,
         states: &["open", "closed"],
         doc: "gripper claw",
+    },
+    ActuatorInfo {
+        kind: ActuatorKind::Broadcast,
+        keyword: "broadcast",
+        count: SIGNALS,
+        slot: ACT_SIGNAL,
+        states: &[],
+        doc: "one to four values, 0..1, the robots within range hear at the next action",
     },
 ];
 
@@ -193,9 +237,20 @@ pub fn actuator_info(kind: ActuatorKind) -> &'static ActuatorInfo {
 /// along, for the `toward(...)` primitive; `None` for channels without a
 /// direction (battery, barrier).
 pub fn channel_bearing(channel: usize) -> Option<f32> {
+    channel_bearing_in(channel, RAB_SECTORS)
+}
+
+/// [`channel_bearing`] with `sectors` range-and-bearing sectors: sector
+/// `s` (and every signal heard in it) looks along `s * 360 / sectors`
+/// degrees.
+pub fn channel_bearing_in(channel: usize, sectors: usize) -> Option<f32> {
+    let sectors = sectors.clamp(1, RAB_SECTORS);
+    let sector = |s: usize| Some((s % sectors) as f32 * std::f32::consts::TAU / sectors as f32);
     match channel {
         c if c < CH_LIGHT => Some(SENSOR_BEARING_DEG[c - CH_IR].to_radians()),
         c if c < CH_BATTERY => Some(SENSOR_BEARING_DEG[c - CH_LIGHT].to_radians()),
+        c if (CH_RAB..CH_HEARD).contains(&c) => sector(c - CH_RAB),
+        c if (CH_HEARD..CHANNELS).contains(&c) => sector(c - CH_HEARD),
         _ => None,
     }
 }

@@ -243,7 +243,7 @@ mod tests {
         let e = Expr { ops, depth };
         assert!(e.is_valid());
         let prev = [0.5; CHANNELS];
-        let act = [0.25, -0.75, 0.0, 1.0];
+        let act = [0.25, -0.75, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
         e.eval(&Env { now: &now, prev: &prev, act: &act, state: &Env::NO_STATE })
     }
 

@@ -407,6 +407,46 @@ pub struct Body {
     /// here sits under the body centre.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub ground: Vec<[f32; 2]>,
+    /// The range-and-bearing board (sensor, signals heard, broadcast);
+    /// `None` when the robot has none of them: nothing of it is computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rab: Option<RangeBearing>,
+}
+
+/// The range-and-bearing board: what a robot perceives of the other
+/// robots within `range` and what it broadcasts to them
+/// (`docs/language.md`, section 18).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RangeBearing {
+    /// Sectors around the body, 1..=8 (the `range_bearing` sensor's count;
+    /// 8 when only signals are declared): sector `s` is centred on
+    /// `s * 360 / sectors` degrees counter-clockwise from the heading.
+    pub sectors: u8,
+    /// Values each robot broadcasts, 0..=4 (the `broadcast` actuator's count).
+    pub signals: u8,
+    /// How far another robot is perceived and heard, body surface to body
+    /// surface, mm.
+    pub range: f32,
+    /// Uniform noise in `-n..n` added to a perceived proximity.
+    pub range_noise: f32,
+    /// Uniform noise in `-b..b` degrees added to a perceived bearing.
+    pub bearing_noise: f32,
+    /// Inner walls and cylinders between two robots' centres hide them
+    /// from each other (as they shade a lamp).
+    pub occlusion: bool,
+}
+
+impl RangeBearing {
+    /// The defaults: 8 sectors, 300 mm, 0.02 proximity noise, 5 degrees
+    /// bearing noise, occluded by walls and cylinders.
+    pub const DEFAULT: RangeBearing = RangeBearing {
+        sectors: 8,
+        signals: 0,
+        range: 300.0,
+        range_noise: 0.02,
+        bearing_noise: 5.0,
+        occlusion: true,
+    };
 }
 
 /// A declared layout of the eight IR sensors (the ambient light sensors
@@ -443,6 +483,7 @@ impl Default for Body {
             preset: None,
             ir: None,
             ground: Vec::new(),
+            rab: None,
         }
     }
 }
@@ -672,6 +713,11 @@ pub enum Action {
     /// Deliver the module's reinforcement: the value of this expression.
     /// Takes no time: the next step runs in the same action.
     Reinforce(Expr),
+    /// Set the values the robot broadcasts (`signal(1, 0)`: a `broadcast`
+    /// actuator by its name; each 0..1, every declared value given). Takes
+    /// no time: the next step runs in the same action, and the values
+    /// stay until set again.
+    Signal(Vec<f32>),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -603,6 +603,14 @@ fn body(at: &At, b: &Body) -> R {
             at.field("ir").field("facing").index(k).within(deg, -180.0, 180.0)?;
         }
     }
+    if let Some(r) = &b.rab {
+        let at = at.field("rab");
+        at.field("sectors").count(u32::from(r.sectors), 1, catalog::RAB_SECTORS as u32)?;
+        at.field("signals").count(u32::from(r.signals), 0, catalog::SIGNALS as u32)?;
+        at.field("range").within(r.range, 1.0, 1e6)?;
+        at.field("range_noise").within(r.range_noise, 0.0, 1.0)?;
+        at.field("bearing_noise").within(r.bearing_noise, 0.0, 180.0)?;
+    }
     at.field("ground").ensure(b.ground.len() <= catalog::GROUND_SENSORS, || {
         format!("{} ground sensors, at most {}", b.ground.len(), catalog::GROUND_SENSORS)
     })?;
@@ -753,6 +761,14 @@ fn script(at: &At, sc: &Script) -> R {
             }
             Action::Reinforce(e) => expr(&action, e)?,
             Action::Arm(_) | Action::Claw(_) | Action::Wait { .. } => {}
+            Action::Signal(v) => {
+                action.ensure(!v.is_empty() && v.len() <= catalog::SIGNALS, || {
+                    format!("{} broadcast values (1 to {})", v.len(), catalog::SIGNALS)
+                })?;
+                for (k, &x) in v.iter().enumerate() {
+                    action.index(k).within(x, 0.0, 1.0)?;
+                }
+            }
         }
         match &st.end {
             StepEnd::Actions(n) => at.field("end").count(*n, 1, u32::MAX)?,

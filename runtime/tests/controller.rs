@@ -15,12 +15,17 @@ use shaping_runtime::sim::{Command, Outcome};
 use shaping_runtime::testkit::{self, expr};
 
 /// A robot whose percept the test sets; it records the commands it receives.
-#[derive(Default)]
 struct Puppet {
     percept: [f32; CHANNELS],
     commands: Vec<Command>,
     /// Outcome of every step.
     outcome: Outcome,
+}
+
+impl Default for Puppet {
+    fn default() -> Puppet {
+        Puppet { percept: [0.0; CHANNELS], commands: Vec::new(), outcome: Outcome::default() }
+    }
 }
 
 impl Robot for Puppet {

@@ -31,6 +31,7 @@ fn the_simulator_step_never_allocates() {
                     arm: (i % 97 == 0).then_some(i % 2 == 0),
                     claw: (i % 89 == 0).then_some(i % 3 == 0),
                     charge: i % 7 == 0,
+                    signal: None,
                 };
                 sim.step(&cmd);
             }

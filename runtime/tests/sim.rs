@@ -436,7 +436,7 @@ fn physical_objects_block_and_virtual_ones_do_not() {
 
 fn arb_command() -> impl Strategy<Value = Command> {
     (-1.5f32..1.5, -1.5f32..1.5, any::<Option<bool>>(), any::<Option<bool>>(), any::<bool>())
-        .prop_map(|(l, r, arm, claw, charge)| Command { wheels: [l, r], arm, claw, charge })
+        .prop_map(|(l, r, arm, claw, charge)| Command { wheels: [l, r], arm, claw, charge, signal: None })
 }
 
 proptest! {

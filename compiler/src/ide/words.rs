@@ -231,6 +231,10 @@ const LIST: &[Word] = &[
     w("action", C, BODY | CLAUSE, "`action T ms`: the length of an action (in a fitness: `per action`)", WORLD_S),
     w("wheel_noise", C, BODY, "`wheel_noise K`: relative noise of the wheel speeds", WORLD_S),
     w("sensor_noise", C, BODY, "`sensor_noise K`: noise added to the sensor readings", WORLD_S),
+    w("rab_range", C, BODY, "`rab_range 300mm`: how far, body to body, the range-and-bearing board perceives and hears other robots", WORLD_S),
+    w("rab_noise", C, BODY, "`rab_noise 0.02`: noise added to a perceived robot's proximity", WORLD_S),
+    w("rab_bearing_noise", C, BODY, "`rab_bearing_noise 5`: noise, in degrees, added to a perceived robot's bearing", WORLD_S),
+    w("rab_occlusion", C, BODY, "`rab_occlusion on|off`: inner walls and cylinders hide robots from the range-and-bearing board", WORLD_S),
     w("facing", C, CLAUSE, "`proximity at [...] facing [B0, ..., B7]`: where the 8 IR sensors look, degrees counter-clockwise from the heading", BODIES),
     // evolution settings
     w("population", C, EVOLVE, "`population N`: individuals per generation", EVOLUTION),

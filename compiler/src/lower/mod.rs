@@ -980,7 +980,23 @@ impl<'a> Lower<'a> {
                     });
                     continue;
                 };
-                if let Some((n, sp)) = h.count {
+                // A broadcast actuator has 1 to its most values; the others
+                // exactly their count.
+                let variable = info.kind == catalog::ActuatorKind::Broadcast;
+                let mut count = info.count as u16;
+                if variable {
+                    count = h.count.map_or(1, |(n, _)| (n as usize).clamp(1, info.count) as u16);
+                }
+                if let Some((n, sp)) = h.count.filter(|_| variable) {
+                    if n == 0 || n as usize > info.count {
+                        self.value_error(
+                            sp,
+                            format!("a `broadcast` actuator has 1 to {} values, not {n}", info.count),
+                            "wrong number of values",
+                            None,
+                        );
+                    }
+                } else if let Some((n, sp)) = h.count {
                     if n as usize != info.count {
                         self.value_error(
                             sp,
@@ -1010,7 +1026,7 @@ impl<'a> Lower<'a> {
                 st.actuators.push(ActuatorSt {
                     name: h.name.text.clone(),
                     kind: info.kind,
-                    count: info.count as u16,
+                    count,
                     slot: info.slot as u16,
                     stage: s,
                     span: h.span,
@@ -1107,6 +1123,7 @@ impl<'a> Lower<'a> {
         self.check_charger(&st.world);
         self.check_fit(&st.world, decl.name.span, decl.span);
         self.check_ground(&st, s, decl.span);
+        self.rab_board(&mut st, s, decl.span);
         self.check_items(&st.world, decl.span);
         self.check_crowded(&st.world, decl.span);
         let before_team = self.errors.len();

@@ -468,9 +468,60 @@ impl Lower<'_> {
         })
     }
 
+    /// `signal(1, 0)`: every value of the broadcast actuator `name`, each
+    /// 0..1; it takes no time, so it has no `for` or `until`.
+    fn signal_step(
+        &mut self,
+        hw: &Hw,
+        name: &ast::Name,
+        values: &[f64],
+        span: Span,
+        timed: bool,
+    ) -> Option<Action> {
+        let a = hw.actuators.iter().find(|a| a.name == name.text)?;
+        let mut ok = true;
+        if values.len() != a.count as usize {
+            self.errors.push(Error::SignalValues {
+                span: span.into(),
+                message: format!(
+                    "`{}` broadcasts {} value{}, and this step gives {}",
+                    a.name,
+                    a.count,
+                    if a.count == 1 { "" } else { "s" },
+                    values.len()
+                ),
+                help: format!("give every value: `{}({})`", a.name, vec!["1"; a.count as usize].join(", ")),
+            });
+            ok = false;
+        }
+        if let Some(v) = values.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+            self.errors.push(Error::SignalValues {
+                span: span.into(),
+                message: format!("a broadcast value is 0 to 1, not {v}"),
+                help: "a neighbour reads the value as it is sent: 0 silent .. 1 loudest".into(),
+            });
+            ok = false;
+        }
+        if timed {
+            self.value_error(
+                span,
+                format!("`{}(...)` takes no time, so it cannot last `for` or `until`", a.name),
+                "instant step",
+                Some("put the duration on the step after it: the values stay until set again".into()),
+            );
+            ok = false;
+        }
+        ok.then(|| Action::Signal(values.iter().map(|&v| v as f32).collect()))
+    }
+
     fn step(&mut self, hw: &Hw, x: &ast::StepDecl, scope: &Scope) -> Option<Step> {
         let span = x.action.span();
         let action = match &x.action {
+            ActionDecl::Motion(Motion::Wheels(name, values), sp)
+                if hw.actuators.iter().any(|a| a.name == name.text && a.kind == ActuatorKind::Broadcast) =>
+            {
+                self.signal_step(hw, name, values, *sp, x.end.is_some())?
+            }
             ActionDecl::Motion(m, sp) => {
                 let [left, right] = self.motion(hw, m, *sp)?;
                 Action::Wheels { left, right }

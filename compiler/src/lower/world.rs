@@ -15,8 +15,18 @@ use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, Unit};
 
 /// The settings of `body { }`.
-pub(crate) const BODY_SETTINGS: [&str; 6] =
-    ["radius", "wheel_base", "v_max", "action", "wheel_noise", "sensor_noise"];
+pub(crate) const BODY_SETTINGS: [&str; 10] = [
+    "radius",
+    "wheel_base",
+    "v_max",
+    "action",
+    "wheel_noise",
+    "sensor_noise",
+    "rab_range",
+    "rab_noise",
+    "rab_bearing_noise",
+    "rab_occlusion",
+];
 
 impl Lower<'_> {
     pub(super) fn world(&mut self, ws: &mut WorldSt, block: &ast::WorldBlock, stage: &str) {
@@ -714,6 +724,81 @@ impl Lower<'_> {
     /// A robot with several ground sensors needs the body to place them:
     /// reported at the stage that declares the sensors, or at the stage
     /// whose body places too few.
+    /// The range-and-bearing board of stage `s`'s world: there when its
+    /// robot has a `range_bearing` or `signal` sensor or a `broadcast`
+    /// actuator (its sectors the sensor's count, 8 without one; its
+    /// signals the actuator's count), else none (body settings for it are
+    /// the warning `S0047`). A range beyond the arena's diagonal is
+    /// `S0043`; a `signal` sensor that is not whole sectors of the values
+    /// broadcast `S0044`; a broadcast that no robot hears the warning
+    /// `S0045`.
+    pub(super) fn rab_board(&mut self, st: &mut StageSt, s: u16, stage: Span) {
+        let sensor = |k| st.sensors.iter().find(|x| x.kind == k);
+        let rab = sensor(catalog::SensorKind::RangeBearing);
+        let heard = sensor(catalog::SensorKind::Signal);
+        let broadcast = st.actuators.iter().find(|a| a.kind == catalog::ActuatorKind::Broadcast);
+        let body_span = st.world.spans.get("body").copied().unwrap_or(stage);
+        let world = &mut st.world.world;
+        if rab.is_none() && heard.is_none() && broadcast.is_none() {
+            if world.body.rab.take().is_some() {
+                self.errors.push(Error::RabUnused {
+                    span: body_span.into(),
+                    message: "this body sets a range-and-bearing board, but the robot has none".into(),
+                    help: "declare it in the robot: `sensor rab[8] range_bearing`, `sensor heard[8] signal`, `actuator signal broadcast`".into(),
+                });
+            }
+            return;
+        }
+        let sectors = rab.map_or(catalog::RAB_SECTORS as u16, |r| r.count);
+        let signals = broadcast.map_or(0, |a| a.count);
+        let board = world.body.rab.get_or_insert(RangeBearing::DEFAULT);
+        board.sectors = sectors as u8;
+        board.signals = signals as u8;
+        let diagonal = world.arena[0].hypot(world.arena[1]);
+        if board.range > diagonal {
+            self.errors.push(Error::RabRange {
+                span: body_span.into(),
+                message: format!(
+                    "the range-and-bearing range, {} mm, is longer than the arena's diagonal, {diagonal:.0} mm",
+                    board.range
+                ),
+                help: format!("every robot would perceive every other: give `rab_range` at most {diagonal:.0}mm"),
+            });
+        }
+        if let Some(h) = heard {
+            if h.stage == s && (signals == 0 || h.count % sectors != 0 || h.count > sectors * signals) {
+                let message = if signals == 0 {
+                    format!("sensor `{}` hears signals, but the robot broadcasts none", h.name)
+                } else {
+                    format!(
+                        "sensor `{}` has {} elements, not whole sectors ({sectors}) of the {signals} broadcast value{}",
+                        h.name,
+                        h.count,
+                        if signals == 1 { "" } else { "s" }
+                    )
+                };
+                self.errors.push(Error::SignalChannels {
+                    span: h.span.into(),
+                    message,
+                    help: format!(
+                        "a `signal` sensor has one element per sector and broadcast value: `sensor {}[{}] signal`, with an `actuator NAME[{signals}] broadcast`",
+                        h.name,
+                        sectors * signals.max(1)
+                    ),
+                });
+            }
+        }
+        if let Some(a) = broadcast.filter(|a| a.stage == s && heard.is_none()) {
+            self.errors.push(Error::Unheard {
+                span: a.span.into(),
+                message: format!("actuator `{}` broadcasts, but no robot can hear it", a.name),
+                help:
+                    "give the robot a `signal` sensor (`sensor heard[8] signal`), or leave the actuator out"
+                        .into(),
+            });
+        }
+    }
+
     pub(super) fn check_ground(&mut self, st: &StageSt, s: u16, stage: Span) {
         if st.world.refused.contains(&("body", "ground".into())) {
             // A refused body or ground layout said so already.
@@ -1121,6 +1206,21 @@ impl Lower<'_> {
         self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
             let n = set.name.text.as_str();
+            if n == "rab_occlusion" {
+                let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
+                match &set.value {
+                    ast::SettingValue::Word(w) if w.text == "on" || w.text == "off" => {
+                        rab.occlusion = w.text == "on"
+                    }
+                    _ => self.value_error(
+                        set.span,
+                        "`rab_occlusion` is `on` or `off`".into(),
+                        "not `on` or `off`",
+                        None,
+                    ),
+                }
+                continue;
+            }
             let ast::SettingValue::Quantity(q) = &set.value else {
                 if BODY_SETTINGS.contains(&n) {
                     self.value_error(set.span, format!("`{n}` needs a number"), "not a number", None);
@@ -1169,6 +1269,28 @@ impl Lower<'_> {
                 }
                 "sensor_noise" => {
                     body.sensor_noise = self.plain(q, "`sensor_noise`", 0.0, 1.0).unwrap_or(body.sensor_noise)
+                }
+                "rab_range" => {
+                    let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
+                    if q.value <= 0.0 {
+                        self.errors.push(Error::RabRange {
+                            span: q.span.into(),
+                            message: "a range-and-bearing range of 0 perceives nothing".into(),
+                            help: "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`".into(),
+                        });
+                    } else if let Some(v) = self.length(q, "the range-and-bearing range") {
+                        rab.range = v;
+                    }
+                }
+                "rab_noise" => {
+                    let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
+                    rab.range_noise = self.plain(q, "`rab_noise`", 0.0, 1.0).unwrap_or(rab.range_noise)
+                }
+                "rab_bearing_noise" => {
+                    let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
+                    rab.bearing_noise = self
+                        .plain(q, "`rab_bearing_noise` (degrees)", 0.0, 180.0)
+                        .unwrap_or(rab.bearing_noise)
                 }
                 _ => self.errors.push(Error::Unknown {
                     span: set.name.span.into(),

@@ -85,10 +85,15 @@ fn kind(e: &Error) -> &'static str {
         Error::RoleInTest { .. } => "RoleInTest",
         Error::RoleFitnessReadsOther { .. } => "RoleFitnessReadsOther",
         Error::RoleFitnessAlone { .. } => "RoleFitnessAlone",
+        Error::RabRange { .. } => "RabRange",
+        Error::SignalChannels { .. } => "SignalChannels",
+        Error::Unheard { .. } => "Unheard",
+        Error::SignalValues { .. } => "SignalValues",
+        Error::RabUnused { .. } => "RabUnused",
     }
 }
 
-const KINDS: [&str; 42] = [
+const KINDS: [&str; 47] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -131,6 +136,11 @@ const KINDS: [&str; 42] = [
     "RoleInTest",
     "RoleFitnessReadsOther",
     "RoleFitnessAlone",
+    "RabRange",
+    "SignalChannels",
+    "Unheard",
+    "SignalValues",
+    "RabUnused",
 ];
 
 #[test]

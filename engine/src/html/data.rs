@@ -259,6 +259,9 @@ fn action_text(stage: &Stage, a: &Action) -> String {
         Action::Claw(closed) => if *closed { "claw closed" } else { "claw open" }.into(),
         Action::Wait { charge } => if *charge { "wait, uses charger" } else { "wait" }.into(),
         Action::Reinforce(_) => "reinforce".into(),
+        Action::Signal(v) => {
+            format!("signal({})", v.iter().map(|x| fmt_num(*x)).collect::<Vec<_>>().join(", "))
+        }
     }
 }
 

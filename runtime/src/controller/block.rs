@@ -19,7 +19,7 @@ pub const LANES: usize = 8;
 
 /// A percept with room for the padding channel (index [`PAD`], always 0);
 /// a power of two so that a masked index needs no bounds check.
-const SPAN: usize = 32;
+const SPAN: usize = 64;
 const PAD: u8 = CHANNELS as u8;
 const _: () = assert!(CHANNELS < SPAN);
 

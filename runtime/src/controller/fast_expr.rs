@@ -250,7 +250,7 @@ mod tests {
                 FOp::Then { push: Op::Const(2.0), op: Op::Div },
             ]
         );
-        let act = [0.25, -0.75, 0.0, 1.0];
+        let act = [0.25, -0.75, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0];
         let p = [0.0; CHANNELS];
         assert_eq!(f.eval(&Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE }), 0.25);
     }

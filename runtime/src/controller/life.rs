@@ -31,6 +31,10 @@ pub trait Bodies {
     fn begin_action(&mut self) {}
     /// Robot `i` is about to sense or act (a team: its neighbours found).
     fn prepare(&mut self, _i: usize) {}
+    /// Every robot has acted in this action (a team with a
+    /// range-and-bearing board: what each robot reads of the others,
+    /// measured on one snapshot).
+    fn end_action(&mut self) {}
     /// Robot `i`.
     fn member(&mut self, i: usize) -> Self::Member<'_>;
     /// The state every controller is given (`[team.spread, team.grouped,
@@ -178,6 +182,7 @@ pub fn live<'s, B: Bodies>(
             hooks.acted(i, c, &rep, row, &member);
         }
         actions += 1;
+        bodies.end_action();
         if let Some(s) = bodies.state(groups) {
             for c in ctls.iter_mut() {
                 c.set_team(s);

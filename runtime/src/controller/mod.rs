@@ -90,7 +90,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SLOTS, CHANNELS};
+use crate::catalog::{ACT_ARM, ACT_CLAW, ACT_LEFT, ACT_RIGHT, ACT_SIGNAL, ACT_SLOTS, CHANNELS, SIGNALS};
 use crate::expr::Env;
 use crate::genome::Genome;
 use crate::program::{Behavior, Decode, Event, LearnTarget, LearnWhen, Learning, Param, Stage};
@@ -428,9 +428,11 @@ impl<'s> Controller<'s> {
                 a.params.iter().map(&mut value).collect(),
             );
             let gen = match &m.behavior {
-                Behavior::Script(s) => {
-                    Gen::Script(ScriptRun::new(s, stage.world.body.ir.as_ref().map(|l| &l.facing)))
-                }
+                Behavior::Script(s) => Gen::Script(ScriptRun::new(
+                    s,
+                    stage.world.body.ir.as_ref().map(|l| &l.facing),
+                    stage.world.body.rab.as_ref().map_or(crate::catalog::RAB_SECTORS, |r| r.sectors.into()),
+                )),
                 Behavior::Neural(nb) => Gen::Neural {
                     net: Net::with_context(
                         nb.inputs.clone(),
@@ -1012,6 +1014,9 @@ pub fn record_command(slots: &mut [f32; ACT_SLOTS], cmd: &Command) {
     }
     if let Some(c) = cmd.claw {
         slots[ACT_CLAW] = f32::from(u8::from(c));
+    }
+    if let Some(v) = cmd.signal {
+        slots[ACT_SIGNAL..ACT_SIGNAL + SIGNALS].copy_from_slice(&v);
     }
 }
 

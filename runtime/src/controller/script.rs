@@ -28,7 +28,7 @@
 use nalgebra::Vector2;
 
 use super::fast_expr::FastExpr;
-use crate::catalog::{channel_bearing, CHANNELS};
+use crate::catalog::{channel_bearing_in, CHANNELS, CH_BATTERY, SIGNALS};
 use crate::expr::Env;
 use crate::program::{Action, Script, StepEnd};
 use crate::sim::Command;
@@ -55,6 +55,7 @@ enum Op {
         charge: bool,
     },
     Reinforce(FastExpr),
+    Signal([f32; SIGNALS]),
 }
 
 #[derive(Clone, Debug)]
@@ -82,8 +83,9 @@ pub struct ScriptRun {
 
 impl ScriptRun {
     /// `facing`: the bearings (degrees) of a declared IR layout, which
-    /// `toward` steers by instead of the catalog's nominal ones.
-    pub fn new(script: &Script, facing: Option<&[f32; 8]>) -> ScriptRun {
+    /// `toward` steers by instead of the catalog's nominal ones; `sectors`:
+    /// the range-and-bearing sectors (their bearings and their signals').
+    pub fn new(script: &Script, facing: Option<&[f32; 8]>, sectors: usize) -> ScriptRun {
         let steps = script
             .steps
             .iter()
@@ -93,7 +95,7 @@ impl ScriptRun {
                     Action::Toward { channels, speed } => Op::Toward {
                         dirs: channels
                             .iter()
-                            .filter_map(|&c| Some((c, bearing_vector(c as usize, facing)?)))
+                            .filter_map(|&c| Some((c, bearing_vector(c as usize, facing, sectors)?)))
                             .collect(),
                         speed: *speed,
                     },
@@ -101,6 +103,13 @@ impl ScriptRun {
                     Action::Claw(c) => Op::Claw(*c),
                     Action::Wait { charge } => Op::Wait { charge: *charge },
                     Action::Reinforce(e) => Op::Reinforce(FastExpr::new(e)),
+                    Action::Signal(v) => {
+                        let mut values = [0.0; SIGNALS];
+                        for (x, &y) in values.iter_mut().zip(v) {
+                            *x = y;
+                        }
+                        Op::Signal(values)
+                    }
                 };
                 let end = match &s.end {
                     StepEnd::Actions(n) => End::Actions(*n),
@@ -155,6 +164,7 @@ impl ScriptRun {
         // Each step at most once per action, so a script made only of
         // `reinforce` steps cannot loop forever.
         self.acted = false;
+        let mut signal = None;
         for _ in 0..self.steps.len() {
             if self.when[self.pos].as_ref().is_some_and(|w| w.eval(env) == 0.0) {
                 self.advance();
@@ -167,6 +177,11 @@ impl ScriptRun {
                     self.advance();
                     continue;
                 }
+                Op::Signal(v) => {
+                    signal = Some(*v);
+                    self.advance();
+                    continue;
+                }
                 Op::Wheels(w) => Command { wheels: *w, ..Command::default() },
                 Op::Toward { dirs, speed } => {
                     Command { wheels: toward(dirs, *speed, env.now), ..Command::default() }
@@ -176,9 +191,9 @@ impl ScriptRun {
                 Op::Wait { charge } => Command { charge: *charge, ..Command::default() },
             };
             self.acted = true;
-            return cmd;
+            return Command { signal, ..cmd };
         }
-        Command::default()
+        Command { signal, ..Command::default() }
     }
 
     /// Called after the action the script drove: counts it and moves to the
@@ -202,11 +217,11 @@ impl ScriptRun {
 
 /// The unit vector (body frame) along a channel's bearing: the declared
 /// layout's when there is one, else the catalog's.
-fn bearing_vector(channel: usize, facing: Option<&[f32; 8]>) -> Option<Vector2<f32>> {
-    let b = channel_bearing(channel)?;
+fn bearing_vector(channel: usize, facing: Option<&[f32; 8]>, sectors: usize) -> Option<Vector2<f32>> {
+    let b = channel_bearing_in(channel, sectors)?;
     let b = match facing {
-        Some(f) => f[channel % 8].to_radians(),
-        None => b,
+        Some(f) if channel < CH_BATTERY => f[channel % 8].to_radians(),
+        _ => b,
     };
     Some(Vector2::new(b.cos(), b.sin()))
 }
@@ -285,7 +300,7 @@ mod tests {
     use crate::catalog::{CH_IR, CH_LIGHT};
 
     fn dirs(chans: std::ops::Range<usize>) -> Vec<(u16, Vector2<f32>)> {
-        chans.map(|c| (c as u16, bearing_vector(c, None).unwrap())).collect()
+        chans.map(|c| (c as u16, bearing_vector(c, None, 8).unwrap())).collect()
     }
 
     #[test]
@@ -309,7 +324,7 @@ mod tests {
             let mut p = [0.0; CHANNELS];
             p[CH_BARRIER] = barrier;
             let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
-            let mut s = ScriptRun::new(&script, None);
+            let mut s = ScriptRun::new(&script, None, 8);
             assert_eq!(s.command(&env, &mut r).arm, Some(true));
             s.after_action(&env);
             let cmd = s.command(&env, &mut r);
@@ -328,7 +343,7 @@ mod tests {
         // Every step skipped: nothing moves and nothing is counted.
         let never = Expr { ops: vec![Op::Const(0.0)], depth: 1 };
         let script = Script { steps: vec![step(Action::Arm(true), Some(never))], commit: false };
-        let mut s = ScriptRun::new(&script, None);
+        let mut s = ScriptRun::new(&script, None, 8);
         let p = [0.0; CHANNELS];
         let env = Env { now: &p, prev: &p, act: &act, state: &Env::NO_STATE };
         assert_eq!(s.command(&env, &mut r), Command::default());
@@ -397,7 +412,7 @@ mod tests {
         let facing = [-17.2, -45.9, -90.0, -151.5, 151.2, 90.0, 45.8, 17.1];
         let chans: Vec<u16> = (CH_IR as u16..CH_IR as u16 + 8).collect();
         let d: Vec<(u16, Vector2<f32>)> =
-            chans.iter().map(|&c| (c, bearing_vector(c as usize, Some(&facing)).unwrap())).collect();
+            chans.iter().map(|&c| (c, bearing_vector(c as usize, Some(&facing), 8).unwrap())).collect();
         let mut p = [0.0; CHANNELS];
         p[CH_IR + 5] = 1.0;
         assert_eq!(toward(&d, 0.5, &p), [-0.5, 0.5], "sensor 5 is on the left");
@@ -409,9 +424,9 @@ mod tests {
         p[CH_IR + 7] = 1.0;
         assert_eq!(toward(&d, 0.5, &p), [0.5, 0.5], "0 and 7 look ahead");
         // the light channels share the bearings
-        let v = bearing_vector(CH_LIGHT + 5, Some(&facing)).unwrap();
+        let v = bearing_vector(CH_LIGHT + 5, Some(&facing), 8).unwrap();
         assert!((v.y - 1.0).abs() < 1e-6);
         // without a layout, the catalog's: sensor 5 on the right
-        assert!(bearing_vector(CH_IR + 5, None).unwrap().y < -0.99);
+        assert!(bearing_vector(CH_IR + 5, None, 8).unwrap().y < -0.99);
     }
 }

@@ -170,6 +170,9 @@ impl Bodies for TeamBodies<'_> {
     fn prepare(&mut self, i: usize) {
         self.team.prepare(i);
     }
+    fn end_action(&mut self) {
+        self.team.end_action();
+    }
     fn member(&mut self, i: usize) -> TeamMember<'_> {
         TeamMember { team: &mut *self.team, i }
     }

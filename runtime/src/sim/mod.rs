@@ -54,7 +54,7 @@ use rng::Xoshiro256pp;
 use simd::{Kernel, Lanes};
 
 use crate::catalog::{
-    CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, GROUND_SENSORS,
+    CHANNELS, CH_BARRIER, CH_BATTERY, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, GROUND_SENSORS, SIGNALS,
 };
 use crate::program::{Wall, World};
 
@@ -72,6 +72,8 @@ pub struct Command {
     pub claw: Option<bool>,
     /// Ask the charger to recharge (only works in contact with the bar).
     pub charge: bool,
+    /// Set the values the robot broadcasts (each 0..1), or leave them.
+    pub signal: Option<[f32; SIGNALS]>,
 }
 
 /// What happened during one action.

@@ -20,13 +20,34 @@
 //! - **the charger**: it serves one robot at a time. The robot that
 //!   charges while no other does holds it until it stops charging or its
 //!   battery is full; meanwhile the others cannot charge.
+//! - **the range-and-bearing board** (when the body has one,
+//!   `Body::rab`): after every robot acted ([`Team::end_action`]), each
+//!   robot's readings of the others within range and of what they
+//!   broadcast, all measured on one snapshot, so the order in which the
+//!   robots act changes nothing of them; [`Team::sense`] hands each robot
+//!   the last measurement. Without the board none of it runs.
 
 use nalgebra::Point2;
 use rand::SeedableRng;
 
 use super::rng::Xoshiro256pp;
 use super::{Command, Outcome, Sim, CHANNELS};
-use crate::program::World;
+use crate::catalog::{CH_RAB, RAB_SECTORS, SIGNALS};
+use crate::program::{RangeBearing, World};
+
+/// The channels of the range-and-bearing board, from [`CH_RAB`]: the
+/// sectors, then the heard signals.
+pub const RAB_CHANNELS: usize = RAB_SECTORS + RAB_SECTORS * SIGNALS;
+
+/// A team's range-and-bearing board.
+#[derive(Clone, Debug)]
+struct Rab {
+    spec: RangeBearing,
+    /// Each robot's broadcast values now (its last command that set them).
+    signal: Vec<[f32; SIGNALS]>,
+    /// Each robot's readings, measured after the last action.
+    read: Vec<[f32; RAB_CHANNELS]>,
+}
 
 /// The seed of robot `i`'s simulator and controller in the episode of
 /// seed `seed`: `seed` itself for robot 0 (a team's first robot is the
@@ -56,6 +77,8 @@ pub struct Team {
     /// parent) and each group's size.
     group: Vec<u32>,
     size: Vec<u32>,
+    /// The range-and-bearing board, if the robots have one.
+    rab: Option<Rab>,
 }
 
 impl Team {
@@ -82,7 +105,15 @@ impl Team {
         // grid, so the grid's cells hold everything within reach.
         let travel = s.travel * (1.0 + s.wheel_noise);
         let reach = 2.0 * s.radius + super::ir::RANGE + 2.0 * travel + 1.0;
-        let grid = Grid::new(s.width, s.depth, reach + 2.0 * travel, n);
+        // The board measures on a grid built for it: its cells hold every
+        // robot within its range (centre to centre) without a move.
+        let rab = world.body.rab.clone().map(|spec| Rab {
+            spec,
+            signal: vec![[0.0; SIGNALS]; n],
+            read: vec![[0.0; RAB_CHANNELS]; n],
+        });
+        let rab_reach = rab.as_ref().map_or(0.0, |r| 2.0 * s.radius + r.spec.range.max(0.0) + 1.0);
+        let grid = Grid::new(s.width, s.depth, (reach + 2.0 * travel).max(rab_reach), n);
         // Room for every body that fits within reach, and for a row of
         // three cells more (`prepare` writes a row's candidates before it
         // keeps those within reach), so `prepare` never allocates. Bodies
@@ -98,7 +129,9 @@ impl Team {
         for sim in &mut sims {
             sim.others.reserve_exact(room);
         }
-        let mut team = Team { sims, at, grid, reach, charger: None, group: vec![0; n], size: vec![0; n] };
+        let mut team =
+            Team { sims, at, grid, reach, charger: None, group: vec![0; n], size: vec![0; n], rab };
+        team.end_action();
         team.begin_action();
         team
     }
@@ -152,8 +185,75 @@ impl Team {
     }
 
     /// Robot `i` senses ([`Sim::sense`]); [`Team::prepare`] it first.
+    /// With a range-and-bearing board, its channels are the measurement
+    /// after the last action every robot finished ([`Team::end_action`]).
     pub fn sense(&mut self, i: usize, out: &mut [f32; CHANNELS]) {
         self.sims[i].sense(out);
+        if let Some(rab) = &self.rab {
+            out[CH_RAB..CH_RAB + RAB_CHANNELS].copy_from_slice(&rab.read[i]);
+        }
+    }
+
+    /// Ends an action every robot has acted in: with a range-and-bearing
+    /// board, measures every robot's readings on where the robots are and
+    /// what they broadcast now (a robot whose battery is empty is seen
+    /// and broadcasts 0). Nothing without a board.
+    pub fn end_action(&mut self) {
+        let Some(rab) = &mut self.rab else { return };
+        self.grid.build(&self.at);
+        for (sim, signal) in self.sims.iter().zip(rab.signal.iter_mut()) {
+            if !sim.alive() {
+                *signal = [0.0; SIGNALS];
+            }
+        }
+        let Rab { spec, signal, read } = rab;
+        let sectors = usize::from(spec.sectors).clamp(1, RAB_SECTORS);
+        let signals = usize::from(spec.signals).min(SIGNALS);
+        let width = std::f32::consts::TAU / sectors as f32;
+        let range = spec.range.max(f32::MIN_POSITIVE);
+        let apart = 2.0 * self.sims[0].radius;
+        let reach = apart + range;
+        let (noise, turn) = (spec.range_noise, spec.bearing_noise.to_radians());
+        for i in 0..self.at.len() {
+            let p = self.at[i];
+            let sim = &mut self.sims[i];
+            let heading = sim.pose().theta;
+            let occluded = spec.occlusion && sim.shades;
+            let out = &mut read[i];
+            *out = [0.0; RAB_CHANNELS];
+            self.grid.near(p, |run| {
+                for e in run {
+                    let d = e.at - p;
+                    let dist2 = d.norm_squared();
+                    if e.robot as usize == i || dist2 > reach * reach {
+                        continue;
+                    }
+                    if occluded && sim.shaded(&p, &e.at) {
+                        continue;
+                    }
+                    let gap = (dist2.sqrt() - apart).max(0.0);
+                    let (mut prox, mut bearing) = (1.0 - gap / range, d.y.atan2(d.x) - heading);
+                    if noise > 0.0 || turn > 0.0 {
+                        let (a, b) = super::noise_pair(&mut sim.rng, 1.0);
+                        prox += a * noise;
+                        bearing += b * turn;
+                    }
+                    let prox = prox.clamp(0.0, 1.0);
+                    let s = ((bearing / width + 0.5).floor() as i64).rem_euclid(sectors as i64) as usize;
+                    out[s] = out[s].max(prox);
+                    let heard = &signal[e.robot as usize];
+                    for (k, &v) in heard.iter().enumerate().take(signals) {
+                        let c = RAB_SECTORS + k * sectors + s;
+                        out[c] = out[c].max(v);
+                    }
+                }
+            });
+        }
+    }
+
+    /// What robot `i` broadcasts now (zeros without a board).
+    pub fn signal(&self, i: usize) -> [f32; SIGNALS] {
+        self.rab.as_ref().map_or([0.0; SIGNALS], |r| r.signal[i])
     }
 
     /// Robot `i` executes one action ([`Sim::step`]) among the others
@@ -165,6 +265,9 @@ impl Team {
         sim.charger_free = self.charger.is_none_or(|h| h == i);
         let held = sim.held;
         let out = sim.step(cmd);
+        if let (Some(rab), Some(v)) = (&mut self.rab, cmd.signal) {
+            rab.signal[i] = v.map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) });
+        }
         if sim.charging && sim.battery() < 1.0 {
             self.charger = Some(i);
         } else if self.charger == Some(i) {
@@ -412,5 +515,92 @@ mod tests {
             }
         }
         assert!(team.sims.iter().map(|s| s.others.len()).sum::<usize>() > 0, "some robots are near others");
+    }
+
+    /// Two robots' range-and-bearing readings: robot 0 at (300, 500)
+    /// facing east, robot 1 at (455, 500) facing north (bodies 100 mm
+    /// apart), `wall` an inner wall between them.
+    fn pair(wall: bool, seed: u64) -> Team {
+        use crate::program::{InnerWall, RangeBearing};
+        let mut world = World { arena: [1000.0, 1000.0], robots: 2, ..arena_world() };
+        world.body.rab =
+            Some(RangeBearing { range_noise: 0.0, bearing_noise: 0.0, signals: 2, ..RangeBearing::DEFAULT });
+        world.body.sensor_noise = 0.0;
+        if wall {
+            world.items.walls.push(InnerWall { name: None, from: [377.0, 450.0], to: [377.0, 550.0] });
+        }
+        let mut team = Team::new(&world, seed);
+        let far = |x| super::super::Pose { x, y: 150.0, theta: 0.0 };
+        assert!(team.place(0, far(100.0)) && team.place(1, far(800.0)));
+        assert!(team.place(0, super::super::Pose { x: 300.0, y: 500.0, theta: 0.0 }));
+        let north = std::f32::consts::FRAC_PI_2;
+        assert!(team.place(1, super::super::Pose { x: 455.0, y: 500.0, theta: north }));
+        team.end_action();
+        team
+    }
+
+    fn rab(team: &mut Team, i: usize) -> [f32; RAB_CHANNELS] {
+        let mut out = [0.0; CHANNELS];
+        team.sense(i, &mut out);
+        out[CH_RAB..CH_RAB + RAB_CHANNELS].try_into().unwrap()
+    }
+
+    /// Each robot reads the other in the sector it is in, at the proximity
+    /// of the gap between the bodies (1 - 100 / 300), and nothing elsewhere.
+    #[test]
+    fn two_robots_read_each_other_in_the_right_sector() {
+        let mut team = pair(false, 3);
+        let expect = 1.0 - 100.0 / 300.0;
+        let a = rab(&mut team, 0);
+        let b = rab(&mut team, 1);
+        // Robot 1 is straight ahead of robot 0: sector 0.
+        assert!((a[0] - expect).abs() < 1e-4, "{a:?}");
+        assert!(a[1..].iter().all(|&v| v == 0.0), "{a:?}");
+        // Robot 0 is on robot 1's left (90 degrees): sector 2 of 8.
+        assert!((b[2] - expect).abs() < 1e-4, "{b:?}");
+        assert!(b.iter().enumerate().all(|(k, &v)| k == 2 || v == 0.0), "{b:?}");
+    }
+
+    /// An inner wall between the two robots hides them from each other;
+    /// without occlusion it does not.
+    #[test]
+    fn a_wall_between_two_robots_hides_them() {
+        let mut team = pair(true, 3);
+        assert_eq!(rab(&mut team, 0), [0.0; RAB_CHANNELS]);
+        assert_eq!(rab(&mut team, 1), [0.0; RAB_CHANNELS]);
+        team.rab.as_mut().unwrap().spec.occlusion = false;
+        team.end_action();
+        assert!(rab(&mut team, 0)[0] > 0.6);
+    }
+
+    /// A value broadcast during an action is heard once every robot has
+    /// acted (the next action's readings), in the sector of the robot
+    /// that sent it, whatever the order of the robots; not before.
+    #[test]
+    fn a_signal_is_heard_at_the_next_action_not_before() {
+        let mut team = pair(false, 3);
+        team.begin_action();
+        // Robot 1 acts after robot 0, but signals before robot 0 senses
+        // again: robot 0 still hears nothing in this action.
+        team.prepare(1);
+        team.step(1, &Command { signal: Some([0.0, 0.75, 0.0, 0.0]), ..Command::default() });
+        team.prepare(0);
+        assert_eq!(rab(&mut team, 0)[RAB_SECTORS..], [0.0; RAB_CHANNELS - RAB_SECTORS]);
+        team.end_action();
+        let heard = rab(&mut team, 0);
+        // Signal 1 in sector 0 (8 sectors): channel 8 + 1 * 8 + 0 after the sectors.
+        assert_eq!(heard[RAB_SECTORS + 8], 0.75, "{heard:?}");
+        assert_eq!(heard[RAB_SECTORS..].iter().filter(|&&v| v != 0.0).count(), 1, "{heard:?}");
+        // Robot 1 hears nothing: robot 0 sent nothing.
+        assert_eq!(rab(&mut team, 1)[RAB_SECTORS..], [0.0; RAB_CHANNELS - RAB_SECTORS]);
+    }
+
+    /// A robot alone reads 0 on every channel of the board.
+    #[test]
+    fn a_robot_alone_reads_nothing() {
+        let mut team = pair(false, 3);
+        assert!(team.place(1, super::super::Pose { x: 900.0, y: 900.0, theta: 0.0 }));
+        team.end_action();
+        assert_eq!(rab(&mut team, 0), [0.0; RAB_CHANNELS]);
     }
 }
