@@ -35,11 +35,13 @@ pub enum ErrorKind {
 pub struct Error {
     kind: ErrorKind,
     message: String,
+    /// The diagnostics as data, for an error of kind `Diagnostics`.
+    diagnosed: Option<Box<crate::diag::Diagnosed>>,
 }
 
 impl Error {
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
-        Error { kind, message: message.into() }
+        Error { kind, message: message.into(), diagnosed: None }
     }
 
     /// A file-system failure (also the kind of messages not classified).
@@ -47,9 +49,25 @@ impl Error {
         Error::new(ErrorKind::Io, message)
     }
 
-    /// Rendered diagnostics about a source file.
-    pub fn diagnostics(message: impl Into<String>) -> Error {
+    /// Diagnostics about a source file: the message is their text, and
+    /// [`Error::diagnosed`] their data.
+    pub fn diagnostics(rendered: crate::diag::Rendered) -> Error {
+        Error {
+            diagnosed: Some(Box::new(rendered.data)),
+            ..Error::new(ErrorKind::Diagnostics, rendered.text)
+        }
+    }
+
+    /// Diagnostics known only as text (a command's own, such as `fmt
+    /// --check`'s): no data.
+    pub fn diagnostics_text(message: impl Into<String>) -> Error {
         Error::new(ErrorKind::Diagnostics, message)
+    }
+
+    /// The diagnostics as data (lines, columns, codes), for an error about
+    /// a source file.
+    pub fn diagnosed(&self) -> Option<&crate::diag::Diagnosed> {
+        self.diagnosed.as_deref()
     }
 
     pub fn kind(&self) -> ErrorKind {

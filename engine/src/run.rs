@@ -72,6 +72,54 @@ pub enum Event<'a> {
     Warning(String),
 }
 
+impl serde::Serialize for Event<'_> {
+    /// The one JSON form of an event, for every front (`run --json`'s
+    /// lines, Python's callback): `{"event": "generation", "stage": ...}`.
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        let path = |p: &Path| p.display().to_string();
+        let record = match *self {
+            Event::EvolveStart { stage, generations, done } => {
+                Record::EvolveStart { stage, generations, done }
+            }
+            Event::Resumed { stage, generation, generations, finished, checkpoint } => {
+                Record::Resumed { stage, generation, generations, finished, checkpoint: path(checkpoint) }
+            }
+            Event::Generation { stage, stats } => Record::Generation { stage, stats },
+            Event::EvolveEnd { stage, completed } => Record::EvolveEnd { stage, completed },
+            Event::Evolved { stage, generations, last, chosen, dir } => {
+                Record::Evolved { stage, generations, last, chosen, dir: path(dir) }
+            }
+            Event::Trained { stage, trained, recorded, reused, dir } => Record::Trained {
+                stage: &stage.name,
+                actions: trained.result.actions,
+                performance: &trained.performance,
+                recorded,
+                reused,
+                dir: path(dir),
+            },
+            Event::Tested { stage, summary, lives, dir, .. } => {
+                Record::Tested { stage, summary, lives, dir: path(dir) }
+            }
+            Event::Warning(ref message) => Record::Warning { message },
+        };
+        record.serialize(serializer)
+    }
+}
+
+/// [`Event`]'s JSON form.
+#[derive(serde::Serialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+enum Record<'a> {
+    EvolveStart { stage: &'a str, generations: u32, done: u32 },
+    Resumed { stage: &'a str, generation: u32, generations: u32, finished: bool, checkpoint: String },
+    Generation { stage: &'a str, stats: &'a GenStats },
+    EvolveEnd { stage: &'a str, completed: bool },
+    Evolved { stage: &'a str, generations: u32, last: Option<&'a GenStats>, chosen: f32, dir: String },
+    Trained { stage: &'a str, actions: u32, performance: &'a [f32], recorded: u32, reused: bool, dir: String },
+    Tested { stage: &'a str, summary: &'a TestSummary, lives: u32, dir: String },
+    Warning { message: &'a str },
+}
+
 /// Receives a run's [`Event`]s.
 pub trait Observer {
     fn event(&self, event: Event<'_>);

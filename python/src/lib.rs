@@ -11,7 +11,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use miette::Diagnostic as _;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
@@ -256,67 +255,48 @@ impl Diagnostic {
     }
 }
 
-/// Line and column (1-based, the column in characters) of byte `offset`.
-fn position(source: &str, offset: usize) -> (usize, usize) {
-    shaping_engine::diag::line_column(source, offset)
-}
-
-fn severity(d: &dyn miette::Diagnostic) -> String {
-    match d.severity() {
-        Some(miette::Severity::Warning) => "warning",
-        Some(miette::Severity::Advice) => "advice",
-        _ => "error",
-    }
-    .to_string()
+/// Python's diagnostics of the engine's: a file's errors and warnings (the
+/// `related` of its diagnostics), or the one diagnostic when it has none
+/// (a file that is not UTF-8).
+fn diagnostics_from(d: &shaping_engine::diag::Diagnosed, file: &str) -> Vec<Diagnostic> {
+    let items: Vec<&shaping_engine::diag::Diagnosed> =
+        if d.related.is_empty() { vec![d] } else { d.related.iter().collect() };
+    items
+        .into_iter()
+        .map(|d| Diagnostic {
+            message: d.message.clone(),
+            severity: d.severity.into(),
+            code: d.code.clone(),
+            line: d.line,
+            column: d.column,
+            help: d.help.clone(),
+            file: file.to_string(),
+        })
+        .collect()
 }
 
 /// The diagnostics of `path`, or the engine's error for a file that cannot
 /// be read.
 fn diagnostics_of(path: &Path) -> Result<Vec<Diagnostic>, shaping_engine::Error> {
     let file = path.display().to_string();
-    let plain = |message: String, severity: &str| Diagnostic {
-        message,
-        severity: severity.into(),
-        code: None,
-        line: None,
-        column: None,
-        help: None,
-        file: file.clone(),
-    };
-    if path.extension().is_some_and(|e| e == "json") {
-        return match load::load_built(path) {
-            Ok(_) => Ok(Vec::new()),
-            Err(e) if e.kind() == ErrorKind::Io => Err(e),
-            Err(e) => Ok(vec![plain(e.message().to_string(), "error")]),
-        };
+    match load::load_program(path, ErrorFormat::Plain) {
+        Ok((_, None)) => Ok(Vec::new()),
+        Ok((_, Some(w))) => Ok(diagnostics_from(&w.data, &file)),
+        Err(e) => match e.diagnosed() {
+            Some(d) => Ok(diagnostics_from(d, &file)),
+            // A built program (`.json`) that cannot be used: its message.
+            None if e.kind() != ErrorKind::Io => Ok(vec![Diagnostic {
+                message: e.message().to_string(),
+                severity: "error".into(),
+                code: None,
+                line: None,
+                column: None,
+                help: None,
+                file,
+            }]),
+            None => Err(e),
+        },
     }
-    let source = match load::read_source(path, ErrorFormat::Plain) {
-        Ok(s) => s,
-        Err(e) if e.kind() == ErrorKind::Diagnostics => {
-            // Not UTF-8: the message of the plain rendering's first line.
-            let first = e.message().lines().find(|l| !l.trim().is_empty()).unwrap_or("").trim();
-            let message = first.trim_start_matches(['×', 'x', ' ']).to_string();
-            return Ok(vec![plain(message, "error")]);
-        }
-        Err(e) => return Err(e),
-    };
-    let (_, diagnostics) = shaping_compiler::check(&source, &file);
-    Ok(diagnostics
-        .errors()
-        .iter()
-        .map(|d| {
-            let first = d.labels().and_then(|mut l| l.next()).map(|l| position(&source, l.offset()));
-            Diagnostic {
-                message: d.to_string(),
-                severity: severity(d),
-                code: d.code().map(|c| c.to_string()),
-                line: first.map(|p| p.0),
-                column: first.map(|p| p.1),
-                help: d.help().map(|h| h.to_string()),
-                file: file.clone(),
-            }
-        })
-        .collect())
 }
 
 /// Every diagnostic of the `.bat` file `path` (errors and warnings), as
@@ -346,16 +326,14 @@ fn load(py: Python<'_>, path: &Path) -> PyResult<Compiled> {
     match loaded {
         Ok((program, warnings)) => {
             if let Some(w) = warnings {
-                warn(py, w.trim_end())?;
+                warn(py, w.text.trim_end())?;
             }
             Ok(program)
         }
         Err(e) => {
             let err = shaping_error(py, &e);
-            if e.kind() == ErrorKind::Diagnostics {
-                if let Ok(d) = diagnostics_of(path) {
-                    let _ = err.value(py).setattr("diagnostics", d);
-                }
+            if let Some(d) = e.diagnosed() {
+                let _ = err.value(py).setattr("diagnostics", diagnostics_from(d, &path.display().to_string()));
             }
             Err(err)
         }
@@ -1387,40 +1365,6 @@ struct PyObserver {
     stop: Arc<AtomicBool>,
 }
 
-fn event_json(event: &Event<'_>) -> Option<serde_json::Value> {
-    use serde_json::json;
-    Some(match event {
-        Event::EvolveStart { stage, generations, done } => {
-            json!({"event": "evolve_start", "stage": stage, "generations": generations, "done": done})
-        }
-        Event::Resumed { stage, generation, generations, finished, checkpoint } => json!({
-            "event": "resumed", "stage": stage, "generation": generation, "generations": generations,
-            "finished": finished, "checkpoint": checkpoint.display().to_string(),
-        }),
-        Event::Generation { stage, stats } => {
-            json!({"event": "generation", "stage": stage, "stats": serde_json::to_value(stats).ok()})
-        }
-        Event::EvolveEnd { stage, completed } => {
-            json!({"event": "evolve_end", "stage": stage, "completed": completed})
-        }
-        Event::Evolved { stage, generations, chosen, dir, .. } => json!({
-            "event": "evolved", "stage": stage, "generations": generations, "chosen": chosen,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Trained { stage, trained, recorded, reused, dir } => json!({
-            "event": "trained", "stage": stage.name, "actions": trained.result.actions,
-            "performance": trained.performance, "recorded": recorded, "reused": reused,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Tested { stage, summary, lives, dir, .. } => json!({
-            "event": "tested", "stage": stage, "summary": summary, "lives": lives,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Warning(w) => json!({"event": "warning", "message": w}),
-        _ => return None,
-    })
-}
-
 impl Observer for PyObserver {
     fn event(&self, event: Event<'_>) {
         if let Event::Warning(w) = &event {
@@ -1432,7 +1376,7 @@ impl Observer for PyObserver {
         if self.error.lock().map(|e| e.is_some()).unwrap_or(true) {
             return;
         }
-        let Some(value) = event_json(&event) else { return };
+        let Ok(value) = serde_json::to_value(&event) else { return };
         Python::attach(|py| {
             let result = json_to_py(py, &value).and_then(|v| callback.call1(py, (v,)));
             if let Err(e) = result {
