@@ -18,7 +18,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::files::{create_dir, unsealed_warning, DirLock, Unsealed};
 use crate::rundir::{self, TestSummary};
 use crate::sweep::Assignment;
-use crate::{html, report, RECORDED_TRAINING_ACTIONS};
+use crate::{html, report, Engine, RECORDED_TRAINING_ACTIONS};
 
 /// What a run does: which stages, with which seed, into which directory.
 #[derive(Clone, Debug, Default)]
@@ -199,7 +199,7 @@ impl Local<'_> {
     /// Once `stop` is set, the episodes not yet started are not run and a
     /// team's episode under way is given up at its next action: their
     /// fitness is NaN, so the generation fails and nothing of it is kept
-    /// (see [`Runner`]).
+    /// (see [`Engine`]).
     pub fn stopped_by(self, stop: Option<&AtomicBool>) -> Local<'_> {
         Local { pool: self.pool, stop }
     }
@@ -616,25 +616,7 @@ impl Saved {
     }
 }
 
-/// Who runs a program's stages: the caller's observer, evaluator and
-/// interruption flag.
-pub struct Runner<'a> {
-    /// Told of progress and warnings.
-    pub observer: &'a dyn Observer,
-    /// Evaluates evolved stages' episodes (this process's threads: `None`).
-    pub evaluator: Option<&'a dyn Evaluate>,
-    /// Once set, the run stops at the next safe point (after the generation
-    /// under way, at the next action of a test's life) and says where.
-    pub interrupt: Option<&'a AtomicBool>,
-}
-
-impl Default for Runner<'_> {
-    fn default() -> Self {
-        Runner { observer: &Silent, evaluator: None, interrupt: None }
-    }
-}
-
-impl Runner<'_> {
+impl Engine<'_> {
     fn stopped(&self) -> bool {
         self.interrupt.is_some_and(|f| f.load(Ordering::Relaxed))
     }
@@ -647,11 +629,11 @@ impl Runner<'_> {
         self.run_source(program, None, opts)
     }
 
-    /// [`Runner::run`] of the program loaded from the file `source`: of a
+    /// [`Engine::run`] of the program loaded from the file `source`: of a
     /// `.bat` file, the directory records the file's name (`source.json`),
     /// and a run of another file into it is refused unless `opts.fresh`
     /// (several files may share a program's name, their robot's); a built
-    /// program (`.json`) is [`Runner::run`]'s.
+    /// program (`.json`) is [`Engine::run`]'s.
     pub fn run_file(&self, program: Program, source: &Path, opts: &RunOptions) -> Result<RunOutcome> {
         if source.extension().is_some_and(|e| e == "json") {
             return self.run(program, opts);
@@ -827,7 +809,7 @@ fn evolved_parent<'a>(
     })
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs (or resumes) evolved stage `index` to its end and its chosen best,
     /// writing its files into `dir`.
     #[allow(clippy::too_many_arguments)]
@@ -1219,7 +1201,7 @@ struct TestRun<'a> {
     learning: bool,
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs test stage `t` and writes its files into `dir` (all of them or,
     /// when stopped or failing on the way, none); returns its summary.
     fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<TestSummary> {
@@ -1426,7 +1408,7 @@ fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> BTreeMap<String, run
     out
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs training stage `index` (or reuses the `trained.json` a previous
     /// run of the same stage and seed left in `dir`) and writes its files:
     /// the learned weights, the trace of the training life (its first

@@ -3,7 +3,7 @@
 //! it; its docstrings and type stubs are there.
 //!
 //! Everything goes through the engine (`shaping_engine`): `load` to read a
-//! file, `run::Runner` to run it, `descriptors` to evaluate genomes, so the
+//! file, `shaping_engine::Engine` to run it, `descriptors` to evaluate genomes, so the
 //! results and the messages are the command line's.
 
 use std::path::{Path, PathBuf};
@@ -19,7 +19,8 @@ use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use shaping_engine::descriptors::{self, Described};
 use shaping_engine::diag::ErrorFormat;
-use shaping_engine::run::{self as engine_run, Event, Observer, RunOptions, Runner};
+use shaping_engine::run::{self as engine_run, Event, Observer, RunOptions};
+use shaping_engine::Engine;
 use shaping_engine::{load, rundir, sweep, ErrorKind};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Program as Compiled, StageRun};
@@ -333,7 +334,8 @@ fn load(py: Python<'_>, path: &Path) -> PyResult<Compiled> {
         Err(e) => {
             let err = shaping_error(py, &e);
             if let Some(d) = e.diagnosed() {
-                let _ = err.value(py).setattr("diagnostics", diagnostics_from(d, &path.display().to_string()));
+                let _ =
+                    err.value(py).setattr("diagnostics", diagnostics_from(d, &path.display().to_string()));
             }
             Err(err)
         }
@@ -1447,7 +1449,7 @@ fn run(
     let out = out.unwrap_or_else(|| engine_run::default_out(&path));
     let options = RunOptions { stage, seed, out, jobs, fresh, no_report: !report, sets };
     let outcome = observed(py, callback, |observer, stop| {
-        Runner { observer, evaluator: None, interrupt: Some(stop) }.run_file(program, &path, &options)
+        Engine { observer, evaluator: None, interrupt: Some(stop) }.run_file(program, &path, &options)
     })?;
     Ok(Run::of(outcome))
 }
@@ -1724,16 +1726,8 @@ fn experiment(
         fresh,
         no_report: !report,
     };
-    let plan = shaping_engine::experiment::Plan::new(program, options).map_err(|e| engine_error(py, &e))?;
     let (outcomes, finished) = observed(py, callback, |observer, stop| {
-        let _lock = plan.lock()?;
-        let runner = Runner { observer, evaluator: None, interrupt: Some(stop) };
-        let outcomes = plan
-            .tasks()
-            .into_iter()
-            .map(|task| plan.run_task(task, jobs, &runner))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok((outcomes, plan.finish()?))
+        Engine { observer, evaluator: None, interrupt: Some(stop) }.experiment(program, options)
     })?;
     let mut runs = Vec::new();
     let mut seen = Vec::new();
@@ -1744,7 +1738,7 @@ fn experiment(
         runs.push(Py::new(py, Run::of(o))?);
     }
     Ok(Experiment {
-        out: plan.out().to_path_buf(),
+        out: finished.out,
         seeds: seen,
         runs,
         summary_text: finished.summary,
