@@ -12,6 +12,8 @@ pub enum ErrorKind {
     Diagnostics,
     /// A file or directory could not be read or written.
     Io,
+    /// A file or directory the caller named does not exist.
+    NotFound,
     /// A saved file is damaged: it does not parse, or its checksum does not
     /// match its contents, or it disagrees with the file it was derived from.
     Corrupt,
@@ -47,6 +49,14 @@ impl Error {
     /// A file-system failure (also the kind of messages not classified).
     pub fn io(message: impl Into<String>) -> Error {
         Error::new(ErrorKind::Io, message)
+    }
+
+    /// A failure of the file system's on `path` to `what` (`read`,
+    /// `write`, ...): [`ErrorKind::NotFound`] when it does not exist, else
+    /// [`ErrorKind::Io`]; the message names the path and the system's reason.
+    pub fn of_io(what: &str, path: &std::path::Path, e: &std::io::Error) -> Error {
+        let kind = if e.kind() == std::io::ErrorKind::NotFound { ErrorKind::NotFound } else { ErrorKind::Io };
+        Error::new(kind, format!("error: cannot {what} `{}`: {e}", path.display()))
     }
 
     /// Diagnostics about a source file: the message is their text, and

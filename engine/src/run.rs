@@ -1102,7 +1102,10 @@ pub fn before_after(
     stop: Option<&AtomicBool>,
 ) -> Result<BeforeAfter, Error> {
     if lives == 0 {
-        return Err(Error::io(format!("error: test stage `{}` has no life to run", stage.name)));
+        return Err(Error::new(
+            ErrorKind::Invalid,
+            format!("error: test stage `{}` has no life to run", stage.name),
+        ));
     }
     let mut run = TeamRun::new(stage, genome, seed)
         .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
@@ -1267,7 +1270,7 @@ fn test_files(
     stop: Option<&AtomicBool>,
 ) -> Result<TestSummary, Error> {
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let check = || if stopped() { Err(Error::io(report::STOPPED)) } else { Ok(()) };
+    let check = || if stopped() { Err(interrupted(report::STOPPED.into())) } else { Ok(()) };
     // The change, and the other lives' starts lightly (unlabelled marks).
     let mut marks: Vec<(u32, String)> =
         ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();

@@ -32,10 +32,60 @@ create_exception!(
     "An error of shaping (a file with errors, a run that cannot resume, ...): its text is the command line's message, `kind` says which kind of error it is."
 );
 
+create_exception!(
+    _shaping,
+    CompileError,
+    ShapingError,
+    "A file with errors: `diagnostics` has them (a list of Diagnostic)."
+);
+create_exception!(
+    _shaping,
+    CorruptError,
+    ShapingError,
+    "A saved file is damaged: it does not parse, its checksum does not match, or it disagrees with the file it came from."
+);
+create_exception!(
+    _shaping,
+    StaleError,
+    ShapingError,
+    "A saved result belongs to another program, seed or setting than this run's."
+);
+create_exception!(_shaping, LockedError, ShapingError, "The run directory is in use by another process.");
+create_exception!(
+    _shaping,
+    EvaluationError,
+    ShapingError,
+    "Evaluation failed (a robot link, a rank of a cluster)."
+);
+
+/// `shaping.NotFoundError`: a file or directory that does not exist, both
+/// a `FileNotFoundError` and a `ShapingError` (made once, at import).
+static NOT_FOUND: pyo3::sync::PyOnceLock<Py<pyo3::types::PyType>> = pyo3::sync::PyOnceLock::new();
+
+fn not_found_type(py: Python<'_>) -> PyResult<&Bound<'_, pyo3::types::PyType>> {
+    let t = NOT_FOUND.get_or_try_init(py, || -> PyResult<_> {
+        let builtins = py.import("builtins")?;
+        let bases = pyo3::types::PyTuple::new(
+            py,
+            [builtins.getattr("FileNotFoundError")?, py.get_type::<ShapingError>().into_any()],
+        )?;
+        let dict = pyo3::types::PyDict::new(py);
+        dict.set_item("__module__", "shaping")?;
+        dict.set_item(
+            "__doc__",
+            "A file or directory that does not exist: a FileNotFoundError and a ShapingError.",
+        )?;
+        let made = builtins.getattr("type")?.call1(("NotFoundError", bases, dict))?;
+        Ok(made.cast_into::<pyo3::types::PyType>()?.unbind())
+    })?;
+    Ok(t.bind(py))
+}
+
 fn kind_name(kind: ErrorKind) -> &'static str {
     match kind {
         ErrorKind::Diagnostics => "diagnostics",
         ErrorKind::Io => "io",
+        ErrorKind::NotFound => "not_found",
         ErrorKind::Corrupt => "corrupt",
         ErrorKind::Stale => "stale",
         ErrorKind::Interrupted => "interrupted",
@@ -47,9 +97,22 @@ fn kind_name(kind: ErrorKind) -> &'static str {
     }
 }
 
-/// A `ShapingError` with the engine error's message and kind.
+/// The `ShapingError` (the subclass of its kind) with the engine error's
+/// message and kind; a file that does not exist raises `NotFoundError`.
 fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
-    let err = ShapingError::new_err(e.message().to_string());
+    let message = e.message().to_string();
+    let err = match e.kind() {
+        ErrorKind::Diagnostics => CompileError::new_err(message),
+        ErrorKind::Corrupt => CorruptError::new_err(message),
+        ErrorKind::Stale => StaleError::new_err(message),
+        ErrorKind::Locked => LockedError::new_err(message),
+        ErrorKind::Evaluation => EvaluationError::new_err(message),
+        ErrorKind::NotFound => match not_found_type(py) {
+            Ok(t) => PyErr::from_type(t.clone(), (message,)),
+            Err(e) => e,
+        },
+        _ => ShapingError::new_err(message),
+    };
     let _ = err.value(py).setattr("kind", kind_name(e.kind()));
     err
 }
@@ -286,7 +349,7 @@ fn diagnostics_of(path: &Path) -> Result<Vec<Diagnostic>, shaping_engine::Error>
         Err(e) => match e.diagnosed() {
             Some(d) => Ok(diagnostics_from(d, &file)),
             // A built program (`.json`) that cannot be used: its message.
-            None if e.kind() != ErrorKind::Io => Ok(vec![Diagnostic {
+            None if !matches!(e.kind(), ErrorKind::Io | ErrorKind::NotFound) => Ok(vec![Diagnostic {
                 message: e.message().to_string(),
                 severity: "error".into(),
                 code: None,
@@ -1749,6 +1812,12 @@ fn experiment(
 #[pymodule]
 fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ShapingError", m.py().get_type::<ShapingError>())?;
+    m.add("CompileError", m.py().get_type::<CompileError>())?;
+    m.add("CorruptError", m.py().get_type::<CorruptError>())?;
+    m.add("StaleError", m.py().get_type::<StaleError>())?;
+    m.add("LockedError", m.py().get_type::<LockedError>())?;
+    m.add("EvaluationError", m.py().get_type::<EvaluationError>())?;
+    m.add("NotFoundError", not_found_type(m.py())?)?;
     m.add("SQUARE_MM", descriptors::SQUARE_MM)?;
     m.add_class::<Diagnostic>()?;
     m.add_class::<Program>()?;
