@@ -475,27 +475,7 @@ impl Lower<'_> {
                 let [left, right] = self.motion(hw, m, *sp)?;
                 Action::Wheels { left, right }
             }
-            ActionDecl::Toward { refs, speed, span } => {
-                self.has_wheels(hw, *span);
-                let channels = self.sensor_refs(hw, refs)?;
-                if let Some(c) = channels.iter().find(|c| catalog::channel_bearing(**c as usize).is_none()) {
-                    let name = hw
-                        .sensors
-                        .iter()
-                        .find(|s| s.channel <= *c && *c < s.channel + s.count)
-                        .map(|s| s.name.clone())
-                        .unwrap_or_default();
-                    self.value_error(
-                        *span,
-                        format!("`toward` needs sensors with a direction, and `{name}` has none"),
-                        "no direction",
-                        Some("steer toward proximity or ambient sensors, e.g. `toward(light)`".into()),
-                    );
-                    return None;
-                }
-                let speed = self.speed(*speed, *span);
-                Action::Toward { channels, speed }
-            }
+            ActionDecl::Toward { refs, speed, span } => self.toward(hw, refs, *speed, *span)?,
             ActionDecl::Wait(_) => Action::Wait { charge: x.uses_charger.is_some() },
             ActionDecl::Recharge(_) => Action::Wait { charge: true },
             ActionDecl::Reinforce(e, sp) => {
@@ -510,52 +490,7 @@ impl Lower<'_> {
                 Action::Reinforce(self.expr(hw, e, scope)?)
             }
             ActionDecl::Set { actuator, state, span } => {
-                let Some(a) = hw.actuators.iter().find(|a| a.name == actuator.text) else {
-                    if hw.sensors.iter().any(|s| s.name == actuator.text) {
-                        self.value_error(
-                            actuator.span,
-                            format!("`{}` is a sensor, not an actuator", actuator.text),
-                            "not an actuator",
-                            None,
-                        );
-                    } else if !self.missing_gripper(hw, actuator, state.as_ref()) {
-                        self.unknown_action(hw, actuator);
-                    }
-                    return None;
-                };
-                let info = catalog::actuator_info(a.kind);
-                if info.states.is_empty() {
-                    self.value_error(
-                        *span,
-                        format!("`{}` takes speeds, not a state", a.name),
-                        "no states",
-                        Some(format!("write `{}(0.5, 0.5)` or `forward`", a.name)),
-                    );
-                    return None;
-                }
-                let Some(state) = state else {
-                    self.value_error(
-                        *span,
-                        format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
-                        "no state",
-                        Some(format!("write `{} {}`", a.name, info.states[0])),
-                    );
-                    return None;
-                };
-                let Some(i) = info.states.iter().position(|s| *s == state.text) else {
-                    self.errors.push(Error::Unknown {
-                        span: state.span.into(),
-                        what: "state",
-                        name: state.text.clone(),
-                        help: did_you_mean(&state.text, info.states.iter().copied())
-                            .or_else(|| Some(format!("`{}` is {}", a.name, info.states.join(" or ")))),
-                    });
-                    return None;
-                };
-                match a.kind {
-                    ActuatorKind::Lift => Action::Arm(i == 1),
-                    _ => Action::Claw(i == 1),
-                }
+                self.set_actuator(hw, actuator, state.as_ref(), *span)?
             }
         };
         if let Some(sp) = x.uses_charger {
@@ -600,6 +535,85 @@ impl Lower<'_> {
             None => None,
         };
         Some(Step { action, end, when })
+    }
+
+    /// `toward(SENSORS)`: steering toward sensors that have a direction.
+    fn toward(&mut self, hw: &Hw, refs: &[ast::SensorRef], speed: Option<f64>, span: Span) -> Option<Action> {
+        self.has_wheels(hw, span);
+        let channels = self.sensor_refs(hw, refs)?;
+        if let Some(c) = channels.iter().find(|c| catalog::channel_bearing(**c as usize).is_none()) {
+            let name = hw
+                .sensors
+                .iter()
+                .find(|s| s.channel <= *c && *c < s.channel + s.count)
+                .map(|s| s.name.clone())
+                .unwrap_or_default();
+            self.value_error(
+                span,
+                format!("`toward` needs sensors with a direction, and `{name}` has none"),
+                "no direction",
+                Some("steer toward proximity or ambient sensors, e.g. `toward(light)`".into()),
+            );
+            return None;
+        }
+        let speed = self.speed(speed, span);
+        Some(Action::Toward { channels, speed })
+    }
+
+    /// `ACTUATOR STATE`: the gripper's lift or claw set to one of its states.
+    fn set_actuator(
+        &mut self,
+        hw: &Hw,
+        actuator: &ast::Name,
+        state: Option<&ast::Name>,
+        span: Span,
+    ) -> Option<Action> {
+        let Some(a) = hw.actuators.iter().find(|a| a.name == actuator.text) else {
+            if hw.sensors.iter().any(|s| s.name == actuator.text) {
+                self.value_error(
+                    actuator.span,
+                    format!("`{}` is a sensor, not an actuator", actuator.text),
+                    "not an actuator",
+                    None,
+                );
+            } else if !self.missing_gripper(hw, actuator, state) {
+                self.unknown_action(hw, actuator);
+            }
+            return None;
+        };
+        let info = catalog::actuator_info(a.kind);
+        if info.states.is_empty() {
+            self.value_error(
+                span,
+                format!("`{}` takes speeds, not a state", a.name),
+                "no states",
+                Some(format!("write `{}(0.5, 0.5)` or `forward`", a.name)),
+            );
+            return None;
+        }
+        let Some(state) = state else {
+            self.value_error(
+                span,
+                format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
+                "no state",
+                Some(format!("write `{} {}`", a.name, info.states[0])),
+            );
+            return None;
+        };
+        let Some(i) = info.states.iter().position(|s| *s == state.text) else {
+            self.errors.push(Error::Unknown {
+                span: state.span.into(),
+                what: "state",
+                name: state.text.clone(),
+                help: did_you_mean(&state.text, info.states.iter().copied())
+                    .or_else(|| Some(format!("`{}` is {}", a.name, info.states.join(" or ")))),
+            });
+            return None;
+        };
+        Some(match a.kind {
+            ActuatorKind::Lift => Action::Arm(i == 1),
+            _ => Action::Claw(i == 1),
+        })
     }
 
     /// A neural behavior; also gives the gene range when its weights evolve.
