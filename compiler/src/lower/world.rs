@@ -136,34 +136,7 @@ impl Lower<'_> {
                     ws.arena_bare = width.unit.is_none() && depth.unit.is_none();
                 }
             }
-            W::Charger { length, wall, lamp, span } => {
-                let len = self.length(length, "the charger length");
-                let w = match wall.text.as_str() {
-                    "north" => Some(Wall::North),
-                    "south" => Some(Wall::South),
-                    "east" => Some(Wall::East),
-                    "west" => Some(Wall::West),
-                    _ => {
-                        self.errors.push(Error::Unknown {
-                            span: wall.span.into(),
-                            what: "wall",
-                            name: wall.text.clone(),
-                            help: did_you_mean(&wall.text, ["north", "south", "east", "west"])
-                                .or_else(|| Some("the walls are `north`, `south`, `east` and `west`".into())),
-                        });
-                        None
-                    }
-                };
-                let lamp_height = match lamp {
-                    None => Some(None),
-                    Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
-                    Some(Some(q)) => self.length(q, "the lamp height").map(Some),
-                };
-                if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
-                    ws.world.charger = Some(Charger { wall, length, lamp_height });
-                    ws.spans.insert("charger", *span);
-                }
-            }
+            W::Charger { length, wall, lamp, span } => self.charger(ws, length, wall, lamp.as_ref(), *span),
             W::Battery(q, span) => {
                 if let Some(c) = self.count(q, "the battery capacity", 1) {
                     let recharge = ws.world.battery.as_ref().map(|b| b.recharge).unwrap_or(DEFAULT_RECHARGE);
@@ -223,6 +196,43 @@ impl Lower<'_> {
                 ws.spans.insert("body", *span);
             }
             _ => {}
+        }
+    }
+
+    /// `charger LENGTH on WALL wall [with lamp [HEIGHT]]`.
+    fn charger(
+        &mut self,
+        ws: &mut WorldSt,
+        length: &ast::Quantity,
+        wall: &ast::Name,
+        lamp: Option<&Option<ast::Quantity>>,
+        span: Span,
+    ) {
+        let len = self.length(length, "the charger length");
+        let w = match wall.text.as_str() {
+            "north" => Some(Wall::North),
+            "south" => Some(Wall::South),
+            "east" => Some(Wall::East),
+            "west" => Some(Wall::West),
+            _ => {
+                self.errors.push(Error::Unknown {
+                    span: wall.span.into(),
+                    what: "wall",
+                    name: wall.text.clone(),
+                    help: did_you_mean(&wall.text, ["north", "south", "east", "west"])
+                        .or_else(|| Some("the walls are `north`, `south`, `east` and `west`".into())),
+                });
+                None
+            }
+        };
+        let lamp_height = match lamp {
+            None => Some(None),
+            Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
+            Some(Some(q)) => self.length(q, "the lamp height").map(Some),
+        };
+        if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
+            ws.world.charger = Some(Charger { wall, length, lamp_height });
+            ws.spans.insert("charger", span);
         }
     }
 
