@@ -1,18 +1,19 @@
-//! The engine as a library: compile `examples/khepera.bat`, run its stages
+//! The engine as a library: load `examples/khepera.bat`, run its stages
 //! into a temporary directory, print each stage's name and chosen best.
 //!
 //! ```sh
 //! cargo run --release --example library
 //! ```
 
-use shaping_engine::run::{RunOptions, Runner, StageOutcome};
+use shaping_engine::run::{RunOptions, StageOutcome};
+use shaping_engine::Engine;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let source = std::fs::read_to_string("examples/khepera.bat")?;
-    let program = shaping_compiler::compile(&source, "khepera.bat").map_err(|d| format!("{d:?}"))?;
+    let engine = Engine::default();
+    let program = engine.load("examples/khepera.bat".as_ref())?;
     let out = std::env::temp_dir().join(format!("shaping-library-{}", std::process::id()));
     let options = RunOptions { out: out.clone(), no_report: true, ..RunOptions::default() };
-    let outcome = Runner::default().run(program, &options)?;
+    let outcome = engine.run(program, &options)?;
     for stage in &outcome.stages {
         match stage {
             StageOutcome::Evolve { stage, best, genome, .. } => {

@@ -2,7 +2,7 @@
 //! one after another (or over MPI ranks), the summary printed.
 
 use shaping_engine::experiment::Plan;
-use shaping_engine::run::Runner;
+use shaping_engine::Engine;
 
 use crate::cluster::Coordinator;
 use crate::out::out;
@@ -52,7 +52,7 @@ pub fn run_task(
 ) -> Result<(), CliError> {
     let terminal = Terminal::new(quiet, false);
     let interrupted = if cluster.is_none() { interrupt_flag(true) } else { None };
-    let runner = Runner {
+    let runner = Engine {
         observer: &terminal,
         evaluator: cluster.map(|c| c as &dyn shaping_engine::run::Evaluate),
         interrupt: interrupted.as_deref(),

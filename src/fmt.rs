@@ -40,7 +40,7 @@ pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<
     }
     match worst {
         Some(e) => Err(CliError::new(e.kind(), String::new())),
-        None if check && changed > 0 => Err(CliError::diagnostics(format!(
+        None if check && changed > 0 => Err(CliError::diagnostics_text(format!(
             "{changed} file{} would be reformatted by `shaping fmt`",
             if changed == 1 { "" } else { "s" }
         ))),
@@ -56,7 +56,7 @@ fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
     if check {
         if out != src {
             outln!("<stdin>")?;
-            return Err(CliError::diagnostics("standard input would be reformatted by `shaping fmt`"));
+            return Err(CliError::diagnostics_text("standard input would be reformatted by `shaping fmt`"));
         }
         return Ok(());
     }
@@ -65,7 +65,7 @@ fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
 
 fn format_one(src: &str, name: &str, error_format: ErrorFormat) -> Result<String, CliError> {
     format(src, name).map_err(|e| match e {
-        FormatError::Syntax(d) => CliError::diagnostics(format!(
+        FormatError::Syntax(d) => CliError::diagnostics_text(format!(
             "{}\n{name}: not formatted (it does not parse)",
             diag::render(&d, error_format).trim_end()
         )),

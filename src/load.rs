@@ -15,7 +15,7 @@ use crate::CliError;
 pub fn load_program(path: &Path, format: ErrorFormat) -> Result<Program, CliError> {
     let (program, warnings) = shaping_engine::load::load_program(path, format)?;
     if let Some(w) = warnings {
-        eprintln!("{}", w.trim_end());
+        eprintln!("{}", w.text.trim_end());
     }
     Ok(program)
 }

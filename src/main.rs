@@ -762,7 +762,7 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
                 if format != ErrorFormat::Json {
                     // Warnings do not change the exit code.
                     if let Some(w) = warnings {
-                        eprintln!("{}", w.trim_end());
+                        eprintln!("{}", w.text.trim_end());
                     }
                     let genes: Vec<String> =
                         program.stages.iter().map(|s| format!("{} {} bits", s.name, s.layout.bits)).collect();
@@ -787,42 +787,18 @@ fn check(files: &[PathBuf], format: ErrorFormat) -> Result<(), CliError> {
     }
 }
 
-/// Adds `line` and `column` (1-based, in characters) beside each label's
-/// byte span of a JSON diagnostic and its related ones, and to each
-/// diagnostic the position of its first label.
-fn add_positions(diagnostic: &mut serde_json::Map<String, serde_json::Value>, source: &str) {
-    let position = |offset: usize| diag::line_column(source, offset);
-    let mut first = None;
-    if let Some(labels) = diagnostic.get_mut("labels").and_then(|l| l.as_array_mut()) {
-        for label in labels {
-            let Some(offset) = label["span"]["offset"].as_u64() else { continue };
-            let (line, column) = position(offset as usize);
-            first.get_or_insert((line, column));
-            label["line"] = line.into();
-            label["column"] = column.into();
-        }
-    }
-    if let Some((line, column)) = first {
-        diagnostic.insert("line".into(), line.into());
-        diagnostic.insert("column".into(), column.into());
-    }
-    if let Some(related) = diagnostic.get_mut("related").and_then(|r| r.as_array_mut()) {
-        for r in related {
-            if let Some(map) = r.as_object_mut() {
-                add_positions(map, source);
-            }
-        }
-    }
-}
-
 /// The JSON object `check --error-format json` prints for one file: `file`
 /// and `ok` always; for a good file its stages and their genome bits; for a
 /// bad one the diagnostic (`message`, `severity`, `labels`, `related`, ...).
 fn check_json(
     file: &std::path::Path,
-    result: &Result<(shaping_runtime::program::Program, Option<String>), CliError>,
+    result: &Result<(shaping_runtime::program::Program, Option<diag::Rendered>), CliError>,
 ) -> String {
     let name = file.display().to_string();
+    let object = |v: serde_json::Value| match v {
+        serde_json::Value::Object(map) => map,
+        _ => serde_json::Map::new(),
+    };
     let value = match result {
         Ok((program, warnings)) => {
             let stages: Vec<serde_json::Value> = program
@@ -833,29 +809,22 @@ fn check_json(
             let mut v = serde_json::json!({"file": name, "ok": true, "stages": stages});
             // A good file's warnings: the diagnostic object of the warnings.
             if let Some(w) = warnings {
-                v["warnings"] =
-                    serde_json::from_str(w).unwrap_or_else(|_| serde_json::Value::String(w.trim().into()));
+                v["warnings"] = serde_json::to_value(&w.data).unwrap_or_default();
             }
             v
         }
-        Err(e) if e.kind() == shaping_engine::ErrorKind::Diagnostics => match serde_json::from_str::<
-            serde_json::Value,
-        >(e.message())
-        {
-            Ok(serde_json::Value::Object(mut diagnostic)) => {
-                if let Ok(source) = std::fs::read_to_string(file) {
-                    add_positions(&mut diagnostic, &source);
-                }
+        Err(e) => match e.diagnosed() {
+            Some(d) => {
+                let mut diagnostic = object(serde_json::to_value(d).unwrap_or_default());
                 diagnostic.insert("file".into(), name.into());
                 diagnostic.insert("ok".into(), false.into());
                 serde_json::Value::Object(diagnostic)
             }
-            _ => serde_json::json!({"file": name, "ok": false, "severity": "error", "message": e.message()}),
+            None => {
+                let msg = e.message().strip_prefix("error: ").unwrap_or(e.message());
+                serde_json::json!({"file": name, "ok": false, "severity": "error", "message": msg})
+            }
         },
-        Err(e) => {
-            let msg = e.message().strip_prefix("error: ").unwrap_or(e.message());
-            serde_json::json!({"file": name, "ok": false, "severity": "error", "message": msg})
-        }
     };
     value.to_string()
 }

@@ -8,7 +8,8 @@ use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
-use shaping_engine::run::{default_out, Evaluate, RunOptions, Runner};
+use shaping_engine::run::{default_out, Evaluate, RunOptions};
+use shaping_engine::Engine;
 
 use crate::cluster::Coordinator;
 use crate::out::outln;
@@ -68,7 +69,7 @@ pub fn run(args: RunArgs, cluster: Option<&Coordinator>) -> Result<(), CliError>
         (None, Some(c)) => Some(c),
         (None, None) => None,
     };
-    let runner = Runner { observer: &terminal, evaluator, interrupt: interrupted.as_deref() };
+    let runner = Engine { observer: &terminal, evaluator, interrupt: interrupted.as_deref() };
     let started = Instant::now();
     // A built program (`program.json`) names no file: the directory's own
     // program.json may be run into it.

@@ -45,6 +45,15 @@ impl Terminal {
 
 impl Observer for Terminal {
     fn event(&self, event: Event<'_>) {
+        // `--json`: a generation's, a training's and a test's event, one line each.
+        let line = self.json.then(|| serde_json::to_string(&event));
+        let json = || match &line {
+            None => {}
+            Some(Ok(line)) => self.print_json(line.clone()),
+            Some(Err(e)) => {
+                self.failed.borrow_mut().get_or_insert(CliError::io(format!("error: cannot serialise: {e}")));
+            }
+        };
         match event {
             Event::EvolveStart { stage, generations, done } => {
                 *self.bar.borrow_mut() = Some(progress_bar(!self.human(), stage, generations, done));
@@ -65,14 +74,7 @@ impl Observer for Terminal {
                     bar.inc(1);
                 }
                 if self.json {
-                    match serde_json::to_string(stats) {
-                        Ok(line) => self.print_json(line),
-                        Err(e) => {
-                            self.failed
-                                .borrow_mut()
-                                .get_or_insert(CliError::io(format!("error: cannot serialise: {e}")));
-                        }
-                    }
+                    json();
                 }
             }
             Event::EvolveEnd { completed, .. } => {
@@ -102,10 +104,7 @@ impl Observer for Terminal {
                         eprintln!("stage {:<12} trained before, reused  -> {}", stage.name, dir.display());
                     }
                 } else if self.json {
-                    self.print_json(
-                        serde_json::json!({"stage": stage.name, "trained": trained.result.actions, "recorded": recorded, "performance": trained.performance})
-                            .to_string(),
-                    );
+                    json();
                 } else if !self.quiet {
                     let perf: Vec<String> = stage
                         .modules
@@ -128,9 +127,9 @@ impl Observer for Terminal {
                     );
                 }
             }
-            Event::Tested { stage, summary, lives, before, after, dir } => {
+            Event::Tested { stage, lives, before, after, dir, .. } => {
                 if self.json {
-                    self.print_json(serde_json::to_value(summary).map(|v| v.to_string()).unwrap_or_default());
+                    json();
                 } else if !self.quiet {
                     let how = if lives == 1 {
                         String::new()

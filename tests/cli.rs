@@ -503,7 +503,8 @@ fn the_terminal_says_what_each_stage_did() {
     let lines: Vec<serde_json::Value> =
         text(&json.stdout).lines().map(|l| serde_json::from_str(l).unwrap()).collect();
     let trained = &lines[0];
-    assert_eq!((trained["trained"].as_u64(), trained["recorded"].as_u64()), (Some(30000), Some(20000)));
+    assert_eq!((trained["event"].as_str(), trained["stage"].as_str()), (Some("trained"), Some("practice")));
+    assert_eq!((trained["actions"].as_u64(), trained["recorded"].as_u64()), (Some(30000), Some(20000)));
     assert_eq!(lines.len(), 1 + 2 + 1 + 1, "trained, 2 generations, tested, done: {lines:?}");
     assert_eq!(lines[3]["lives"], 2, "{}", lines[3]);
     assert_eq!(lines[4]["stages"][2]["summary"]["lives"], 2, "{}", lines[4]);
@@ -675,7 +676,8 @@ fn machine_readable_output_covers_every_file_and_the_end_of_a_run() {
         if pass == 0 {
             // One line per generation: 6 + 4, then the end of the run.
             assert_eq!(lines.len(), 11, "{}", text(&out.stdout));
-            assert_eq!(lines[9]["generation"], 9);
+            assert_eq!(lines[9]["stats"]["generation"], 9);
+            assert_eq!(lines[9]["event"], "generation");
         }
         let last = lines.last().unwrap();
         assert_eq!(last["done"], true, "pass {pass}: {last}");

@@ -207,6 +207,30 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         program.stages.len(),
         program.name
     );
+    write_table(&mut out, program, stage);
+    let frozen: Vec<_> = st.layout.genes.iter().filter(|g| g.frozen).collect();
+    let fbits: u32 = frozen.iter().map(|g| g.bits as u32).sum();
+    let n = st.layout.genes.len();
+    let _ = writeln!(
+        out,
+        "genes: {n}, bits: {}, frozen: {} genes ({fbits} bits), evolvable: {} genes ({} bits)",
+        st.layout.bits,
+        frozen.len(),
+        n - frozen.len(),
+        st.layout.bits - fbits
+    );
+    write_roles(&mut out, program, st);
+    write_trained(&mut out, program, st);
+    if let StageRun::Train { actions } = st.run {
+        let _ = writeln!(out, "training stage: its modules learn for {actions} actions; nothing is evolved");
+    }
+    write_variants(&mut out, st);
+    out
+}
+
+/// The table of the genes of stage `stage`: a line per gene, its cells
+/// aligned in columns.
+fn write_table(out: &mut String, program: &Program, stage: usize) {
     let rows: Vec<[String; 7]> = layout_rows(program, stage)
         .into_iter()
         .map(|r| {
@@ -239,24 +263,16 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         }
         let _ = writeln!(out, "{}", s.trim_end());
     };
-    line(&mut out, &header);
+    line(out, &header);
     for r in &rows {
         let cells: Vec<&str> = r.iter().map(String::as_str).collect();
-        line(&mut out, &cells);
+        line(out, &cells);
     }
-    let frozen: Vec<_> = st.layout.genes.iter().filter(|g| g.frozen).collect();
-    let fbits: u32 = frozen.iter().map(|g| g.bits as u32).sum();
-    let n = st.layout.genes.len();
-    let _ = writeln!(
-        out,
-        "genes: {n}, bits: {}, frozen: {} genes ({fbits} bits), evolvable: {} genes ({} bits)",
-        st.layout.bits,
-        frozen.len(),
-        n - frozen.len(),
-        st.layout.bits - fbits
-    );
-    // The roles of a heterogeneous team: who plays them, which modules and
-    // genes are theirs.
+}
+
+/// The roles of a heterogeneous team: who plays them, which modules and
+/// genes are theirs.
+fn write_roles(out: &mut String, program: &Program, st: &Stage) {
     let mut robot = 0u64;
     for (r, role) in st.roles.iter().enumerate() {
         let mods = st.role_modules(r);
@@ -295,7 +311,10 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
         );
         robot = last + 1;
     }
-    // Parameters that are not genes: what training stages learned.
+}
+
+/// The parameters that are not genes: what training stages learned.
+fn write_trained(out: &mut String, program: &Program, st: &Stage) {
     for (i, m) in st.modules.iter().enumerate() {
         for (part, name) in [(Part::Activation, "activation network"), (Part::Behavior, "behavior")] {
             let mut params = m.network_params().filter(|(p, _)| *p == part).map(|(_, q)| q);
@@ -313,9 +332,11 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
             );
         }
     }
-    if let StageRun::Train { actions } = st.run {
-        let _ = writeln!(out, "training stage: its modules learn for {actions} actions; nothing is evolved");
-    }
+}
+
+/// A stage's variants: how they are drawn, how their fitness is combined,
+/// and what each one changes in the stage's world.
+fn write_variants(out: &mut String, st: &Stage) {
     if let Some(v) = &st.variants {
         let n = v.list.len();
         let how = match (v.draw, &st.run) {
@@ -334,7 +355,6 @@ pub fn render_layout(program: &Program, stage: usize) -> String {
             let _ = writeln!(out, "  {}: {what}", x.name);
         }
     }
-    out
 }
 
 /// The items of `variant` that differ from `base`'s, in words.

@@ -51,7 +51,7 @@ pub fn load(file: &str, stage: &str) -> Result<(Program, usize), String> {
         Err(e) => return Err(message(e)),
     };
     if let Some(w) = warnings {
-        eprintln!("{}", w.trim_end());
+        eprintln!("{}", w.text.trim_end());
     }
     let index = load::stage_index(&program, Some(stage)).map_err(message)?;
     Ok((program, index))

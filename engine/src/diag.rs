@@ -1,10 +1,13 @@
-//! Rendering diagnostics as text (`--error-format human|plain|json`).
+//! Diagnostics as data ([`Diagnosed`]: what a front renders, with its
+//! lines and columns) and rendered as text (`--error-format
+//! human|plain|json`).
 
 use std::io::IsTerminal;
 
 use miette::{
     Diagnostic, GraphicalReportHandler, GraphicalTheme, JSONReportHandler, ThemeCharacters, ThemeStyles,
 };
+use serde::Serialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ErrorFormat {
@@ -15,6 +18,22 @@ pub enum ErrorFormat {
     Plain,
     /// One JSON object per file, on stdout.
     Json,
+}
+
+/// Diagnostics rendered in the format a front asked for, and as data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rendered {
+    /// As text, in the format asked for (JSON: miette's object).
+    pub text: String,
+    pub data: Diagnosed,
+}
+
+impl Rendered {
+    /// `diag` (about `filename`, whose text is `source`) rendered in `format`
+    /// and as data.
+    pub fn new(diag: &dyn Diagnostic, format: ErrorFormat, filename: &str, source: &str) -> Rendered {
+        Rendered { text: render(diag, format), data: Diagnosed::of(diag, filename, source) }
+    }
 }
 
 /// Renders a diagnostic (with its related diagnostics) as text.
@@ -42,6 +61,106 @@ pub fn render(diag: &dyn Diagnostic, format: ErrorFormat) -> String {
         out = diag.to_string();
     }
     out
+}
+
+/// A diagnostic as data: what `check --error-format json` prints, Python's
+/// `Diagnostic` and the language server read, with the keys of miette's
+/// JSON rendering and each label's line and column. A file's diagnostics
+/// are one of these whose `related` are the errors and warnings.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Diagnosed {
+    pub message: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub code: Option<String>,
+    /// `error`, `warning` or `advice`.
+    pub severity: &'static str,
+    /// The chain of errors under this one (none for the compiler's).
+    pub causes: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub help: Option<String>,
+    /// The file the labels point into (empty when none does).
+    pub filename: String,
+    pub labels: Vec<Label>,
+    pub related: Vec<Diagnosed>,
+    /// The first label's line and column (1-based, the column in
+    /// characters), when it has a label.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub line: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub column: Option<usize>,
+}
+
+/// A labelled span of a [`Diagnosed`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Label {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+    pub span: Span,
+    /// Where the span starts (1-based, the column in characters).
+    pub line: usize,
+    pub column: usize,
+}
+
+/// Bytes `offset` to `offset + length` of the source.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Span {
+    pub offset: usize,
+    pub length: usize,
+}
+
+impl Diagnosed {
+    /// `diag` as data, its labels' positions in `source` (the text its
+    /// spans point into); `filename` when `diag` names no source of its own.
+    pub fn of(diag: &dyn Diagnostic, filename: &str, source: &str) -> Diagnosed {
+        let severity = match diag.severity() {
+            Some(miette::Severity::Error) | None => "error",
+            Some(miette::Severity::Warning) => "warning",
+            Some(miette::Severity::Advice) => "advice",
+        };
+        let mut causes = Vec::new();
+        let mut cause = std::error::Error::source(diag);
+        while let Some(c) = cause {
+            causes.push(c.to_string());
+            cause = c.source();
+        }
+        let labels: Vec<Label> = diag
+            .labels()
+            .into_iter()
+            .flatten()
+            .map(|l| {
+                let (line, column) = line_column(source, l.offset());
+                Label {
+                    label: l.label().map(str::to_string),
+                    span: Span { offset: l.offset(), length: l.len() },
+                    line,
+                    column,
+                }
+            })
+            .collect();
+        let named = diag
+            .source_code()
+            .zip(labels.first())
+            .and_then(|(src, l)| src.read_span(&(l.span.offset, l.span.length).into(), 0, 0).ok())
+            .and_then(|c| c.name().map(str::to_string));
+        Diagnosed {
+            message: diag.to_string(),
+            code: diag.code().map(|c| c.to_string()),
+            severity,
+            causes,
+            help: diag.help().map(|h| h.to_string()),
+            filename: named
+                .unwrap_or_else(|| if labels.is_empty() { String::new() } else { filename.into() }),
+            line: labels.first().map(|l| l.line),
+            column: labels.first().map(|l| l.column),
+            related: diag
+                .related()
+                .into_iter()
+                .flatten()
+                .map(|r| Diagnosed::of(r, filename, source))
+                .collect(),
+            labels,
+        }
+    }
 }
 
 /// Line and column (1-based, the column in characters) of byte `offset` of

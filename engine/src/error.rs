@@ -12,6 +12,8 @@ pub enum ErrorKind {
     Diagnostics,
     /// A file or directory could not be read or written.
     Io,
+    /// A file or directory the caller named does not exist.
+    NotFound,
     /// A saved file is damaged: it does not parse, or its checksum does not
     /// match its contents, or it disagrees with the file it was derived from.
     Corrupt,
@@ -35,11 +37,13 @@ pub enum ErrorKind {
 pub struct Error {
     kind: ErrorKind,
     message: String,
+    /// The diagnostics as data, for an error of kind `Diagnostics`.
+    diagnosed: Option<Box<crate::diag::Diagnosed>>,
 }
 
 impl Error {
     pub fn new(kind: ErrorKind, message: impl Into<String>) -> Error {
-        Error { kind, message: message.into() }
+        Error { kind, message: message.into(), diagnosed: None }
     }
 
     /// A file-system failure (also the kind of messages not classified).
@@ -47,9 +51,33 @@ impl Error {
         Error::new(ErrorKind::Io, message)
     }
 
-    /// Rendered diagnostics about a source file.
-    pub fn diagnostics(message: impl Into<String>) -> Error {
+    /// A failure of the file system's on `path` to `what` (`read`,
+    /// `write`, ...): [`ErrorKind::NotFound`] when it does not exist, else
+    /// [`ErrorKind::Io`]; the message names the path and the system's reason.
+    pub fn of_io(what: &str, path: &std::path::Path, e: &std::io::Error) -> Error {
+        let kind = if e.kind() == std::io::ErrorKind::NotFound { ErrorKind::NotFound } else { ErrorKind::Io };
+        Error::new(kind, format!("error: cannot {what} `{}`: {e}", path.display()))
+    }
+
+    /// Diagnostics about a source file: the message is their text, and
+    /// [`Error::diagnosed`] their data.
+    pub fn diagnostics(rendered: crate::diag::Rendered) -> Error {
+        Error {
+            diagnosed: Some(Box::new(rendered.data)),
+            ..Error::new(ErrorKind::Diagnostics, rendered.text)
+        }
+    }
+
+    /// Diagnostics known only as text (a command's own, such as `fmt
+    /// --check`'s): no data.
+    pub fn diagnostics_text(message: impl Into<String>) -> Error {
         Error::new(ErrorKind::Diagnostics, message)
+    }
+
+    /// The diagnostics as data (lines, columns, codes), for an error about
+    /// a source file.
+    pub fn diagnosed(&self) -> Option<&crate::diag::Diagnosed> {
+        self.diagnosed.as_deref()
     }
 
     pub fn kind(&self) -> ErrorKind {

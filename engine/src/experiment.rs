@@ -152,7 +152,7 @@ impl Plan {
         &self,
         (point, seed): Task,
         jobs: Option<usize>,
-        runner: &run::Runner<'_>,
+        runner: &crate::Engine<'_>,
     ) -> Result<run::RunOutcome, Error> {
         let assignments = self.points.get(point as usize).ok_or_else(|| {
             Error::new(
@@ -191,7 +191,7 @@ impl Plan {
     /// The summaries (`summary.md`, `summary.json`), the pictures and the
     /// reports, from the files the tasks wrote.
     pub fn finish(&self) -> Result<Finished, Error> {
-        let mut finished = Finished::default();
+        let mut finished = Finished { out: self.out.clone(), ..Finished::default() };
         let unsealed = std::cell::RefCell::new(Vec::new());
         let u = |p: &Path| unsealed.borrow_mut().push(p.to_path_buf());
         let program = &self.program;
@@ -280,6 +280,8 @@ impl Plan {
 /// ([`crate::files::unsealed_warning`]).
 #[derive(Clone, Debug, Default)]
 pub struct Finished {
+    /// The experiment's directory.
+    pub out: PathBuf,
     pub summary: String,
     pub reports: Vec<PathBuf>,
     pub unsealed: Vec<PathBuf>,

@@ -68,8 +68,7 @@ pub fn read_input(mut reader: impl std::io::Read, name: &str) -> Result<Vec<u8>>
 
 /// Reads a source file or built program: [`read_input`] of a file.
 pub fn read_input_file(path: &Path) -> Result<Vec<u8>> {
-    let file =
-        File::open(path).map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", path.display())))?;
+    let file = File::open(path).map_err(|e| Error::of_io("read", path, &e))?;
     read_input(file, &path.display().to_string())
 }
 

@@ -8,7 +8,7 @@ use miette::{Diagnostic, NamedSource, SourceSpan};
 use shaping_runtime::limits;
 use shaping_runtime::program::{Program, StageRun, FORMAT_VERSION};
 
-use crate::diag::{self, ErrorFormat};
+use crate::diag::{ErrorFormat, Rendered};
 use crate::error::{Error, ErrorKind, Result};
 
 use crate::RECORDED_TRAINING_ACTIONS;
@@ -55,7 +55,7 @@ impl Diagnostic for NotUtf8 {
 
 /// Reads and compiles a `.bat` file, or loads a built `Program` (`.json`);
 /// the warnings of a file that compiles are rendered and returned.
-pub fn load_program(path: &Path, format: ErrorFormat) -> Result<(Program, Option<String>), Error> {
+pub fn load_program(path: &Path, format: ErrorFormat) -> Result<(Program, Option<Rendered>), Error> {
     if path.extension().is_some_and(|e| e == "json") {
         return Ok((load_built(path)?, None));
     }
@@ -63,9 +63,9 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<(Program, Option
     let name = path.display().to_string();
     let (program, diagnostics) = shaping_compiler::check(&source, &name);
     let Some(program) = program else {
-        return Err(Error::diagnostics(diag::render(&diagnostics, format)));
+        return Err(Error::diagnostics(Rendered::new(&diagnostics, format, &name, &source)));
     };
-    let warnings = (!diagnostics.is_empty()).then(|| diag::render(&diagnostics, format));
+    let warnings = (!diagnostics.is_empty()).then(|| Rendered::new(&diagnostics, format, &name, &source));
     // The compiler's output always validates (a property test checks it);
     // validating here too makes every command run only validated programs.
     program.validate().map_err(|e| {
@@ -92,9 +92,9 @@ pub fn read_source(path: &Path, format: ErrorFormat) -> Result<String, Error> {
             }
             lossy.truncate(end);
             let column = at - lossy[..at].rfind('\n').map_or(0, |i| i + 1);
-            let src = (column <= 1000).then(|| NamedSource::new(&name, lossy));
-            let report = NotUtf8 { src, name, at: (at, 1).into() };
-            Err(Error::diagnostics(diag::render(&report, format)))
+            let src = (column <= 1000).then(|| NamedSource::new(&name, lossy.clone()));
+            let report = NotUtf8 { src, name: name.clone(), at: (at, 1).into() };
+            Err(Error::diagnostics(Rendered::new(&report, format, &name, &lossy)))
         }
     }
 }

@@ -386,7 +386,7 @@ pub fn episode_files_until(
         return Ok(());
     }
     if stop() {
-        return Err(Error::io(STOPPED));
+        return Err(Error::new(crate::ErrorKind::Interrupted, STOPPED));
     }
     pictures(dir, title, stage, trace, others, scene, marks, path, stop)
 }
@@ -417,7 +417,7 @@ fn pictures(
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
     let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
-    let check = || if stop() { Err(Error::io(STOPPED)) } else { Ok(()) };
+    let check = || if stop() { Err(Error::new(crate::ErrorKind::Interrupted, STOPPED)) } else { Ok(()) };
     if trace.rows.is_empty() {
         return Ok(());
     }

@@ -18,7 +18,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::files::{create_dir, unsealed_warning, DirLock, Unsealed};
 use crate::rundir::{self, TestSummary};
 use crate::sweep::Assignment;
-use crate::{html, report, RECORDED_TRAINING_ACTIONS};
+use crate::{html, report, Engine, RECORDED_TRAINING_ACTIONS};
 
 /// What a run does: which stages, with which seed, into which directory.
 #[derive(Clone, Debug, Default)]
@@ -70,6 +70,54 @@ pub enum Event<'a> {
     /// Something the user should know: the results are not what they seem
     /// (a crowded world), or a saved file was not used.
     Warning(String),
+}
+
+impl serde::Serialize for Event<'_> {
+    /// The one JSON form of an event, for every front (`run --json`'s
+    /// lines, Python's callback): `{"event": "generation", "stage": ...}`.
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> std::result::Result<S::Ok, S::Error> {
+        let path = |p: &Path| p.display().to_string();
+        let record = match *self {
+            Event::EvolveStart { stage, generations, done } => {
+                Record::EvolveStart { stage, generations, done }
+            }
+            Event::Resumed { stage, generation, generations, finished, checkpoint } => {
+                Record::Resumed { stage, generation, generations, finished, checkpoint: path(checkpoint) }
+            }
+            Event::Generation { stage, stats } => Record::Generation { stage, stats },
+            Event::EvolveEnd { stage, completed } => Record::EvolveEnd { stage, completed },
+            Event::Evolved { stage, generations, last, chosen, dir } => {
+                Record::Evolved { stage, generations, last, chosen, dir: path(dir) }
+            }
+            Event::Trained { stage, trained, recorded, reused, dir } => Record::Trained {
+                stage: &stage.name,
+                actions: trained.result.actions,
+                performance: &trained.performance,
+                recorded,
+                reused,
+                dir: path(dir),
+            },
+            Event::Tested { stage, summary, lives, dir, .. } => {
+                Record::Tested { stage, summary, lives, dir: path(dir) }
+            }
+            Event::Warning(ref message) => Record::Warning { message },
+        };
+        record.serialize(serializer)
+    }
+}
+
+/// [`Event`]'s JSON form.
+#[derive(serde::Serialize)]
+#[serde(tag = "event", rename_all = "snake_case")]
+enum Record<'a> {
+    EvolveStart { stage: &'a str, generations: u32, done: u32 },
+    Resumed { stage: &'a str, generation: u32, generations: u32, finished: bool, checkpoint: String },
+    Generation { stage: &'a str, stats: &'a GenStats },
+    EvolveEnd { stage: &'a str, completed: bool },
+    Evolved { stage: &'a str, generations: u32, last: Option<&'a GenStats>, chosen: f32, dir: String },
+    Trained { stage: &'a str, actions: u32, performance: &'a [f32], recorded: u32, reused: bool, dir: String },
+    Tested { stage: &'a str, summary: &'a TestSummary, lives: u32, dir: String },
+    Warning { message: &'a str },
 }
 
 /// Receives a run's [`Event`]s.
@@ -151,7 +199,7 @@ impl Local<'_> {
     /// Once `stop` is set, the episodes not yet started are not run and a
     /// team's episode under way is given up at its next action: their
     /// fitness is NaN, so the generation fails and nothing of it is kept
-    /// (see [`Runner`]).
+    /// (see [`Engine`]).
     pub fn stopped_by(self, stop: Option<&AtomicBool>) -> Local<'_> {
         Local { pool: self.pool, stop }
     }
@@ -568,25 +616,7 @@ impl Saved {
     }
 }
 
-/// Who runs a program's stages: the caller's observer, evaluator and
-/// interruption flag.
-pub struct Runner<'a> {
-    /// Told of progress and warnings.
-    pub observer: &'a dyn Observer,
-    /// Evaluates evolved stages' episodes (this process's threads: `None`).
-    pub evaluator: Option<&'a dyn Evaluate>,
-    /// Once set, the run stops at the next safe point (after the generation
-    /// under way, at the next action of a test's life) and says where.
-    pub interrupt: Option<&'a AtomicBool>,
-}
-
-impl Default for Runner<'_> {
-    fn default() -> Self {
-        Runner { observer: &Silent, evaluator: None, interrupt: None }
-    }
-}
-
-impl Runner<'_> {
+impl Engine<'_> {
     fn stopped(&self) -> bool {
         self.interrupt.is_some_and(|f| f.load(Ordering::Relaxed))
     }
@@ -599,11 +629,11 @@ impl Runner<'_> {
         self.run_source(program, None, opts)
     }
 
-    /// [`Runner::run`] of the program loaded from the file `source`: of a
+    /// [`Engine::run`] of the program loaded from the file `source`: of a
     /// `.bat` file, the directory records the file's name (`source.json`),
     /// and a run of another file into it is refused unless `opts.fresh`
     /// (several files may share a program's name, their robot's); a built
-    /// program (`.json`) is [`Runner::run`]'s.
+    /// program (`.json`) is [`Engine::run`]'s.
     pub fn run_file(&self, program: Program, source: &Path, opts: &RunOptions) -> Result<RunOutcome> {
         if source.extension().is_some_and(|e| e == "json") {
             return self.run(program, opts);
@@ -779,7 +809,7 @@ fn evolved_parent<'a>(
     })
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs (or resumes) evolved stage `index` to its end and its chosen best,
     /// writing its files into `dir`.
     #[allow(clippy::too_many_arguments)]
@@ -1072,7 +1102,10 @@ pub fn before_after(
     stop: Option<&AtomicBool>,
 ) -> Result<BeforeAfter, Error> {
     if lives == 0 {
-        return Err(Error::io(format!("error: test stage `{}` has no life to run", stage.name)));
+        return Err(Error::new(
+            ErrorKind::Invalid,
+            format!("error: test stage `{}` has no life to run", stage.name),
+        ));
     }
     let mut run = TeamRun::new(stage, genome, seed)
         .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
@@ -1171,7 +1204,7 @@ struct TestRun<'a> {
     learning: bool,
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs test stage `t` and writes its files into `dir` (all of them or,
     /// when stopped or failing on the way, none); returns its summary.
     fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<TestSummary> {
@@ -1237,7 +1270,7 @@ fn test_files(
     stop: Option<&AtomicBool>,
 ) -> Result<TestSummary, Error> {
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let check = || if stopped() { Err(Error::io(report::STOPPED)) } else { Ok(()) };
+    let check = || if stopped() { Err(interrupted(report::STOPPED.into())) } else { Ok(()) };
     // The change, and the other lives' starts lightly (unlabelled marks).
     let mut marks: Vec<(u32, String)> =
         ba.life_starts().into_iter().filter(|&a| a != ba.switch).map(|a| (a, String::new())).collect();
@@ -1378,7 +1411,7 @@ fn reinforcement_counts(stage: &Stage, ba: &BeforeAfter) -> BTreeMap<String, run
     out
 }
 
-impl Runner<'_> {
+impl Engine<'_> {
     /// Runs training stage `index` (or reuses the `trained.json` a previous
     /// run of the same stage and seed left in `dir`) and writes its files:
     /// the learned weights, the trace of the training life (its first

@@ -543,9 +543,15 @@ pub const REWRITE: &str = "run the same command again to write it anew";
 /// against its seal ([`read_checked`]); one without a seal is read, and
 /// `unsealed` told.
 pub fn read_best_genome(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Genome>> {
-    let path = best_genome_path(dir);
-    let Some(file) = read_checked(&path, REWRITE, unsealed)? else { return Ok(None) };
-    parse_genome(&file.bytes, &path).map(Some)
+    read_sealed_genome(&best_genome_path(dir), unsealed)
+}
+
+/// A genome file of a run, a replay or a drive (`best.genome`, `genome`)
+/// as it was written (`None`: no file), checked against its seal as
+/// [`read_best_genome`] does.
+pub fn read_sealed_genome(path: &Path, unsealed: Unsealed<'_>) -> Result<Option<Genome>> {
+    let Some(file) = read_checked(path, REWRITE, unsealed)? else { return Ok(None) };
+    parse_genome(&file.bytes, path).map(Some)
 }
 
 /// Reads a genome file (`best.genome`): a string of 0 and 1; any other

@@ -12,8 +12,9 @@ use common::{
     tiny, tiny_experiment, StopAfter,
 };
 use shaping_engine::experiment::{ExperimentOptions, Plan};
-use shaping_engine::run::{RunOptions, Runner};
+use shaping_engine::run::RunOptions;
 use shaping_engine::sweep::parse_set;
+use shaping_engine::Engine;
 use shaping_engine::ErrorKind;
 
 /// The sweep of the tests: two mutation rates by two battery sizes, two seeds.
@@ -44,7 +45,7 @@ fn a_sweep_point_is_the_run_with_its_settings() {
         ..options(&alone)
     };
     // As `shaping run tiny.bat` runs it (the file's name in `source.json`).
-    Runner::default().run_file(tiny(), &common::tiny_bat(), &opts).unwrap();
+    Engine::default().run_file(tiny(), &common::tiny_bat(), &opts).unwrap();
     let in_sweep = result_files(&d.join("sweep").join(point).join("seed-2"));
     assert!(in_sweep.len() >= 6, "{in_sweep:?}");
     let names = |v: &[(String, Vec<u8>)]| v.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
@@ -279,7 +280,7 @@ fn a_stopped_or_killed_sweep_resumes_to_the_same_result() {
         let tasks = plan.tasks();
         // The first point's two seeds, then the second point's first seed, stopped.
         for &task in &tasks[..2] {
-            plan.run_task(task, Some(1), &Runner::default()).unwrap();
+            plan.run_task(task, Some(1), &Engine::default()).unwrap();
         }
         let flag = AtomicBool::new(false);
         let stop = StopAfter::new(&flag, 1);

@@ -11,8 +11,9 @@ use std::path::Path;
 
 use common::{experiment, files, load, options, root, tiny_experiment};
 use shaping_engine::files::{unseal, Sealed};
-use shaping_engine::run::{RunOptions, Runner};
+use shaping_engine::run::RunOptions;
 use shaping_engine::sweep::parse_set;
+use shaping_engine::Engine;
 use shaping_runtime::evolve::fingerprint::fnv1a;
 
 /// The result files a run, an experiment or a sweep writes (not the
@@ -55,7 +56,7 @@ fn check(what: &str, dir: &Path, want: &[(&str, u64)]) {
 fn khepera_seed_1_writes_the_pinned_files() {
     let dir = tempfile::tempdir().unwrap();
     let program = load(&root().join("examples/khepera.bat"));
-    Runner::default().run(program, &RunOptions { seed: Some(1), ..options(dir.path()) }).unwrap();
+    Engine::default().run(program, &RunOptions { seed: Some(1), ..options(dir.path()) }).unwrap();
     check("khepera.bat seed 1", dir.path(), KHEPERA);
 }
 
@@ -76,7 +77,7 @@ fn the_team_examples_write_the_pinned_files() {
             sets: sets.iter().map(|&(t, v)| (t.to_string(), v.to_string())).collect(),
             ..options(dir.path())
         };
-        Runner::default().run(program, &opts).unwrap();
+        Engine::default().run(program, &opts).unwrap();
         check(file, dir.path(), want);
     }
 }

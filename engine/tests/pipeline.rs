@@ -10,7 +10,8 @@ use std::sync::{Arc, Barrier};
 
 use common::{files, options, read_text, root, tiny, Holding};
 use shaping_engine::files::{unseal, Sealed};
-use shaping_engine::run::{Event, Observer, RunOptions, Runner, StageOutcome};
+use shaping_engine::run::{Event, Observer, RunOptions, StageOutcome};
+use shaping_engine::Engine;
 use shaping_engine::{html, replay, ErrorKind};
 use shaping_runtime::evolve::fingerprint::fnv1a;
 use shaping_runtime::program::Program;
@@ -41,7 +42,7 @@ fn hashes(dir: &std::path::Path) -> Vec<(String, u64)> {
 #[test]
 fn a_small_run_writes_the_same_files_as_before() {
     let dir = tempfile::tempdir().unwrap();
-    let outcome = Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    let outcome = Engine::default().run(tiny(), &options(dir.path())).unwrap();
     let names: Vec<&str> = outcome.stages.iter().map(StageOutcome::stage).collect();
     assert_eq!(names, ["first", "second"]);
     let got = hashes(dir.path());
@@ -80,8 +81,8 @@ const PINNED: &[(&str, u64)] = &[
 fn a_run_writes_its_files_the_same_on_one_or_two_threads() {
     let a = tempfile::tempdir().unwrap();
     let b = tempfile::tempdir().unwrap();
-    Runner::default().run(tiny(), &RunOptions { jobs: Some(1), ..options(a.path()) }).unwrap();
-    Runner::default().run(tiny(), &options(b.path())).unwrap();
+    Engine::default().run(tiny(), &RunOptions { jobs: Some(1), ..options(a.path()) }).unwrap();
+    Engine::default().run(tiny(), &options(b.path())).unwrap();
     for stage in ["first", "second"] {
         for f in ["generations.csv", "best.genome", "checkpoint.json", "fitness.svg", "fitness.png"] {
             assert!(a.path().join(stage).join(f).exists(), "{stage}/{f}");
@@ -105,19 +106,19 @@ fn a_run_writes_its_files_the_same_on_one_or_two_threads() {
 fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharmed() {
     let dir = tempfile::tempdir().unwrap();
     let straight = tempfile::tempdir().unwrap();
-    Runner::default().run(tiny(), &options(straight.path())).unwrap();
+    Engine::default().run(tiny(), &options(straight.path())).unwrap();
     let barrier = Arc::new(Barrier::new(2));
     let out = dir.path().to_path_buf();
     let first = {
         let barrier = Arc::clone(&barrier);
         std::thread::spawn(move || {
             let observer = Holding::new(barrier);
-            let runner = Runner { observer: &observer, ..Runner::default() };
+            let runner = Engine { observer: &observer, ..Engine::default() };
             runner.run(tiny(), &options(&out)).map(|_| ())
         })
     };
     barrier.wait();
-    let err = Runner::default().run(tiny(), &options(dir.path())).unwrap_err();
+    let err = Engine::default().run(tiny(), &options(dir.path())).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Locked, "{err}");
     assert!(err.message().contains("is in use by another run of this process"), "{err}");
     assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
@@ -138,7 +139,7 @@ fn a_link_planted_at_a_temporary_name_is_not_followed() {
         std::os::unix::fs::symlink(&victim, out.join("first").join(name)).unwrap();
     }
     std::os::unix::fs::symlink(&victim, out.join("program.json.tmp")).unwrap();
-    Runner::default().run(tiny(), &options(&out)).unwrap();
+    Engine::default().run(tiny(), &options(&out)).unwrap();
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
     let best = out.join("first/best.genome");
     assert!(!std::fs::symlink_metadata(&best).unwrap().file_type().is_symlink());
@@ -148,13 +149,13 @@ fn a_link_planted_at_a_temporary_name_is_not_followed() {
 #[test]
 fn a_refused_run_has_written_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    Engine::default().run(tiny(), &options(dir.path())).unwrap();
     let before = files(dir.path());
     // The world of the first stage changed since: its checkpoint no longer fits.
     let mut changed = tiny();
     changed.stages[0].world.arena[0] *= 2.0;
     changed.stages[1].world.arena[0] *= 2.0;
-    let err = Runner::default().run(changed, &options(dir.path())).unwrap_err();
+    let err = Engine::default().run(changed, &options(dir.path())).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Stale, "{err}");
     assert!(err.message().contains("world"), "{err}");
     assert_eq!(files(dir.path()), before, "program.json and every other file as they were");
@@ -165,7 +166,7 @@ fn a_checkpoint_changed_by_one_digit_is_refused_not_resumed() {
     let dir = tempfile::tempdir().unwrap();
     let mut opts = options(dir.path());
     opts.stage = Some("first".into());
-    Runner::default().run(tiny(), &opts).unwrap();
+    Engine::default().run(tiny(), &opts).unwrap();
     let path = dir.path().join("first/checkpoint.json");
     let text = std::fs::read_to_string(&path).unwrap();
     // One bit of the population's first genome.
@@ -174,7 +175,7 @@ fn a_checkpoint_changed_by_one_digit_is_refused_not_resumed() {
     let flipped = if &text[digit..=digit] == "0" { "1" } else { "0" };
     let damaged = format!("{}{flipped}{}", &text[..digit], &text[digit + 1..]);
     std::fs::write(&path, &damaged).unwrap();
-    let err = Runner::default().run(tiny(), &options(dir.path())).unwrap_err();
+    let err = Engine::default().run(tiny(), &options(dir.path())).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Corrupt, "{err}");
     assert!(err.message().contains("checkpoint.json"), "{err}");
     assert!(err.message().contains("checksum does not match"), "{err}");
@@ -184,7 +185,7 @@ fn a_checkpoint_changed_by_one_digit_is_refused_not_resumed() {
 #[test]
 fn an_edited_best_genome_is_refused_by_replay_and_the_report() {
     let dir = tempfile::tempdir().unwrap();
-    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    Engine::default().run(tiny(), &options(dir.path())).unwrap();
     let path = dir.path().join("second/best.genome");
     let text = std::fs::read_to_string(&path).unwrap();
     let edited: String = text
@@ -215,7 +216,7 @@ fn an_edited_best_genome_is_refused_by_replay_and_the_report() {
     assert!(err.message().contains("best.genome"), "{err}");
     // Derived anew from the checkpoint, it is accepted again.
     std::fs::remove_file(&path).unwrap();
-    Runner::default().run(tiny(), &options(dir.path())).unwrap();
+    Engine::default().run(tiny(), &options(dir.path())).unwrap();
     assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
 }
 
@@ -233,7 +234,7 @@ fn a_run_resumed_is_the_run_straight_and_tells_its_observer() {
     }
     let dir = tempfile::tempdir().unwrap();
     let count = Count(Cell::new(0), Cell::new(0));
-    let runner = Runner { observer: &count, ..Runner::default() };
+    let runner = Engine { observer: &count, ..Engine::default() };
     runner.run(tiny(), &options(dir.path())).unwrap();
     assert_eq!(count.0.get(), 10, "6 + 4 generations");
     let before = files(dir.path());
@@ -301,7 +302,7 @@ fn an_experiment_summarises_the_settings_that_ran() {
     let plan = Plan::new(tiny(), opts).unwrap();
     let _lock = plan.lock().unwrap();
     for task in plan.tasks() {
-        plan.run_task(task, Some(1), &Runner::default()).unwrap();
+        plan.run_task(task, Some(1), &Engine::default()).unwrap();
     }
     plan.finish().unwrap();
     let md = std::fs::read_to_string(dir.path().join("first.evolve.generations=2/summary.md")).unwrap();

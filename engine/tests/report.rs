@@ -101,7 +101,7 @@ fn the_report_names_a_damaged_genome_summary_or_checkpoint() {
         (
             "navigation/best.genome",
             "10x1\n",
-            "is not a genome of stage `navigation`: it is not a string of 0 and 1",
+            "does not hold a genome: line 1, column 3 is `x`; a genome is a string of 0 and 1",
         ),
         ("bigger/summary.json", "{}", "is not a test stage's summary: missing field `stage`"),
         ("bigger/summary.json", "[1]", "is not a test stage's summary: it is not a JSON object"),

@@ -268,7 +268,7 @@ fn a_run_of_another_file_into_a_directory_is_refused_naming_both() {
     let other = source.replace("population 12", "population 10").replace("seed 3", "seed 2");
     let (b, b_program) = write_bat(d, "b.bat", &other);
     let out = d.join("out");
-    let runner = shaping_engine::run::Runner::default();
+    let runner = shaping_engine::Engine::default();
     runner.run_file(a_program.clone(), &a, &options(&out)).unwrap();
     let before = files(&out);
     let err = error(runner.run_file(b_program.clone(), &b, &options(&out)));

@@ -8,7 +8,8 @@ mod common;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use common::{load, options, read_text, result_files, run, sets};
-use shaping_engine::run::{Event, Observer, RunOptions, Runner};
+use shaping_engine::run::{Event, Observer, RunOptions};
+use shaping_engine::Engine;
 use shaping_engine::ErrorKind;
 use shaping_runtime::genome::Genome;
 
@@ -67,7 +68,7 @@ fn a_shaped_team_evolves_keeps_its_frozen_genes_and_resumes() {
     let opts = options(dir.path());
     let flag = AtomicBool::new(false);
     let observer = StopAt { flag: &flag, stage: "escort" };
-    let runner = Runner { observer: &observer, interrupt: Some(&flag), ..Runner::default() };
+    let runner = Engine { observer: &observer, interrupt: Some(&flag), ..Engine::default() };
     let err = runner.run(program.clone(), &opts).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Interrupted, "{err}");
     flag.store(false, Ordering::Relaxed);

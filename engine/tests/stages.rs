@@ -12,7 +12,8 @@ use common::{
     error, experiment, load, options, read_json, read_text, report_data, root, run, sets, test_file,
     tiny_bat, write_bat, Log, Seen,
 };
-use shaping_engine::run::{RunOptions, Runner, StageOutcome};
+use shaping_engine::run::{RunOptions, StageOutcome};
+use shaping_engine::Engine;
 use shaping_engine::{html, replay, ErrorKind};
 
 fn replay_opts(
@@ -335,7 +336,7 @@ fn a_stopped_test_stage_stops_at_once_and_writes_nothing_of_it() {
     let opts = options(&out);
     let stop = Arc::clone(&flag);
     std::thread::spawn(move || {
-        let runner = Runner { interrupt: Some(&stop), ..Runner::default() };
+        let runner = Engine { interrupt: Some(&stop), ..Engine::default() };
         let _ = send.send(runner.run(program, &opts));
     });
     // The evolved stage is done once its episode is written: the test is under way.

@@ -12,7 +12,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use common::{load, options, read_text, result_files, run, tiny_bat, write_bat, Log};
 use shaping_engine::episode::{self, Episode};
 use shaping_engine::replay::{self, ReplayOptions};
-use shaping_engine::run::{Event, Observer, RunOptions, Runner};
+use shaping_engine::run::{Event, Observer, RunOptions};
+use shaping_engine::Engine;
 use shaping_engine::ErrorKind;
 use shaping_runtime::controller::{run_episode, EpisodeOptions, Trace};
 use shaping_runtime::genome::Genome;
@@ -213,7 +214,7 @@ fn an_evolved_teams_generation_is_given_up_at_the_next_action() {
         }
     }
     let flag = AtomicBool::new(false);
-    let runner = Runner { interrupt: Some(&flag), ..Runner::default() };
+    let runner = Engine { interrupt: Some(&flag), ..Engine::default() };
     let err = std::thread::scope(|s| {
         s.spawn(|| {
             std::thread::sleep(std::time::Duration::from_millis(300));
@@ -241,7 +242,7 @@ fn a_team_stopped_in_a_generation_or_the_choice_of_its_best_resumes_to_the_strai
     let flag = AtomicBool::new(false);
     let choosing =
         StopAt { flag: &flag, at: |e| matches!(e, Event::EvolveEnd { stage: "first", completed: true }) };
-    let runner = Runner { observer: &choosing, interrupt: Some(&flag), ..Runner::default() };
+    let runner = Engine { observer: &choosing, interrupt: Some(&flag), ..Engine::default() };
     let err = runner.run(program.clone(), &opts).unwrap_err();
     assert_eq!(err.kind(), ErrorKind::Interrupted, "{err}");
     assert!(
@@ -251,7 +252,7 @@ fn a_team_stopped_in_a_generation_or_the_choice_of_its_best_resumes_to_the_strai
     assert!(!dir.path().join("first/best.genome").exists());
     flag.store(false, Ordering::Relaxed);
     let next = StopAt { flag: &flag, at: |e| matches!(e, Event::EvolveStart { stage: "second", .. }) };
-    let runner = Runner { observer: &next, interrupt: Some(&flag), ..Runner::default() };
+    let runner = Engine { observer: &next, interrupt: Some(&flag), ..Engine::default() };
     let err = runner.run(program.clone(), &opts).unwrap_err();
     assert!(err.message().contains("stage `second` stopped in its first generation"), "{err}");
     assert!(!dir.path().join("second/checkpoint.json").exists());

@@ -13,7 +13,7 @@ use std::sync::{Arc, Barrier};
 use common::{error, files, options, run, tiny, tiny_bat, Holding, Log};
 use shaping_engine::files::{remove_stale_temporaries, DirLock, SEALS};
 use shaping_engine::replay::{self, ReplayOptions};
-use shaping_engine::run::Runner;
+use shaping_engine::Engine;
 use shaping_engine::{html, ErrorKind};
 
 /// `text` with its last `"checksum"` field removed, as a hand edit leaves it.
@@ -57,7 +57,7 @@ fn a_checkpoint_without_its_checksum_is_refused_unless_nothing_in_its_directory_
     std::fs::remove_file(dir.path().join("first").join(SEALS)).unwrap();
     std::fs::write(&path, &removed).unwrap();
     let log = Log::default();
-    Runner { observer: &log, ..Runner::default() }.run(tiny(), &opts).unwrap();
+    Engine { observer: &log, ..Engine::default() }.run(tiny(), &opts).unwrap();
     let warnings = log.warnings();
     assert!(
         warnings.iter().any(|w| w.starts_with("warning: `") && w.contains("checkpoint.json` has no seal")),
@@ -220,7 +220,7 @@ fn a_run_whose_lock_was_removed_says_so_at_its_next_write() {
         let barrier = Arc::clone(&barrier);
         std::thread::spawn(move || {
             let observer = Holding::new(barrier);
-            let runner = Runner { observer: &observer, ..Runner::default() };
+            let runner = Engine { observer: &observer, ..Engine::default() };
             runner.run(tiny(), &options(&out)).map(|_| ())
         })
     };

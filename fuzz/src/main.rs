@@ -20,7 +20,7 @@
 //!   `evolve::check_resume_of` and the best (as `rundir::checked_best` does
 //!   for `shaping replay --run`), and `evolve::resume` (as a run of the
 //!   checkpoint's seed resumes it). Every 16th input that parses also goes
-//!   through a whole run of the engine (`run::Runner::run` in a scratch
+//!   through a whole run of the engine (`shaping_engine::Engine::run` in a scratch
 //!   directory, with a cheap evaluator) as the checkpoint of its stage, with
 //!   the file's seed and, where it differs, the checkpoint's own: there the
 //!   engine's own checks decide (`precheck`, and `evolve_stage`'s, which
@@ -441,7 +441,7 @@ fn engine_run(program: &Program, stage: &str, file: &str, input: &[u8], seed: Op
         no_report: true,
         ..run::RunOptions::default()
     };
-    let runner = run::Runner { observer: &run::Silent, evaluator: Some(&Ones), interrupt: None };
+    let runner = shaping_engine::Engine { observer: &run::Silent, evaluator: Some(&Ones), interrupt: None };
     RUNS.fetch_add(1, Ordering::Relaxed);
     match runner.run(program.clone(), &opts) {
         Ok(_) => {

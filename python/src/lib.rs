@@ -3,7 +3,7 @@
 //! it; its docstrings and type stubs are there.
 //!
 //! Everything goes through the engine (`shaping_engine`): `load` to read a
-//! file, `run::Runner` to run it, `descriptors` to evaluate genomes, so the
+//! file, `shaping_engine::Engine` to run it, `descriptors` to evaluate genomes, so the
 //! results and the messages are the command line's.
 
 use std::path::{Path, PathBuf};
@@ -11,7 +11,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use miette::Diagnostic as _;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
@@ -20,7 +19,8 @@ use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use shaping_engine::descriptors::{self, Described};
 use shaping_engine::diag::ErrorFormat;
-use shaping_engine::run::{self as engine_run, Event, Observer, RunOptions, Runner};
+use shaping_engine::run::{self as engine_run, Event, Observer, RunOptions};
+use shaping_engine::Engine;
 use shaping_engine::{load, rundir, sweep, ErrorKind};
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Program as Compiled, StageRun};
@@ -32,10 +32,60 @@ create_exception!(
     "An error of shaping (a file with errors, a run that cannot resume, ...): its text is the command line's message, `kind` says which kind of error it is."
 );
 
+create_exception!(
+    _shaping,
+    CompileError,
+    ShapingError,
+    "A file with errors: `diagnostics` has them (a list of Diagnostic)."
+);
+create_exception!(
+    _shaping,
+    CorruptError,
+    ShapingError,
+    "A saved file is damaged: it does not parse, its checksum does not match, or it disagrees with the file it came from."
+);
+create_exception!(
+    _shaping,
+    StaleError,
+    ShapingError,
+    "A saved result belongs to another program, seed or setting than this run's."
+);
+create_exception!(_shaping, LockedError, ShapingError, "The run directory is in use by another process.");
+create_exception!(
+    _shaping,
+    EvaluationError,
+    ShapingError,
+    "Evaluation failed (a robot link, a rank of a cluster)."
+);
+
+/// `shaping.NotFoundError`: a file or directory that does not exist, both
+/// a `FileNotFoundError` and a `ShapingError` (made once, at import).
+static NOT_FOUND: pyo3::sync::PyOnceLock<Py<pyo3::types::PyType>> = pyo3::sync::PyOnceLock::new();
+
+fn not_found_type(py: Python<'_>) -> PyResult<&Bound<'_, pyo3::types::PyType>> {
+    let t = NOT_FOUND.get_or_try_init(py, || -> PyResult<_> {
+        let builtins = py.import("builtins")?;
+        let bases = pyo3::types::PyTuple::new(
+            py,
+            [builtins.getattr("FileNotFoundError")?, py.get_type::<ShapingError>().into_any()],
+        )?;
+        let dict = pyo3::types::PyDict::new(py);
+        dict.set_item("__module__", "shaping")?;
+        dict.set_item(
+            "__doc__",
+            "A file or directory that does not exist: a FileNotFoundError and a ShapingError.",
+        )?;
+        let made = builtins.getattr("type")?.call1(("NotFoundError", bases, dict))?;
+        Ok(made.cast_into::<pyo3::types::PyType>()?.unbind())
+    })?;
+    Ok(t.bind(py))
+}
+
 fn kind_name(kind: ErrorKind) -> &'static str {
     match kind {
         ErrorKind::Diagnostics => "diagnostics",
         ErrorKind::Io => "io",
+        ErrorKind::NotFound => "not_found",
         ErrorKind::Corrupt => "corrupt",
         ErrorKind::Stale => "stale",
         ErrorKind::Interrupted => "interrupted",
@@ -47,9 +97,22 @@ fn kind_name(kind: ErrorKind) -> &'static str {
     }
 }
 
-/// A `ShapingError` with the engine error's message and kind.
+/// The `ShapingError` (the subclass of its kind) with the engine error's
+/// message and kind; a file that does not exist raises `NotFoundError`.
 fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
-    let err = ShapingError::new_err(e.message().to_string());
+    let message = e.message().to_string();
+    let err = match e.kind() {
+        ErrorKind::Diagnostics => CompileError::new_err(message),
+        ErrorKind::Corrupt => CorruptError::new_err(message),
+        ErrorKind::Stale => StaleError::new_err(message),
+        ErrorKind::Locked => LockedError::new_err(message),
+        ErrorKind::Evaluation => EvaluationError::new_err(message),
+        ErrorKind::NotFound => match not_found_type(py) {
+            Ok(t) => PyErr::from_type(t.clone(), (message,)),
+            Err(e) => e,
+        },
+        _ => ShapingError::new_err(message),
+    };
     let _ = err.value(py).setattr("kind", kind_name(e.kind()));
     err
 }
@@ -256,67 +319,48 @@ impl Diagnostic {
     }
 }
 
-/// Line and column (1-based, the column in characters) of byte `offset`.
-fn position(source: &str, offset: usize) -> (usize, usize) {
-    shaping_engine::diag::line_column(source, offset)
-}
-
-fn severity(d: &dyn miette::Diagnostic) -> String {
-    match d.severity() {
-        Some(miette::Severity::Warning) => "warning",
-        Some(miette::Severity::Advice) => "advice",
-        _ => "error",
-    }
-    .to_string()
+/// Python's diagnostics of the engine's: a file's errors and warnings (the
+/// `related` of its diagnostics), or the one diagnostic when it has none
+/// (a file that is not UTF-8).
+fn diagnostics_from(d: &shaping_engine::diag::Diagnosed, file: &str) -> Vec<Diagnostic> {
+    let items: Vec<&shaping_engine::diag::Diagnosed> =
+        if d.related.is_empty() { vec![d] } else { d.related.iter().collect() };
+    items
+        .into_iter()
+        .map(|d| Diagnostic {
+            message: d.message.clone(),
+            severity: d.severity.into(),
+            code: d.code.clone(),
+            line: d.line,
+            column: d.column,
+            help: d.help.clone(),
+            file: file.to_string(),
+        })
+        .collect()
 }
 
 /// The diagnostics of `path`, or the engine's error for a file that cannot
 /// be read.
 fn diagnostics_of(path: &Path) -> Result<Vec<Diagnostic>, shaping_engine::Error> {
     let file = path.display().to_string();
-    let plain = |message: String, severity: &str| Diagnostic {
-        message,
-        severity: severity.into(),
-        code: None,
-        line: None,
-        column: None,
-        help: None,
-        file: file.clone(),
-    };
-    if path.extension().is_some_and(|e| e == "json") {
-        return match load::load_built(path) {
-            Ok(_) => Ok(Vec::new()),
-            Err(e) if e.kind() == ErrorKind::Io => Err(e),
-            Err(e) => Ok(vec![plain(e.message().to_string(), "error")]),
-        };
+    match load::load_program(path, ErrorFormat::Plain) {
+        Ok((_, None)) => Ok(Vec::new()),
+        Ok((_, Some(w))) => Ok(diagnostics_from(&w.data, &file)),
+        Err(e) => match e.diagnosed() {
+            Some(d) => Ok(diagnostics_from(d, &file)),
+            // A built program (`.json`) that cannot be used: its message.
+            None if !matches!(e.kind(), ErrorKind::Io | ErrorKind::NotFound) => Ok(vec![Diagnostic {
+                message: e.message().to_string(),
+                severity: "error".into(),
+                code: None,
+                line: None,
+                column: None,
+                help: None,
+                file,
+            }]),
+            None => Err(e),
+        },
     }
-    let source = match load::read_source(path, ErrorFormat::Plain) {
-        Ok(s) => s,
-        Err(e) if e.kind() == ErrorKind::Diagnostics => {
-            // Not UTF-8: the message of the plain rendering's first line.
-            let first = e.message().lines().find(|l| !l.trim().is_empty()).unwrap_or("").trim();
-            let message = first.trim_start_matches(['×', 'x', ' ']).to_string();
-            return Ok(vec![plain(message, "error")]);
-        }
-        Err(e) => return Err(e),
-    };
-    let (_, diagnostics) = shaping_compiler::check(&source, &file);
-    Ok(diagnostics
-        .errors()
-        .iter()
-        .map(|d| {
-            let first = d.labels().and_then(|mut l| l.next()).map(|l| position(&source, l.offset()));
-            Diagnostic {
-                message: d.to_string(),
-                severity: severity(d),
-                code: d.code().map(|c| c.to_string()),
-                line: first.map(|p| p.0),
-                column: first.map(|p| p.1),
-                help: d.help().map(|h| h.to_string()),
-                file: file.clone(),
-            }
-        })
-        .collect())
 }
 
 /// Every diagnostic of the `.bat` file `path` (errors and warnings), as
@@ -346,16 +390,15 @@ fn load(py: Python<'_>, path: &Path) -> PyResult<Compiled> {
     match loaded {
         Ok((program, warnings)) => {
             if let Some(w) = warnings {
-                warn(py, w.trim_end())?;
+                warn(py, w.text.trim_end())?;
             }
             Ok(program)
         }
         Err(e) => {
             let err = shaping_error(py, &e);
-            if e.kind() == ErrorKind::Diagnostics {
-                if let Ok(d) = diagnostics_of(path) {
-                    let _ = err.value(py).setattr("diagnostics", d);
-                }
+            if let Some(d) = e.diagnosed() {
+                let _ =
+                    err.value(py).setattr("diagnostics", diagnostics_from(d, &path.display().to_string()));
             }
             Err(err)
         }
@@ -1387,40 +1430,6 @@ struct PyObserver {
     stop: Arc<AtomicBool>,
 }
 
-fn event_json(event: &Event<'_>) -> Option<serde_json::Value> {
-    use serde_json::json;
-    Some(match event {
-        Event::EvolveStart { stage, generations, done } => {
-            json!({"event": "evolve_start", "stage": stage, "generations": generations, "done": done})
-        }
-        Event::Resumed { stage, generation, generations, finished, checkpoint } => json!({
-            "event": "resumed", "stage": stage, "generation": generation, "generations": generations,
-            "finished": finished, "checkpoint": checkpoint.display().to_string(),
-        }),
-        Event::Generation { stage, stats } => {
-            json!({"event": "generation", "stage": stage, "stats": serde_json::to_value(stats).ok()})
-        }
-        Event::EvolveEnd { stage, completed } => {
-            json!({"event": "evolve_end", "stage": stage, "completed": completed})
-        }
-        Event::Evolved { stage, generations, chosen, dir, .. } => json!({
-            "event": "evolved", "stage": stage, "generations": generations, "chosen": chosen,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Trained { stage, trained, recorded, reused, dir } => json!({
-            "event": "trained", "stage": stage.name, "actions": trained.result.actions,
-            "performance": trained.performance, "recorded": recorded, "reused": reused,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Tested { stage, summary, lives, dir, .. } => json!({
-            "event": "tested", "stage": stage, "summary": summary, "lives": lives,
-            "dir": dir.display().to_string(),
-        }),
-        Event::Warning(w) => json!({"event": "warning", "message": w}),
-        _ => return None,
-    })
-}
-
 impl Observer for PyObserver {
     fn event(&self, event: Event<'_>) {
         if let Event::Warning(w) = &event {
@@ -1432,7 +1441,7 @@ impl Observer for PyObserver {
         if self.error.lock().map(|e| e.is_some()).unwrap_or(true) {
             return;
         }
-        let Some(value) = event_json(&event) else { return };
+        let Ok(value) = serde_json::to_value(&event) else { return };
         Python::attach(|py| {
             let result = json_to_py(py, &value).and_then(|v| callback.call1(py, (v,)));
             if let Err(e) = result {
@@ -1503,7 +1512,7 @@ fn run(
     let out = out.unwrap_or_else(|| engine_run::default_out(&path));
     let options = RunOptions { stage, seed, out, jobs, fresh, no_report: !report, sets };
     let outcome = observed(py, callback, |observer, stop| {
-        Runner { observer, evaluator: None, interrupt: Some(stop) }.run_file(program, &path, &options)
+        Engine { observer, evaluator: None, interrupt: Some(stop) }.run_file(program, &path, &options)
     })?;
     Ok(Run::of(outcome))
 }
@@ -1780,16 +1789,8 @@ fn experiment(
         fresh,
         no_report: !report,
     };
-    let plan = shaping_engine::experiment::Plan::new(program, options).map_err(|e| engine_error(py, &e))?;
     let (outcomes, finished) = observed(py, callback, |observer, stop| {
-        let _lock = plan.lock()?;
-        let runner = Runner { observer, evaluator: None, interrupt: Some(stop) };
-        let outcomes = plan
-            .tasks()
-            .into_iter()
-            .map(|task| plan.run_task(task, jobs, &runner))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok((outcomes, plan.finish()?))
+        Engine { observer, evaluator: None, interrupt: Some(stop) }.experiment(program, options)
     })?;
     let mut runs = Vec::new();
     let mut seen = Vec::new();
@@ -1800,7 +1801,7 @@ fn experiment(
         runs.push(Py::new(py, Run::of(o))?);
     }
     Ok(Experiment {
-        out: plan.out().to_path_buf(),
+        out: finished.out,
         seeds: seen,
         runs,
         summary_text: finished.summary,
@@ -1811,6 +1812,12 @@ fn experiment(
 #[pymodule]
 fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ShapingError", m.py().get_type::<ShapingError>())?;
+    m.add("CompileError", m.py().get_type::<CompileError>())?;
+    m.add("CorruptError", m.py().get_type::<CorruptError>())?;
+    m.add("StaleError", m.py().get_type::<StaleError>())?;
+    m.add("LockedError", m.py().get_type::<LockedError>())?;
+    m.add("EvaluationError", m.py().get_type::<EvaluationError>())?;
+    m.add("NotFoundError", not_found_type(m.py())?)?;
     m.add("SQUARE_MM", descriptors::SQUARE_MM)?;
     m.add_class::<Diagnostic>()?;
     m.add_class::<Program>()?;

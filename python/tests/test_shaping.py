@@ -95,9 +95,10 @@ def test_check_good_and_bad_files(tmp_path):
 def test_compile_errors_raise_with_the_cli_message(tmp_path):
     bad = tmp_path / "bad.bat"
     bad.write_text(BAD)
-    with pytest.raises(shaping.ShapingError) as e:
+    with pytest.raises(shaping.CompileError) as e:
         shaping.compile(bad)
     assert e.value.kind == "diagnostics"
+    assert isinstance(e.value, shaping.ShapingError)
     assert [d.line for d in e.value.diagnostics] == [3]
     out = shaping_cli("check", "--error-format", "plain", bad)
     assert out.returncode == 1
@@ -107,9 +108,10 @@ def test_compile_errors_raise_with_the_cli_message(tmp_path):
 
 def test_a_missing_file_raises_with_the_cli_message(tmp_path):
     missing = tmp_path / "nope.bat"
-    with pytest.raises(shaping.ShapingError) as e:
+    with pytest.raises(FileNotFoundError) as e:
         shaping.compile(missing)
-    assert e.value.kind == "io"
+    assert e.value.kind == "not_found"
+    assert isinstance(e.value, shaping.NotFoundError) and isinstance(e.value, shaping.ShapingError)
     out = shaping_cli("check", missing)
     assert str(e.value).strip() == out.stderr.strip()
     with pytest.raises(shaping.ShapingError):

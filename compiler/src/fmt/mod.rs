@@ -420,10 +420,7 @@ impl F<'_> {
                         },
                         None => &mut head_comment,
                     };
-                    *slot = Some(match slot.take() {
-                        Some(t) => format!("{t} {text}"),
-                        None => text,
-                    });
+                    append_comment(slot, text);
                 } else {
                     let blank = self.has_blank_line(prev_end, c.span.start);
                     pieces.push(Piece::Comment { text: self.comment_text(c), blank });
@@ -467,10 +464,7 @@ impl F<'_> {
                     Some(Piece::Entry(e)) => &mut e.trailing,
                     _ => &mut head_comment,
                 };
-                *slot = Some(match slot.take() {
-                    Some(t) => format!("{t} {text}"),
-                    None => text,
-                });
+                append_comment(slot, text);
             } else {
                 let blank = self.has_blank_line(prev_end, c.span.start);
                 pieces.push(Piece::Comment { text, blank });
@@ -478,17 +472,7 @@ impl F<'_> {
             }
             prev_end = c.span.end;
         }
-        // The separator written between two entries goes to the later one
-        // (it is printed only when they share a line).
-        let mut sep = None;
-        for p in &mut pieces {
-            if let Piece::Entry(e) = p {
-                e.sep_before = sep.take().map(|s| if s == "," { ", " } else { "; " });
-                sep = e.sep;
-            } else {
-                sep = None;
-            }
-        }
+        separators_before(&mut pieces);
         (head_comment, pieces)
     }
 
@@ -775,22 +759,26 @@ impl F<'_> {
                 self.qty(heading),
                 self.qty(after)
             ),
-            WorldItem::Body { preset, items, span } => {
-                let head = preset.as_ref().map_or("body".to_string(), |p| format!("body {}", p.text));
-                if !self.lx.tokens_in(*span).iter().any(|t| self.text(t.span) == "{") {
-                    return self.item(*span, Doc::Text(head));
-                }
-                let items = items
-                    .iter()
-                    .map(|i| match i {
-                        BodyItem::Setting(s) => self.item(s.span, Doc::Text(self.setting(s))),
-                        BodyItem::Layout(l) => self.item(l.span, Doc::Text(self.layout(l))),
-                    })
-                    .collect();
-                return self.item(*span, self.block(head, *span, items));
-            }
+            WorldItem::Body { preset, items, span } => return self.body(preset.as_ref(), items, *span),
         };
         self.item(x.span(), Doc::Text(t))
+    }
+
+    /// `body [PRESET]`, and its block of settings and sensor layouts if it
+    /// has one.
+    fn body(&self, preset: Option<&Name>, items: &[BodyItem], span: Span) -> Item {
+        let head = preset.map_or("body".to_string(), |p| format!("body {}", p.text));
+        if !self.lx.tokens_in(span).iter().any(|t| self.text(t.span) == "{") {
+            return self.item(span, Doc::Text(head));
+        }
+        let items = items
+            .iter()
+            .map(|i| match i {
+                BodyItem::Setting(s) => self.item(s.span, Doc::Text(self.setting(s))),
+                BodyItem::Layout(l) => self.item(l.span, Doc::Text(self.layout(l))),
+            })
+            .collect();
+        self.item(span, self.block(head, span, items))
     }
 
     /// `proximity at [...] facing [...]`, `ground at [...]`.
@@ -1082,6 +1070,28 @@ impl F<'_> {
             format!("({s})")
         } else {
             s
+        }
+    }
+}
+
+/// A trailing comment added to `slot`, after the one already there.
+fn append_comment(slot: &mut Option<String>, text: String) {
+    *slot = Some(match slot.take() {
+        Some(t) => format!("{t} {text}"),
+        None => text,
+    });
+}
+
+/// The separator written between two entries goes to the later one (it is
+/// printed only when they share a line).
+fn separators_before(pieces: &mut [Piece]) {
+    let mut sep = None;
+    for p in pieces {
+        if let Piece::Entry(e) = p {
+            e.sep_before = sep.take().map(|s| if s == "," { ", " } else { "; " });
+            sep = e.sep;
+        } else {
+            sep = None;
         }
     }
 }

@@ -265,51 +265,11 @@ fn context(text: &str, offset: usize) -> Context {
         .into_iter()
         .take_while(|t| t.span.end < offset || (t.span.start < offset && t.kind != TokenKind::Word))
         .collect();
-    let w = |k: usize| -> &str {
-        before.len().checked_sub(k + 1).map_or("", |i| &text[before[i].span.start..before[i].span.end])
-    };
+    let w = |k: usize| back(text, &before, k);
     let kind = |k: usize| before.len().checked_sub(k + 1).map(|i| before[i].kind);
     let block = block_at(text, &before);
-    match (w(0), w(1)) {
-        ("sense", _) | ("(", "toward") => return Context::Sensors,
-        ("link", _) => return Context::Modules,
-        (">", "-") if w(3) == "link" => return Context::Modules,
-        (">", "-") | ("|", _) => return Context::Table,
-        ("behavior", _) | ("{" | ";", "script" | "behavior" | "commit") => return Context::Steps,
-        ("script", _) => return Context::Only(&["commit"]),
-        ("turn", _) => return Context::Only(&["left", "right", "toward"]),
-        ("extends", _) => return Context::Stages,
-        ("trained", _) => return Context::TrainingStages,
-        ("module", _) => return Context::InheritedModules,
-        ("on", _) if block == Some("world") => return Context::Walls,
-        ("on", _) => return Context::Only(&["behavior", "activation"]),
-        ("activation", _) => return Context::Words(words::ACTIVATION),
-        ("weights", _) if block == Some("neural") => {
-            return Context::Only(&["evolvable", "fixed", "random", "trained"])
-        }
-        ("outputs", _) => return Context::Only(&["sign", "linear"]),
-        ("learn", _) => return Context::Only(&["crbp"]),
-        ("links", _) if matches!(block, Some("stage" | "role")) => return Context::Only(&["all"]),
-        ("role", _) => return Context::Nothing,
-        (_, "role") if kind(0) == Some(TokenKind::Word) => return Context::Only(&["robots", "adds"]),
-        ("all", "links") => return Context::Only(&["evolvable", "fixed"]),
-        ("test", _) => return Context::Only(&["best"]),
-        ("best", _) | ("train", _) => return Context::Only(&["for"]),
-        ("world", _) => return Context::Only(&["adds", "changes"]),
-        ("fitness", _) => return Context::Only(&["adds", "per"]),
-        ("per", _) if kind(1) == Some(TokenKind::Number) => return Context::Words(words::EVENT),
-        ("per", _) => return Context::Only(&["action"]),
-        ("action", "per") => return Context::Expression,
-        ("uses", _) => return Context::Only(&["charger"]),
-        ("selection", _) => return Context::Only(&["truncation", "roulette"]),
-        ("body", _) => return Context::Only(&["khepera", "e-puck"]),
-        ("proximity", _) if block == Some("body") => return Context::Only(&["at", "facing"]),
-        ("ground", _) if block == Some("body") => return Context::Only(&["at"]),
-        ("inheritance", _) => return Context::Only(&["darwinian", "lamarckian"]),
-        ("stage" | "robot" | "sensor" | "actuator" | "lamp" | "wall" | "zone" | "cylinder", _) => {
-            return Context::Nothing
-        }
-        _ => {}
+    if let Some(c) = keyword_context(text, &before, block) {
+        return c;
     }
     // `sensor NAME ` and `actuator NAME[8] `: the kinds.
     let declared = if kind(0) == Some(TokenKind::Word) {
@@ -380,6 +340,59 @@ fn context(text: &str, offset: usize) -> Context {
     }
 }
 
+/// The context that the last words fix by themselves, whatever comes
+/// before them: after `sense`, `link`, `turn`, `extends`, `selection`, ...
+fn keyword_context(text: &str, before: &[Token], block: Option<&str>) -> Option<Context> {
+    let w = |k: usize| back(text, before, k);
+    let kind = |k: usize| before.len().checked_sub(k + 1).map(|i| before[i].kind);
+    Some(match (w(0), w(1)) {
+        ("sense", _) | ("(", "toward") => Context::Sensors,
+        ("link", _) => Context::Modules,
+        (">", "-") if w(3) == "link" => Context::Modules,
+        (">", "-") | ("|", _) => Context::Table,
+        ("behavior", _) | ("{" | ";", "script" | "behavior" | "commit") => Context::Steps,
+        ("script", _) => Context::Only(&["commit"]),
+        ("turn", _) => Context::Only(&["left", "right", "toward"]),
+        ("extends", _) => Context::Stages,
+        ("trained", _) => Context::TrainingStages,
+        ("module", _) => Context::InheritedModules,
+        ("on", _) if block == Some("world") => Context::Walls,
+        ("on", _) => Context::Only(&["behavior", "activation"]),
+        ("activation", _) => Context::Words(words::ACTIVATION),
+        ("weights", _) if block == Some("neural") => {
+            Context::Only(&["evolvable", "fixed", "random", "trained"])
+        }
+        ("outputs", _) => Context::Only(&["sign", "linear"]),
+        ("learn", _) => Context::Only(&["crbp"]),
+        ("links", _) if matches!(block, Some("stage" | "role")) => Context::Only(&["all"]),
+        ("role", _) => Context::Nothing,
+        (_, "role") if kind(0) == Some(TokenKind::Word) => Context::Only(&["robots", "adds"]),
+        ("all", "links") => Context::Only(&["evolvable", "fixed"]),
+        ("test", _) => Context::Only(&["best"]),
+        ("best", _) | ("train", _) => Context::Only(&["for"]),
+        ("world", _) => Context::Only(&["adds", "changes"]),
+        ("fitness", _) => Context::Only(&["adds", "per"]),
+        ("per", _) if kind(1) == Some(TokenKind::Number) => Context::Words(words::EVENT),
+        ("per", _) => Context::Only(&["action"]),
+        ("action", "per") => Context::Expression,
+        ("uses", _) => Context::Only(&["charger"]),
+        ("selection", _) => Context::Only(&["truncation", "roulette"]),
+        ("body", _) => Context::Only(&["khepera", "e-puck"]),
+        ("proximity", _) if block == Some("body") => Context::Only(&["at", "facing"]),
+        ("ground", _) if block == Some("body") => Context::Only(&["at"]),
+        ("inheritance", _) => Context::Only(&["darwinian", "lamarckian"]),
+        ("stage" | "robot" | "sensor" | "actuator" | "lamp" | "wall" | "zone" | "cylinder", _) => {
+            Context::Nothing
+        }
+        _ => return None,
+    })
+}
+
+/// The text of the `k`th token before the cursor (0: the last), or "".
+fn back<'t>(text: &'t str, before: &[Token], k: usize) -> &'t str {
+    before.len().checked_sub(k + 1).map_or("", |i| &text[before[i].span.start..before[i].span.end])
+}
+
 /// The stage declared around `offset`, and its ancestors by `extends`.
 fn lineage(file: &ast::File, offset: usize) -> Vec<&ast::StageDecl> {
     let mut out: Vec<&ast::StageDecl> = Vec::new();
@@ -414,74 +427,26 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
     let file = file.as_ref();
     let stages = lineage_or_all(file, offset);
     let here = file.and_then(|f| f.stages.iter().find(|s| s.span.start <= offset && offset <= s.span.end));
-    let hardware = |sensor: bool| -> Vec<String> {
-        let mut names: Vec<String> = Vec::new();
-        let robots = file.iter().flat_map(|f| f.robots.iter()).flat_map(|r| r.hardware.iter());
-        let added = stages.iter().flat_map(|s| s.items.iter()).flat_map(|i| match i {
-            ast::StageItem::RobotAdds(h, _) => h.iter().collect(),
-            _ => Vec::new(),
-        });
-        for h in robots.chain(added) {
-            if h.is_sensor == sensor && !names.contains(&h.name.text) {
-                names.push(h.name.text.clone());
-            }
-        }
-        names
-    };
-    let item = |label: &str, kind: K, detail: &str| Completion {
-        label: label.to_string(),
-        kind,
-        detail: detail.to_string(),
-    };
-    let of_words = |places: Places| -> Vec<Completion> {
-        words::words()
-            .into_iter()
-            .filter(|w| w.places & places != 0)
-            .map(|w| {
-                let kind = match w.kind {
-                    words::WordKind::Function => K::Function,
-                    _ if places & (words::STEP | words::TABLE) != 0 => K::Motion,
-                    _ => K::Keyword,
-                };
-                item(w.text, kind, w.meaning)
-            })
-            .collect()
-    };
+    let hardware = |sensor: bool| hardware_names(file, &stages, sensor);
     // The role the cursor is in: its modules are the ones a link names.
     let role = here.and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end));
-    let modules = |stages: &[&ast::StageDecl]| -> Vec<String> {
-        let mut names: Vec<String> = Vec::new();
-        // A role's modules: those of the role of that name in this stage
-        // and the stages it extends (`role NAME adds { ... }` adds to them).
-        let declared: Vec<&ast::ModuleDecl> = match role {
-            Some(r) => stages
-                .iter()
-                .rev()
-                .flat_map(|s| s.roles().filter(|x| x.name.text == r.name.text))
-                .flat_map(|x| x.modules())
-                .collect(),
-            None => stages.iter().rev().flat_map(|s| s.all_modules()).collect(),
-        };
-        for m in declared {
-            if !names.contains(&m.name.text) {
-                names.push(m.name.text.clone());
-            }
-        }
-        names
-    };
+    let modules = |stages: &[&ast::StageDecl]| module_names(stages, role);
     match ctx {
         Context::Words(places) => of_words(places),
         Context::Only(list) => {
-            list.iter().map(|t| item(t, K::Keyword, words::word(t).map_or("", |w| w.meaning))).collect()
+            list.iter().map(|t| completion(t, K::Keyword, words::word(t).map_or("", |w| w.meaning))).collect()
         }
         Context::Nothing => Vec::new(),
-        Context::Sensors => hardware(true).iter().map(|n| item(n, K::Sensor, "sensor")).collect(),
-        Context::Modules => modules(&stages).iter().map(|n| item(n, K::Module, "module")).collect(),
+        Context::Sensors => hardware(true).iter().map(|n| completion(n, K::Sensor, "sensor")).collect(),
+        Context::Modules => modules(&stages).iter().map(|n| completion(n, K::Module, "module")).collect(),
         Context::InheritedModules => {
             let parents: Vec<&ast::StageDecl> = stages.iter().skip(1).copied().collect();
             // A role's modules are new: a stage with roles extends none.
             let parents = if here.is_some() && role.is_none() { parents } else { Vec::new() };
-            modules(&parents).iter().map(|n| item(n, K::Module, "inherited module: changes it")).collect()
+            modules(&parents)
+                .iter()
+                .map(|n| completion(n, K::Module, "inherited module: changes it"))
+                .collect()
         }
         Context::Stages | Context::TrainingStages => file
             .iter()
@@ -490,10 +455,10 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
             .filter(|s| {
                 ctx == Context::Stages || s.items.iter().any(|i| matches!(i, ast::StageItem::Train { .. }))
             })
-            .map(|s| item(&s.name.text, K::Stage, "stage"))
+            .map(|s| completion(&s.name.text, K::Stage, "stage"))
             .collect(),
         Context::Walls => {
-            ["north", "south", "east", "west"].iter().map(|w| item(w, K::Keyword, "wall")).collect()
+            ["north", "south", "east", "west"].iter().map(|w| completion(w, K::Keyword, "wall")).collect()
         }
         Context::Steps | Context::Table => {
             let places = if ctx == Context::Steps { words::STEP } else { words::TABLE };
@@ -501,22 +466,91 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
             if ctx == Context::Table {
                 out.retain(|c| c.label != "turn");
             }
-            out.extend(["turn left", "turn right"].iter().map(|m| item(m, K::Motion, "turn in place")));
+            out.extend(["turn left", "turn right"].iter().map(|m| completion(m, K::Motion, "turn in place")));
             for a in hardware(false) {
-                out.push(item(&format!("{a}(0.5, 0.5)"), K::Actuator, "wheel speeds (a `speed` actuator)"));
+                out.push(completion(
+                    &format!("{a}(0.5, 0.5)"),
+                    K::Actuator,
+                    "wheel speeds (a `speed` actuator)",
+                ));
                 if ctx == Context::Steps {
-                    out.push(item(&a, K::Actuator, "an actuator and a state: `arm down`, `claw closed`"));
+                    out.push(completion(
+                        &a,
+                        K::Actuator,
+                        "an actuator and a state: `arm down`, `claw closed`",
+                    ));
                 }
             }
             out
         }
         Context::Expression => {
             let mut out = of_words(words::EXPR);
-            out.extend(hardware(true).iter().map(|n| item(n, K::Sensor, "sensor")));
-            out.extend(hardware(false).iter().map(|n| item(n, K::Actuator, "actuator")));
+            out.extend(hardware(true).iter().map(|n| completion(n, K::Sensor, "sensor")));
+            out.extend(hardware(false).iter().map(|n| completion(n, K::Actuator, "actuator")));
             out
         }
     }
+}
+
+/// A completion item.
+fn completion(label: &str, kind: CompletionKind, detail: &str) -> Completion {
+    Completion { label: label.to_string(), kind, detail: detail.to_string() }
+}
+
+/// The words of the language that fit `places`, as completion items.
+fn of_words(places: Places) -> Vec<Completion> {
+    use CompletionKind as K;
+    words::words()
+        .into_iter()
+        .filter(|w| w.places & places != 0)
+        .map(|w| {
+            let kind = match w.kind {
+                words::WordKind::Function => K::Function,
+                _ if places & (words::STEP | words::TABLE) != 0 => K::Motion,
+                _ => K::Keyword,
+            };
+            completion(w.text, kind, w.meaning)
+        })
+        .collect()
+}
+
+/// The names of the sensors (`sensor`) or the actuators the robot and
+/// `stages` declare, each once.
+fn hardware_names(file: Option<&ast::File>, stages: &[&ast::StageDecl], sensor: bool) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    let robots = file.iter().flat_map(|f| f.robots.iter()).flat_map(|r| r.hardware.iter());
+    let added = stages.iter().flat_map(|s| s.items.iter()).flat_map(|i| match i {
+        ast::StageItem::RobotAdds(h, _) => h.iter().collect(),
+        _ => Vec::new(),
+    });
+    for h in robots.chain(added) {
+        if h.is_sensor == sensor && !names.contains(&h.name.text) {
+            names.push(h.name.text.clone());
+        }
+    }
+    names
+}
+
+/// The names of the modules of `stages`, each once, or of `role`'s modules
+/// in them: those of the role of that name in each stage (`role NAME adds
+/// { ... }` adds to them).
+fn module_names(stages: &[&ast::StageDecl], role: Option<&ast::RoleDecl>) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    let declared: Vec<&ast::ModuleDecl> = match role {
+        Some(r) => stages
+            .iter()
+            .rev()
+            .flat_map(|s| s.roles().filter(|x| x.name.text == r.name.text))
+            .flat_map(|x| x.modules())
+            .collect(),
+        None => stages.iter().rev().flat_map(|s| s.all_modules()).collect(),
+    };
+    for m in declared {
+        if !names.contains(&m.name.text) {
+            names.push(m.name.text.clone());
+        }
+    }
+    names
 }
 
 // ------------------------------------------------------------------ rename
@@ -635,67 +669,8 @@ pub fn hover(text: &str, offset: usize) -> Option<(Span, String)> {
     let p = &program;
     let md = || -> Option<String> {
         Some(match kind {
-            Kind::Stage => {
-                let (i, st) = p.stage(word)?;
-                let table = render_layout(p, i);
-                let totals = table.lines().find(|l| l.starts_with("genes:")).unwrap_or("");
-                let added: Vec<&str> =
-                    st.modules.iter().filter(|m| m.stage as usize == i).map(|m| m.name.as_str()).collect();
-                let parent =
-                    st.parent.map(|j| format!(", extends `{}`", p.stages[j].name)).unwrap_or_default();
-                format!(
-                    "**stage `{word}`** ({} of {}{parent})\n\nadds modules: {}\n\n{totals}",
-                    i + 1,
-                    p.stages.len(),
-                    if added.is_empty() { "none".to_string() } else { added.join(", ") }
-                )
-            }
-            Kind::Module => {
-                let stage_name = here.map(|s| s.name.text.as_str());
-                let (i, st) = match stage_name.and_then(|n| p.stage(n)) {
-                    Some((i, st)) if st.modules.iter().any(|m| m.name == word) => (i, st),
-                    _ => p
-                        .stages
-                        .iter()
-                        .enumerate()
-                        .rev()
-                        .find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
-                };
-                // In a stage with roles, the module of the role at the
-                // cursor (two roles may each have a module of this name).
-                let role_at = here
-                    .and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end))
-                    .and_then(|d| st.roles.iter().position(|x| x.name == d.name.text));
-                let in_role = role_at
-                    .filter(|_| !st.roles.is_empty())
-                    .and_then(|r| st.role_modules(r).find(|&k| st.modules[k].name == word));
-                let mi = in_role.or_else(|| st.modules.iter().position(|m| m.name == word))?;
-                let m = &st.modules[mi];
-                let label = crate::module_label(st, mi);
-                let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
-                let table = render_layout(p, i);
-                let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
-                rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(label.as_str())));
-                // Weights that are not genes: what a training stage learned.
-                let trained = format!("trained: `{label}` ");
-                let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
-                let genes = if rows.len() > 1 {
-                    format!("```text\n{}\n```", rows.join("\n"))
-                } else {
-                    "no genes in this stage".to_string()
-                };
-                let extra =
-                    if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
-                let role = match label.split_once('.') {
-                    Some((r, _)) if !st.roles.is_empty() => format!(", role `{r}`"),
-                    _ => String::new(),
-                };
-                format!(
-                    "**module `{word}`** in stage `{}`{role}\n\nsenses: {}\n\n{genes}{extra}",
-                    st.name,
-                    if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
-                )
-            }
+            Kind::Stage => hover_stage(p, word)?,
+            Kind::Module => hover_module(p, word, here, offset)?,
             Kind::Sensor => {
                 let s = p.stages.iter().find_map(|st| st.sensors.iter().find(|s| s.name == word))?;
                 let chans = if s.count == 1 {
@@ -721,6 +696,67 @@ pub fn hover(text: &str, offset: usize) -> Option<(Span, String)> {
     // What the program does not hold (a stage in an `extends` cycle, say) is named only.
     let md = md().unwrap_or_else(|| format!("**{} `{word}`**", kind.as_str()));
     Some((span, md))
+}
+
+/// The hover of stage `word`: its place, what it extends, the modules it
+/// adds and its genome's totals.
+fn hover_stage(p: &Program, word: &str) -> Option<String> {
+    let (i, st) = p.stage(word)?;
+    let table = render_layout(p, i);
+    let totals = table.lines().find(|l| l.starts_with("genes:")).unwrap_or("");
+    let added: Vec<&str> =
+        st.modules.iter().filter(|m| m.stage as usize == i).map(|m| m.name.as_str()).collect();
+    let parent = st.parent.map(|j| format!(", extends `{}`", p.stages[j].name)).unwrap_or_default();
+    Some(format!(
+        "**stage `{word}`** ({} of {}{parent})\n\nadds modules: {}\n\n{totals}",
+        i + 1,
+        p.stages.len(),
+        if added.is_empty() { "none".to_string() } else { added.join(", ") }
+    ))
+}
+
+/// The hover of module `word` (the one of the stage `here` and the role
+/// at `offset`, else of the last stage that has one): what it senses and
+/// its rows of the genome layout.
+fn hover_module(p: &Program, word: &str, here: Option<&ast::StageDecl>, offset: usize) -> Option<String> {
+    let stage_name = here.map(|s| s.name.text.as_str());
+    let (i, st) = match stage_name.and_then(|n| p.stage(n)) {
+        Some((i, st)) if st.modules.iter().any(|m| m.name == word) => (i, st),
+        _ => p.stages.iter().enumerate().rev().find(|(_, s)| s.modules.iter().any(|m| m.name == word))?,
+    };
+    // In a stage with roles, the module of the role at the
+    // cursor (two roles may each have a module of this name).
+    let role_at = here
+        .and_then(|s| s.roles().find(|r| r.span.start <= offset && offset <= r.span.end))
+        .and_then(|d| st.roles.iter().position(|x| x.name == d.name.text));
+    let in_role = role_at
+        .filter(|_| !st.roles.is_empty())
+        .and_then(|r| st.role_modules(r).find(|&k| st.modules[k].name == word));
+    let mi = in_role.or_else(|| st.modules.iter().position(|m| m.name == word))?;
+    let m = &st.modules[mi];
+    let label = crate::module_label(st, mi);
+    let senses: Vec<String> = m.inputs.iter().map(|&c| channel(p, i, c)).collect();
+    let table = render_layout(p, i);
+    let mut rows: Vec<&str> = table.lines().skip(1).take(1).collect();
+    rows.extend(table.lines().filter(|l| l.split_whitespace().nth(3) == Some(label.as_str())));
+    // Weights that are not genes: what a training stage learned.
+    let trained = format!("trained: `{label}` ");
+    let extra: Vec<&str> = table.lines().filter(|l| l.starts_with(&trained)).collect();
+    let genes = if rows.len() > 1 {
+        format!("```text\n{}\n```", rows.join("\n"))
+    } else {
+        "no genes in this stage".to_string()
+    };
+    let extra = if extra.is_empty() { String::new() } else { format!("\n\n{}", extra.join("\n")) };
+    let role = match label.split_once('.') {
+        Some((r, _)) if !st.roles.is_empty() => format!(", role `{r}`"),
+        _ => String::new(),
+    };
+    Some(format!(
+        "**module `{word}`** in stage `{}`{role}\n\nsenses: {}\n\n{genes}{extra}",
+        st.name,
+        if senses.is_empty() { "nothing".into() } else { senses.join(", ") },
+    ))
 }
 
 /// The name of a percept channel: `ir[3]`, `battery`.

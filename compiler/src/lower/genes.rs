@@ -32,43 +32,12 @@ impl Lower<'_> {
         let (role, others) = role.unwrap_or(("", &[]));
         use ast::StageItem as I;
         let names: Vec<String> = modules.iter().map(|m| m.name.clone()).collect();
-        let lookup = |lw: &mut Lower, n: &ast::Name| -> Option<u16> {
-            if let Some(i) = names.iter().position(|m| *m == n.text) {
-                return Some(i as u16);
-            }
-            if let Some((_, other)) = others.iter().find(|(m, _)| *m == n.text) {
-                lw.errors.push(Error::LinkAcrossRoles {
-                    span: n.span.into(),
-                    module: n.text.clone(),
-                    role: role.to_string(),
-                    other: other.clone(),
-                    help: format!(
-                        "each robot runs its role's modules only, so a link joins two modules of one role: link `{}` to a module of role `{role}`, or give role `{role}` a module of its own",
-                        n.text
-                    ),
-                });
-                return None;
-            }
-            let help = match lw.module_origin.get(&n.text) {
-                Some(origin) => Some(format!(
-                    "`{}` is declared by stage `{origin}`, which does not come before this one",
-                    n.text
-                )),
-                None => did_you_mean(&n.text, names.iter().map(String::as_str)),
-            };
-            lw.errors.push(Error::Unknown {
-                span: n.span.into(),
-                what: "module",
-                name: n.text.clone(),
-                help,
-            });
-            None
-        };
         let mut link_index: HashMap<(u16, u16), usize> =
             links.iter().enumerate().map(|(k, x)| ((x.from, x.to), k)).collect();
         for item in items {
             let I::Link(l) = item else { continue };
-            let (from, to) = (lookup(self, &l.from), lookup(self, &l.to));
+            let from = self.link_end(&names, role, others, &l.from);
+            let to = self.link_end(&names, role, others, &l.to);
             let (Some(from), Some(to)) = (from, to) else { continue };
             let kind = match &l.kind {
                 ast::LinkKind::Evolvable(r) => Ok(r.as_ref().and_then(|r| self.range(r))),
@@ -122,6 +91,43 @@ impl Lower<'_> {
                 }
             }
         }
+    }
+
+    /// The module a link names, as its index in `names` (the modules of the
+    /// stage, or of the role `role`); a module of one of the `others` roles,
+    /// or an unknown one, is reported.
+    fn link_end(
+        &mut self,
+        names: &[String],
+        role: &str,
+        others: &[(String, String)],
+        n: &ast::Name,
+    ) -> Option<u16> {
+        if let Some(i) = names.iter().position(|m| *m == n.text) {
+            return Some(i as u16);
+        }
+        if let Some((_, other)) = others.iter().find(|(m, _)| *m == n.text) {
+            self.errors.push(Error::LinkAcrossRoles {
+                span: n.span.into(),
+                module: n.text.clone(),
+                role: role.to_string(),
+                other: other.clone(),
+                help: format!(
+                    "each robot runs its role's modules only, so a link joins two modules of one role: link `{}` to a module of role `{role}`, or give role `{role}` a module of its own",
+                    n.text
+                ),
+            });
+            return None;
+        }
+        let help = match self.module_origin.get(&n.text) {
+            Some(origin) => Some(format!(
+                "`{}` is declared by stage `{origin}`, which does not come before this one",
+                n.text
+            )),
+            None => did_you_mean(&n.text, names.iter().map(String::as_str)),
+        };
+        self.errors.push(Error::Unknown { span: n.span.into(), what: "module", name: n.text.clone(), help });
+        None
     }
 
     /// Appends the genes this stage introduces, in the order of the paper's

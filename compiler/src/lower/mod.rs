@@ -610,82 +610,10 @@ impl<'a> Lower<'a> {
             );
             return Program { format: FORMAT_VERSION, name, stages: Vec::new() };
         }
-        // Stage names and where later hardware / modules come from.
-        let mut by_name: HashMap<&str, usize> = HashMap::new();
-        for (i, s) in file.stages.iter().enumerate() {
-            if let Some(&j) = by_name.get(s.name.text.as_str()) {
-                self.errors.push(Error::Duplicate {
-                    span: s.name.span.into(),
-                    first: file.stages[j].name.span.into(),
-                    what: "stage",
-                    name: s.name.text.clone(),
-                });
-            } else {
-                by_name.insert(&s.name.text, i);
-            }
-            for item in &s.items {
-                if let ast::StageItem::RobotAdds(hw, _) = item {
-                    for h in hw {
-                        self.hw_origin.entry(h.name.text.clone()).or_insert_with(|| s.name.text.clone());
-                    }
-                }
-            }
-            for m in s.all_modules() {
-                self.module_origin.entry(m.name.text.clone()).or_insert_with(|| s.name.text.clone());
-            }
-        }
-        // Parents.
-        let mut parent: Vec<Option<usize>> = vec![None; file.stages.len()];
-        let mut orphan = vec![false; file.stages.len()];
-        for (i, s) in file.stages.iter().enumerate() {
-            if let Some(p) = &s.extends {
-                match by_name.get(p.text.as_str()) {
-                    Some(&j) => parent[i] = Some(j),
-                    None => {
-                        orphan[i] = true;
-                        self.errors.push(Error::Unknown {
-                            span: p.span.into(),
-                            what: "stage",
-                            name: p.text.clone(),
-                            help: did_you_mean(&p.text, file.stages.iter().map(|s| s.name.text.as_str())),
-                        });
-                    }
-                }
-            }
-        }
+        let by_name = self.stages_by_name();
+        let (parent, orphan) = self.parents(&by_name);
         let in_cycle = self.stage_cycles(&parent);
-        // Dependency order, stable by declaration: parents first, and the
-        // stages whose weights a stage uses (`weights trained STAGE`). Uses
-        // that depend on each other cannot all be met: then the first stage
-        // whose parent is ready goes next, and reports the use it misses.
-        let uses: Vec<Vec<usize>> = file
-            .stages
-            .iter()
-            .map(|s| trained_uses(s).filter_map(|n| by_name.get(n.text.as_str()).copied()).collect())
-            .collect();
-        let mut index: Vec<Option<usize>> = vec![None; file.stages.len()];
-        let mut order = Vec::new();
-        let eligible = |i: usize, index: &[Option<usize>]| {
-            index[i].is_none()
-                && !in_cycle[i]
-                && by_name.get(file.stages[i].name.text.as_str()) == Some(&i)
-                && parent[i].is_none_or(|p| index[p].is_some())
-        };
-        loop {
-            let mut progress = false;
-            for i in 0..file.stages.len() {
-                if eligible(i, &index) && uses[i].iter().all(|&u| u == i || index[u].is_some()) {
-                    index[i] = Some(order.len());
-                    order.push(i);
-                    progress = true;
-                }
-            }
-            if !progress {
-                let Some(i) = (0..file.stages.len()).find(|&i| eligible(i, &index)) else { break };
-                index[i] = Some(order.len());
-                order.push(i);
-            }
-        }
+        let (order, index) = self.stage_order(&by_name, &parent, &in_cycle);
         let mut states: Vec<StageSt> = Vec::new();
         let mut stages: Vec<Stage> = Vec::new();
         for &i in &order {
@@ -725,6 +653,106 @@ impl<'a> Lower<'a> {
             stages.push(stage);
         }
         Program { format: FORMAT_VERSION, name, stages }
+    }
+
+    /// The stages by name (a duplicate name reported), and where the
+    /// hardware and the modules of later stages come from.
+    fn stages_by_name(&mut self) -> HashMap<&'a str, usize> {
+        let file = self.file;
+        let mut by_name: HashMap<&str, usize> = HashMap::new();
+        for (i, s) in file.stages.iter().enumerate() {
+            if let Some(&j) = by_name.get(s.name.text.as_str()) {
+                self.errors.push(Error::Duplicate {
+                    span: s.name.span.into(),
+                    first: file.stages[j].name.span.into(),
+                    what: "stage",
+                    name: s.name.text.clone(),
+                });
+            } else {
+                by_name.insert(&s.name.text, i);
+            }
+            for item in &s.items {
+                if let ast::StageItem::RobotAdds(hw, _) = item {
+                    for h in hw {
+                        self.hw_origin.entry(h.name.text.clone()).or_insert_with(|| s.name.text.clone());
+                    }
+                }
+            }
+            for m in s.all_modules() {
+                self.module_origin.entry(m.name.text.clone()).or_insert_with(|| s.name.text.clone());
+            }
+        }
+        by_name
+    }
+
+    /// The stage each stage extends, and which stages extend an unknown one
+    /// (reported).
+    fn parents(&mut self, by_name: &HashMap<&str, usize>) -> (Vec<Option<usize>>, Vec<bool>) {
+        let file = self.file;
+        let mut parent: Vec<Option<usize>> = vec![None; file.stages.len()];
+        let mut orphan = vec![false; file.stages.len()];
+        for (i, s) in file.stages.iter().enumerate() {
+            if let Some(p) = &s.extends {
+                match by_name.get(p.text.as_str()) {
+                    Some(&j) => parent[i] = Some(j),
+                    None => {
+                        orphan[i] = true;
+                        self.errors.push(Error::Unknown {
+                            span: p.span.into(),
+                            what: "stage",
+                            name: p.text.clone(),
+                            help: did_you_mean(&p.text, file.stages.iter().map(|s| s.name.text.as_str())),
+                        });
+                    }
+                }
+            }
+        }
+        (parent, orphan)
+    }
+
+    /// The order in which the stages are lowered (their indices in the file),
+    /// and each stage's place in it: none for a stage left out (a duplicate
+    /// name, in a cycle, or extending one left out).
+    fn stage_order(
+        &self,
+        by_name: &HashMap<&str, usize>,
+        parent: &[Option<usize>],
+        in_cycle: &[bool],
+    ) -> (Vec<usize>, Vec<Option<usize>>) {
+        let file = self.file;
+        // Dependency order, stable by declaration: parents first, and the
+        // stages whose weights a stage uses (`weights trained STAGE`). Uses
+        // that depend on each other cannot all be met: then the first stage
+        // whose parent is ready goes next, and reports the use it misses.
+        let uses: Vec<Vec<usize>> = file
+            .stages
+            .iter()
+            .map(|s| trained_uses(s).filter_map(|n| by_name.get(n.text.as_str()).copied()).collect())
+            .collect();
+        let mut index: Vec<Option<usize>> = vec![None; file.stages.len()];
+        let mut order = Vec::new();
+        let eligible = |i: usize, index: &[Option<usize>]| {
+            index[i].is_none()
+                && !in_cycle[i]
+                && by_name.get(file.stages[i].name.text.as_str()) == Some(&i)
+                && parent[i].is_none_or(|p| index[p].is_some())
+        };
+        loop {
+            let mut progress = false;
+            for i in 0..file.stages.len() {
+                if eligible(i, &index) && uses[i].iter().all(|&u| u == i || index[u].is_some()) {
+                    index[i] = Some(order.len());
+                    order.push(i);
+                    progress = true;
+                }
+            }
+            if !progress {
+                let Some(i) = (0..file.stages.len()).find(|&i| eligible(i, &index)) else { break };
+                index[i] = Some(order.len());
+                order.push(i);
+            }
+        }
+        (order, index)
     }
 
     /// The stages in a cycle of `extends` (walking up from every stage),
@@ -1100,18 +1128,7 @@ impl<'a> Lower<'a> {
         let inherited_roles = !st.roles.is_empty();
         let role_decls = self.role_heads(&mut st, decl);
         let (roles, heads) = (st.roles.clone(), st.role_heads.clone());
-        // A later stage that adds a role or changes a role's robots changes the team here.
-        let in_world = decl.items.iter().find_map(|i| match i {
-            I::World(w) => w.items.iter().find_map(|x| match x {
-                ast::WorldItem::RoleRobots { span, .. } => Some(*span),
-                _ => None,
-            }),
-            _ => None,
-        });
-        let changed = decl
-            .extends
-            .as_ref()
-            .and(decl.roles().find(|r| r.robots.is_some()).map(|r| r.head()).or(in_world));
+        let changed = team_change(decl);
         self.role_robots(
             &mut st.world,
             &roles,
@@ -1148,27 +1165,8 @@ impl<'a> Lower<'a> {
         if own_roles {
             self.role_modules(&hw, &mut st, decl, s, &role_decls);
         }
-        let mut declared_here: HashMap<String, Span> = HashMap::new();
-        for item in &decl.items {
-            if role_stage {
-                break;
-            }
-            if let I::Module(m) = item {
-                if !self.declare_module(&mut declared_here, &m.name) {
-                    continue;
-                }
-                if st.modules.len() >= MAX_MODULES && !st.modules.iter().any(|x| x.name == m.name.text) {
-                    self.value_error(
-                        m.name.span,
-                        format!("stage `{sname}` has more than {MAX_MODULES} modules"),
-                        "one module too many",
-                        None,
-                    );
-                    break;
-                }
-                self.similar_module(&st.modules, m, s);
-                self.module(&hw, &mut st.modules, m, s);
-            }
+        if !role_stage {
+            self.stage_modules(&hw, &mut st, decl, s);
         }
         for m in &st.modules {
             if m.stage == s {
@@ -1197,6 +1195,31 @@ impl<'a> Lower<'a> {
         self.check_team_clause(&stage, decl);
         self.check_lamp(&st, &stage, s);
         (st, stage)
+    }
+
+    /// The modules a stage without roles declares, lowered in order after
+    /// the ones it inherits (a module of the same name replaces one).
+    fn stage_modules(&mut self, hw: &Hw, st: &mut StageSt, decl: &ast::StageDecl, s: u16) {
+        let sname = &decl.name.text;
+        let mut declared_here: HashMap<String, Span> = HashMap::new();
+        for item in &decl.items {
+            if let ast::StageItem::Module(m) = item {
+                if !self.declare_module(&mut declared_here, &m.name) {
+                    continue;
+                }
+                if st.modules.len() >= MAX_MODULES && !st.modules.iter().any(|x| x.name == m.name.text) {
+                    self.value_error(
+                        m.name.span,
+                        format!("stage `{sname}` has more than {MAX_MODULES} modules"),
+                        "one module too many",
+                        None,
+                    );
+                    break;
+                }
+                self.similar_module(&st.modules, m, s);
+                self.module(hw, &mut st.modules, m, s);
+            }
+        }
     }
 
     /// A stage's fitness (its own, replaced or added to) and its roles';
@@ -1248,6 +1271,20 @@ impl<'a> Lower<'a> {
             );
         }
     }
+}
+
+/// Where a stage changes the team it inherits: a role it adds or whose
+/// robots it changes, or a role's robots changed in its `world`; none for
+/// a stage that extends none.
+fn team_change(decl: &ast::StageDecl) -> Option<Span> {
+    let in_world = decl.items.iter().find_map(|i| match i {
+        ast::StageItem::World(w) => w.items.iter().find_map(|x| match x {
+            ast::WorldItem::RoleRobots { span, .. } => Some(*span),
+            _ => None,
+        }),
+        _ => None,
+    });
+    decl.extends.as_ref().and(decl.roles().find(|r| r.robots.is_some()).map(|r| r.head()).or(in_world))
 }
 
 /// The length of a stage's lives (actions), and where `decl` sets it

@@ -20,26 +20,7 @@ impl Lower<'_> {
         let existing = modules.iter().position(|x| x.name == m.name.text);
         let mut st = match existing {
             Some(i) => modules[i].clone(),
-            None => ModuleSt {
-                name: m.name.text.clone(),
-                span: m.name.span,
-                stage: s,
-                inputs: Vec::new(),
-                inputs_span: None,
-                hidden: 0,
-                recurrent: false,
-                source: Source::Evolvable(None),
-                act_span: None,
-                act_params: Vec::new(),
-                behavior: None,
-                behavior_genes: None,
-                behavior_stage: s,
-                learning: None,
-                learn_span: None,
-                reinforce: None,
-                reinforce_declared: false,
-                script_reinforces: false,
-            },
+            None => new_module(m, s),
         };
         let inherited = existing.is_some();
         let by = self.stage_names[st.stage as usize].clone();
@@ -92,25 +73,7 @@ impl Lower<'_> {
             }
         }
         if !inherited {
-            st.act_params = match &st.source {
-                Source::Evolvable(_) => Vec::new(), // genes, allocated with the stage
-                Source::Fixed(vals) => {
-                    let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
-                    self.fixed_params(vals, n, st.act_span.unwrap_or(st.span))
-                }
-                Source::Random(lo, hi) => {
-                    let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
-                    vec![Param::Random { lo: *lo, hi: *hi }; n]
-                }
-                Source::Trained(_) => {
-                    let shape = (st.inputs.len() as u16, st.hidden, 1, st.recurrent);
-                    trained_at
-                        .and_then(|(name, sp)| {
-                            self.trained_params(&name, sp, &st.name, shape, Part::Activation)
-                        })
-                        .unwrap_or_default()
-                }
-            };
+            st.act_params = self.activation_params(&st, trained_at);
         }
         self.module_behavior(hw, &mut st, m, s);
         if st.behavior.is_none() && !m.items.iter().any(|i| matches!(i, ModuleItem::Behavior(_))) {
@@ -124,6 +87,29 @@ impl Lower<'_> {
         match existing {
             Some(i) => modules[i] = st,
             None => modules.push(st),
+        }
+    }
+
+    /// The parameters of a new module's activation network: none for
+    /// evolvable weights (genes, allocated with the stage), else its fixed,
+    /// random or trained weights.
+    fn activation_params(&mut self, st: &ModuleSt, trained_at: Option<(ast::Name, Span)>) -> Vec<Param> {
+        match &st.source {
+            Source::Evolvable(_) => Vec::new(), // genes, allocated with the stage
+            Source::Fixed(vals) => {
+                let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
+                self.fixed_params(vals, n, st.act_span.unwrap_or(st.span))
+            }
+            Source::Random(lo, hi) => {
+                let n = Network::param_count_of(st.inputs.len(), st.hidden as usize, 1, st.recurrent);
+                vec![Param::Random { lo: *lo, hi: *hi }; n]
+            }
+            Source::Trained(_) => {
+                let shape = (st.inputs.len() as u16, st.hidden, 1, st.recurrent);
+                trained_at
+                    .and_then(|(name, sp)| self.trained_params(&name, sp, &st.name, shape, Part::Activation))
+                    .unwrap_or_default()
+            }
         }
     }
 
@@ -526,27 +512,7 @@ impl Lower<'_> {
                 let [left, right] = self.motion(hw, m, *sp)?;
                 Action::Wheels { left, right }
             }
-            ActionDecl::Toward { refs, speed, span } => {
-                self.has_wheels(hw, *span);
-                let channels = self.sensor_refs(hw, refs)?;
-                if let Some(c) = channels.iter().find(|c| catalog::channel_bearing(**c as usize).is_none()) {
-                    let name = hw
-                        .sensors
-                        .iter()
-                        .find(|s| s.channel <= *c && *c < s.channel + s.count)
-                        .map(|s| s.name.clone())
-                        .unwrap_or_default();
-                    self.value_error(
-                        *span,
-                        format!("`toward` needs sensors with a direction, and `{name}` has none"),
-                        "no direction",
-                        Some("steer toward proximity or ambient sensors, e.g. `toward(light)`".into()),
-                    );
-                    return None;
-                }
-                let speed = self.speed(*speed, *span);
-                Action::Toward { channels, speed }
-            }
+            ActionDecl::Toward { refs, speed, span } => self.toward(hw, refs, *speed, *span)?,
             ActionDecl::Wait(_) => Action::Wait { charge: x.uses_charger.is_some() },
             ActionDecl::Recharge(_) => Action::Wait { charge: true },
             ActionDecl::Reinforce(e, sp) => {
@@ -561,52 +527,7 @@ impl Lower<'_> {
                 Action::Reinforce(self.expr(hw, e, scope)?)
             }
             ActionDecl::Set { actuator, state, span } => {
-                let Some(a) = hw.actuators.iter().find(|a| a.name == actuator.text) else {
-                    if hw.sensors.iter().any(|s| s.name == actuator.text) {
-                        self.value_error(
-                            actuator.span,
-                            format!("`{}` is a sensor, not an actuator", actuator.text),
-                            "not an actuator",
-                            None,
-                        );
-                    } else if !self.missing_gripper(hw, actuator, state.as_ref()) {
-                        self.unknown_action(hw, actuator);
-                    }
-                    return None;
-                };
-                let info = catalog::actuator_info(a.kind);
-                if info.states.is_empty() {
-                    self.value_error(
-                        *span,
-                        format!("`{}` takes speeds, not a state", a.name),
-                        "no states",
-                        Some(format!("write `{}(0.5, 0.5)` or `forward`", a.name)),
-                    );
-                    return None;
-                }
-                let Some(state) = state else {
-                    self.value_error(
-                        *span,
-                        format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
-                        "no state",
-                        Some(format!("write `{} {}`", a.name, info.states[0])),
-                    );
-                    return None;
-                };
-                let Some(i) = info.states.iter().position(|s| *s == state.text) else {
-                    self.errors.push(Error::Unknown {
-                        span: state.span.into(),
-                        what: "state",
-                        name: state.text.clone(),
-                        help: did_you_mean(&state.text, info.states.iter().copied())
-                            .or_else(|| Some(format!("`{}` is {}", a.name, info.states.join(" or ")))),
-                    });
-                    return None;
-                };
-                match a.kind {
-                    ActuatorKind::Lift => Action::Arm(i == 1),
-                    _ => Action::Claw(i == 1),
-                }
+                self.set_actuator(hw, actuator, state.as_ref(), *span)?
             }
         };
         if let Some(sp) = x.uses_charger {
@@ -653,6 +574,85 @@ impl Lower<'_> {
         Some(Step { action, end, when })
     }
 
+    /// `toward(SENSORS)`: steering toward sensors that have a direction.
+    fn toward(&mut self, hw: &Hw, refs: &[ast::SensorRef], speed: Option<f64>, span: Span) -> Option<Action> {
+        self.has_wheels(hw, span);
+        let channels = self.sensor_refs(hw, refs)?;
+        if let Some(c) = channels.iter().find(|c| catalog::channel_bearing(**c as usize).is_none()) {
+            let name = hw
+                .sensors
+                .iter()
+                .find(|s| s.channel <= *c && *c < s.channel + s.count)
+                .map(|s| s.name.clone())
+                .unwrap_or_default();
+            self.value_error(
+                span,
+                format!("`toward` needs sensors with a direction, and `{name}` has none"),
+                "no direction",
+                Some("steer toward proximity or ambient sensors, e.g. `toward(light)`".into()),
+            );
+            return None;
+        }
+        let speed = self.speed(speed, span);
+        Some(Action::Toward { channels, speed })
+    }
+
+    /// `ACTUATOR STATE`: the gripper's lift or claw set to one of its states.
+    fn set_actuator(
+        &mut self,
+        hw: &Hw,
+        actuator: &ast::Name,
+        state: Option<&ast::Name>,
+        span: Span,
+    ) -> Option<Action> {
+        let Some(a) = hw.actuators.iter().find(|a| a.name == actuator.text) else {
+            if hw.sensors.iter().any(|s| s.name == actuator.text) {
+                self.value_error(
+                    actuator.span,
+                    format!("`{}` is a sensor, not an actuator", actuator.text),
+                    "not an actuator",
+                    None,
+                );
+            } else if !self.missing_gripper(hw, actuator, state) {
+                self.unknown_action(hw, actuator);
+            }
+            return None;
+        };
+        let info = catalog::actuator_info(a.kind);
+        if info.states.is_empty() {
+            self.value_error(
+                span,
+                format!("`{}` takes speeds, not a state", a.name),
+                "no states",
+                Some(format!("write `{}(0.5, 0.5)` or `forward`", a.name)),
+            );
+            return None;
+        }
+        let Some(state) = state else {
+            self.value_error(
+                span,
+                format!("`{}` needs a state: `{}`", a.name, info.states.join("` or `")),
+                "no state",
+                Some(format!("write `{} {}`", a.name, info.states[0])),
+            );
+            return None;
+        };
+        let Some(i) = info.states.iter().position(|s| *s == state.text) else {
+            self.errors.push(Error::Unknown {
+                span: state.span.into(),
+                what: "state",
+                name: state.text.clone(),
+                help: did_you_mean(&state.text, info.states.iter().copied())
+                    .or_else(|| Some(format!("`{}` is {}", a.name, info.states.join(" or ")))),
+            });
+            return None;
+        };
+        Some(match a.kind {
+            ActuatorKind::Lift => Action::Arm(i == 1),
+            _ => Action::Claw(i == 1),
+        })
+    }
+
     /// A neural behavior; also gives the gene range when its weights evolve.
     fn neural(
         &mut self,
@@ -675,62 +675,7 @@ impl Lower<'_> {
             },
             None => 0,
         };
-        let (outputs, decode) = match &n.outputs {
-            None => {
-                self.value_error(
-                    n.span,
-                    "a neural behavior needs `outputs`".into(),
-                    "no `outputs`",
-                    Some("e.g. `outputs sign(2) -> forward | right | left | back`".into()),
-                );
-                return (None, None);
-            }
-            Some(ast::OutputsDecl::Linear { scale, span }) => {
-                let scale = scale.unwrap_or(1.0);
-                // Checked as the runtime will hold it: `1e-46` is 0 in f32.
-                if !(scale as f32 > 0.0 && scale <= 1.0) {
-                    self.value_error(
-                        *span,
-                        format!("the scale is between 0 and 1, not {scale}"),
-                        "out of range",
-                        None,
-                    );
-                }
-                if !self.has_wheels(hw, *span) {
-                    return (None, None);
-                }
-                (2u16, Decode::Linear { scale: scale as f32 })
-            }
-            Some(ast::OutputsDecl::Sign { count, table, span }) => {
-                let Some(k) = self.count(count, "the number of outputs", 1) else { return (None, None) };
-                if k > 4 {
-                    self.value_error(
-                        count.span,
-                        format!("a sign decoding has 1 to 4 outputs, not {k}"),
-                        "too many outputs",
-                        None,
-                    );
-                    return (None, None);
-                }
-                let want = 1usize << k;
-                if table.len() != want {
-                    self.value_error(
-                        *span,
-                        format!("{k} sign outputs select among {want} motions, but {} are listed", table.len()),
-                        "wrong number of motions",
-                        Some("list one motion per sign pattern, from all outputs positive down to all negative".into()),
-                    );
-                    return (None, None);
-                }
-                let mut rows = Vec::with_capacity(want);
-                for (m, sp) in table {
-                    rows.push(self.motion(hw, m, *sp).unwrap_or([0.0, 0.0]));
-                }
-                // Listed from all outputs on (bits 11..1) down to all off (00..0).
-                rows.reverse();
-                (k as u16, Decode::Table(rows))
-            }
-        };
+        let Some((outputs, decode)) = self.outputs(hw, n) else { return (None, None) };
         let recurrent = n.recurrent && hidden > 0;
         let count = Network::param_count_of(inputs.len(), hidden as usize, outputs as usize, recurrent);
         let (params, genes) = match &n.weights {
@@ -754,6 +699,67 @@ impl Lower<'_> {
         };
         let net = Network { inputs: inputs.len() as u16, hidden, outputs, recurrent, params };
         (Some(NeuralBehavior { inputs, net, decode }), genes)
+    }
+
+    /// A neural behavior's outputs and how they decode into wheel speeds:
+    /// `linear`, or `sign(N)` and its table of motions.
+    fn outputs(&mut self, hw: &Hw, n: &ast::NeuralDecl) -> Option<(u16, Decode)> {
+        match &n.outputs {
+            None => {
+                self.value_error(
+                    n.span,
+                    "a neural behavior needs `outputs`".into(),
+                    "no `outputs`",
+                    Some("e.g. `outputs sign(2) -> forward | right | left | back`".into()),
+                );
+                None
+            }
+            Some(ast::OutputsDecl::Linear { scale, span }) => {
+                let scale = scale.unwrap_or(1.0);
+                // Checked as the runtime will hold it: `1e-46` is 0 in f32.
+                if !(scale as f32 > 0.0 && scale <= 1.0) {
+                    self.value_error(
+                        *span,
+                        format!("the scale is between 0 and 1, not {scale}"),
+                        "out of range",
+                        None,
+                    );
+                }
+                if !self.has_wheels(hw, *span) {
+                    return None;
+                }
+                Some((2u16, Decode::Linear { scale: scale as f32 }))
+            }
+            Some(ast::OutputsDecl::Sign { count, table, span }) => {
+                let k = self.count(count, "the number of outputs", 1)?;
+                if k > 4 {
+                    self.value_error(
+                        count.span,
+                        format!("a sign decoding has 1 to 4 outputs, not {k}"),
+                        "too many outputs",
+                        None,
+                    );
+                    return None;
+                }
+                let want = 1usize << k;
+                if table.len() != want {
+                    self.value_error(
+                        *span,
+                        format!("{k} sign outputs select among {want} motions, but {} are listed", table.len()),
+                        "wrong number of motions",
+                        Some("list one motion per sign pattern, from all outputs positive down to all negative".into()),
+                    );
+                    return None;
+                }
+                let mut rows = Vec::with_capacity(want);
+                for (m, sp) in table {
+                    rows.push(self.motion(hw, m, *sp).unwrap_or([0.0, 0.0]));
+                }
+                // Listed from all outputs on (bits 11..1) down to all off (00..0).
+                rows.reverse();
+                Some((k as u16, Decode::Table(rows)))
+            }
+        }
     }
 
     /// `weights trained STAGE` (`part` behavior) or `activation trained
@@ -943,5 +949,30 @@ fn recurrent_word(recurrent: bool) -> &'static str {
         "recurrent "
     } else {
         ""
+    }
+}
+
+/// A module declared for the first time, in stage `s`: no inputs, no
+/// behavior, its activation network evolvable until its clauses say.
+fn new_module(m: &ast::ModuleDecl, s: u16) -> ModuleSt {
+    ModuleSt {
+        name: m.name.text.clone(),
+        span: m.name.span,
+        stage: s,
+        inputs: Vec::new(),
+        inputs_span: None,
+        hidden: 0,
+        recurrent: false,
+        source: Source::Evolvable(None),
+        act_span: None,
+        act_params: Vec::new(),
+        behavior: None,
+        behavior_genes: None,
+        behavior_stage: s,
+        learning: None,
+        learn_span: None,
+        reinforce: None,
+        reinforce_declared: false,
+        script_reinforces: false,
     }
 }

@@ -470,24 +470,7 @@ impl Lower<'_> {
     ) {
         let roles: Vec<&ast::RoleDecl> = decl.roles().collect();
         let n = st.roles.len();
-        // Each role's modules and links, numbered within the role.
-        let (mut mods, mut links, mut starts) = (Vec::new(), Vec::new(), Vec::new());
-        let mut start = 0usize;
-        for role in &st.roles {
-            let len = (role.modules as usize).min(st.modules.len().saturating_sub(start));
-            let range = start..start + len;
-            mods.push(st.modules[range.clone()].to_vec());
-            let inside = |i: u16| range.contains(&(i as usize));
-            links.push(
-                st.links
-                    .iter()
-                    .filter(|l| inside(l.from) && inside(l.to))
-                    .map(|l| LinkSt { from: l.from - start as u16, to: l.to - start as u16, ..l.clone() })
-                    .collect::<Vec<_>>(),
-            );
-            starts.push(start);
-            start = range.end;
-        }
+        let (mut mods, mut links, starts) = split_by_role(st);
         let old: Vec<usize> = mods.iter().map(Vec::len).collect();
         // The names of every role's modules (its own and those it declares
         // here): a link to another role's is named so.
@@ -544,31 +527,7 @@ impl Lower<'_> {
                 .collect();
             self.links_of(&mods[r], &mut links[r], &decl.name.text, &d.items, s, Some((&role, &others)));
         }
-        // Concatenated in role order: a role's added modules follow its
-        // own, and the later roles' move (`map`: old index to new).
-        let mut map: Vec<u16> = (0..st.modules.len() as u16).collect();
-        let (mut modules, mut all_links) = (Vec::new(), Vec::new());
-        for (r, (ms, ls)) in mods.into_iter().zip(links).enumerate() {
-            let off = modules.len();
-            for k in 0..old[r] {
-                if let Some(x) = map.get_mut(starts[r] + k) {
-                    *x = (off + k) as u16;
-                }
-            }
-            let o = off as u16;
-            all_links.extend(ls.into_iter().map(|l| LinkSt { from: l.from + o, to: l.to + o, ..l }));
-            st.roles[r].modules = ms.len() as u16;
-            modules.extend(ms);
-        }
-        let moved = |i: u16| map.get(i as usize).copied().unwrap_or(i);
-        for g in &mut st.genes {
-            g.module = moved(g.module);
-            if let GeneRole::Link { from } = &mut g.role {
-                *from = moved(*from);
-            }
-        }
-        st.modules = modules;
-        st.links = all_links;
+        join_roles(st, mods, links, &starts, &old);
     }
 
     /// The fitness each role of `decl` declares (`fitness` inside the
@@ -741,4 +700,64 @@ impl Lower<'_> {
             });
         }
     }
+}
+
+/// Each role's modules and links, numbered within the role, and the index
+/// of each role's first module in the stage's.
+fn split_by_role(st: &StageSt) -> (Vec<Vec<ModuleSt>>, Vec<Vec<LinkSt>>, Vec<usize>) {
+    let (mut mods, mut links, mut starts) = (Vec::new(), Vec::new(), Vec::new());
+    let mut start = 0usize;
+    for role in &st.roles {
+        let len = (role.modules as usize).min(st.modules.len().saturating_sub(start));
+        let range = start..start + len;
+        mods.push(st.modules[range.clone()].to_vec());
+        let inside = |i: u16| range.contains(&(i as usize));
+        links.push(
+            st.links
+                .iter()
+                .filter(|l| inside(l.from) && inside(l.to))
+                .map(|l| LinkSt { from: l.from - start as u16, to: l.to - start as u16, ..l.clone() })
+                .collect::<Vec<_>>(),
+        );
+        starts.push(start);
+        start = range.end;
+    }
+    (mods, links, starts)
+}
+
+/// The roles' modules and links concatenated again in role order: a role's
+/// added modules follow its own (the first `old[r]` of `mods[r]`, from
+/// `starts[r]` in the stage), and the later roles' move, their links and
+/// the genes of moved modules renumbered.
+fn join_roles(
+    st: &mut StageSt,
+    mods: Vec<Vec<ModuleSt>>,
+    links: Vec<Vec<LinkSt>>,
+    starts: &[usize],
+    old: &[usize],
+) {
+    // `map`: a module's old index to its new.
+    let mut map: Vec<u16> = (0..st.modules.len() as u16).collect();
+    let (mut modules, mut all_links) = (Vec::new(), Vec::new());
+    for (r, (ms, ls)) in mods.into_iter().zip(links).enumerate() {
+        let off = modules.len();
+        for k in 0..old[r] {
+            if let Some(x) = map.get_mut(starts[r] + k) {
+                *x = (off + k) as u16;
+            }
+        }
+        let o = off as u16;
+        all_links.extend(ls.into_iter().map(|l| LinkSt { from: l.from + o, to: l.to + o, ..l }));
+        st.roles[r].modules = ms.len() as u16;
+        modules.extend(ms);
+    }
+    let moved = |i: u16| map.get(i as usize).copied().unwrap_or(i);
+    for g in &mut st.genes {
+        g.module = moved(g.module);
+        if let GeneRole::Link { from } = &mut g.role {
+            *from = moved(*from);
+        }
+    }
+    st.modules = modules;
+    st.links = all_links;
 }

@@ -171,24 +171,7 @@ impl Lower<'_> {
                         keep_span = Some(q.span);
                     }
                 }
-                (ast::SettingValue::WordAndNumber(w, q), _) => {
-                    let message = match w.text.as_str() {
-                        "truncation" => "`selection truncation` takes its number after `keep`".to_string(),
-                        "roulette" => "`selection roulette` takes no number".to_string(),
-                        other => {
-                            self.errors.push(Error::Unknown {
-                                span: w.span.into(),
-                                what: "selection",
-                                name: other.to_string(),
-                                help: did_you_mean(other, ["truncation", "roulette"])
-                                    .map(|d| format!("{d} {}", evolve_help("selection")))
-                                    .or_else(|| Some(evolve_help("selection"))),
-                            });
-                            continue;
-                        }
-                    };
-                    self.value_error(q.span, message, "unexpected number", Some(evolve_help("selection")));
-                }
+                (ast::SettingValue::WordAndNumber(w, q), _) => self.selection_with_number(w, q),
                 (ast::SettingValue::Word(w), "selection") => {
                     if w.text == "roulette" {
                         ev.selection = Selection::Roulette;
@@ -266,7 +249,40 @@ impl Lower<'_> {
                 }),
             }
         }
-        if keep_span.is_some() || ev.selection == Selection::Roulette {
+        self.check_population(st, settings, keep_span, population_span);
+    }
+
+    /// `selection WORD N`: a number where `selection` takes none, or takes it
+    /// after `keep`; an unknown selection.
+    fn selection_with_number(&mut self, w: &ast::Name, q: &ast::Quantity) {
+        let message = match w.text.as_str() {
+            "truncation" => "`selection truncation` takes its number after `keep`".to_string(),
+            "roulette" => "`selection roulette` takes no number".to_string(),
+            other => {
+                self.errors.push(Error::Unknown {
+                    span: w.span.into(),
+                    what: "selection",
+                    name: other.to_string(),
+                    help: did_you_mean(other, ["truncation", "roulette"])
+                        .map(|d| format!("{d} {}", evolve_help("selection")))
+                        .or_else(|| Some(evolve_help("selection"))),
+                });
+                return;
+            }
+        };
+        self.value_error(q.span, message, "unexpected number", Some(evolve_help("selection")));
+    }
+
+    /// The default `keep` of a truncation (a fifth of the population), and
+    /// `keep` and `elitism` checked against the population.
+    fn check_population(
+        &mut self,
+        st: &mut StageSt,
+        settings: &[ast::Setting],
+        keep_span: Option<Span>,
+        population_span: Option<Span>,
+    ) {
+        if keep_span.is_some() || st.evolution.selection == Selection::Roulette {
             st.keep_default = false;
         }
         // A population written here but refused: nothing to compare with.

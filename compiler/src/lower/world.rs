@@ -146,34 +146,7 @@ impl Lower<'_> {
                     ws.arena_bare = width.unit.is_none() && depth.unit.is_none();
                 }
             }
-            W::Charger { length, wall, lamp, span } => {
-                let len = self.length(length, "the charger length");
-                let w = match wall.text.as_str() {
-                    "north" => Some(Wall::North),
-                    "south" => Some(Wall::South),
-                    "east" => Some(Wall::East),
-                    "west" => Some(Wall::West),
-                    _ => {
-                        self.errors.push(Error::Unknown {
-                            span: wall.span.into(),
-                            what: "wall",
-                            name: wall.text.clone(),
-                            help: did_you_mean(&wall.text, ["north", "south", "east", "west"])
-                                .or_else(|| Some("the walls are `north`, `south`, `east` and `west`".into())),
-                        });
-                        None
-                    }
-                };
-                let lamp_height = match lamp {
-                    None => Some(None),
-                    Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
-                    Some(Some(q)) => self.length(q, "the lamp height").map(Some),
-                };
-                if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
-                    ws.world.charger = Some(Charger { wall, length, lamp_height });
-                    ws.spans.insert("charger", *span);
-                }
-            }
+            W::Charger { length, wall, lamp, span } => self.charger(ws, length, wall, lamp.as_ref(), *span),
             W::Battery(q, span) => {
                 if let Some(c) = self.count(q, "the battery capacity", 1) {
                     let recharge = ws.world.battery.as_ref().map(|b| b.recharge).unwrap_or(DEFAULT_RECHARGE);
@@ -233,6 +206,43 @@ impl Lower<'_> {
                 ws.spans.insert("body", *span);
             }
             _ => {}
+        }
+    }
+
+    /// `charger LENGTH on WALL wall [with lamp [HEIGHT]]`.
+    fn charger(
+        &mut self,
+        ws: &mut WorldSt,
+        length: &ast::Quantity,
+        wall: &ast::Name,
+        lamp: Option<&Option<ast::Quantity>>,
+        span: Span,
+    ) {
+        let len = self.length(length, "the charger length");
+        let w = match wall.text.as_str() {
+            "north" => Some(Wall::North),
+            "south" => Some(Wall::South),
+            "east" => Some(Wall::East),
+            "west" => Some(Wall::West),
+            _ => {
+                self.errors.push(Error::Unknown {
+                    span: wall.span.into(),
+                    what: "wall",
+                    name: wall.text.clone(),
+                    help: did_you_mean(&wall.text, ["north", "south", "east", "west"])
+                        .or_else(|| Some("the walls are `north`, `south`, `east` and `west`".into())),
+                });
+                None
+            }
+        };
+        let lamp_height = match lamp {
+            None => Some(None),
+            Some(None) => Some(Some(DEFAULT_LAMP_HEIGHT)),
+            Some(Some(q)) => self.length(q, "the lamp height").map(Some),
+        };
+        if let (Some(length), Some(wall), Some(lamp_height)) = (len, w, lamp_height) {
+            ws.world.charger = Some(Charger { wall, length, lamp_height });
+            ws.spans.insert("charger", span);
         }
     }
 
@@ -482,6 +492,18 @@ impl Lower<'_> {
                 );
             }
         }
+        self.check_places(ws, decl);
+        self.check_start(ws, decl);
+    }
+
+    /// Placements (`place ... after N actions`) where the body fits: inside
+    /// the arena's walls, clear of walls and cylinders, and in a world of
+    /// one robot.
+    fn check_places(&mut self, ws: &WorldSt, decl: Span) {
+        let [w, d] = ws.world.arena;
+        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
+        let spans = |kind: &str| ws.item_spans.get(kind).cloned().unwrap_or_default();
+        let items = &ws.world.items;
         let r = ws.world.body.radius;
         for (p, sp) in items.places.iter().zip(spans("place")) {
             if !here(&sp) {
@@ -499,16 +521,7 @@ impl Lower<'_> {
                 });
                 continue;
             }
-            let (what, other) = match blocker(items, p.at, r) {
-                None => continue,
-                Some(Blocker::Wall(i)) => {
-                    (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied())
-                }
-                Some(Blocker::Cylinder(i)) => (
-                    format!("the cylinder{}", item_name(&items.cylinders[i].name)),
-                    spans("cylinder").get(i).copied(),
-                ),
-            };
+            let Some((what, other)) = blocking(ws, p.at, r) else { continue };
             self.errors.push(Error::PlaceBlocked {
                 span: sp.into(),
                 other: other.map(Into::into),
@@ -531,6 +544,15 @@ impl Lower<'_> {
                 });
             }
         }
+    }
+
+    /// A start pose where the body fits: inside the arena's walls, and clear
+    /// of walls and cylinders when the start is one point.
+    fn check_start(&mut self, ws: &WorldSt, decl: Span) {
+        let [w, d] = ws.world.arena;
+        let here = |sp: &Span| decl.start <= sp.start && sp.end <= decl.end;
+        let items = &ws.world.items;
+        let r = ws.world.body.radius;
         let (Some(s), Some(sp)) = (&items.start, ws.spans.get("start")) else { return };
         if !here(sp) {
             return;
@@ -548,16 +570,7 @@ impl Lower<'_> {
         if s.from != s.to {
             return;
         }
-        let (what, other) = match blocker(items, s.from, r) {
-            None => return,
-            Some(Blocker::Wall(i)) => {
-                (format!("the wall{}", item_name(&items.walls[i].name)), spans("wall").get(i).copied())
-            }
-            Some(Blocker::Cylinder(i)) => (
-                format!("the cylinder{}", item_name(&items.cylinders[i].name)),
-                spans("cylinder").get(i).copied(),
-            ),
-        };
+        let Some((what, other)) = blocking(ws, s.from, r) else { return };
         self.errors.push(Error::Conflict {
             span: (*sp).into(),
             other: other.unwrap_or(*sp).into(),
@@ -1310,6 +1323,19 @@ fn put<T>(list: &mut Vec<T>, place: Result<Option<usize>, ()>, item: T) {
         Ok(None) => list.push(item),
         Err(()) => {}
     }
+}
+
+/// What a body of radius `r` at `at` overlaps: the wall or cylinder in
+/// words, and where it is declared.
+fn blocking(ws: &WorldSt, at: [f32; 2], r: f32) -> Option<(String, Option<Span>)> {
+    let items = &ws.world.items;
+    let span = |kind: &str, i: usize| ws.item_spans.get(kind).and_then(|s| s.get(i)).copied();
+    Some(match blocker(items, at, r)? {
+        Blocker::Wall(i) => (format!("the wall{}", item_name(&items.walls[i].name)), span("wall", i)),
+        Blocker::Cylinder(i) => {
+            (format!("the cylinder{}", item_name(&items.cylinders[i].name)), span("cylinder", i))
+        }
+    })
 }
 
 /// ` `name`` for a named item, else nothing.

@@ -48,52 +48,102 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
     let rest = src[pos..].trim_start();
     let whole_part = rest.is_empty() || rest.starts_with("stage") || rest.starts_with("robot");
     let base = part_start(src, pos, !whole_part);
-    let (tokens, end) = window_tokens(src, base, pos);
-    let window_end = tokens.last().map_or(pos, |t| t.span.end).max(at.end).min(src.len());
-    // Lines counted from the line of `base`; see `absolute` for messages.
-    let line_starts: Vec<usize> = std::iter::once(base)
-        .chain(src[base..window_end].match_indices('\n').map(|(i, _)| base + i + 1))
-        .collect();
-    let line_of = |at: usize| line_starts.partition_point(|&s| s <= at);
-    let absolute = |line: usize| src.as_bytes()[..base].iter().filter(|&&b| b == b'\n').count() + line;
-    let indent_of = |at: usize| {
-        let line = &src[line_starts[line_of(at) - 1]..];
-        line.len() - line.trim_start_matches([' ', '\t']).len()
-    };
-    let first_on_line =
-        |i: usize| i == 0 || line_of(tokens[i - 1].span.start) < line_of(tokens[i].span.start);
-    let punct = |t: &Token| (t.kind == TokenKind::Punct).then(|| src.as_bytes()[t.span.start]);
+    let w = Window::new(src, base, pos, at);
+    let (stack, suspects) = w.open_brackets();
+    let chosen = w.choose(&stack, &suspects)?;
+    Some(w.error(chosen, at, found))
+}
 
-    let mut stack: Vec<Open> = Vec::new();
-    // Brackets most likely closed by a bracket of an outer one.
-    let mut suspects: Vec<Suspect> = Vec::new();
-    for (i, t) in tokens[..end].iter().enumerate() {
-        match punct(t) {
-            Some(b @ (b'(' | b'[' | b'{')) => stack.push(Open { tok: i, bracket: b }),
-            Some(c @ (b')' | b']' | b'}')) => {
-                let Some(k) = stack.iter().rposition(|o| closing(o.bracket) == c) else { continue };
-                let opened = stack[k].tok;
-                if c == b'}'
-                    && first_on_line(i)
-                    && indent_of(t.span.start) < indent_of(tokens[opened].span.start)
-                {
-                    let outer = k.checked_sub(1).map(|o| stack[o].tok);
-                    suspects.push(Suspect { open: opened, closed_by: i, outer });
-                }
-                let skipped = stack.drain(k..).skip(1);
-                suspects.extend(skipped.map(|o| Suspect { open: o.tok, closed_by: i, outer: None }));
-            }
-            _ => {}
-        }
+/// The source read around a syntax error: its tokens, and where its lines
+/// start.
+struct Window<'s> {
+    src: &'s str,
+    tokens: Vec<Token>,
+    /// The index of the first token after the error's position.
+    end: usize,
+    /// The start of each line, from the line of the window's first byte.
+    line_starts: Vec<usize>,
+}
+
+impl<'s> Window<'s> {
+    /// The window from `base` to the two tokens after `pos` (and `at`).
+    fn new(src: &'s str, base: usize, pos: usize, at: Span) -> Window<'s> {
+        let (tokens, end) = window_tokens(src, base, pos);
+        let window_end = tokens.last().map_or(pos, |t| t.span.end).max(at.end).min(src.len());
+        let line_starts: Vec<usize> = std::iter::once(base)
+            .chain(src[base..window_end].match_indices('\n').map(|(i, _)| base + i + 1))
+            .collect();
+        Window { src, tokens, end, line_starts }
     }
-    let top = stack.last()?;
-    let at_top = Suspect { open: top.tok, closed_by: end, outer: None };
-    // A suspect inside the innermost open bracket, else that bracket.
-    let candidate = suspects.iter().rev().find(|s| s.open > top.tok).copied().unwrap_or(at_top);
-    let next = tokens.get(end);
-    let chosen = match next {
-        None => candidate,
-        Some(n) => match punct(n) {
+
+    /// The line of byte `at`, counted from 1 at the window's first line;
+    /// see `absolute` for messages.
+    fn line_of(&self, at: usize) -> usize {
+        self.line_starts.partition_point(|&s| s <= at)
+    }
+
+    /// The line of the file (from 1) of the window's line `line`.
+    fn absolute(&self, line: usize) -> usize {
+        self.src.as_bytes()[..self.line_starts[0]].iter().filter(|&&b| b == b'\n').count() + line
+    }
+
+    /// The indentation of the line of byte `at`.
+    fn indent_of(&self, at: usize) -> usize {
+        let line = &self.src[self.line_starts[self.line_of(at) - 1]..];
+        line.len() - line.trim_start_matches([' ', '\t']).len()
+    }
+
+    /// Whether token `i` is the first of its line.
+    fn first_on_line(&self, i: usize) -> bool {
+        let t = &self.tokens;
+        i == 0 || self.line_of(t[i - 1].span.start) < self.line_of(t[i].span.start)
+    }
+
+    /// The bracket or other punctuation that token `t` is, if any.
+    fn punct(&self, t: &Token) -> Option<u8> {
+        (t.kind == TokenKind::Punct).then(|| self.src.as_bytes()[t.span.start])
+    }
+
+    /// The brackets still open before the error's position (the innermost
+    /// last), and the suspects: brackets most likely closed by a bracket
+    /// of an outer one.
+    fn open_brackets(&self) -> (Vec<Open>, Vec<Suspect>) {
+        let tokens = &self.tokens;
+        let mut stack: Vec<Open> = Vec::new();
+        let mut suspects: Vec<Suspect> = Vec::new();
+        for (i, t) in tokens[..self.end].iter().enumerate() {
+            match self.punct(t) {
+                Some(b @ (b'(' | b'[' | b'{')) => stack.push(Open { tok: i, bracket: b }),
+                Some(c @ (b')' | b']' | b'}')) => {
+                    let Some(k) = stack.iter().rposition(|o| closing(o.bracket) == c) else { continue };
+                    let opened = stack[k].tok;
+                    if c == b'}'
+                        && self.first_on_line(i)
+                        && self.indent_of(t.span.start) < self.indent_of(tokens[opened].span.start)
+                    {
+                        let outer = k.checked_sub(1).map(|o| stack[o].tok);
+                        suspects.push(Suspect { open: opened, closed_by: i, outer });
+                    }
+                    let skipped = stack.drain(k..).skip(1);
+                    suspects.extend(skipped.map(|o| Suspect { open: o.tok, closed_by: i, outer: None }));
+                }
+                _ => {}
+            }
+        }
+        (stack, suspects)
+    }
+
+    /// The bracket to name, from what the parse failed at: the innermost
+    /// open bracket, or a suspect inside it; `None` when the failure does
+    /// not look like a bracket left open.
+    fn choose(&self, stack: &[Open], suspects: &[Suspect]) -> Option<Suspect> {
+        let (src, tokens, end) = (self.src, &self.tokens, self.end);
+        let top = stack.last()?;
+        let at_top = Suspect { open: top.tok, closed_by: end, outer: None };
+        // A suspect inside the innermost open bracket, else that bracket.
+        let candidate = suspects.iter().rev().find(|s| s.open > top.tok).copied().unwrap_or(at_top);
+        let Some(n) = tokens.get(end) else { return Some(candidate) };
+        Some(match self.punct(n) {
             // A closing bracket of an outer one (not a stray one).
             Some(c @ (b')' | b']' | b'}'))
                 if c != closing(top.bracket) && stack.iter().any(|o| closing(o.bracket) == c) =>
@@ -108,69 +158,78 @@ pub(super) fn unclosed(src: &str, pos: usize, at: Span, found: &str) -> Option<E
                 let round = top.bracket != b'{';
                 if round && CLAUSE_WORDS.contains(&w) {
                     at_top
-                } else if starts_part(src, &tokens, end)
-                    || (!round && starts_item(src, &tokens, end) && !opens_stage(src, &tokens, top.tok))
+                } else if starts_part(src, tokens, end)
+                    || (!round && starts_item(src, tokens, end) && !opens_stage(src, tokens, top.tok))
                 {
                     candidate
                 } else {
                     return None;
                 }
             }
-        },
-    };
-    let open = tokens[chosen.open].span;
-    let bracket = src.as_bytes()[open.start] as char;
-    let close = closing(bracket as u8) as char;
-    let block = (bracket == '{').then(|| block_name(src, &tokens, chosen.open)).flatten();
+        })
+    }
 
-    let message = match &block {
-        Some(block) => format!("{block} is not closed"),
-        None => format!("this `{bracket}` is not closed"),
-    };
-    let label = if block.is_some() { format!("its `{bracket}` opens here") } else { "opened here".into() };
-    let before = match found {
-        "end of file" => "the end of the file".to_string(),
-        "`-`" if src[at.start..].starts_with("->") => "`->`".to_string(),
-        _ => found.to_string(),
-    };
-    // Where the parse failed, or the bracket that closed this one instead
-    // of an outer one.
-    let other = match (tokens.get(chosen.closed_by).filter(|_| chosen.closed_by != end), chosen.outer) {
-        (Some(c), Some(outer)) => {
-            let outer = block_name(src, &tokens, outer).unwrap_or_else(|| "the block around it".into());
-            let this = block.as_deref().unwrap_or("it");
-            (c.span, format!("this `}}` closes {this}, so {outer} is not closed"))
+    /// The error of the bracket `chosen` left open, the parse having
+    /// failed at `at` on `found`: where the closing bracket is missing
+    /// (there an editor shows it), labelling the bracket too.
+    fn error(&self, chosen: Suspect, at: Span, found: &str) -> Error {
+        let (src, tokens, end) = (self.src, &self.tokens, self.end);
+        let open = tokens[chosen.open].span;
+        let bracket = src.as_bytes()[open.start] as char;
+        let close = closing(bracket as u8) as char;
+        let block = (bracket == '{').then(|| block_name(src, tokens, chosen.open)).flatten();
+
+        let message = match &block {
+            Some(block) => format!("{block} is not closed"),
+            None => format!("this `{bracket}` is not closed"),
+        };
+        let label =
+            if block.is_some() { format!("its `{bracket}` opens here") } else { "opened here".into() };
+        let before = match found {
+            "end of file" => "the end of the file".to_string(),
+            "`-`" if src[at.start..].starts_with("->") => "`->`".to_string(),
+            _ => found.to_string(),
+        };
+        // Where the parse failed, or the bracket that closed this one instead
+        // of an outer one.
+        let other = match (tokens.get(chosen.closed_by).filter(|_| chosen.closed_by != end), chosen.outer) {
+            (Some(c), Some(outer)) => {
+                let outer = block_name(src, tokens, outer).unwrap_or_else(|| "the block around it".into());
+                let this = block.as_deref().unwrap_or("it");
+                (c.span, format!("this `}}` closes {this}, so {outer} is not closed"))
+            }
+            (Some(c), None) => {
+                (c.span, format!("expected `{close}` before this `{}`", &src[c.span.start..c.span.end]))
+            }
+            (None, _) if found == "end of file" => (at, "the file ends here".into()),
+            (None, _) => (at, format!("expected `{close}` before {before}")),
+        };
+        // The closing bracket goes after the last token before the one that
+        // closed it instead, or before the token the parse failed at.
+        let last = chosen.closed_by.checked_sub(1).filter(|&b| b > chosen.open).map(|b| tokens[b]);
+        let same_line = last.is_some_and(|l| self.line_of(l.span.start) == self.line_of(other.0.start));
+        let help = match (last, &block) {
+            (Some(l), Some(block)) if !same_line => {
+                format!(
+                    "add `}}` at the end of line {}, where {block} ends",
+                    self.absolute(self.line_of(l.span.start))
+                )
+            }
+            (Some(l), None) if !same_line => format!(
+                "add `{close}` at the end of line {}, or where the bracketed part ends",
+                self.absolute(self.line_of(l.span.start))
+            ),
+            _ if other.0 == at => format!("add `{close}` before {before}"),
+            _ => format!("add `{close}` before the `{}`", &src[other.0.start..other.0.end]),
+        };
+        Error::Syntax {
+            span: other.0.into(),
+            message,
+            label: other.1,
+            others: vec![LabeledSpan::new_with_span(Some(label), miette::SourceSpan::from(open))],
+            help: Some(help),
         }
-        (Some(c), None) => {
-            (c.span, format!("expected `{close}` before this `{}`", &src[c.span.start..c.span.end]))
-        }
-        (None, _) if found == "end of file" => (at, "the file ends here".into()),
-        (None, _) => (at, format!("expected `{close}` before {before}")),
-    };
-    // The closing bracket goes after the last token before the one that
-    // closed it instead, or before the token the parse failed at.
-    let last = chosen.closed_by.checked_sub(1).filter(|&b| b > chosen.open).map(|b| tokens[b]);
-    let same_line = last.is_some_and(|l| line_of(l.span.start) == line_of(other.0.start));
-    let help = match (last, &block) {
-        (Some(l), Some(block)) if !same_line => {
-            format!("add `}}` at the end of line {}, where {block} ends", absolute(line_of(l.span.start)))
-        }
-        (Some(l), None) if !same_line => format!(
-            "add `{close}` at the end of line {}, or where the bracketed part ends",
-            absolute(line_of(l.span.start))
-        ),
-        _ if other.0 == at => format!("add `{close}` before {before}"),
-        _ => format!("add `{close}` before the `{}`", &src[other.0.start..other.0.end]),
-    };
-    // The error is where the closing bracket is missing (there an editor
-    // shows it), and labels the bracket too.
-    Some(Error::Syntax {
-        span: other.0.into(),
-        message,
-        label: other.1,
-        others: vec![LabeledSpan::new_with_span(Some(label), miette::SourceSpan::from(open))],
-        help: Some(help),
-    })
+    }
 }
 
 /// The start of the line of the last `stage` or `robot` (not `robot adds`)

@@ -272,7 +272,17 @@ fn check_nesting(src: &str) -> Option<Error> {
     None
 }
 
+/// What a rule expects, in the words of a syntax error's "expected ...".
 fn describe(rule: Rule) -> Option<&'static str> {
+    describe_file(rule)
+        .or_else(|| describe_world(rule))
+        .or_else(|| describe_stage(rule))
+        .or_else(|| describe_module(rule))
+}
+
+/// What is expected in the file's outline, in a `robot` or `genome`
+/// declaration, and the words of every part: names, numbers, units.
+fn describe_file(rule: Rule) -> Option<&'static str> {
     Some(match rule {
         Rule::EOI => "end of file",
         // pest reports the whole rule when the first item fails at the start.
@@ -294,6 +304,13 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::gene_setting | Rule::bits_setting | Rule::k_bits => "`bits`",
         Rule::range_setting | Rule::k_range => "`range`",
         Rule::gene_group => "`links`, `weights` or `biases`",
+        _ => return None,
+    })
+}
+
+/// What is expected in a `world` and its items.
+fn describe_world(rule: Rule) -> Option<&'static str> {
+    Some(match rule {
         Rule::world => "`world`",
         Rule::world_mode => "`adds` or `changes`",
         Rule::arena => "`arena`",
@@ -328,6 +345,13 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::zone_grey => "`grey`",
         Rule::zone_charger => "`charger`",
         Rule::heading => "`heading`",
+        _ => return None,
+    })
+}
+
+/// What is expected in a stage's settings, its run and its fitness.
+fn describe_stage(rule: Rule) -> Option<&'static str> {
+    Some(match rule {
         Rule::setting => "a setting",
         Rule::evolve => "`evolve`",
         Rule::selection => "`selection`",
@@ -344,6 +368,14 @@ fn describe(rule: Rule) -> Option<&'static str> {
         Rule::at_end => "`at end`",
         Rule::bonus => "a bonus `N per EVENT`",
         Rule::k_outside => "`outside`",
+        _ => return None,
+    })
+}
+
+/// What is expected in a `module`, its behavior, learning and links, and
+/// in an expression.
+fn describe_module(rule: Rule) -> Option<&'static str> {
+    Some(match rule {
         Rule::module => "`module`",
         Rule::sense => "`sense`",
         Rule::sensor_ref => "a sensor",
@@ -1020,41 +1052,7 @@ impl Builder {
                         items.push(ModuleItem::Behavior(decl));
                     }
                 }
-                Rule::learn => {
-                    let mut l = LearnDecl {
-                        rates: None,
-                        error: None,
-                        target: Name { text: String::new(), span: csp },
-                        below: None,
-                        window: None,
-                        span: csp,
-                    };
-                    for o in c.into_inner() {
-                        match o.as_rule() {
-                            Rule::rates => {
-                                let rs = span(&o);
-                                let mut v: Vec<f64> = Vec::new();
-                                for n in o.into_inner() {
-                                    match n.as_rule() {
-                                        Rule::learn_error => l.error = Some(name(n)),
-                                        _ => v.push(num(&n)),
-                                    }
-                                }
-                                if v.len() == 2 {
-                                    l.rates = Some((v[0], v[1], rs));
-                                }
-                            }
-                            Rule::learn_target => l.target = name(o),
-                            Rule::learn_when => {
-                                l.below =
-                                    o.into_inner().find(|x| x.as_rule() == Rule::number).map(|n| num(&n))
-                            }
-                            Rule::window => l.window = o.into_inner().next().map(quantity),
-                            _ => {}
-                        }
-                    }
-                    items.push(ModuleItem::Learn(l));
-                }
+                Rule::learn => items.push(ModuleItem::Learn(learn(c))),
                 Rule::reinforce => {
                     if let Some(e) = c.into_inner().next() {
                         let e = self.expr(e);
@@ -1374,81 +1372,110 @@ fn world(p: Pair<Rule>) -> WorldBlock {
                 items.push(WorldItem::Body { preset, items: body, span: csp });
             }
             Rule::inner_wall | Rule::cylinder | Rule::lamp_item | Rule::zone | Rule::start | Rule::place => {
-                let rule = c.as_rule();
-                let mut name_ = None;
-                let mut points = Vec::new();
-                let (mut diameter, mut height, mut intensity, mut grey, mut heading) =
-                    (None, None, None, None, None);
-                let mut switch = None;
-                let mut after = None;
-                let mut charger = false;
-                for o in c.into_inner() {
-                    match o.as_rule() {
-                        Rule::item_name => name_ = o.into_inner().next().map(name),
-                        Rule::point => {
-                            let mut q = o.into_inner().map(quantity);
-                            let q0 = Quantity { value: 0.0, unit: None, span: csp };
-                            let x = q.next().unwrap_or(q0.clone());
-                            let y = q.next().unwrap_or(q0);
-                            points.push(Point { x, y });
-                        }
-                        Rule::diameter => diameter = o.into_inner().next().map(quantity),
-                        Rule::lamp_height => height = o.into_inner().next().map(quantity),
-                        Rule::lamp_intensity => intensity = o.into_inner().next().map(quantity),
-                        Rule::lamp_switch => {
-                            let mut it = o.into_inner();
-                            let on = it.next().is_some_and(|w| w.as_str() == "on");
-                            switch = it.find(|q| q.as_rule() == Rule::quantity).map(|q| (on, quantity(q)));
-                        }
-                        Rule::zone_grey => grey = o.into_inner().next().map(quantity),
-                        Rule::zone_charger => charger = true,
-                        Rule::heading => heading = o.into_inner().next().map(quantity),
-                        Rule::place_after => {
-                            after = o.into_inner().find(|q| q.as_rule() == Rule::quantity).map(quantity)
-                        }
-                        _ => {}
-                    }
-                }
-                let q0 = Quantity { value: 0.0, unit: None, span: csp };
-                let p0 = Point { x: q0.clone(), y: q0.clone() };
-                let mut points = points.into_iter();
-                let first = points.next().unwrap_or(p0.clone());
-                let second = points.next();
-                items.push(match rule {
-                    Rule::inner_wall => {
-                        WorldItem::Wall { name: name_, from: first, to: second.unwrap_or(p0), span: csp }
-                    }
-                    Rule::cylinder => WorldItem::Cylinder {
-                        name: name_,
-                        at: first,
-                        diameter: diameter.unwrap_or(q0),
-                        span: csp,
-                    },
-                    Rule::lamp_item => {
-                        WorldItem::Lamp { name: name_, at: first, height, intensity, switch, span: csp }
-                    }
-                    Rule::zone => WorldItem::Zone {
-                        name: name_,
-                        from: first,
-                        to: second.unwrap_or(p0),
-                        grey,
-                        charger,
-                        span: csp,
-                    },
-                    Rule::place => WorldItem::Place {
-                        name: name_,
-                        at: first,
-                        heading: heading.unwrap_or(q0.clone()),
-                        after: after.unwrap_or(q0),
-                        span: csp,
-                    },
-                    _ => WorldItem::Start { from: first, to: second, heading, span: csp },
-                });
+                items.push(placed_item(c))
             }
             _ => {}
         }
     }
     WorldBlock { mode, items, span: sp }
+}
+
+/// A placed world item: `wall`, `cylinder`, `lamp`, `zone`, `start` or
+/// `place`, with its name, points and settings.
+fn placed_item(c: Pair<Rule>) -> WorldItem {
+    let csp = span(&c);
+    let rule = c.as_rule();
+    let mut name_ = None;
+    let mut points = Vec::new();
+    let (mut diameter, mut height, mut intensity, mut grey, mut heading) = (None, None, None, None, None);
+    let mut switch = None;
+    let mut after = None;
+    let mut charger = false;
+    for o in c.into_inner() {
+        match o.as_rule() {
+            Rule::item_name => name_ = o.into_inner().next().map(name),
+            Rule::point => {
+                let mut q = o.into_inner().map(quantity);
+                let q0 = Quantity { value: 0.0, unit: None, span: csp };
+                let x = q.next().unwrap_or(q0.clone());
+                let y = q.next().unwrap_or(q0);
+                points.push(Point { x, y });
+            }
+            Rule::diameter => diameter = o.into_inner().next().map(quantity),
+            Rule::lamp_height => height = o.into_inner().next().map(quantity),
+            Rule::lamp_intensity => intensity = o.into_inner().next().map(quantity),
+            Rule::lamp_switch => {
+                let mut it = o.into_inner();
+                let on = it.next().is_some_and(|w| w.as_str() == "on");
+                switch = it.find(|q| q.as_rule() == Rule::quantity).map(|q| (on, quantity(q)));
+            }
+            Rule::zone_grey => grey = o.into_inner().next().map(quantity),
+            Rule::zone_charger => charger = true,
+            Rule::heading => heading = o.into_inner().next().map(quantity),
+            Rule::place_after => after = o.into_inner().find(|q| q.as_rule() == Rule::quantity).map(quantity),
+            _ => {}
+        }
+    }
+    let q0 = Quantity { value: 0.0, unit: None, span: csp };
+    let p0 = Point { x: q0.clone(), y: q0.clone() };
+    let mut points = points.into_iter();
+    let first = points.next().unwrap_or(p0.clone());
+    let second = points.next();
+    match rule {
+        Rule::inner_wall => WorldItem::Wall { name: name_, from: first, to: second.unwrap_or(p0), span: csp },
+        Rule::cylinder => {
+            WorldItem::Cylinder { name: name_, at: first, diameter: diameter.unwrap_or(q0), span: csp }
+        }
+        Rule::lamp_item => WorldItem::Lamp { name: name_, at: first, height, intensity, switch, span: csp },
+        Rule::zone => {
+            WorldItem::Zone { name: name_, from: first, to: second.unwrap_or(p0), grey, charger, span: csp }
+        }
+        Rule::place => WorldItem::Place {
+            name: name_,
+            at: first,
+            heading: heading.unwrap_or(q0.clone()),
+            after: after.unwrap_or(q0),
+            span: csp,
+        },
+        _ => WorldItem::Start { from: first, to: second, heading, span: csp },
+    }
+}
+
+/// `learn crbp(RATE, RATE[, error ERROR]) on TARGET always|when ... [over N]`.
+fn learn(c: Pair<Rule>) -> LearnDecl {
+    let csp = span(&c);
+    let mut l = LearnDecl {
+        rates: None,
+        error: None,
+        target: Name { text: String::new(), span: csp },
+        below: None,
+        window: None,
+        span: csp,
+    };
+    for o in c.into_inner() {
+        match o.as_rule() {
+            Rule::rates => {
+                let rs = span(&o);
+                let mut v: Vec<f64> = Vec::new();
+                for n in o.into_inner() {
+                    match n.as_rule() {
+                        Rule::learn_error => l.error = Some(name(n)),
+                        _ => v.push(num(&n)),
+                    }
+                }
+                if v.len() == 2 {
+                    l.rates = Some((v[0], v[1], rs));
+                }
+            }
+            Rule::learn_target => l.target = name(o),
+            Rule::learn_when => {
+                l.below = o.into_inner().find(|x| x.as_rule() == Rule::number).map(|n| num(&n))
+            }
+            Rule::window => l.window = o.into_inner().next().map(quantity),
+            _ => {}
+        }
+    }
+    l
 }
 
 /// `proximity at [...] facing [...]`, `ground at [...]`.

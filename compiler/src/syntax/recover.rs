@@ -217,40 +217,7 @@ fn stage_items(
         return None;
     }
     let body = toks[i].span.end;
-    // Items: split at item words; a `}` at an item's own depth 0 closes the stage.
-    let mut items: Vec<(usize, usize)> = Vec::new();
-    let mut start = body;
-    let mut depth = 0i64;
-    let mut close = None;
-    // Inside a role's braces, its modules and links belong to the role's item.
-    let mut in_role = false;
-    for (j, t) in toks.iter().enumerate().skip(i + 1) {
-        let inner = in_role && depth > 0;
-        let starts = !inner && (starts_item(src, toks, j) || (depth == 0 && misspelt_item(src, toks, j)));
-        if starts {
-            in_role = word(src, Some(t)) == Some("role");
-        }
-        if starts && t.span.start > start {
-            items.push((start, t.span.start));
-            start = t.span.start;
-            depth = 0;
-        } else if starts {
-            depth = 0;
-        }
-        match punct(src, t) {
-            Some(b'{') => depth += 1,
-            Some(b'}') if depth == 0 => {
-                close = Some(t.span.start);
-                break;
-            }
-            Some(b'}') => depth -= 1,
-            _ => {}
-        }
-    }
-    let end = close.unwrap_or(b);
-    if src[start..end].trim() != "" || items.is_empty() {
-        items.push((start, end));
-    }
+    let (items, close) = split_items(src, toks, i, b);
     let mut errors = Vec::new();
     let mut last_kept = body;
     for &(s, e) in &items {
@@ -300,6 +267,46 @@ fn stage_items(
         }
     }
     Some(errors)
+}
+
+/// The items of a stage whose `{` is `toks[i]`, as byte ranges split at
+/// item words, and the stage's closing brace: a `}` at an item's own depth
+/// 0; without one the last item ends at `b`.
+fn split_items(src: &str, toks: &[Token], i: usize, b: usize) -> (Vec<(usize, usize)>, Option<usize>) {
+    let mut items: Vec<(usize, usize)> = Vec::new();
+    let mut start = toks[i].span.end;
+    let mut depth = 0i64;
+    let mut close = None;
+    // Inside a role's braces, its modules and links belong to the role's item.
+    let mut in_role = false;
+    for (j, t) in toks.iter().enumerate().skip(i + 1) {
+        let inner = in_role && depth > 0;
+        let starts = !inner && (starts_item(src, toks, j) || (depth == 0 && misspelt_item(src, toks, j)));
+        if starts {
+            in_role = word(src, Some(t)) == Some("role");
+        }
+        if starts && t.span.start > start {
+            items.push((start, t.span.start));
+            start = t.span.start;
+            depth = 0;
+        } else if starts {
+            depth = 0;
+        }
+        match punct(src, t) {
+            Some(b'{') => depth += 1,
+            Some(b'}') if depth == 0 => {
+                close = Some(t.span.start);
+                break;
+            }
+            Some(b'}') => depth -= 1,
+            _ => {}
+        }
+    }
+    let end = close.unwrap_or(b);
+    if src[start..end].trim() != "" || items.is_empty() {
+        items.push((start, end));
+    }
+    (items, close)
 }
 
 /// What the wrapper of a lone item of a role adds before it.

@@ -13,7 +13,7 @@ use shaping_runtime::program::{
 };
 
 use crate::episode::{Episode, EPISODE_FORMAT};
-use crate::error::Error;
+use crate::error::{Error, ErrorKind};
 use crate::files::{read_checked, Unsealed};
 use crate::rundir::{ExperimentSummary, GenRow, PointSummary, StageFigures};
 use crate::{load, rundir};
@@ -155,11 +155,6 @@ fn read_sealed(path: &Path, u: Unsealed<'_>) -> Result<Vec<u8>, Error> {
         .ok_or_else(|| Error::io(format!("error: cannot read `{}`: there is no such file", path.display())))
 }
 
-fn read_text(path: &Path, u: Unsealed<'_>) -> Result<String, Error> {
-    let bytes = read_sealed(path, u)?;
-    String::from_utf8(bytes).map_err(|_| Error::io(format!("error: `{}` is not UTF-8 text", path.display())))
-}
-
 fn read_episode(path: &Path, u: Unsealed<'_>) -> Result<Episode, Error> {
     let bytes = read_sealed(path, u)?;
     let ep: Episode = serde_json::from_slice(&bytes).map_err(|e| {
@@ -192,21 +187,18 @@ fn read_episode(path: &Path, u: Unsealed<'_>) -> Result<Episode, Error> {
 /// The genome in `path` (`None` when there is no such file: the stage has
 /// not run); one that is not a genome of `stage` is an error naming it.
 fn read_genome(path: &Path, stage: &Stage, u: Unsealed<'_>) -> Result<Option<Genome>, Error> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let text = read_text(path, u)?;
-    let bad = |what: String| {
-        Error::io(format!("error: `{}` is not a genome of stage `{}`: {what}", path.display(), stage.name))
-    };
-    let genome =
-        Genome::from_bitstring(text.trim()).ok_or_else(|| bad("it is not a string of 0 and 1".into()))?;
+    let Some(genome) = rundir::read_sealed_genome(path, u)? else { return Ok(None) };
     if genome.bits.len() != stage.layout.bits as usize {
-        return Err(bad(format!(
-            "it has {} bits, the stage's genome {}",
-            genome.bits.len(),
-            stage.layout.bits
-        )));
+        return Err(Error::new(
+            ErrorKind::Corrupt,
+            format!(
+                "error: `{}` is not a genome of stage `{}`: it has {} bits, the stage's genome {}",
+                path.display(),
+                stage.name,
+                genome.bits.len(),
+                stage.layout.bits
+            ),
+        ));
     }
     Ok(Some(genome))
 }

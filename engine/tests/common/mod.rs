@@ -12,7 +12,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use shaping_engine::diag::ErrorFormat;
 use shaping_engine::experiment::{ExperimentOptions, Finished, Plan};
 use shaping_engine::files::DirLock;
-use shaping_engine::run::{Event, Observer, RunOptions, RunOutcome, Runner};
+use shaping_engine::run::{Event, Observer, RunOptions, RunOutcome};
+use shaping_engine::Engine;
 use shaping_engine::Error;
 use shaping_runtime::program::Program;
 
@@ -68,7 +69,7 @@ pub fn sets(values: &[&str]) -> Vec<(String, String)> {
 
 /// Runs `program` with no observer, evaluator or interruption.
 pub fn run(program: Program, opts: &RunOptions) -> Result<RunOutcome, Error> {
-    Runner::default().run(program, opts)
+    Engine::default().run(program, opts)
 }
 
 /// The error of what should have failed.
@@ -86,7 +87,7 @@ pub fn experiment(program: Program, opts: ExperimentOptions) -> Result<Finished,
     let plan = Plan::new(program, opts)?;
     let _lock = plan.lock()?;
     for task in plan.tasks() {
-        plan.run_task(task, jobs, &Runner::default())?;
+        plan.run_task(task, jobs, &Engine::default())?;
     }
     plan.finish()
 }
@@ -201,8 +202,8 @@ impl Log {
     }
 
     /// A runner that tells this log.
-    pub fn runner(&self) -> Runner<'_> {
-        Runner { observer: self, ..Runner::default() }
+    pub fn runner(&self) -> Engine<'_> {
+        Engine { observer: self, ..Engine::default() }
     }
 }
 
@@ -239,8 +240,8 @@ impl<'a> StopAfter<'a> {
     }
 
     /// A runner stopped by this observer.
-    pub fn runner(&self) -> Runner<'_> {
-        Runner { observer: self, evaluator: None, interrupt: Some(self.flag) }
+    pub fn runner(&self) -> Engine<'_> {
+        Engine { observer: self, evaluator: None, interrupt: Some(self.flag) }
     }
 }
 

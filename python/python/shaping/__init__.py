@@ -16,7 +16,10 @@ stage's robot from a reinforcement-learning library (``shaping.gym``, with
 (n,)
 
 Errors of shaping raise :class:`ShapingError` (its text is the command
-line's message, its ``kind`` says which kind of error it is); wrong
+line's message, its ``kind`` says which kind of error it is), or its
+subclass of that kind (:class:`CompileError`, :class:`CorruptError`,
+:class:`StaleError`, :class:`LockedError`, :class:`EvaluationError`, and
+:class:`NotFoundError`, also a ``FileNotFoundError``); wrong
 arguments (a stage that does not exist, a genome array of the wrong shape,
 dtype or values) raise :class:`ValueError`.
 """
@@ -29,6 +32,12 @@ from ._shaping import (
     Program,
     Run,
     ShapingError,
+    CompileError,
+    CorruptError,
+    StaleError,
+    LockedError,
+    EvaluationError,
+    NotFoundError,
     check,
     compile,
     experiment,
@@ -68,6 +77,12 @@ __all__ = [
     "Program",
     "Run",
     "ShapingError",
+    "CompileError",
+    "CorruptError",
+    "StaleError",
+    "LockedError",
+    "EvaluationError",
+    "NotFoundError",
     "check",
     "compile",
     "experiment",

@@ -8,6 +8,12 @@ import numpy.typing as npt
 
 __all__ = [
     "ShapingError",
+    "CompileError",
+    "CorruptError",
+    "StaleError",
+    "LockedError",
+    "EvaluationError",
+    "NotFoundError",
     "SQUARE_MM",
     "Diagnostic",
     "Program",
@@ -34,13 +40,31 @@ SQUARE_MM: float
 class ShapingError(Exception):
     """An error of shaping: the text is the command line's message.
 
-    ``kind`` is one of "diagnostics", "io", "corrupt", "stale",
+    ``kind`` is one of "diagnostics", "io", "not_found", "corrupt", "stale",
     "interrupted", "memory", "invalid", "locked", "evaluation"; a file with
     errors also has ``diagnostics`` (a list of :class:`Diagnostic`).
     """
 
     kind: str
     diagnostics: list[Diagnostic]
+
+class CompileError(ShapingError):
+    """A file with errors (kind "diagnostics"): ``diagnostics`` has them."""
+
+class CorruptError(ShapingError):
+    """A saved file is damaged (kind "corrupt")."""
+
+class StaleError(ShapingError):
+    """A saved result belongs to another program, seed or setting (kind "stale")."""
+
+class LockedError(ShapingError):
+    """The run directory is in use by another process (kind "locked")."""
+
+class EvaluationError(ShapingError):
+    """Evaluation failed: a robot link, a rank of a cluster (kind "evaluation")."""
+
+class NotFoundError(FileNotFoundError, ShapingError):
+    """A file or directory that does not exist (kind "not_found")."""
 
 @final
 class Diagnostic:
