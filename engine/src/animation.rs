@@ -4,7 +4,8 @@
 //! it after an action (the objects where they were, held ones in the
 //! gripper, those thrown out gone) and of its path so far, coloured by the
 //! module that won each action (a team's other robots: their paths so far
-//! and bodies, one colour each); the strip above the arena shows the
+//! and bodies, one colour each, or their role's in a team of roles; `replay
+//! --robot N` draws the team as robot N lived it); the strip above the arena shows the
 //! battery as a bar and the action's number (drawn with a small built-in
 //! digit font, so a frame looks the same whatever fonts the machine has).
 //! At most [`MAX_FRAMES`] frames: a longer episode is subsampled evenly,
@@ -56,9 +57,21 @@ pub fn frame_actions(actions: usize, max: usize) -> Vec<usize> {
 /// `scene` (the world before the first action: what does not move, and
 /// which objects are virtual) and the episode's per-action columns.
 pub fn frames(scene: &Scene, episode: &Episode) -> Result<Vec<Rgb>, Error> {
+    frames_of_team(scene, episode, &[], 0)
+}
+
+/// [`frames`] of a team of `roles` (names and robots, in order; empty
+/// without roles), each robot outlined in its role's colour, as lived by
+/// robot `robot` (the episode is [`Episode::following`] it; 0 otherwise).
+pub fn frames_of_team(
+    scene: &Scene,
+    episode: &Episode,
+    roles: &[(String, u32)],
+    robot: usize,
+) -> Result<Vec<Rgb>, Error> {
     let c = &episode.actions;
     let end = episode.worlds.get(1).map_or(c.x.len(), |w| w.from as usize).min(c.x.len());
-    let base = report::picture(scene, Vec::new());
+    let base = plot::TrajectoryScene { roles: roles.to_vec(), robot, ..report::picture(scene, Vec::new()) };
     let mut objects = base.objects.clone();
     let mut changes = c.objects.iter().peekable();
     let mut out = Vec::new();

@@ -337,7 +337,8 @@ pub fn replay(
     let mut animations = Vec::new();
     if args.gif.is_some() || args.mp4.is_some() {
         let following = team.as_ref().map(|t| ep.following(t, robot));
-        let frames = animation::frames(&scene, following.as_ref().unwrap_or(&ep))?;
+        let roles: Vec<(String, u32)> = stage.roles.iter().map(|r| (r.name.clone(), r.robots)).collect();
+        let frames = animation::frames_of_team(&scene, following.as_ref().unwrap_or(&ep), &roles, robot)?;
         if let Some(path) = &args.gif {
             animation::write_gif(path, &frames)?;
             animations.push(path.clone());
