@@ -392,6 +392,13 @@ fn a_replay_follows_the_robot_asked_for() {
     assert!(xs.iter().zip(&cols).all(|(a, b)| (a - b).abs() < 0.006), "{xs:?} {cols:?}");
     assert!(read_text(&d.join("two/report.html")).contains("\"follow\":2"));
 
+    // Columns that are not of the episode beside them: the report says so.
+    let mut other: shaping_engine::episode::TeamColumns = serde_json::from_value(robots.clone()).unwrap();
+    other.robots.truncate(1);
+    shaping_engine::rundir::write_robots(&d.join("two"), &other).unwrap();
+    let err = shaping_engine::html::write(&d.join("two"), None).unwrap_err();
+    assert!(err.message().contains("robots.json` is not of the episode beside it"), "{err}");
+
     let err = replay::replay(program.clone(), &args(3, "three"), &Log::default()).unwrap_err();
     assert_eq!(err.message(), "error: `--robot 3`: stage `first` has 3 robots, 0 to 2");
     let err = replay::replay(team(load(&tiny_bat()), 1), &args(1, "one"), &Log::default()).unwrap_err();
