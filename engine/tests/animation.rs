@@ -10,13 +10,16 @@ use shaping_runtime::controller::EpisodeOptions;
 use shaping_runtime::genome::Genome;
 
 /// The best individual of `examples/aggregation.bat` with 24 robots in a
-/// 930 x 930 mm arena (the example's density) after 6 generations of 20
-/// (`--set aggregate.evolve.actions=200`): robots that go about the arena.
-const EVOLVED: &str = "11110110111101110100000000101110001100010001001110010110001101000010110100100111010000100110011000101011011011111111011111001100001000101101110001011101001010110010000110110100";
+/// 930 x 930 mm arena (the example's density) after 25 generations of 30
+/// (`--set aggregate.evolve.actions=200 --set aggregate.evolve.evaluations=1`):
+/// robots that go about the arena all the time (every robot's pixels
+/// change in every frame, which is what the GIF holds).
+const EVOLVED: &str = "10001110011100100001000010011000000011010100000110000011011000101001010001001110011000000010111000111100010001111101111110100110010110101101110111010100001010010010010010100100";
 
 /// The measured episode: that individual's 200 actions (seed 1), whose GIF
-/// took 4,730,506 bytes when each frame was the whole rectangle that
-/// changed in a palette of its own, and takes 1,505,647 now.
+/// took 3,222,945 bytes when each frame was the whole rectangle that
+/// changed in a palette of its own, and takes 2,065,831 now (an individual
+/// of 6 generations: 4,730,506 then, 1,505,647 now).
 #[test]
 fn the_gif_of_24_robots_over_200_actions_is_at_most_3_mb() {
     let mut program = load(&root().join("examples/aggregation.bat"));
@@ -29,11 +32,11 @@ fn the_gif_of_24_robots_over_200_actions_is_at_most_3_mb() {
     let rec =
         episode::record(stage, &genome, &EpisodeOptions { actions: 200, learning: true, seed: 1 }).unwrap();
     assert_eq!(rec.episode.actions.x.len(), 200);
-    let moved = rec.others.iter().filter(|o| {
-        let (a, b) = (&o.trace.rows[0].pose, &o.trace.rows[199].pose);
-        (a.x - b.x).hypot(a.y - b.y) > 50.0
-    });
-    assert!(moved.count() >= 8, "robots go about the arena");
+    let travelled = |o: &episode::OtherRobot| -> f32 {
+        o.trace.rows.windows(2).map(|w| (w[1].pose.x - w[0].pose.x).hypot(w[1].pose.y - w[0].pose.y)).sum()
+    };
+    let moved = rec.others.iter().filter(|o| travelled(o) > 200.0).count();
+    assert!(moved >= 16, "robots go about the arena: {moved} of 23 went 200 mm");
     let frames = animation::frames(&rec.scene, &rec.episode).unwrap();
     assert_eq!(frames.len(), 200, "a frame per action: none dropped");
     let bytes = animation::gif(&frames).unwrap();
