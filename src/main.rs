@@ -247,6 +247,12 @@ enum Command {
         /// Change a setting as the run did (`--set` of `run`, one value each).
         #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
         sets: Vec<sweep::Set>,
+        /// The robot of a team the pictures, the report and the animations follow.
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        robot: u32,
+        /// Live in this declared variant of the stage's world.
+        #[arg(long, value_name = "NAME")]
+        variant: Option<String>,
         #[arg(long, default_value = "human", value_parser = error_format())]
         error_format: ErrorFormat,
     },
@@ -531,6 +537,8 @@ fn run_command(command: Command) -> Result<(), CliError> {
             gif,
             mp4,
             sets,
+            robot,
+            variant,
             error_format,
         } => replay::replay(
             shaping_engine::replay::ReplayOptions {
@@ -546,6 +554,8 @@ fn run_command(command: Command) -> Result<(), CliError> {
                 gif,
                 mp4,
                 sets: single_values(sets, "replay")?,
+                robot,
+                variant,
             },
             error_format,
         ),

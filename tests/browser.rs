@@ -288,3 +288,133 @@ window.addEventListener('load', () => {
     assert_eq!(log[7], at(played), "the fragment follows the replay");
     assert_eq!(log[8], "7 navigation #stage=navigation&action=7", "a changed fragment moves the replay");
 }
+
+/// Runs `examples/aggregation-roles.bat` briefly into `dir` (a team of 10
+/// robots in two roles) and replays its best with `--report` into
+/// `dir/replay` (and `extra` arguments). Returns the replay's report and
+/// its `trace.csv`'s header and rows (every robot's, a `robot` column
+/// first).
+fn team_run(dir: &Path, extra: &[&str]) -> (PathBuf, Vec<String>, Vec<Vec<String>>) {
+    let file = root().join("examples/aggregation-roles.bat");
+    let sets =
+        ["aggregate.evolve.generations=1", "aggregate.evolve.population=4", "aggregate.evolve.actions=60"];
+    let sets: Vec<String> = sets.iter().flat_map(|s| ["--set".to_string(), s.to_string()]).collect();
+    if !dir.join("aggregate/best.genome").exists() {
+        let out = shaping()
+            .arg("run")
+            .arg(&file)
+            .arg("--out")
+            .arg(dir)
+            .arg("--quiet")
+            .args(&sets)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let replay = dir.join("replay");
+    let out = shaping()
+        .arg("replay")
+        .arg(&file)
+        .arg("--run")
+        .arg(dir)
+        .arg("--out")
+        .arg(&replay)
+        .arg("--report")
+        .args(&sets)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let trace = std::fs::read_to_string(replay.join("trace.csv")).unwrap();
+    let header = trace.lines().next().unwrap().split(',').map(str::to_string).collect();
+    let rows = trace.lines().skip(1).map(|l| l.split(',').map(str::to_string).collect()).collect();
+    (replay.join("report.html"), header, rows)
+}
+
+/// Checks that the page shows robot `robot` at `action`: its number, role
+/// and position as `trace.csv` has them.
+fn follows(dom: &str, header: &[String], rows: &[Vec<String>], robot: usize, action: usize, role: &str) {
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let row = rows
+        .iter()
+        .find(|r| r[col("robot")] == robot.to_string() && r[col("action")] == action.to_string())
+        .unwrap_or_else(|| panic!("no row of robot {robot} at action {action}"));
+    assert_eq!(body_attr(dom, "data-robot"), Some(robot.to_string().as_str()), "the robot followed");
+    assert_eq!(text_of(dom, "r-action"), action.to_string());
+    assert_eq!(text_of(dom, "r-robot"), format!("{robot} of 10, role {role}"));
+    for (id, c) in [("r-x", "x"), ("r-y", "y")] {
+        let shown: f64 = text_of(dom, id).parse().unwrap();
+        let csv: f64 = row[col(c)].parse().unwrap();
+        assert!(
+            (shown - csv).abs() <= 0.011,
+            "robot {robot}'s {c} at action {action}: page {shown}, trace.csv {csv}"
+        );
+    }
+}
+
+/// The report of a team follows any robot: `#robot=N` selects robot N on
+/// load; the selector changes the robot followed and the address with it;
+/// a robot the team does not have is said, not followed.
+#[test]
+fn the_report_of_a_team_follows_any_robot() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("team");
+    let (page, header, rows) = team_run(&dir, &[]);
+
+    // A deep link to robot 7 (of the second role) at action 30.
+    let url = format!("{}#stage=aggregate&action=30&robot=7", file_url(&page));
+    let out = headless(&browser, &scratch("profile-team"), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(body_attr(&dom, "data-ready"), Some("1"), "the page's script did not finish");
+    assert_eq!(body_attr(&dom, "data-errors"), None, "the page reported errors: {}", text_of(&dom, "errors"));
+    follows(&dom, &header, &rows, 7, 30, "second");
+
+    // The selector: robot 2, then the address and the readout follow it.
+    let html = std::fs::read_to_string(&page).unwrap();
+    let driver = r#"<script>
+window.addEventListener('load', () => {
+  const log = [];
+  const sel = document.getElementById('robot');
+  log.push(sel.options.length + ' ' + sel.options[7].textContent);
+  sel.value = '2'; sel.dispatchEvent(new Event('change'));
+  log.push(location.hash);
+  document.body.dataset.driven = JSON.stringify(log);
+});
+</script>
+</body>"#;
+    let driven = dir.join("driven.html");
+    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
+    let url = format!("{}#stage=aggregate&action=12&robot=7", file_url(&driven));
+    let out = headless(&browser, &scratch("profile-team-select"), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let log: Vec<String> = serde_json::from_str(
+        &body_attr(&dom, "data-driven")
+            .expect("the driver ran")
+            .replace("&quot;", "\"")
+            .replace("&amp;", "&"),
+    )
+    .unwrap();
+    assert_eq!(log[0], "10 robot 7 (second)", "one entry per robot, with its role");
+    assert_eq!(log[1], "#stage=aggregate&action=12&robot=2", "the address follows the selector");
+    follows(&dom, &header, &rows, 2, 12, "first");
+
+    // A robot the team does not have: said, and robot 0 followed.
+    let url = format!("{}#stage=aggregate&action=5&robot=12", file_url(&page));
+    let out = headless(&browser, &scratch("profile-team-bad"), &url, "--dump-dom");
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(body_attr(&dom, "data-errors"), None);
+    assert!(text_of(&dom, "robot-note").contains("no robot 12 in this episode (robots 0 to 9)"));
+    follows(&dom, &header, &rows, 0, 5, "first");
+
+    // `replay --robot 4`: its report follows robot 4 when it opens.
+    let (page, header, rows) = team_run(&dir, &["--robot", "4"]);
+    let url = format!("{}#stage=aggregate&action=9", file_url(&page));
+    let out = headless(&browser, &scratch("profile-team-replay"), &url, "--dump-dom");
+    let dom = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(body_attr(&dom, "data-errors"), None);
+    follows(&dom, &header, &rows, 4, 9, "first");
+}

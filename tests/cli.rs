@@ -946,3 +946,40 @@ fn compare_prints_the_tests_of_two_experiments() {
     assert!(err.contains("no test: `") && err.contains("needs at least 2 seeds per side"), "{err}");
     assert_eq!(run(shaping().arg("compare").arg(&a)).status.code(), Some(2));
 }
+
+/// `replay --robot N` of a robot the team does not have, and `--variant`
+/// of a variant the stage does not declare: exit 2, saying what and where,
+/// nothing written.
+#[test]
+fn replay_refuses_a_robot_or_a_variant_the_stage_does_not_have() {
+    let dir = scratch("replay-robot");
+    let file = root().join("examples/aggregation.bat");
+    let genome = "0".repeat(176);
+    let replay = |extra: &[&str]| {
+        run(shaping()
+            .arg("replay")
+            .arg(&file)
+            .args(["--genome", &genome, "--actions", "5"])
+            .arg("--out")
+            .arg(dir.join("out"))
+            .args(extra))
+    };
+    let out = replay(&["--robot", "10"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("`--robot 10`: stage `aggregate` has 10 robots, 0 to 9"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = replay(&["--variant", "dark"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("`--variant dark`: stage `aggregate` declares no variants"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!dir.join("out").exists(), "nothing written");
+    let out = replay(&["--robot", "9"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    assert!(dir.join("out/robots.json").exists());
+}

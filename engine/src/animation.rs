@@ -4,16 +4,19 @@
 //! it after an action (the objects where they were, held ones in the
 //! gripper, those thrown out gone) and of its path so far, coloured by the
 //! module that won each action (a team's other robots: their paths so far
-//! and bodies, one colour each); the strip above the arena shows the
+//! and bodies, one colour each, or their role's in a team of roles; `replay
+//! --robot N` draws the team as robot N lived it); the strip above the arena shows the
 //! battery as a bar and the action's number (drawn with a small built-in
 //! digit font, so a frame looks the same whatever fonts the machine has).
 //! At most [`MAX_FRAMES`] frames: a longer episode is subsampled evenly,
 //! and the last action is always the last frame.
 //!
 //! The GIF is written by the `gif` crate (the encoder plotters' own GIF
-//! backend uses) in memory, each frame only the rectangle that changed
-//! since the one before (so a 300-frame episode takes a few hundred
-//! kilobytes), then written whole like every other file; plotters'
+//! backend uses) in memory, in one palette for all frames, each frame only
+//! the rectangle that changed since the one before with its unchanged
+//! pixels transparent (so a 300-frame episode of one robot takes a few
+//! hundred kilobytes, and one of 24 robots over 200 actions under 3 MB),
+//! then written whole like every other file; plotters'
 //! `BitMapBackend::gif` would write every frame whole, straight into the
 //! target file as it draws. The MP4 is the same frames piped to `ffmpeg`, which must be on the
 //! `PATH`.
@@ -54,9 +57,21 @@ pub fn frame_actions(actions: usize, max: usize) -> Vec<usize> {
 /// `scene` (the world before the first action: what does not move, and
 /// which objects are virtual) and the episode's per-action columns.
 pub fn frames(scene: &Scene, episode: &Episode) -> Result<Vec<Rgb>, Error> {
+    frames_of_team(scene, episode, &[], 0)
+}
+
+/// [`frames`] of a team of `roles` (names and robots, in order; empty
+/// without roles), each robot outlined in its role's colour, as lived by
+/// robot `robot` (the episode is [`Episode::following`] it; 0 otherwise).
+pub fn frames_of_team(
+    scene: &Scene,
+    episode: &Episode,
+    roles: &[(String, u32)],
+    robot: usize,
+) -> Result<Vec<Rgb>, Error> {
     let c = &episode.actions;
     let end = episode.worlds.get(1).map_or(c.x.len(), |w| w.from as usize).min(c.x.len());
-    let base = report::picture(scene, Vec::new());
+    let base = plot::TrajectoryScene { roles: roles.to_vec(), robot, ..report::picture(scene, Vec::new()) };
     let mut objects = base.objects.clone();
     let mut changes = c.objects.iter().peekable();
     let mut out = Vec::new();
@@ -175,25 +190,94 @@ fn overlay(f: &mut Rgb, battery: f32, action: usize, actions: usize) {
     }
 }
 
+/// The index of the transparent colour in a GIF's palette: a pixel the
+/// frame before showed already.
+const CLEAR: u8 = 255;
+
+/// One palette of at most 255 colours for every frame (index [`CLEAR`] is
+/// transparent): the colours of the first and last frames when they are
+/// that few (a picture of flat colours: exact), else NeuQuant's 255 for
+/// them; every pixel is then its nearest palette colour.
+struct Palette {
+    rgb: Vec<[u8; 3]>,
+    known: std::collections::HashMap<[u8; 3], u8>,
+}
+
+impl Palette {
+    fn of(frames: &[Rgb]) -> Palette {
+        let sample: Vec<&Rgb> = match (frames.first(), frames.last()) {
+            (Some(a), Some(b)) => vec![a, b],
+            _ => Vec::new(),
+        };
+        let mut seen = std::collections::HashMap::new();
+        let mut rgb: Vec<[u8; 3]> = Vec::new();
+        'count: for f in &sample {
+            for p in f.pixels.chunks_exact(3) {
+                let c = [p[0], p[1], p[2]];
+                if seen.contains_key(&c) {
+                    continue;
+                }
+                if rgb.len() == usize::from(CLEAR) {
+                    rgb.clear();
+                    break 'count;
+                }
+                seen.insert(c, rgb.len() as u8);
+                rgb.push(c);
+            }
+        }
+        if rgb.is_empty() && !sample.is_empty() {
+            seen.clear();
+            let rgba: Vec<u8> = sample
+                .iter()
+                .flat_map(|f| f.pixels.chunks_exact(3))
+                .flat_map(|p| [p[0], p[1], p[2], 255])
+                .collect();
+            let nq = color_quant::NeuQuant::new(10, usize::from(CLEAR), &rgba);
+            rgb = nq.color_map_rgb().chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        }
+        Palette { rgb, known: seen }
+    }
+
+    /// The index of the palette colour nearest `c`.
+    fn index(&mut self, c: [u8; 3]) -> u8 {
+        if let Some(&i) = self.known.get(&c) {
+            return i;
+        }
+        let d = |p: &[u8; 3]| (0..3).map(|k| (i32::from(p[k]) - i32::from(c[k])).pow(2)).sum::<i32>();
+        let i = (0..self.rgb.len()).min_by_key(|&i| d(&self.rgb[i])).unwrap_or(0) as u8;
+        self.known.insert(c, i);
+        i
+    }
+
+    /// The table the GIF holds: 256 colours, the transparent one last.
+    fn table(&self) -> Vec<u8> {
+        let mut t: Vec<u8> = self.rgb.iter().flatten().copied().collect();
+        t.resize(256 * 3, 255);
+        t
+    }
+}
+
 /// The bounding box `(x, y, w, h)` of the pixels that differ between two
-/// frames of one size; `None` when none does.
-fn changed(a: &Rgb, b: &Rgb) -> Option<(u32, u32, u32, u32)> {
-    let (w, h) = (a.width as usize, a.height as usize);
+/// frames of palette indices of width `w`; `None` when none does.
+fn changed_indices(a: &[u8], b: &[u8], w: usize) -> Option<(u32, u32, u32, u32)> {
+    let h = a.len() / w.max(1);
     let (mut x0, mut y0, mut x1, mut y1) = (w, h, 0, 0);
     for y in 0..h {
-        let (ra, rb) = (&a.pixels[y * w * 3..(y + 1) * w * 3], &b.pixels[y * w * 3..(y + 1) * w * 3]);
+        let (ra, rb) = (&a[y * w..(y + 1) * w], &b[y * w..(y + 1) * w]);
         if ra == rb {
             continue;
         }
-        let first = (0..w).find(|&x| ra[x * 3..x * 3 + 3] != rb[x * 3..x * 3 + 3]).unwrap_or(0);
-        let last = (0..w).rev().find(|&x| ra[x * 3..x * 3 + 3] != rb[x * 3..x * 3 + 3]).unwrap_or(0);
+        let first = (0..w).find(|&x| ra[x] != rb[x]).unwrap_or(0);
+        let last = (0..w).rev().find(|&x| ra[x] != rb[x]).unwrap_or(0);
         (x0, x1, y0, y1) = (x0.min(first), x1.max(last + 1), y0.min(y), y + 1);
     }
     (x1 > x0).then(|| (x0 as u32, y0 as u32, (x1 - x0) as u32, (y1 - y0) as u32))
 }
 
-/// The frames as an animated GIF that loops: the first whole, each later
-/// one as the rectangle that changed (drawn over the frame before).
+/// The frames as an animated GIF that loops, in one palette for all
+/// ([`Palette`]): the first whole, each later one as the rectangle that
+/// changed (drawn over the frame before), in which the pixels that did not
+/// change are transparent (long runs of one index, which LZW packs small).
 pub fn gif(frames: &[Rgb]) -> Result<Vec<u8>, String> {
     let first = frames.first().ok_or("no frames to animate")?;
     let (w, h) = (first.width, first.height);
@@ -202,29 +286,36 @@ pub fn gif(frames: &[Rgb]) -> Result<Vec<u8>, String> {
     }
     let side =
         |v: u32| u16::try_from(v).map_err(|_| format!("a frame of {w} x {h} pixels is too large for a GIF"));
+    let mut palette = Palette::of(frames);
     let mut bytes = Vec::new();
     {
-        let mut enc = gif::Encoder::new(&mut bytes, side(w)?, side(h)?, &[]).map_err(|e| e.to_string())?;
+        let mut enc =
+            gif::Encoder::new(&mut bytes, side(w)?, side(h)?, &palette.table()).map_err(|e| e.to_string())?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(|e| e.to_string())?;
-        let mut prev: Option<&Rgb> = None;
+        let mut prev: Option<Vec<u8>> = None;
         for f in frames {
-            let (x, y, fw, fh) = match prev {
+            let now: Vec<u8> = f.pixels.chunks_exact(3).map(|p| palette.index([p[0], p[1], p[2]])).collect();
+            let (x, y, fw, fh) = match &prev {
                 None => (0, 0, w, h),
                 // An unchanged frame still takes its time: one pixel.
-                Some(p) => changed(p, f).unwrap_or((0, 0, 1, 1)),
+                Some(p) => changed_indices(p, &now, w as usize).unwrap_or((0, 0, 1, 1)),
             };
-            let mut part = Vec::with_capacity(fw as usize * fh as usize * 3);
+            let mut part = Vec::with_capacity(fw as usize * fh as usize);
             for row in y..y + fh {
-                let from = (row as usize * w as usize + x as usize) * 3;
-                part.extend_from_slice(&f.pixels[from..from + fw as usize * 3]);
+                let from = row as usize * w as usize + x as usize;
+                let cells = from..from + fw as usize;
+                match &prev {
+                    None => part.extend_from_slice(&now[cells]),
+                    Some(p) => part.extend(cells.map(|i| if p[i] == now[i] { CLEAR } else { now[i] })),
+                }
             }
-            let mut frame = gif::Frame::from_rgb_speed(side(fw)?, side(fh)?, &part, 10);
+            let mut frame = gif::Frame::from_indexed_pixels(side(fw)?, side(fh)?, part, Some(CLEAR));
             frame.left = side(x)?;
             frame.top = side(y)?;
             frame.delay = FRAME_DELAY_CS;
             frame.dispose = gif::DisposalMethod::Keep;
             enc.write_frame(&frame).map_err(|e| e.to_string())?;
-            prev = Some(f);
+            prev = Some(now);
         }
     }
     Ok(bytes)

@@ -445,9 +445,161 @@ impl Episode {
         }
     }
 
+    /// This episode as robot `robot` of the team lived it (`team`: the
+    /// others' columns, [`TeamColumns`]): its columns, modules and starts
+    /// in place of robot 0's, the others' poses (robot 0's among them, in
+    /// the order of their numbers) around it; itself for robot 0 or a
+    /// robot `team` does not have.
+    pub fn following(&self, team: &TeamColumns, robot: usize) -> Episode {
+        let Some(mine) = robot.checked_sub(1).and_then(|k| team.robots.get(k)) else { return self.clone() };
+        let c0 = &self.actions;
+        let pose = |j: usize| match j {
+            0 => PoseColumns { x: c0.x.clone(), y: c0.y.clone(), theta: c0.theta.clone() },
+            _ => c0.others.get(j - 1).cloned().unwrap_or_default(),
+        };
+        let nums: Vec<usize> = (0..=c0.others.len()).filter(|&j| j != robot).collect();
+        let mut actions = mine.actions.clone();
+        actions.objects.clone_from(&c0.objects);
+        actions.others = nums.iter().map(|&j| pose(j)).collect();
+        let worlds = self
+            .worlds
+            .iter()
+            .map(|w| {
+                let start = |j: usize| if j == 0 { Some(w.start) } else { w.others.get(j - 1).copied() };
+                let others = if w.others.len() >= robot {
+                    nums.iter().filter_map(|&j| start(j)).collect()
+                } else {
+                    Vec::new()
+                };
+                EpisodeWorld { start: start(robot).unwrap_or(w.start), others, ..w.clone() }
+            })
+            .collect();
+        Episode { modules: mine.modules.clone(), worlds, actions, ..self.clone() }
+    }
+
     /// The robots of the team in world `w` (1 for one robot).
     pub fn robots_in(&self, w: usize) -> usize {
         1 + self.worlds.get(w).map_or(0, |x| x.others.len())
+    }
+}
+
+/// Version of `robots.json`.
+pub const ROBOTS_FORMAT: u32 = 1;
+
+/// `robots.json`, beside a team's `episode.json` (which keeps robot 0's
+/// columns and only the poses of the others, as it always has): every
+/// other robot's columns, for the report to follow any robot.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TeamColumns {
+    pub format: u32,
+    /// The robot a replay follows (`replay --robot N`): the report shows
+    /// it first; 0 for a run's episode.
+    #[serde(default)]
+    pub follow: u32,
+    /// The role robot 0 plays, in a team of roles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub role: Option<String>,
+    /// Robots 1, 2, ... in order.
+    pub robots: Vec<RobotColumns>,
+}
+
+/// One robot of a team ([`TeamColumns`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RobotColumns {
+    pub robot: u32,
+    /// The role it plays, in a team of roles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub role: Option<String>,
+    /// Its modules (its role's), the columns of `actions`' per-module ones.
+    pub modules: Vec<String>,
+    /// Its columns, as long as the episode's (an action of a world it was
+    /// not in repeats its last row, or is zeros before its first); without
+    /// `objects` and `others`.
+    pub actions: EpisodeColumns,
+}
+
+impl TeamColumns {
+    /// The columns of a team's `others` (of an episode of `actions`
+    /// actions), robot `follow` followed; `None` for one robot.
+    pub fn of(
+        stage: &shaping_runtime::program::Stage,
+        others: &[OtherRobot],
+        actions: usize,
+        follow: u32,
+    ) -> Option<TeamColumns> {
+        let most = others.iter().map(|o| o.robot).max()?;
+        let robots = (1..=most)
+            .map(|j| {
+                let mut rows: Vec<(&TraceRow, &EpisodeColumns, usize)> = others
+                    .iter()
+                    .filter(|o| o.robot == j)
+                    .flat_map(|o| o.trace.rows.iter().enumerate().map(move |(k, r)| (r, &o.sensed, k)))
+                    .collect();
+                rows.sort_by_key(|(r, ..)| r.action);
+                let modules =
+                    others.iter().find(|o| o.robot == j).map(|o| o.trace.modules.clone()).unwrap_or_default();
+                let mut c = EpisodeColumns::new(modules.len());
+                let mut next = rows.iter().peekable();
+                let mut last: Option<(&TraceRow, &EpisodeColumns, usize)> = None;
+                for a in 0..actions {
+                    while let Some(&&(r, sensed, k)) = next.peek() {
+                        if r.action as usize > a {
+                            break;
+                        }
+                        if r.action as usize == a {
+                            last = Some((r, sensed, k));
+                        }
+                        next.next();
+                    }
+                    match last {
+                        Some((r, sensed, k)) => {
+                            c.push_row(r);
+                            c.push_sensed(sensed, k);
+                        }
+                        None => c.push_blank(),
+                    }
+                }
+                let role = stage.roles.get(stage.role_of(j)).map(|r| r.name.clone());
+                RobotColumns { robot: j as u32, role, modules, actions: c }
+            })
+            .collect();
+        let role = stage.roles.first().map(|r| r.name.clone());
+        Some(TeamColumns { format: ROBOTS_FORMAT, follow, role, robots })
+    }
+}
+
+impl EpisodeColumns {
+    /// Adds what `c` sensed at its index `k` (see [`Self::push_frame`]).
+    fn push_sensed(&mut self, c: &EpisodeColumns, k: usize) {
+        self.ir.push(c.ir.get(k).copied().unwrap_or_default());
+        self.light.push(c.light.get(k).copied().unwrap_or_default());
+        self.barrier.push(c.barrier.get(k).copied().unwrap_or_default());
+        self.floor.push(c.floor.get(k).copied().unwrap_or_default());
+        self.lamp_distance.push(c.lamp_distance.get(k).copied().unwrap_or_default());
+        self.arm_down.push(c.arm_down.get(k).copied().unwrap_or_default());
+        self.claw_closed.push(c.claw_closed.get(k).copied().unwrap_or_default());
+        self.wheels.push(c.wheels.get(k).copied().unwrap_or_default());
+    }
+
+    /// Adds an action of a robot not yet in the episode's world: zeros.
+    fn push_blank(&mut self) {
+        let modules = self.activation.len();
+        let row = TraceRow {
+            action: 0,
+            activations: vec![0.0; modules],
+            winner: 0,
+            battery: 0.0,
+            holding: false,
+            reinforcement: vec![0.0; modules],
+            performance: vec![0.0; modules],
+            pose: Pose::default(),
+            grips: 0,
+            releases_outside: 0,
+            recharged: false,
+            collided: false,
+        };
+        self.push_row(&row);
+        self.push_sensed(&EpisodeColumns::default(), 0);
     }
 }
 

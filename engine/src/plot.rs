@@ -112,8 +112,12 @@ pub struct TrajectoryScene {
     /// at its start and its body at its end (empty for one robot).
     pub others: Vec<Vec<[f32; 3]>>,
     /// A heterogeneous team's roles, in order, and how many robots play
-    /// each (robot 0 plays the first; legend only; empty without roles).
+    /// each (robot 0 plays the first; empty without roles): each role's
+    /// robots are drawn in its colour, named in the legend.
     pub roles: Vec<(String, u32)>,
+    /// The team's robot whose path is `path` (0 unless a replay follows
+    /// another, `replay --robot`); `others` are the rest, in order.
+    pub robot: usize,
 }
 
 /// A picture could not be drawn or written.

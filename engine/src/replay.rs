@@ -6,11 +6,12 @@ use std::path::{Path, PathBuf};
 use shaping_runtime::controller::EpisodeOptions;
 use shaping_runtime::evolve;
 use shaping_runtime::genome::Genome;
-use shaping_runtime::program::{Program, StageRun};
+use shaping_runtime::program::{Program, Stage, StageRun};
 use shaping_runtime::sim::Sim;
 
 use shaping_runtime::controller::EpisodeResult;
 
+use crate::episode::TeamColumns;
 use crate::error::Error;
 use crate::files::create_dir;
 use crate::run::{Event, Observer};
@@ -36,6 +37,51 @@ pub struct ReplayOptions {
     pub mp4: Option<PathBuf>,
     /// Settings changed from the file's, as the run was made (`--set`).
     pub sets: Vec<crate::sweep::Assignment>,
+    /// The robot of a team the pictures, the report's readout and the
+    /// animations follow (`--robot`; 0, the first, by default).
+    pub robot: u32,
+    /// Live in this declared variant of the stage's world (`--variant`),
+    /// not in the stage's own world.
+    pub variant: Option<String>,
+}
+
+/// Stage `stage` in its variant `name` (see [`ReplayOptions::variant`]):
+/// an error naming the stage's variants when it has no such one.
+pub fn in_named_variant(stage: &Stage, name: &str) -> Result<Stage, Error> {
+    let names: Vec<&str> =
+        stage.variants.iter().flat_map(|v| v.list.iter().map(|x| x.name.as_str())).collect();
+    if let Some(v) = names.iter().position(|n| *n == name) {
+        return Ok(stage.in_variant(v));
+    }
+    if names.is_empty() {
+        return Err(Error::io(format!(
+            "error: `--variant {name}`: stage `{}` declares no variants (`variants mean {{ ... }}` in its world)",
+            stage.name
+        )));
+    }
+    let listed: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
+    let hint = shaping_compiler::diag::did_you_mean(name, names.iter().copied())
+        .map(|h| format!("; {h}"))
+        .unwrap_or_default();
+    Err(Error::io(format!(
+        "error: `--variant {name}`: stage `{}` has no variant `{name}` (its variants: {}){hint}",
+        stage.name,
+        listed.join(", ")
+    )))
+}
+
+/// Refuses `--robot N` of a stage whose team has no robot `N`.
+fn check_robot(stage: &Stage, robot: u32) -> Result<(), Error> {
+    let robots = stage.world.robots.max(1);
+    if robot < robots {
+        return Ok(());
+    }
+    let has = if robots == 1 {
+        "one robot, robot 0".to_string()
+    } else {
+        format!("{robots} robots, 0 to {}", robots - 1)
+    };
+    Err(Error::io(format!("error: `--robot {robot}`: stage `{}` has {has}", stage.name)))
 }
 
 /// Reads `--genome`: an argument made only of `0`, `1`, `_` and blanks is
@@ -238,7 +284,11 @@ pub fn replay(
         observer,
     )?;
     let Chosen { program, index, genome, training_seed } = chosen;
-    let stage = &program.stages[index];
+    let in_variant =
+        args.variant.as_deref().map(|v| in_named_variant(&program.stages[index], v)).transpose()?;
+    let stage = in_variant.as_ref().unwrap_or(&program.stages[index]);
+    check_robot(stage, args.robot)?;
+    let robot = args.robot as usize;
     let out = args.out.clone().unwrap_or_else(|| rundir::replay_dir(&run_dir, &stage.name));
     rundir::check_replay_out(&out)?;
     let (actions, learning) = match &stage.run {
@@ -266,14 +316,29 @@ pub fn replay(
     create_dir(&out)?;
     // A team's world is the one its robots started in.
     let scene = if others.is_empty() { Sim::new(&stage.world, seed).scene() } else { team_scene };
-    report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
+    if robot == 0 {
+        report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
+    } else {
+        rundir::write_trace(&out, &report::team_trace_csv(&trace, &others, stage, &ep))?;
+        let (mine, rest) = report::followed(&trace, &others, robot);
+        report::followed_pictures(&out, &stage.name, stage, robot, (&mine, &rest), &scene)?;
+    }
+    // Robot `robot`'s columns, for the report and the animations to follow
+    // (robot 0's are `episode.json`'s own).
+    let team =
+        (robot != 0).then(|| TeamColumns::of(stage, &others, ep.actions.x.len(), args.robot)).flatten();
+    if let Some(team) = &team {
+        rundir::write_robots(&out, team)?;
+    }
     rundir::write_episode(&out, &ep)?;
     rundir::write_program(&out, &program)?;
     rundir::write_genome_file(&out, &genome)?;
     let report = if args.report { Some(html::write(&out, None)?) } else { None };
     let mut animations = Vec::new();
     if args.gif.is_some() || args.mp4.is_some() {
-        let frames = animation::frames(&scene, &ep)?;
+        let following = team.as_ref().map(|t| ep.following(t, robot));
+        let roles: Vec<(String, u32)> = stage.roles.iter().map(|r| (r.name.clone(), r.robots)).collect();
+        let frames = animation::frames_of_team(&scene, following.as_ref().unwrap_or(&ep), &roles, robot)?;
         if let Some(path) = &args.gif {
             animation::write_gif(path, &frames)?;
             animations.push(path.clone());

@@ -13,7 +13,7 @@ use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
-use crate::episode::{Episode, EpisodeColumns, Frame, OtherRobot};
+use crate::episode::{Episode, EpisodeColumns, Frame, OtherRobot, TeamColumns};
 use crate::error::Error;
 use crate::plot;
 use crate::rundir::{self, Picture};
@@ -363,6 +363,20 @@ pub fn episode_files(
     episode_files_until(dir, title, stage, trace, others, episode, scene, marks, path, &|| false)
 }
 
+/// Writes a team's `robots.json` beside its `episode` (of the team's
+/// `others`), or, for one robot, removes any earlier team's.
+pub fn team_columns(
+    dir: &Path,
+    stage: &Stage,
+    others: &[OtherRobot],
+    episode: &Episode,
+) -> Result<(), Error> {
+    match TeamColumns::of(stage, others, episode.actions.x.len(), 0) {
+        Some(team) => rundir::write_robots(dir, &team),
+        None => rundir::remove_robots(dir),
+    }
+}
+
 /// The error [`episode_files_until`] stops with when `stop` says so.
 pub const STOPPED: &str = "stopped";
 
@@ -382,13 +396,50 @@ pub fn episode_files_until(
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
     rundir::write_trace(dir, &team_trace_csv(trace, others, stage, episode))?;
+    team_columns(dir, stage, others, episode)?;
     if trace.rows.is_empty() {
         return Ok(());
     }
     if stop() {
         return Err(Error::new(crate::ErrorKind::Interrupted, STOPPED));
     }
-    pictures(dir, title, stage, trace, others, scene, marks, path, stop)
+    pictures(dir, title, stage, 0, trace, others, scene, marks, path, stop)
+}
+
+/// Robot `robot`'s trace (its rows of every life, in order) and the
+/// team's other robots with robot 0 among them (`trace` is robot 0's):
+/// the team as robot `robot` lived it, for its pictures
+/// ([`followed_pictures`]).
+pub fn followed(trace: &Trace, others: &[OtherRobot], robot: usize) -> (Trace, Vec<OtherRobot>) {
+    if robot == 0 {
+        return (trace.clone(), others.to_vec());
+    }
+    let mine: Vec<&OtherRobot> = others.iter().filter(|o| o.robot == robot).collect();
+    let mut rows: Vec<TraceRow> = mine.iter().flat_map(|o| o.trace.rows.iter().cloned()).collect();
+    rows.sort_by_key(|r| r.action);
+    let modules = mine.first().map(|o| o.trace.modules.clone()).unwrap_or_default();
+    let zero = OtherRobot {
+        robot: 0,
+        part: 0,
+        start: trace.rows.first().map(|r| r.pose).unwrap_or_default(),
+        trace: trace.clone(),
+        sensed: EpisodeColumns::default(),
+    };
+    let rest = std::iter::once(zero).chain(others.iter().filter(|o| o.robot != robot).cloned()).collect();
+    (Trace { modules, rows }, rest)
+}
+
+/// The pictures of an episode as robot `robot` of the team lived it
+/// (`trace` and `others` from [`followed`]): `replay --robot N`.
+pub fn followed_pictures(
+    dir: &Path,
+    title: &str,
+    stage: &Stage,
+    robot: usize,
+    (trace, others): (&Trace, &[OtherRobot]),
+    scene: &Scene,
+) -> Result<(), Error> {
+    pictures(dir, title, stage, robot, trace, others, scene, &[], None, &|| false)
 }
 
 /// The pictures of one episode whose `trace.csv` is written (see
@@ -401,7 +452,7 @@ pub fn episode_pictures(
     trace: &Trace,
     scene: &Scene,
 ) -> Result<(), Error> {
-    pictures(dir, title, stage, trace, &[], scene, &[], None, &|| false)
+    pictures(dir, title, stage, 0, trace, &[], scene, &[], None, &|| false)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -409,6 +460,7 @@ fn pictures(
     dir: &Path,
     title: &str,
     stage: &Stage,
+    robot: usize,
     trace: &Trace,
     others: &[OtherRobot],
     scene: &Scene,
@@ -439,9 +491,12 @@ fn pictures(
     // The performance indicator the controller keeps: the rolling mean of the
     // module's last `window` reinforcement signals (the paper's figures 5, 10
     // and 13 average over signals, not over actions).
+    // The learning modules of the robot's role, at their index in its trace.
+    let own = stage.role_modules(stage.role_of(robot));
     let series: Vec<(String, Vec<f32>)> = learning_modules(stage)
         .into_iter()
-        .map(|(i, name)| (name, performance_curve(trace, i)))
+        .filter(|(i, _)| own.contains(i))
+        .map(|(i, name)| (name, performance_curve(trace, i - own.start)))
         .filter(|(_, v)| v.iter().any(|x| x.is_finite()))
         .collect();
     if !series.is_empty() {
@@ -466,6 +521,7 @@ fn pictures(
         None => (trajectory_scene(scene, trace, others), format!("{title}: trajectory")),
     };
     scene.roles = stage.roles.iter().map(|r| (r.name.clone(), r.robots)).collect();
+    scene.robot = robot;
     plot::trajectory(&rundir::picture_path(dir, Picture::Trajectory), &what, &scene).map_err(to_err)
 }
 
@@ -588,5 +644,6 @@ pub fn picture(scene: &Scene, path: Vec<[f32; 3]>) -> plot::TrajectoryScene {
         module_names: Vec::new(),
         others: Vec::new(),
         roles: Vec::new(),
+        robot: 0,
     }
 }

@@ -785,6 +785,7 @@ fn best_episode(
             dir.display()
         )));
     };
+    report::team_columns(dir, stage, &recorded.others, &recorded.episode)?;
     rundir::write_episode(dir, &recorded.episode)
 }
 

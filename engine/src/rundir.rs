@@ -58,6 +58,8 @@ pub mod names {
     pub const SUMMARY_MD: &str = "summary.md";
     pub const EPISODE: &str = "episode.json";
     pub const TRACE: &str = "trace.csv";
+    /// A team's other robots' columns, beside its `episode.json`.
+    pub const ROBOTS: &str = "robots.json";
     /// A replay's (and a drive's) genome, beside its `program.json`.
     pub const GENOME: &str = "genome";
     /// The default directories of a replay and a drive in a stage's.
@@ -187,6 +189,11 @@ pub fn summary_md_path(dir: &Path) -> PathBuf {
 /// `episode.json` of a stage, a replay or a drive.
 pub fn episode_path(dir: &Path) -> PathBuf {
     dir.join(EPISODE)
+}
+
+/// `robots.json` of a team's stage or replay.
+pub fn robots_path(dir: &Path) -> PathBuf {
+    dir.join(ROBOTS)
 }
 
 /// `trace.csv` of a stage, a replay or a drive.
@@ -432,6 +439,41 @@ pub fn write_genome_file(dir: &Path, genome: &Genome) -> Result<()> {
 /// Writes a drive's `episode.json` and `genome`, sealed together.
 pub fn write_driven(dir: &Path, episode: &Episode, genome: &Genome) -> Result<()> {
     write_sealed(dir, &[(EPISODE, compact_json(episode)?.as_bytes()), (GENOME, &genome_bytes(genome))])
+}
+
+/// Writes a team's `robots.json`, sealed.
+pub fn write_robots(dir: &Path, robots: &crate::episode::TeamColumns) -> Result<()> {
+    write_sealed(dir, &[(ROBOTS, compact_json(robots)?.as_bytes())])
+}
+
+/// Removes a `robots.json` from `dir`, if there is one.
+pub fn remove_robots(dir: &Path) -> Result<()> {
+    match std::fs::remove_file(robots_path(dir)) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            Err(Error::io(format!("error: cannot remove `{}`: {e}", robots_path(dir).display())))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Reads a team's `robots.json` (`None` where there is none: one robot,
+/// or a run made before it was written); one that does not read, or is of
+/// another format, is an error naming it.
+pub fn read_robots(dir: &Path, u: Unsealed<'_>) -> Result<Option<crate::episode::TeamColumns>> {
+    let path = robots_path(dir);
+    let Some(f) = read_checked(&path, REWRITE, u)? else { return Ok(None) };
+    let t: crate::episode::TeamColumns = serde_json::from_slice(&f.bytes).map_err(|e| {
+        Error::io(format!("error: `{}` is not a team's columns written by shaping: {e}", path.display()))
+    })?;
+    if t.format != crate::episode::ROBOTS_FORMAT {
+        return Err(Error::io(format!(
+            "error: `{}` has format {}, this shaping reads format {}; replay the stage again",
+            path.display(),
+            t.format,
+            crate::episode::ROBOTS_FORMAT
+        )));
+    }
+    Ok(Some(t))
 }
 
 /// Writes `trace.csv` (not sealed: a drive writes it as the robot drives).

@@ -6,7 +6,9 @@ mod common;
 
 use std::path::Path;
 
-use common::{error, load, options, read_json, read_text, root, run, sets, test_file, tiny, tiny_bat, Log};
+use common::{
+    error, load, options, read_json, read_text, root, run, sets, test_file, tiny, tiny_bat, write_bat, Log,
+};
 use shaping_engine::episode::{self, Recorder};
 use shaping_engine::replay::{self, ReplayOptions};
 use shaping_engine::report::{self, TraceWriter};
@@ -266,4 +268,52 @@ fn a_trace_written_as_it_goes_is_the_trace_written_at_the_end() {
         lines.concat(),
         "rows 0 to 41 on disk during the episode"
     );
+}
+
+/// `--variant NAME` lives in that declared variant of the stage's world; a
+/// name the stage does not declare is refused with its variants, and the
+/// nearest one; a stage without variants says so.
+#[test]
+fn a_replay_lives_in_a_named_variant() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let src = r#"
+robot r { sensor ir[8] proximity  actuator wheels[2] speed }
+stage s {
+  world { arena 400mm x 400mm  start at (100mm, 200mm) heading 90 }
+  variants mean {
+    west { start at (100mm, 200mm) heading 90 }
+    east { start at (300mm, 200mm) heading 90 }
+  }
+  evolve { population 6  generations 2  actions 5 }
+  fitness at end robot.x
+  module m { sense ir  behavior stop }
+}
+"#;
+    let (file, program) = write_bat(d, "variants.bat", src);
+    let genome = "0".repeat(program.stages[0].layout.bits as usize);
+    let args = |variant: Option<&str>, out: &str| ReplayOptions {
+        file: file.clone(),
+        genome: Some(genome.clone()),
+        out: Some(d.join(out)),
+        variant: variant.map(str::to_string),
+        ..ReplayOptions::default()
+    };
+    let start_x =
+        |out: &str| read_json(&d.join(out).join("episode.json"))["worlds"][0]["start"][0].as_f64().unwrap();
+    replay::replay(program.clone(), &args(None, "own"), &Log::default()).unwrap();
+    replay::replay(program.clone(), &args(Some("east"), "east"), &Log::default()).unwrap();
+    assert_eq!(start_x("own"), 100.0);
+    assert_eq!(start_x("east"), 300.0, "the variant's start");
+
+    let err = error(replay::replay(program.clone(), &args(Some("eats"), "bad"), &Log::default()));
+    assert_eq!(
+        err.message(),
+        "error: `--variant eats`: stage `s` has no variant `eats` (its variants: `west`, `east`); did you mean `east`?"
+    );
+    assert!(!d.join("bad").exists(), "nothing written");
+    let bits = tiny().stages.last().unwrap().layout.bits as usize;
+    let plain = ReplayOptions { genome: Some("0".repeat(bits)), ..args(Some("east"), "none") };
+    let err = error(replay::replay(tiny(), &plain, &Log::default()));
+    assert!(err.message().contains("declares no variants"), "{err}");
 }

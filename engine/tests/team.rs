@@ -340,3 +340,68 @@ fn a_team_with_roles_writes_every_roles_modules() {
     let report = read_text(&d.join("report.html"));
     assert!(report.contains("sitters.go") && report.contains("movers.turn"));
 }
+
+/// `replay --robot N` follows robot N: its pictures, the report's robot
+/// and the GIF are its; `trace.csv` is every robot's as always; a robot
+/// the team does not have is refused, naming how many it has.
+#[test]
+fn a_replay_follows_the_robot_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let program = team(load(&tiny_bat()), 3);
+    let bits = program.stages[0].layout.bits as usize;
+    let genome: String = (0..bits).map(|i| if i % 3 == 0 { '1' } else { '0' }).collect();
+    let args = |robot: u32, out: &str| ReplayOptions {
+        file: tiny_bat(),
+        genome: Some(genome.clone()),
+        stage: Some("first".into()),
+        out: Some(d.join(out)),
+        actions: Some(30),
+        report: true,
+        gif: Some(d.join(format!("{out}.gif"))),
+        robot,
+        ..ReplayOptions::default()
+    };
+    replay::replay(program.clone(), &args(0, "zero"), &Log::default()).unwrap();
+    replay::replay(program.clone(), &args(2, "two"), &Log::default()).unwrap();
+    assert_eq!(
+        read_text(&d.join("zero/trace.csv")),
+        read_text(&d.join("two/trace.csv")),
+        "every robot's rows"
+    );
+    let png = |p: &str| std::fs::read(d.join(p).join("trajectory.png")).unwrap();
+    assert_ne!(png("zero"), png("two"));
+    assert_ne!(std::fs::read(d.join("zero.gif")).unwrap(), std::fs::read(d.join("two.gif")).unwrap());
+    let robots: serde_json::Value = serde_json::from_str(&read_text(&d.join("two/robots.json"))).unwrap();
+    assert_eq!(robots["follow"], 2);
+    assert_eq!(robots["robots"].as_array().unwrap().len(), 2);
+    let zero: serde_json::Value = serde_json::from_str(&read_text(&d.join("zero/robots.json"))).unwrap();
+    assert_eq!(zero["follow"], 0);
+    // Robot 2's columns are its rows of trace.csv.
+    let csv = read_text(&d.join("two/trace.csv"));
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let x = header.iter().position(|h| *h == "x").unwrap();
+    let xs: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .filter(|l| l.starts_with("2,"))
+        .map(|l| l.split(',').nth(x).unwrap().parse().unwrap())
+        .collect();
+    let cols: Vec<f64> =
+        robots["robots"][1]["actions"]["x"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert_eq!(xs.len(), cols.len());
+    assert!(xs.iter().zip(&cols).all(|(a, b)| (a - b).abs() < 0.006), "{xs:?} {cols:?}");
+    assert!(read_text(&d.join("two/report.html")).contains("\"follow\":2"));
+
+    // Columns that are not of the episode beside them: the report says so.
+    let mut other: shaping_engine::episode::TeamColumns = serde_json::from_value(robots.clone()).unwrap();
+    other.robots.truncate(1);
+    shaping_engine::rundir::write_robots(&d.join("two"), &other).unwrap();
+    let err = shaping_engine::html::write(&d.join("two"), None).unwrap_err();
+    assert!(err.message().contains("robots.json` is not of the episode beside it"), "{err}");
+
+    let err = replay::replay(program.clone(), &args(3, "three"), &Log::default()).unwrap_err();
+    assert_eq!(err.message(), "error: `--robot 3`: stage `first` has 3 robots, 0 to 2");
+    let err = replay::replay(team(load(&tiny_bat()), 1), &args(1, "one"), &Log::default()).unwrap_err();
+    assert_eq!(err.message(), "error: `--robot 1`: stage `first` has one robot, robot 0");
+}

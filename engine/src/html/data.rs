@@ -12,11 +12,41 @@ use shaping_runtime::program::{
     Action, Behavior, Decode, Event, LearnTarget, LearnWhen, Param, Program, Stage, StageRun, StepEnd, World,
 };
 
-use crate::episode::{Episode, EPISODE_FORMAT};
+use crate::episode::{Episode, TeamColumns, EPISODE_FORMAT};
 use crate::error::{Error, ErrorKind};
 use crate::files::{read_checked, Unsealed};
 use crate::rundir::{ExperimentSummary, GenRow, PointSummary, StageFigures};
 use crate::{load, rundir};
+
+/// The most robots of a team a report can follow (robot 0 and the next
+/// ones): a larger team's others are drawn, not followed, so that the page
+/// stays small.
+pub const MAX_FOLLOWED: usize = 100;
+
+/// The columns of the team of episode `ep` in `dir` (see
+/// [`ReportData::robots`]): one that is not of that episode (other robots,
+/// other lengths) is an error naming it.
+fn read_team(dir: &Path, ep: &Episode, u: Unsealed<'_>) -> Result<Option<TeamColumns>, Error> {
+    let Some(mut t) = rundir::read_robots(dir, u)? else { return Ok(None) };
+    let n = ep.actions.x.len();
+    let fits = |r: &crate::episode::RobotColumns| {
+        let c = &r.actions;
+        [c.x.len(), c.y.len(), c.theta.len(), c.winner.len(), c.battery.len(), c.ir.len(), c.wheels.len()]
+            .iter()
+            .all(|&k| k == n)
+            && [&c.activation, &c.reinforcement, &c.performance]
+                .iter()
+                .all(|v| v.len() == r.modules.len() && v.iter().all(|m| m.len() == n))
+    };
+    if t.robots.len() != ep.actions.others.len() || !t.robots.iter().all(fits) {
+        return Err(Error::io(format!(
+            "error: `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
+            rundir::robots_path(dir).display()
+        )));
+    }
+    t.robots.truncate(MAX_FOLLOWED - 1);
+    Ok(Some(t))
+}
 
 /// Version of the data embedded in a report.
 pub const REPORT_FORMAT: u32 = 1;
@@ -41,6 +71,10 @@ pub struct ReportData {
     /// One series per evolved stage, in program order.
     pub fitness: Vec<FitnessSeries>,
     pub episodes: Vec<Episode>,
+    /// One per episode, in order: a team's other robots' columns
+    /// (`robots.json`, at most [`MAX_FOLLOWED`] robots in all), which the
+    /// page's readout and timeline can follow; `None` for one robot.
+    pub robots: Vec<Option<TeamColumns>>,
     /// The `summary.json` of the sweep this experiment is a point of (or,
     /// for a sweep's own directory, of the sweep): every point's settings
     /// and figures, listed by the page.
@@ -609,15 +643,20 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
     s
 }
 
+/// A run directory's stage views, its episodes and their teams' columns
+/// (one per episode).
+type RunStages = (Vec<StageView>, Vec<Episode>, Vec<Option<TeamColumns>>);
+
 /// The stages of one run directory, with genomes, results and episodes.
 fn run_stages(
     program: &Program,
     run: &Path,
     only: Option<usize>,
     u: Unsealed<'_>,
-) -> Result<(Vec<StageView>, Vec<Episode>), Error> {
+) -> Result<RunStages, Error> {
     let mut views = Vec::new();
     let mut episodes = Vec::new();
+    let mut teams = Vec::new();
     for (i, st) in program.stages.iter().enumerate() {
         let dir = rundir::stage_dir(run, &st.name);
         if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
@@ -660,10 +699,12 @@ fn run_stages(
         views.push(view);
         let ep = rundir::episode_path(&dir);
         if ep.exists() {
-            episodes.push(read_episode(&ep, u)?);
+            let ep = read_episode(&ep, u)?;
+            teams.push(read_team(&dir, &ep, u)?);
+            episodes.push(ep);
         }
     }
-    Ok((views, episodes))
+    Ok((views, episodes, teams))
 }
 
 /// The words for `n` of `m` episodes (or lives) whose placement overlapped,
@@ -833,6 +874,7 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         stages: Vec::new(),
         fitness: Vec::new(),
         episodes: Vec::new(),
+        robots: Vec::new(),
         sweep: None,
         sweep_point: None,
         tests: None,
@@ -921,13 +963,14 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
                 genome.as_ref().map(|g| (g, rundir::names::GENOME.to_string())),
             ));
             data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
+            data.robots.push(read_team(dir, &ep, u)?);
             data.episodes.push(ep);
             return Ok(data);
         }
         let mut data = base("run", &program, dir);
         let fitness = run_fitness(&program, dir, u)?;
         data.fitness = series_of(&program, &fitness, None);
-        (data.stages, data.episodes) = run_stages(&program, dir, None, u)?;
+        (data.stages, data.episodes, data.robots) = run_stages(&program, dir, None, u)?;
         data.episodes_note = "the best individual of each stage".into();
         return Ok(data);
     }
@@ -963,7 +1006,7 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
             let mut data = base("stage", &program, dir);
             let fitness = run_fitness(&program, run, u)?;
             data.fitness = series_of(&program, &fitness, Some(index));
-            (data.stages, data.episodes) = run_stages(&program, run, Some(index), u)?;
+            (data.stages, data.episodes, data.robots) = run_stages(&program, run, Some(index), u)?;
             data.episodes_note = format!("the best individual of stage `{name}`");
             return Ok(data);
         }
@@ -1003,7 +1046,7 @@ fn experiment(dir: &Path, seeds: &[(u64, PathBuf)], u: Unsealed<'_>) -> Result<R
     order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let pick = order[(order.len() - 1) / 2].1;
     let (seed, run) = &seeds[pick];
-    (data.stages, data.episodes) = run_stages(&program, run, None, u)?;
+    (data.stages, data.episodes, data.robots) = run_stages(&program, run, None, u)?;
     data.shown_seed = Some(*seed);
     data.episodes_note = format!(
         "seed {seed}, the median of {} seeds by the final best fitness{}; genomes and episodes of that seed",

@@ -15,6 +15,8 @@
   window.addEventListener('error', (e) => showError(String(e.message || e)));
 
   const D = JSON.parse(document.getElementById('data').textContent);
+  // A team's other robots' columns (robots.json), beside their episode.
+  D.episodes.forEach((e, i) => { e._team = (D.robots || [])[i] || null; });
   // An episode without a single action (a flat battery) has nothing to show.
   D.episodes = D.episodes.filter((e) => e.actions.x.length > 0);
   const $ = (id) => document.getElementById(id);
@@ -69,10 +71,48 @@
   }));
 
   // ------------------------------------------------------------------ replay
-  const R = { ep: null, epIndex: 0, a: 0, playing: false, speed: 10, acc: 0, last: 0, hashTimer: 0, timer: 0 };
+  const R = { ep: null, base: null, robot: 0, epIndex: 0, a: 0, playing: false, speed: 10, acc: 0, last: 0, hashTimer: 0, timer: 0 };
 
   // The colours of a team's robots 1, 2, ... (robot 0 is drawn by its winning module).
   const TEAM = ['#606e82', '#a6783c', '#46826e', '#965a82', '#6e6e3c', '#3c6ea0', '#a05050', '#645aa0'];
+  // The colours of a team's roles, as the trajectory picture draws them.
+  const ROLES = ['#286ec8', '#dc8200', '#289646', '#8c46aa', '#0096a0', '#966432'];
+  // Robot `j`'s colour: its role's in a team of roles, else its own.
+  function robotColour(ep, j) {
+    const team = ep._team;
+    const role = team && (j === 0 ? team.role : (team.robots[j - 1] || {}).role);
+    if (role) {
+      const names = [];
+      for (const r of [team.role].concat(team.robots.map((x) => x.role))) if (r && !names.includes(r)) names.push(r);
+      return ROLES[names.indexOf(role) % ROLES.length];
+    }
+    return TEAM[(j + TEAM.length - 1) % TEAM.length];
+  }
+
+  // The robots of a team's episode that the page can follow (1 for one robot).
+  const followable = (ep) => 1 + (ep._team ? ep._team.robots.length : 0);
+
+  // Episode `ep` as robot `k` lived it: its columns, modules and starts in
+  // place of robot 0's, the others (robot 0 among them) drawn around it.
+  function robotView(ep, k) {
+    if (!k || !ep._team) return ep;
+    ep._views = ep._views || {};
+    if (ep._views[k]) return ep._views[k];
+    const c0 = ep.actions, team = ep._team, mine = team.robots[k - 1];
+    const total = 1 + (c0.others || []).length;
+    const pose = (j) => j === 0 ? { x: c0.x, y: c0.y, theta: c0.theta } : c0.others[j - 1];
+    const nums = [];
+    for (let j = 0; j < total; j++) if (j !== k) nums.push(j);
+    const actions = Object.assign({}, mine.actions, { objects: c0.objects, others: nums.map(pose) });
+    const start = (w, j) => j === 0 ? w.start : (w.others || [])[j - 1];
+    const worlds = ep.worlds.map((w) => Object.assign({}, w, {
+      start: start(w, k) || w.start,
+      others: (w.others || []).length >= k ? nums.map((j) => start(w, j)).filter((p) => p) : [],
+    }));
+    const v = Object.assign({}, ep, { actions, worlds, modules: mine.modules, _: null, _views: null, _nums: nums, _robot: k, _role: mine.role || null });
+    ep._views[k] = v;
+    return v;
+  }
 
   function prepare(ep) {
     const c = ep.actions;
@@ -185,7 +225,8 @@
     // A team's other robots: each one's trail in this world, its body and heading, its number.
     const others = w.others || [];
     for (let j = 0; j < others.length && j < (c.others || []).length; j++) {
-      const o = c.others[j], col = TEAM[j % TEAM.length], r = w.body_radius;
+      const num = ep._nums ? ep._nums[j] : j + 1;
+      const o = c.others[j], col = robotColour(R.base, num), r = w.body_radius;
       g.strokeStyle = col; g.lineWidth = 1.5; g.globalAlpha = 0.5;
       g.beginPath(); g.moveTo(X(others[j][0]), Y(others[j][1]));
       for (let k = w.from; k <= a; k++) g.lineTo(X(o.x[k]), Y(o.y[k]));
@@ -196,7 +237,7 @@
       g.strokeStyle = col; g.lineWidth = 2; g.stroke();
       g.beginPath(); g.moveTo(X(ox), Y(oy)); g.lineTo(X(ox + r * Math.cos(ot)), Y(oy + r * Math.sin(ot))); g.stroke();
       g.fillStyle = '#38414d'; g.font = '10px sans-serif'; g.textAlign = 'center';
-      g.fillText(String(j + 1), X(ox), Y(oy) + 3.5); g.textAlign = 'start';
+      g.fillText(String(num), X(ox), Y(oy) + 3.5); g.textAlign = 'start';
     }
     // The robot.
     const x = c.x[a], y = c.y[a], th = c.theta[a], br = w.body_radius;
@@ -234,7 +275,7 @@
     g.beginPath(); g.moveTo(X(x), Y(y)); g.lineTo(X(x + br * Math.cos(th)), Y(y + br * Math.sin(th))); g.stroke();
     // The stage whose world this is.
     g.fillStyle = '#5f6b7a'; g.font = '12px sans-serif';
-    const team = others.length ? ' · ' + (others.length + 1) + ' robots' : '';
+    const team = others.length ? ' · ' + (others.length + 1) + ' robots, following robot ' + (ep._robot || 0) : '';
     g.fillText('world of ' + w.stage + ' · ' + Math.round(w.arena[0]) + ' × ' + Math.round(w.arena[1]) + ' mm' + team + ' · action ' + a, pad, 14);
   }
 
@@ -368,7 +409,12 @@
     const win = c.winner[a];
     // A team's robot 0 whose battery is empty stands still while the others go on.
     const stopped = (c.others || []).length > 0 && c.battery[a] <= 0;
-    $('r-winner').textContent = stopped ? 'none: robot 0 stopped, its battery empty' : ep.modules[win] || '–';
+    const robot = ep._robot || 0;
+    $('r-winner').textContent = stopped ? 'none: robot ' + robot + ' stopped, its battery empty' : ep.modules[win] || '–';
+    const team = R.base && R.base._team;
+    const role = robot === 0 ? team && team.role : ep._role;
+    $('r-robot').textContent = team ? robot + ' of ' + followable(R.base) + (role ? ', role ' + role : '') : '0';
+    $('r-robot').hidden = $('r-robot-dt').hidden = !team;
     $('r-winner-chip').style.background = color(win);
     $('r-x').textContent = fmt(c.x[a], 2);
     $('r-y').textContent = fmt(c.y[a], 2);
@@ -405,6 +451,7 @@
     $('b-play').setAttribute('aria-label', R.playing ? 'pause' : 'play');
     document.body.dataset.action = String(a);
     document.body.dataset.stage = ep.stage;
+    document.body.dataset.robot = String(robot);
   }
 
   function render() {
@@ -416,7 +463,8 @@
 
   function writeHash() {
     if (!R.ep) return;
-    const h = '#stage=' + encodeURIComponent(R.ep.stage) + '&action=' + R.a;
+    // A team's episode says which robot is followed.
+    const h = '#stage=' + encodeURIComponent(R.ep.stage) + '&action=' + R.a + (R.base._team ? '&robot=' + R.robot : '');
     if (location.hash === h) return;
     try { history.replaceState(null, '', h); } catch (e) { /* some browsers refuse on file: URLs */ }
   }
@@ -429,12 +477,19 @@
   }
 
   let selectEpisodeTab = () => {};
-  function selectEpisode(i, action) {
-    const ep = D.episodes[i];
-    if (!ep) return;
-    R.epIndex = i; R.ep = ep;
+  function selectEpisode(i, action, robot) {
+    const base = D.episodes[i];
+    if (!base) return;
+    const n = followable(base);
+    // The robot asked for, else the one followed before if this team has
+    // it, else the one a replay follows (`replay --robot`).
+    let k = robot !== undefined ? robot : R.base && R.robot < n ? R.robot : base._team ? base._team.follow || 0 : 0;
+    if (!(k >= 0 && k < n)) k = 0;
+    const ep = robotView(base, k);
+    R.epIndex = i; R.ep = ep; R.base = base; R.robot = k;
     if (!ep._) prepare(ep);
     selectEpisodeTab(i);
+    robotChoice(base, k);
     $('scrub').max = String(Math.max(ep._.n - 1, 0));
     drawTimelineStatic();
     seek(action === undefined ? 0 : action, true);
@@ -468,6 +523,26 @@
     R.timer = setTimeout(tick, frameDelay());
   }
 
+  // The robot selector: one entry per robot of a team's episode (with its
+  // role), hidden for one robot.
+  function robotChoice(base, k) {
+    const box = $('robot-box'), sel = $('robot'), team = base._team;
+    box.hidden = !team;
+    if (!team) return;
+    sel.textContent = '';
+    for (let j = 0; j < followable(base); j++) {
+      const role = j === 0 ? team.role : team.robots[j - 1].role;
+      sel.append(el('option', { value: String(j), text: 'robot ' + j + (role ? ' (' + role + ')' : '') }));
+    }
+    sel.value = String(k);
+  }
+
+  function followRobot(k) {
+    if (!R.base || !(k >= 0 && k < followable(R.base))) return;
+    selectEpisode(R.epIndex, R.a, k);
+    writeHash();
+  }
+
   function parseHash() {
     const out = {};
     for (const part of location.hash.replace(/^#/, '').split('&')) {
@@ -479,14 +554,21 @@
 
   function applyHash() {
     const h = parseHash();
-    if (h.stage === undefined && h.action === undefined) return false;
+    if (h.stage === undefined && h.action === undefined && h.robot === undefined) return false;
     let i = R.epIndex;
     if (h.stage !== undefined) {
       const k = D.episodes.findIndex((e) => e.stage === h.stage);
       if (k >= 0) i = k;
     }
     const a = h.action !== undefined && /^\d+$/.test(h.action) ? parseInt(h.action, 10) : 0;
-    if (i !== R.epIndex || !R.ep) selectEpisode(i, a); else seek(a, true);
+    const n = followable(D.episodes[i]);
+    let k;
+    $('robot-note').textContent = '';
+    if (h.robot !== undefined) {
+      if (/^\d+$/.test(h.robot) && parseInt(h.robot, 10) < n) k = parseInt(h.robot, 10);
+      else $('robot-note').textContent = 'no robot ' + h.robot + ' in this episode (' + (n > 1 ? 'robots 0 to ' + (n - 1) : 'one robot, robot 0') + ')';
+    }
+    if (i !== R.epIndex || !R.ep || (k !== undefined && k !== R.robot)) selectEpisode(i, a, k); else seek(a, true);
     return true;
   }
 
@@ -512,6 +594,7 @@
     $('b-play').addEventListener('click', () => play(!R.playing));
     $('scrub').addEventListener('input', () => seek(Number($('scrub').value)));
     $('speed').addEventListener('change', () => { setSpeed(Number($('speed').value)); $('speed').blur(); });
+    $('robot').addEventListener('change', () => { followRobot(Number($('robot').value)); $('robot').blur(); });
     // After a mouse click the keys drive the replay again, not the button.
     document.querySelectorAll('#controls button, #ep-tabs button').forEach((b) => b.addEventListener('click', (e) => { if (e.detail > 0) b.blur(); }));
     const tl = $('timeline');

@@ -283,6 +283,7 @@ fn sample_data(title: &str) -> ReportData {
         stages: (0..p.stages.len()).map(|i| stage_view(&p, i, None)).collect(),
         fitness: Vec::new(),
         episodes: vec![ep],
+        robots: vec![None],
         sweep: None,
         sweep_point: None,
         tests: None,

@@ -229,7 +229,7 @@ impl Figure for Arena<'_> {
         // A team's other robots under robot 0: each path one colour, its
         // start numbered, its body at the end.
         for (k, path) in s.others.iter().enumerate() {
-            let colour = team_colour(k);
+            let colour = self.robot_colour(self.other_robot(k));
             let line: Vec<(f64, f64)> = path.iter().map(|p| (f64::from(p[0]), f64::from(p[1]))).collect();
             let style = colour.stroke_width(2);
             chart.draw_series(unmitered(&line).into_iter().map(|l| PathElement::new(l, style)))?;
@@ -274,13 +274,16 @@ impl Figure for Arena<'_> {
             }
         }
         if let Some(last) = s.path.last() {
-            self.body(&mut chart, *last, INK)?;
+            let outline = if s.roles.is_empty() { INK } else { self.robot_colour(s.robot) };
+            self.body(&mut chart, *last, outline)?;
         }
         if text && !s.others.is_empty() {
             // Every robot's number beside its start.
             let style = render::label_style(13.0).pos(Pos::new(HPos::Center, VPos::Center));
-            let starts = s.path.first().into_iter().chain(s.others.iter().filter_map(|p| p.first()));
-            for (k, p) in starts.enumerate() {
+            let starts = s.path.first().map(|p| (s.robot, p)).into_iter();
+            let others =
+                s.others.iter().enumerate().filter_map(|(k, p)| Some((self.other_robot(k), p.first()?)));
+            for (k, p) in starts.chain(others) {
                 let at = (f64::from(p[0]), f64::from(p[1]));
                 let label = EmptyElement::at(at)
                     + Circle::new((0, 0), 8, WHITE.mix(0.85).filled())
@@ -293,6 +296,55 @@ impl Figure for Arena<'_> {
         }
         Ok(())
     }
+}
+
+impl Arena<'_> {
+    /// The team's number of `others[k]`.
+    fn other_robot(&self, k: usize) -> usize {
+        if k < self.s.robot {
+            k
+        } else {
+            k + 1
+        }
+    }
+
+    /// The role robot `i` plays (0 without roles, and past their count).
+    fn role_of(&self, i: usize) -> usize {
+        let mut end = 0usize;
+        for (r, (_, robots)) in self.s.roles.iter().enumerate() {
+            end += *robots as usize;
+            if i < end {
+                return r;
+            }
+        }
+        self.s.roles.len().saturating_sub(1)
+    }
+
+    /// The colour of robot `i` of a team: its role's in a team of roles,
+    /// else its own ([`team_colour`]; robot 0's path is coloured by its
+    /// modules or by time, its body outlined in its role's colour).
+    fn robot_colour(&self, i: usize) -> RGBColor {
+        if self.s.roles.is_empty() {
+            team_colour(i.saturating_sub(1))
+        } else {
+            role_colour(self.role_of(i))
+        }
+    }
+}
+
+/// The colour of role `r`: strong hues, apart from the greys of the
+/// clones' team colours and from the headings' red (the report's page
+/// draws a team's roles in the same colours).
+pub(super) fn role_colour(r: usize) -> RGBColor {
+    const C: [RGBColor; 6] = [
+        RGBColor(40, 110, 200),
+        RGBColor(220, 130, 0),
+        RGBColor(40, 150, 70),
+        RGBColor(140, 70, 170),
+        RGBColor(0, 150, 160),
+        RGBColor(150, 100, 50),
+    ];
+    C[r % C.len()]
 }
 
 /// The colour of a team's robot `k + 1` (robot 0's path is coloured by its
@@ -439,16 +491,23 @@ impl Arena<'_> {
         entry(area, &mut y, "final pose and heading")?;
         if !s.others.is_empty() {
             let n = s.others.len() + 1;
-            area.draw(&PathElement::new(vec![(gx, y), (gx + 28, y)], team_colour(0).stroke_width(2)))?;
-            entry(area, &mut y, &format!("robots 1 to {}: paths", n - 1))?;
+            if s.roles.is_empty() {
+                area.draw(&PathElement::new(vec![(gx, y), (gx + 28, y)], team_colour(0).stroke_width(2)))?;
+                let who = if s.robot == 0 { format!("robots 1 to {}", n - 1) } else { "other robots".into() };
+                entry(area, &mut y, &format!("{who}: paths"))?;
+            }
             let style = render::label_style(13.0).pos(Pos::new(HPos::Center, VPos::Center));
-            area.draw(&(EmptyElement::at((gx + 14, y)) + Text::new("0", (0, 0), style)))?;
+            area.draw(&(EmptyElement::at((gx + 14, y)) + Text::new(s.robot.to_string(), (0, 0), style)))?;
             entry(area, &mut y, &format!("robot at its start (of {n})"))?;
             let mut first = 0;
             for (name, robots) in &s.roles {
                 let last = first + robots.saturating_sub(1);
                 let who =
                     if *robots == 1 { format!("robot {first}") } else { format!("robots {first} to {last}") };
+                // The role's colour: its robots' paths and outlines (robot
+                // 0's path keeps its modules' colours).
+                let c = role_colour(self.role_of(first as usize));
+                area.draw(&PathElement::new(vec![(gx, y), (gx + 28, y)], c.stroke_width(3)))?;
                 entry(area, &mut y, &format!("role {name}: {who}"))?;
                 first = last + 1;
             }

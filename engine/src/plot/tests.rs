@@ -512,3 +512,43 @@ fn a_teams_other_robots_are_drawn_each_in_its_colour() {
     let err = trajectory_rgb(&bad).unwrap_err().to_string();
     assert!(err.contains("robot 1's path"), "{err}");
 }
+
+/// A heterogeneous team's robots are drawn in their role's colour, and the
+/// legend names each role beside its colour.
+#[test]
+fn a_teams_roles_each_have_a_colour_named_in_the_legend() {
+    let one = TrajectoryScene {
+        path: vec![[60.0, 60.0, 0.0], [70.0, 60.0, 0.0]],
+        marks: Vec::new(),
+        path_modules: None,
+        ..scene(true)
+    };
+    let others = vec![
+        vec![[300.0, 100.0, 1.0], [300.0, 200.0, 1.5]],
+        vec![[100.0, 450.0, 0.0], [200.0, 450.0, 0.0]],
+        vec![[400.0, 400.0, 0.0], [420.0, 300.0, 0.0]],
+    ];
+    let roles = vec![("scout".to_string(), 2), ("seed".to_string(), 2)];
+    let team = TrajectoryScene { others, roles, ..one };
+    let f = trajectory_rgb(&team).unwrap();
+    let has = |c: plotters::style::RGBColor| f.pixels.chunks(3).filter(|p| *p == [c.0, c.1, c.2]).count();
+    for r in 0..2 {
+        assert!(has(super::arena::role_colour(r)) > 50, "role {r}'s colour");
+    }
+    // The clones' colours are not used.
+    assert_eq!(has(super::arena::team_colour(0)), 0);
+    let d = Dir::new("roles");
+    trajectory(&d.stem("roles"), "team", &team).unwrap();
+    let svg = fs::read_to_string(with_ext(&d.stem("roles"), "svg")).unwrap();
+    if font_path().is_some() {
+        assert!(
+            svg.contains("role scout: robots 0 to 1") && svg.contains("role seed: robots 2 to 3"),
+            "legend"
+        );
+    }
+    let c = super::arena::role_colour(1);
+    assert!(
+        svg.contains(&format!("#{:02X}{:02X}{:02X}", c.0, c.1, c.2)),
+        "the seed role's colour in the SVG"
+    );
+}
