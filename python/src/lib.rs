@@ -1618,15 +1618,7 @@ impl Experiment {
     /// range, mean and standard deviation over the seeds.
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let summary = rundir::read_experiment_summary(&self.out, &|_| {})
-            .map_err(|e| shaping_error(py, &e))?
-            .ok_or_else(|| {
-                let path = rundir::summary_path(&self.out);
-                ShapingError::new_err(format!(
-                    "error: cannot read `{}`: there is no such file",
-                    path.display()
-                ))
-            })?;
+        let summary = self.read_summary(py)?;
         let text = serde_json::to_value(&summary).map(|v| v.to_string()).unwrap_or_default();
         py.import("json")?.call_method1("loads", (text,))
     }
@@ -1635,7 +1627,7 @@ impl Experiment {
     /// measure: each group's median over the seeds with its bootstrap 95%
     /// interval. A group is the experiment, or a point of a sweep.
     fn medians<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let t = self.tests_of_summary()?;
+        let t = self.tests_of_summary(py)?;
         let out = PyList::empty(py);
         for m in &t.measures {
             for (g, figures) in t.groups.iter().zip(&m.groups) {
@@ -1661,7 +1653,7 @@ impl Experiment {
     /// test (a side with fewer than 2 seeds) these are None and `no_test`
     /// says why. Empty for an experiment of one point.
     fn tests<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let t = self.tests_of_summary()?;
+        let t = self.tests_of_summary(py)?;
         let out = PyList::empty(py);
         let name = |i: usize| t.groups.get(i.wrapping_sub(1)).cloned().unwrap_or_default();
         for m in &t.measures {
@@ -1696,19 +1688,23 @@ impl Experiment {
 }
 
 impl Experiment {
+    /// `summary.json`, as the experiment wrote it (through the run
+    /// directory's one reader).
+    fn read_summary(&self, py: Python<'_>) -> PyResult<rundir::ExperimentSummary> {
+        rundir::read_experiment_summary(&self.out, &|_| {}).map_err(|e| shaping_error(py, &e))?.ok_or_else(
+            || {
+                let path = rundir::summary_path(&self.out);
+                ShapingError::new_err(format!(
+                    "error: cannot read `{}`: there is no such file",
+                    path.display()
+                ))
+            },
+        )
+    }
+
     /// The `tests` of `summary.json`, as the experiment wrote them.
-    fn tests_of_summary(&self) -> PyResult<shaping_engine::rundir::Tests> {
-        let path = self.out.join("summary.json");
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| ShapingError::new_err(format!("error: cannot read `{}`: {e}", path.display())))?;
-        let value: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| ShapingError::new_err(format!("error: `{}` is not JSON: {e}", path.display())))?;
-        serde_json::from_value(value.get("tests").cloned().unwrap_or_default()).map_err(|e| {
-            ShapingError::new_err(format!(
-                "error: `{}` has no statistics (`tests`) of this version: {e}; run the experiment again",
-                path.display()
-            ))
-        })
+    fn tests_of_summary(&self, py: Python<'_>) -> PyResult<rundir::Tests> {
+        Ok(self.read_summary(py)?.tests)
     }
 }
 
