@@ -21,19 +21,43 @@ use shaping_engine::{replay, report};
 use crate::terminal::Terminal;
 use shaping_engine::run;
 
+/// The arguments of `shaping drive`.
+#[derive(clap::Args)]
 pub struct DriveArgs {
     pub file: PathBuf,
+    /// Stage to drive (default: the last).
+    #[arg(long)]
     pub stage: Option<String>,
+    /// The genome: a string of 0 and 1, or a file holding one.
+    #[arg(long, conflicts_with = "run")]
     pub genome: Option<String>,
+    /// A run directory holding `<stage>/best.genome` (default: `runs/<file stem>`).
+    #[arg(long)]
     pub run: Option<PathBuf>,
+    /// The robot's serial port (or an emulator's, see `shaping emulate`).
+    #[arg(long)]
     pub port: PathBuf,
+    #[arg(long, default_value_t = 9600)]
     pub baud: u32,
+    /// Actions to run (default: the stage's life length).
+    #[arg(long)]
     pub actions: Option<u32>,
+    /// Output directory (default: `<run>/<stage>/drive`).
+    #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Episode seed: places the virtual objects and the assumed start pose (default: the run seed).
+    #[arg(long)]
     pub seed: Option<u64>,
+    /// Action period in ms (default: the world's action length; 0: as fast as the link allows).
+    #[arg(long = "period", id = "period", value_name = "PERIOD")]
     pub period_ms: Option<u64>,
+    /// Longest wait for an answer of the robot, ms.
+    #[arg(long = "timeout", id = "timeout", value_name = "TIMEOUT", default_value_t = 1000)]
     pub timeout_ms: u64,
+    /// Switch local learning off.
+    #[arg(long)]
     pub no_learning: bool,
+    #[arg(long, default_value = "human", value_parser = crate::error_format())]
     pub error_format: crate::diag::ErrorFormat,
 }
 
