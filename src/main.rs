@@ -147,115 +147,13 @@ enum Command {
     /// Run one individual on a Khepera over its serial port; writes the same
     /// trace and pictures as `replay`. The motors are stopped before exiting,
     /// whatever happens (Ctrl-C, a lost link, a bad answer).
-    Drive {
-        file: PathBuf,
-        /// Stage to drive (default: the last).
-        #[arg(long)]
-        stage: Option<String>,
-        /// The genome: a string of 0 and 1, or a file holding one.
-        #[arg(long, conflicts_with = "run")]
-        genome: Option<String>,
-        /// A run directory holding `<stage>/best.genome` (default: `runs/<file stem>`).
-        #[arg(long)]
-        run: Option<PathBuf>,
-        /// The robot's serial port (or an emulator's, see `shaping emulate`).
-        #[arg(long)]
-        port: PathBuf,
-        #[arg(long, default_value_t = 9600)]
-        baud: u32,
-        /// Actions to run (default: the stage's life length).
-        #[arg(long)]
-        actions: Option<u32>,
-        /// Output directory (default: `<run>/<stage>/drive`).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Episode seed: places the virtual objects and the assumed start pose (default: the run seed).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Action period in ms (default: the world's action length; 0: as fast as the link allows).
-        #[arg(long)]
-        period: Option<u64>,
-        /// Longest wait for an answer of the robot, ms.
-        #[arg(long, default_value_t = 1000)]
-        timeout: u64,
-        /// Switch local learning off.
-        #[arg(long)]
-        no_learning: bool,
-        #[arg(long, default_value = "human", value_parser = error_format())]
-        error_format: ErrorFormat,
-    },
+    Drive(robot::drive::DriveArgs),
     /// An emulated Khepera: answers the serial protocol from the simulator on
     /// a pseudo-terminal made at `--port`, until Ctrl-C.
-    Emulate {
-        /// Architecture file whose world is emulated (default: the built-in `examples/khepera.bat`).
-        file: Option<PathBuf>,
-        /// Path of the pseudo-terminal to create (a symbolic link).
-        #[arg(long)]
-        port: PathBuf,
-        /// Stage whose world is emulated (default: the last).
-        #[arg(long)]
-        stage: Option<String>,
-        /// Seed of the world (default: the run seed), as `drive --seed`.
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Emulated line speed: each byte takes 11 bit times (0: no wire delay).
-        #[arg(long, default_value_t = 9600)]
-        baud: u32,
-        /// The robot's own delay before each answer, ms.
-        #[arg(long, default_value_t = 0)]
-        delay: u64,
-        /// Inject a fault at the N-th request: `drop@N` (no answer), `garbage@N`, `close@N`.
-        #[arg(long, value_parser = robot::emulate::parse_fault)]
-        fault: Option<robot::emulate::Fault>,
-        #[arg(long, default_value = "human", value_parser = error_format())]
-        error_format: ErrorFormat,
-    },
+    Emulate(robot::emulate::EmulateArgs),
     /// Run one individual with a trace; writes `trace.csv` and the pictures
     /// (module activations, reinforcement, trajectory).
-    Replay {
-        file: PathBuf,
-        /// Stage to replay (default: the last).
-        #[arg(long)]
-        stage: Option<String>,
-        /// The genome: a string of 0 and 1, or a file holding one.
-        #[arg(long, conflicts_with = "run")]
-        genome: Option<String>,
-        /// A run directory holding `<stage>/best.genome` (default: `runs/<file stem>`).
-        #[arg(long)]
-        run: Option<PathBuf>,
-        /// Actions to run (default: the stage's life length).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(shaping_runtime::limits::MAX_ACTIONS)))]
-        actions: Option<u32>,
-        /// Output directory (default: `<run>/<stage>/replay`).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Episode seed (default: the run seed).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Switch local learning off.
-        #[arg(long)]
-        no_learning: bool,
-        /// Also write `report.html`: the episode animated in a web page.
-        #[arg(long)]
-        report: bool,
-        /// Also write the episode as an animated GIF (at most 300 frames).
-        #[arg(long, value_name = "FILE")]
-        gif: Option<PathBuf>,
-        /// Also write the episode as an MP4 video (needs `ffmpeg` on the PATH).
-        #[arg(long, value_name = "FILE")]
-        mp4: Option<PathBuf>,
-        /// Change a setting as the run did (`--set` of `run`, one value each).
-        #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=VALUE", value_parser = sweep::parse_set)]
-        sets: Vec<sweep::Set>,
-        /// The robot of a team the pictures, the report and the animations follow.
-        #[arg(long, value_name = "N", default_value_t = 0)]
-        robot: u32,
-        /// Live in this declared variant of the stage's world.
-        #[arg(long, value_name = "NAME")]
-        variant: Option<String>,
-        #[arg(long, default_value = "human", value_parser = error_format())]
-        error_format: ErrorFormat,
-    },
+    Replay(replay::ReplayArgs),
     /// Run every stage over several seeds, or a sweep of settings (`--set`),
     /// and summarise (median and range): `summary.md`, `summary.json` and
     /// pictures.
@@ -433,16 +331,15 @@ fn dispatch(command: Command) -> Result<(), CliError> {
             error_format,
         }),
         Command::Build { file, output, error_format } => build(&file, &output, error_format),
-        run @ (Command::Run { .. }
-        | Command::Drive { .. }
-        | Command::Emulate { .. }
-        | Command::Replay { .. }
-        | Command::Experiment { .. }) => run_command(run),
+        Command::Drive(args) => robot::drive::drive(args),
+        Command::Emulate(args) => robot::emulate::emulate(args),
+        Command::Replay(args) => replay::replay(args),
+        run @ (Command::Run { .. } | Command::Experiment { .. }) => run_command(run),
     }
 }
 
-/// The commands that run programs: `run`, `drive`, `emulate`, `replay`,
-/// `experiment` (`dispatch` gives no other).
+/// The commands that evolve: `run` and `experiment` (`dispatch` gives no
+/// other).
 fn run_command(command: Command) -> Result<(), CliError> {
     match command {
         Command::Run {
@@ -483,82 +380,6 @@ fn run_command(command: Command) -> Result<(), CliError> {
             };
             run_here_or_on_ranks(args, rank_timeout)
         }
-        Command::Drive {
-            file,
-            stage,
-            genome,
-            run,
-            port,
-            baud,
-            actions,
-            out,
-            seed,
-            period,
-            timeout,
-            no_learning,
-            error_format,
-        } => robot::drive::drive(robot::drive::DriveArgs {
-            file,
-            stage,
-            genome,
-            run,
-            port,
-            baud,
-            actions,
-            out,
-            seed,
-            period_ms: period,
-            timeout_ms: timeout,
-            no_learning,
-            error_format,
-        }),
-        Command::Emulate { file, port, stage, seed, baud, delay, fault, error_format } => {
-            robot::emulate::emulate(robot::emulate::EmulateArgs {
-                port,
-                file,
-                stage,
-                seed,
-                baud,
-                delay_ms: delay,
-                fault,
-                error_format,
-            })
-        }
-        Command::Replay {
-            file,
-            stage,
-            genome,
-            run,
-            actions,
-            out,
-            seed,
-            no_learning,
-            report,
-            gif,
-            mp4,
-            sets,
-            robot,
-            variant,
-            error_format,
-        } => replay::replay(
-            shaping_engine::replay::ReplayOptions {
-                file,
-                stage,
-                genome,
-                run,
-                actions,
-                out,
-                seed,
-                no_learning,
-                report,
-                gif,
-                mp4,
-                sets: single_values(sets, "replay")?,
-                robot,
-                variant,
-            },
-            error_format,
-        ),
         Command::Experiment {
             file,
             seeds,

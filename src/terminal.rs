@@ -3,10 +3,13 @@
 //! `replay`, `drive` alike).
 
 use std::cell::RefCell;
+use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use shaping_engine::run::{Event, Observer};
-use shaping_runtime::evolve;
+use shaping_runtime::controller::EpisodeResult;
+use shaping_runtime::evolve::{self, train::Trained};
+use shaping_runtime::program::Stage;
 
 use crate::out::outln;
 use crate::CliError;
@@ -106,47 +109,14 @@ impl Observer for Terminal {
                 } else if self.json {
                     json();
                 } else if !self.quiet {
-                    let perf: Vec<String> = stage
-                        .modules
-                        .iter()
-                        .zip(&trained.performance)
-                        .filter(|(m, _)| m.learning.is_some())
-                        .map(|(m, p)| format!("{} {p:+.2}", m.name))
-                        .collect();
-                    let part = if recorded < trained.result.actions {
-                        format!(" (trace and pictures: its first {recorded} actions)")
-                    } else {
-                        String::new()
-                    };
-                    eprintln!(
-                        "stage {:<12} trained for {} actions, performance {}{part}  -> {}",
-                        stage.name,
-                        trained.result.actions,
-                        perf.join(", "),
-                        dir.display()
-                    );
+                    eprintln!("{}", trained_line(stage, trained, recorded, dir));
                 }
             }
             Event::Tested { stage, lives, before, after, dir, .. } => {
                 if self.json {
                     json();
                 } else if !self.quiet {
-                    let how = if lives == 1 {
-                        String::new()
-                    } else {
-                        format!(" in {lives} lives each (fitness: mean per life)")
-                    };
-                    eprintln!(
-                        "stage {:<12} test of the best, {} actions before and {} after the change{how}: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
-                        stage,
-                        before.actions,
-                        after.actions,
-                        before.fitness,
-                        after.fitness,
-                        before.grips,
-                        after.grips,
-                        dir.display()
-                    );
+                    eprintln!("{}", tested_line(stage, lives, before, after, dir));
                 }
             }
             Event::Warning(w) => match self.bar.borrow().as_ref() {
@@ -156,6 +126,49 @@ impl Observer for Terminal {
             _ => {}
         }
     }
+}
+
+/// The line of a training stage `stage` done: its life of `trained`, the
+/// performance of each module that learns, how much of it the trace and
+/// pictures in `dir` hold (its first `recorded` actions).
+fn trained_line(stage: &Stage, trained: &Trained, recorded: u32, dir: &Path) -> String {
+    let perf: Vec<String> = stage
+        .modules
+        .iter()
+        .zip(&trained.performance)
+        .filter(|(m, _)| m.learning.is_some())
+        .map(|(m, p)| format!("{} {p:+.2}", m.name))
+        .collect();
+    let part = if recorded < trained.result.actions {
+        format!(" (trace and pictures: its first {recorded} actions)")
+    } else {
+        String::new()
+    };
+    format!(
+        "stage {:<12} trained for {} actions, performance {}{part}  -> {}",
+        stage.name,
+        trained.result.actions,
+        perf.join(", "),
+        dir.display()
+    )
+}
+
+/// The line of a test stage `stage` done: the best's episodes before and
+/// after the change (means over `lives` lives), whose files are in `dir`.
+fn tested_line(stage: &str, lives: u32, before: &EpisodeResult, after: &EpisodeResult, dir: &Path) -> String {
+    let how =
+        if lives == 1 { String::new() } else { format!(" in {lives} lives each (fitness: mean per life)") };
+    format!(
+        "stage {:<12} test of the best, {} actions before and {} after the change{how}: fitness {:.3} -> {:.3}, grips {} -> {}  -> {}",
+        stage,
+        before.actions,
+        after.actions,
+        before.fitness,
+        after.fitness,
+        before.grips,
+        after.grips,
+        dir.display()
+    )
 }
 
 fn progress_bar(hidden: bool, stage: &str, generations: u32, done: u32) -> ProgressBar {

@@ -321,6 +321,16 @@ pub struct Crowding {
 }
 
 impl Crowding {
+    /// The episodes counted since `earlier`, a count of the same episodes
+    /// taken before.
+    pub fn since(self, earlier: Crowding) -> Crowding {
+        Crowding {
+            episodes: self.episodes - earlier.episodes,
+            crowded: self.crowded - earlier.crowded,
+            placements: self.placements - earlier.placements,
+        }
+    }
+
     /// Counts one episode with `placement_failures` overlapping placements.
     pub fn add(&mut self, placement_failures: u32) {
         self.episodes += 1;
@@ -655,34 +665,13 @@ impl Engine<'_> {
         if program.stages.is_empty() {
             return Err(Error::new(ErrorKind::Invalid, "error: the program has no stages"));
         }
-        let target = match opts.stage.as_deref() {
-            Some(_) => crate::load::stage_index(&program, opts.stage.as_deref())?,
-            None => program.stages.len() - 1,
-        };
-        let stages =
-            if opts.stage.is_some() { chain(&program, target) } else { (0..program.stages.len()).collect() };
+        let stages = stages_to_run(&program, opts.stage.as_deref())?;
         crate::load::check_memory(&program, &stages, 1)?;
         let out = opts.out.clone();
         let seed = run_seed(&program, opts.seed);
         let local = Local::new(opts.jobs)?.stopped_by(self.interrupt);
         let _lock = DirLock::acquire(&out)?;
-        let warn = |path: &Path| warn_unsealed(self.observer, path);
-        let previous = rundir::read_program(&out);
-        if !opts.fresh {
-            check_owner(&out, previous.as_ref(), &program, source)?;
-        }
-        if let Some(previous) = &previous {
-            check_described(&out, previous, (&program, &file, &opts.sets), &stages)?;
-        }
-        let mut saved =
-            if opts.fresh { Saved::none(&program) } else { precheck(&program, &stages, &out, seed, &warn)? };
-        // The compiled program, for `shaping report` (and `shaping run program.json`).
-        rundir::write_program(&out, &program)?;
-        // Whose it is: the file, where it is known; a run that replaced
-        // another program's leaves no name of that one.
-        if source.is_some() || opts.fresh {
-            rundir::write_source(&out, source)?;
-        }
+        let mut saved = self.take_over(&program, &file, source, opts, &stages, seed)?;
         let evaluator = self.evaluator.unwrap_or(&local);
         let mut finals: Vec<Option<Checkpoint>> = vec![None; program.stages.len()];
         let mut results = Vec::new();
@@ -759,6 +748,50 @@ impl Engine<'_> {
         let report = if opts.no_report { None } else { Some(html::write(&out, None)?) };
         Ok(RunOutcome { out, seed, stages: results, report })
     }
+
+    /// Makes the locked directory `opts.out` the run of `program` (the
+    /// file's own program `file`, before `--set`, read from `source`): checks
+    /// that the directory belongs to it and describes it, reads what the run
+    /// resumes from (nothing with `--fresh`), and writes the program and the
+    /// name of its file.
+    fn take_over(
+        &self,
+        program: &Program,
+        file: &Program,
+        source: Option<&str>,
+        opts: &RunOptions,
+        stages: &[usize],
+        seed: u64,
+    ) -> Result<Saved> {
+        let out = &opts.out;
+        let warn = |path: &Path| warn_unsealed(self.observer, path);
+        let previous = rundir::read_program(out);
+        if !opts.fresh {
+            check_owner(out, previous.as_ref(), program, source)?;
+        }
+        if let Some(previous) = &previous {
+            check_described(out, previous, (program, file, &opts.sets), stages)?;
+        }
+        let saved =
+            if opts.fresh { Saved::none(program) } else { precheck(program, stages, out, seed, &warn)? };
+        // The compiled program, for `shaping report` (and `shaping run program.json`).
+        rundir::write_program(out, program)?;
+        // Whose it is: the file, where it is known; a run that replaced
+        // another program's leaves no name of that one.
+        if source.is_some() || opts.fresh {
+            rundir::write_source(out, source)?;
+        }
+        Ok(saved)
+    }
+}
+
+/// The stages a run of `program` runs, in order: `stage` and the stages it
+/// extends, or every stage.
+fn stages_to_run(program: &Program, stage: Option<&str>) -> Result<Vec<usize>> {
+    Ok(match stage {
+        Some(_) => chain(program, crate::load::stage_index(program, stage)?),
+        None => (0..program.stages.len()).collect(),
+    })
 }
 
 /// `episode.json` of an evolved stage: one recorded episode of its best
@@ -890,13 +923,7 @@ impl Engine<'_> {
             }
             if self.stopped() && !evolve::is_finished(program, &cp) {
                 self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: false });
-                return Err(interrupted(format!(
-                    "interrupted: stage `{}` stopped after generation {} of {}, saved in `{}`; the same command resumes it",
-                    stage.name,
-                    cp.generation,
-                    evo.generations,
-                    path.display()
-                )));
+                return Err(stopped_after(&stage.name, &cp, evo, &path));
             }
         }
         self.observer.event(Event::EvolveEnd { stage: &stage.name, completed: true });
@@ -915,20 +942,30 @@ impl Engine<'_> {
             .map_err(|e| fail(e, &cp))?;
             rundir::write_checkpoint(dir, &cp)?;
         }
-        let now = run_now.get();
-        let choice = Crowding {
-            episodes: now.episodes - generations_now.episodes,
-            crowded: now.crowded - generations_now.crowded,
-            placements: now.placements - generations_now.placements,
-        };
+        self.finish_evolved(stage, evo, &cp, run_now.get().since(generations_now), dir)?;
+        Ok(cp)
+    }
+
+    /// The end of evolved stage `stage`, whose checkpoint `cp` holds its
+    /// chosen best (`evo` its evolution): the warning about a crowded world (`choice` counts the
+    /// episodes of the choice of the best this process ran), the best's
+    /// files and the fitness plot in `dir`, and the stage's summary event.
+    fn finish_evolved(
+        &self,
+        stage: &Stage,
+        evo: &shaping_runtime::program::Evolution,
+        cp: &Checkpoint,
+        choice: Crowding,
+        dir: &Path,
+    ) -> Result<()> {
         if let Some(w) =
-            stage_crowding(&cp, &stage.name, evo, choice).warning(&stage.name, dir, ("episode", "episodes"))
+            stage_crowding(cp, &stage.name, evo, choice).warning(&stage.name, dir, ("episode", "episodes"))
         {
             self.observer.event(Event::Warning(w));
         }
-        let (genome, fitness) = evolve::best_of(&cp)
+        let (genome, fitness) = evolve::best_of(cp)
             .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
-        rundir::write_evolved(dir, &genome, &cp, &report::variant_names(stage))?;
+        rundir::write_evolved(dir, &genome, cp, &report::variant_names(stage))?;
         report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
         self.observer.event(Event::Evolved {
             stage: &stage.name,
@@ -937,7 +974,7 @@ impl Engine<'_> {
             chosen: fitness,
             dir,
         });
-        Ok(cp)
+        Ok(())
     }
 
     /// Evolved stage `index`'s checkpoint to go on from: `existing`
@@ -981,6 +1018,23 @@ impl Engine<'_> {
         })?;
         Ok(cp)
     }
+}
+
+/// Stage `name` (evolved by `evo`) stopped for Ctrl-C after the generation
+/// of `cp`, which is saved at `path`: where the same command goes on.
+fn stopped_after(
+    name: &str,
+    cp: &Checkpoint,
+    evo: &shaping_runtime::program::Evolution,
+    path: &Path,
+) -> Error {
+    interrupted(format!(
+        "interrupted: stage `{}` stopped after generation {} of {}, saved in `{}`; the same command resumes it",
+        name,
+        cp.generation,
+        evo.generations,
+        path.display()
+    ))
 }
 
 /// A generation (or the choice of the best) of the stage of `cp` given up

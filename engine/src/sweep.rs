@@ -216,6 +216,35 @@ enum Value {
     Pair(f64, f64),
 }
 
+impl Value {
+    /// The value of a whole-number setting (0 for a value of another kind).
+    fn whole(&self) -> Result<u32, String> {
+        let n = match self {
+            Value::Count(v) => *v,
+            _ => 0,
+        };
+        u32::try_from(n).map_err(|_| format!("{n} is too large"))
+    }
+
+    /// The value of a real setting (a count as it is; 0 for a value of another kind).
+    fn real(&self) -> f32 {
+        let r = match self {
+            Value::Count(v) => *v as f64,
+            Value::Real(v) => *v,
+            _ => 0.0,
+        };
+        r as f32
+    }
+
+    /// The value of a setting that takes a word (empty for a value of another kind).
+    fn word(&self) -> &str {
+        match self {
+            Value::Word(w) => w.as_str(),
+            _ => "",
+        }
+    }
+}
+
 /// The settings of a stage, with their kinds (a module's are `MODULE.FIELD`).
 const FIELDS: &[(&str, Kind)] = &[
     ("evolve.population", Kind::Count(None)),
@@ -512,13 +541,7 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
 
 /// Writes `value` into the setting `path` (`world.…`) of a world of stage `name`.
 fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(), String> {
-    let whole = |v: u64| u32::try_from(v).map_err(|_| format!("{v} is too large"));
-    let (n, r) = match value {
-        Value::Count(v) => (*v, *v as f64),
-        Value::Real(v) => (0, *v),
-        _ => (0, 0.0),
-    };
-    let r32 = r as f32;
+    let r32 = value.real();
     match path {
         "world.arena" => {
             if let Value::Pair(a, b) = value {
@@ -533,18 +556,21 @@ fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(),
                 Some(r32)
         }
         "world.battery" => {
-            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.capacity = whole(n)?
+            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.capacity =
+                value.whole()?
         }
         "world.recharge" => {
-            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.recharge = whole(n)?
+            w.battery.as_mut().ok_or_else(|| format!("stage `{name}` has no battery"))?.recharge =
+                value.whole()?
         }
         "world.objects" => {
-            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.count = whole(n)?
+            w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.count =
+                value.whole()?
         }
         "world.diameter" => {
             w.objects.as_mut().ok_or_else(|| format!("stage `{name}` has no objects"))?.diameter = r32
         }
-        "world.robots" => w.robots = whole(n)?,
+        "world.robots" => w.robots = value.whole()?,
         "world.body.radius" => w.body.radius = r32,
         "world.body.wheel_base" => w.body.wheel_base = r32,
         "world.body.v_max" => w.body.v_max = r32,
@@ -559,63 +585,20 @@ fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(),
 /// Writes `value` into `path` of stage `s` (its presence checked by [`get`]).
 fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
     let name = s.name.clone();
-    let whole = |v: u64| u32::try_from(v).map_err(|_| format!("{v} is too large"));
-    let (n, r) = match value {
-        Value::Count(v) => (*v, *v as f64),
-        Value::Real(v) => (0, *v),
-        _ => (0, 0.0),
-    };
-    let word = match value {
-        Value::Word(w) => w.as_str(),
-        _ => "",
-    };
-    let r32 = r as f32;
     if let Some(rest) = path.strip_prefix("evolve.") {
-        let StageRun::Evolve(e) = &mut s.run else { return Err(format!("stage `{name}` does not evolve")) };
-        match rest {
-            "population" => {
-                let new = whole(n)?;
-                // The default `keep` is a fifth of the population, as in the compiler.
-                if let Selection::Truncation { keep } = &mut e.selection {
-                    if *keep == (e.population / 5).max(1) {
-                        *keep = (new / 5).max(1);
-                    }
-                }
-                e.population = new;
-            }
-            "generations" => e.generations = whole(n)?,
-            "actions" => e.actions = whole(n)?,
-            "crossover" => e.crossover = r32,
-            "mutation" => e.mutation = r32,
-            "elitism" => e.elitism = whole(n)?,
-            "evaluations" => e.evaluations = whole(n)?,
-            "keep" => e.selection = Selection::Truncation { keep: whole(n)? },
-            "selection" => {
-                e.selection = match (word, e.selection) {
-                    ("roulette", _) => Selection::Roulette,
-                    (_, Selection::Truncation { keep }) => Selection::Truncation { keep },
-                    (_, Selection::Roulette) => Selection::Truncation { keep: (e.population / 5).max(1) },
-                }
-            }
-            "inheritance" => {
-                s.inheritance =
-                    if word == "lamarckian" { Inheritance::Lamarckian } else { Inheritance::Darwinian }
-            }
-            _ => return Err(format!("`{path}` is not a setting")),
-        }
-        return Ok(());
+        return put_evolve(s, rest, path, value);
     }
     if let Some(rest) = path.strip_prefix("variants.") {
         let v = s.variants.as_mut().ok_or_else(|| format!("stage `{name}` has no variants"))?;
         match rest {
-            "aggregate" => v.aggregate = if word == "min" { Aggregate::Min } else { Aggregate::Mean },
-            "draw" => v.draw = Some(whole(n)?),
+            "aggregate" => v.aggregate = if value.word() == "min" { Aggregate::Min } else { Aggregate::Mean },
+            "draw" => v.draw = Some(value.whole()?),
             _ => return Err(format!("`{path}` is not a setting")),
         }
         return Ok(());
     }
     if path == "fitness.team" {
-        s.fitness.team = match word {
+        s.fitness.team = match value.word() {
             "sum" => Aggregate::Sum,
             "min" => Aggregate::Min,
             _ => Aggregate::Mean,
@@ -641,46 +624,103 @@ fn put(s: &mut Stage, path: &str, value: &Value) -> Result<(), String> {
     }
     match path {
         "test.actions" | "train.actions" => match &mut s.run {
-            StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions = whole(n)?,
+            StageRun::Test { actions, .. } | StageRun::Train { actions } => *actions = value.whole()?,
             StageRun::Evolve(_) => return Err(format!("stage `{name}` evolves")),
         },
         "test.lives" => match &mut s.run {
-            StageRun::Test { lives, .. } => *lives = whole(n)?,
+            StageRun::Test { lives, .. } => *lives = value.whole()?,
             _ => return Err(format!("stage `{name}` is not a test stage")),
         },
         _ => {
             let (module_name, field) =
                 path.rsplit_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
             if let (Some(r), "robots") = (s.roles.iter().position(|r| r.name == module_name), field) {
-                s.roles[r].robots = whole(n)?;
-                // The team is its roles' robots, in every world.
-                let robots = s.roles.iter().map(|r| r.robots).sum();
-                s.world.robots = robots;
-                for x in s.variants.iter_mut().flat_map(|v| v.list.iter_mut()) {
-                    x.world.robots = robots;
-                }
-                return Ok(());
+                return put_role_robots(s, r, value);
             }
-            let mi = module(s, module_name)?.0;
-            if field == "range" {
-                let Value::Pair(lo, hi) = value else { return Err(format!("`{path}` takes LO..HI")) };
-                for g in s.layout.genes.iter_mut().filter(|g| activation_gene(g, mi)) {
-                    (g.lo, g.hi) = (*lo as f32, *hi as f32);
+            return put_module(s, module_name, field, path, value);
+        }
+    }
+    Ok(())
+}
+
+/// Writes `value` into the setting `evolve.REST` (`path`) of stage `s`.
+fn put_evolve(s: &mut Stage, rest: &str, path: &str, value: &Value) -> Result<(), String> {
+    let StageRun::Evolve(e) = &mut s.run else { return Err(format!("stage `{}` does not evolve", s.name)) };
+    match rest {
+        "population" => {
+            let new = value.whole()?;
+            // The default `keep` is a fifth of the population, as in the compiler.
+            if let Selection::Truncation { keep } = &mut e.selection {
+                if *keep == (e.population / 5).max(1) {
+                    *keep = (new / 5).max(1);
                 }
-                return Ok(());
             }
-            let l = s.modules[mi]
-                .learning
-                .as_mut()
-                .ok_or_else(|| format!("module `{module_name}` of stage `{name}` does not learn"))?;
-            match field {
-                "reward" => l.rate_reward = r32,
-                "punish" => l.rate_punish = r32,
-                "window" => l.window = whole(n)?,
-                "threshold" => l.when = LearnWhen::Below { threshold: r32 },
-                _ => return Err(format!("`{path}` is not a setting")),
+            e.population = new;
+        }
+        "generations" => e.generations = value.whole()?,
+        "actions" => e.actions = value.whole()?,
+        "crossover" => e.crossover = value.real(),
+        "mutation" => e.mutation = value.real(),
+        "elitism" => e.elitism = value.whole()?,
+        "evaluations" => e.evaluations = value.whole()?,
+        "keep" => e.selection = Selection::Truncation { keep: value.whole()? },
+        "selection" => {
+            e.selection = match (value.word(), e.selection) {
+                ("roulette", _) => Selection::Roulette,
+                (_, Selection::Truncation { keep }) => Selection::Truncation { keep },
+                (_, Selection::Roulette) => Selection::Truncation { keep: (e.population / 5).max(1) },
             }
         }
+        "inheritance" => {
+            s.inheritance =
+                if value.word() == "lamarckian" { Inheritance::Lamarckian } else { Inheritance::Darwinian }
+        }
+        _ => return Err(format!("`{path}` is not a setting")),
+    }
+    Ok(())
+}
+
+/// Writes `value` into the robots of role `r` of stage `s`, and the team
+/// it makes into every world of the stage.
+fn put_role_robots(s: &mut Stage, r: usize, value: &Value) -> Result<(), String> {
+    s.roles[r].robots = value.whole()?;
+    // The team is its roles' robots, in every world.
+    let robots = s.roles.iter().map(|r| r.robots).sum();
+    s.world.robots = robots;
+    for x in s.variants.iter_mut().flat_map(|v| v.list.iter_mut()) {
+        x.world.robots = robots;
+    }
+    Ok(())
+}
+
+/// Writes `value` into the setting `FIELD` of module `module_name` of
+/// stage `s` (`path` is `MODULE.FIELD`): the range of its activation
+/// weights or a setting of its learning.
+fn put_module(
+    s: &mut Stage,
+    module_name: &str,
+    field: &str,
+    path: &str,
+    value: &Value,
+) -> Result<(), String> {
+    let mi = module(s, module_name)?.0;
+    if field == "range" {
+        let Value::Pair(lo, hi) = value else { return Err(format!("`{path}` takes LO..HI")) };
+        for g in s.layout.genes.iter_mut().filter(|g| activation_gene(g, mi)) {
+            (g.lo, g.hi) = (*lo as f32, *hi as f32);
+        }
+        return Ok(());
+    }
+    let l = s.modules[mi]
+        .learning
+        .as_mut()
+        .ok_or_else(|| format!("module `{module_name}` of stage `{}` does not learn", s.name))?;
+    match field {
+        "reward" => l.rate_reward = value.real(),
+        "punish" => l.rate_punish = value.real(),
+        "window" => l.window = value.whole()?,
+        "threshold" => l.when = LearnWhen::Below { threshold: value.real() },
+        _ => return Err(format!("`{path}` is not a setting")),
     }
     Ok(())
 }

@@ -36,14 +36,30 @@ pub fn parse_fault(s: &str) -> Result<Fault, String> {
     }
 }
 
+/// The arguments of `shaping emulate`.
+#[derive(clap::Args)]
 pub struct EmulateArgs {
-    pub port: PathBuf,
+    /// Architecture file whose world is emulated (default: the built-in `examples/khepera.bat`).
     pub file: Option<PathBuf>,
+    /// Path of the pseudo-terminal to create (a symbolic link).
+    #[arg(long)]
+    pub port: PathBuf,
+    /// Stage whose world is emulated (default: the last).
+    #[arg(long)]
     pub stage: Option<String>,
+    /// Seed of the world (default: the run seed), as `drive --seed`.
+    #[arg(long)]
     pub seed: Option<u64>,
+    /// Emulated line speed: each byte takes 11 bit times (0: no wire delay).
+    #[arg(long, default_value_t = 9600)]
     pub baud: u32,
+    /// The robot's own delay before each answer, ms.
+    #[arg(long = "delay", id = "delay", value_name = "DELAY", default_value_t = 0)]
     pub delay_ms: u64,
+    /// Inject a fault at the N-th request: `drop@N` (no answer), `garbage@N`, `close@N`.
+    #[arg(long, value_parser = parse_fault)]
     pub fault: Option<Fault>,
+    #[arg(long, default_value = "human", value_parser = crate::error_format())]
     pub error_format: crate::diag::ErrorFormat,
 }
 
