@@ -465,3 +465,66 @@ for net, run in [("recurrent", "t-maze"), ("feedforward", "t-maze-ff")]:
     print(f"  {net}: {' '.join(f'{x:.2f}' for x in shares)}; median {statistics.median(shares):.2f}, "
           f"seeds at 0.8 or more: {sum(x >= 0.8 for x in shares)}")
     print(f"    per variant (left/right): {' '.join(per)}")
+
+
+# ---------------------------------------------------------------- a team shaped stage by stage
+def mann_whitney(a, b):
+    """Two-sided Mann-Whitney U (U of `a`), normal approximation with tie and
+    continuity corrections (as `shaping compare` without an exact case), and
+    the Vargha-Delaney A12 (the chance that a value of `a` is the larger)."""
+    pooled = sorted(a + b)
+    rank = {}
+    for x in set(pooled):
+        first = pooled.index(x)
+        rank[x] = first + (pooled.count(x) + 1) / 2
+    n1, n2 = len(a), len(b)
+    u = sum(rank[x] for x in a) - n1 * (n1 + 1) / 2
+    n = n1 + n2
+    ties = sum(pooled.count(x) ** 3 - pooled.count(x) for x in set(pooled))
+    var = n1 * n2 / 12 * ((n + 1) - ties / (n * (n - 1)))
+    z = (abs(u - n1 * n2 / 2) - 0.5) / var ** 0.5 if var > 0 else 0.0
+    p = min(1.0, 2 * (1 - statistics.NormalDist().cdf(max(z, 0.0))))
+    a12 = sum((x > y) + 0.5 * (x == y) for x in a for y in b) / (n1 * n2)
+    return u, p, a12
+
+
+print("\n== a team shaped stage by stage (shaped-team.bat) against evolution from scratch (shaped-team-scratch.bat)")
+CRIT, POP, EVALS = 0.43, 40, 2
+# The shaped file's explore and home stages (40 generations each) are spent
+# before escort; a seed that never reaches the criterion counts at the last
+# generation plus one (as `shaping compare`), after every seed that does.
+ev = {}
+for run, before, gens in (("shaped-team", 80, 40), ("shaped-team-scratch", 0, 120)):
+    e, test = [], []
+    for s in SEEDS:
+        g = first_reach(history(run, s, "escort"), CRIT)
+        e.append(POP * EVALS * (before + (g if g is not None else gens + 1)))
+        with open(f"{R}/{run}/seed-{s}/check/summary.json") as f:
+            test.append(json.load(f)["fitness"])
+    reached = sum(x < POP * EVALS * (before + gens + 1) for x in e)
+    ev[run] = e
+    print(f"  {run}: evaluations to escort >= {CRIT}: {' '.join(map(str, e))}; median {statistics.median(e):.0f}; "
+          f"{reached} of {len(e)} seeds reach it")
+    print(f"    test fitness per seed: {' '.join(f'{x:.3f}' for x in test)}")
+u, p, a12 = mann_whitney(ev["shaped-team"], ev["shaped-team-scratch"])
+print(f"  evaluations, shaped against scratch: U = {u:g}, p = {p:.4f}" if p >= 0.001 else f"  evaluations, shaped against scratch: U = {u:g}, p = {p:.1e}", end="")
+print(f", A12 = {a12:.3f} (below 0.5: shaped needs fewer)")
+# Why, by role: the scouts' fitness per life in check's lives after the
+# change (navigation's per-action term from the trace), the guards' (the
+# team's mean holds 2 scouts and 2 guards), and the recharges.
+for run in ("shaped-team", "shaped-team-scratch"):
+    scouts, guards, recharges = [], [], []
+    for s in SEEDS:
+        with open(f"{R}/{run}/seed-{s}/check/summary.json") as f:
+            d = json.load(f)
+        skip = sum(d["before_lives"])
+        fit = 0.0
+        for r in rows(f"{R}/{run}/seed-{s}/check/trace.csv"):
+            if int(r["action"]) >= skip and int(r["robot"]) < 2:
+                ir = max(float(r[f"ir[{k}]"]) for k in range(8))
+                fit += abs(float(r["wheels[0]"]) + float(r["wheels[1]"])) / 2 * (1 - ir) / 300
+        scouts.append(fit / 2 / len(d["after_lives"]))
+        guards.append(2 * d["fitness"] - scouts[-1])
+        recharges.append(d["after"]["recharges"])
+    print(f"  {run}, per life: a scout {' '.join(f'{x:.2f}' for x in scouts)}; a guard "
+          f"{' '.join(f'{x:.2f}' for x in guards)}; recharges in 20 lives {' '.join(map(str, recharges))}")

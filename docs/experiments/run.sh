@@ -101,6 +101,19 @@ grep -q 'behavior neural { hidden 6  outputs linear' $R/t-maze-ff.bat
 $B experiment examples/t-maze.bat --seeds $SEEDS --out $R/t-maze --fresh > /dev/null
 $B experiment $R/t-maze-ff.bat --seeds $SEEDS --out $R/t-maze-ff --fresh > /dev/null
 $B compare $R/t-maze $R/t-maze-ff --stage maze_test
+# A team shaped stage by stage (shaped-team.bat: role `scout` learns to
+# explore, then adds modules to recharge; then role `guard`, whose fitness
+# is to keep the team together, joins it) against the same final
+# architecture evolved from generation 0 for the same 9,600 evaluations
+# (shaped-team-scratch.bat). The criterion, stated before seeds 1 to 10
+# ran: escort's best >= 0.43. The tests (printed): the final test `check`,
+# and escort within its own generations; analyse.py counts the evaluations
+# to the criterion with the shaped file's earlier stages.
+$B experiment examples/shaped-team.bat --seeds $SEEDS --out $R/shaped-team --fresh --criterion escort=0.43 > /dev/null
+$B experiment examples/shaped-team-scratch.bat --seeds $SEEDS --out $R/shaped-team-scratch --fresh \
+  --criterion escort=0.43 > /dev/null
+$B compare $R/shaped-team $R/shaped-team-scratch --stage check
+$B compare $R/shaped-team $R/shaped-team-scratch --stage escort --criterion escort=0.43
 
 # Teams (EXPERIMENTS.md, "Teams: aggregation and cooperative collect"):
 # aggregation.bat's 10 robots, and team-collect.bat's 4 robots with 16
@@ -170,7 +183,8 @@ $B replay examples/floreano-mondada-1996.bat --stage homing --run $R/fm1996/seed
 for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforcement fm1996/fitness-seeds fm1996-replay/trajectory \
   figure11/activations figure11/trajectory \
   khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
-  khepera-practice/seed-1/bigger/reinforcement aggregation-replay/trajectory team-collect-replay/trajectory; do
+  khepera-practice/seed-1/bigger/reinforcement aggregation-replay/trajectory team-collect-replay/trajectory \
+  shaped-team/seed-1/check/trajectory shaped-team-scratch/seed-1/check/trajectory; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
 
