@@ -588,6 +588,12 @@ impl<'s> Controller<'s> {
         &self.now
     }
 
+    /// The actuator slots of the last command executed, as expressions read
+    /// them (`wheels[0]`, a broadcast's values, which stay until set again).
+    pub fn commanded(&self) -> &[f32; ACT_SLOTS] {
+        &self.slots
+    }
+
     /// The current step of module `m`'s script (`None` for a neural behavior).
     pub fn script_position(&self, m: usize) -> Option<usize> {
         match &self.mods[m].gen {
