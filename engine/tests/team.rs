@@ -378,7 +378,7 @@ fn the_trace_records_the_range_and_bearing_board() {
     // when it drives, and is heard.
     assert!(rows.iter().any(|r| r[..8].iter().any(|&v| v > 0.0)), "someone perceived");
     let signalled = rows.iter().any(|r| r[16] == 1.0);
-    let heard = rows.iter().any(|r| r[8..16].iter().any(|&v| v == 1.0));
+    let heard = rows.iter().any(|r| r[8..16].contains(&1.0));
     assert!(signalled && heard, "a signal sent is heard: {signalled} {heard}");
     // Robot 0's columns are the board it sensed: its percept's channels.
     let one = shaping_engine::report::trace_csv(&rec.trace, stage, &rec.episode);

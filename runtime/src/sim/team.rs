@@ -831,6 +831,7 @@ mod tests {
     fn team_measures_match_a_search_over_every_pair() {
         use crate::program::RangeBearing;
         use rand::RngCore;
+        use std::f32::consts::PI;
         let mut rng = Xoshiro256pp::seed_from_u64(11);
         for (case, &n) in [1u32, 2, 3, 7, 40, 150, 300].iter().enumerate() {
             for board in [None, Some(60.0), Some(300.0)] {
@@ -844,7 +845,7 @@ mod tests {
                 let what = |kind: &str| format!("{n} robots, board {board:?}, {kind}");
                 // Uniform over the arena, any headings.
                 for i in 0..n as usize {
-                    let (x, y, t) = (u(30.0, 2970.0), u(30.0, 1970.0), u(-3.14, 3.14));
+                    let (x, y, t) = (u(30.0, 2970.0), u(30.0, 1970.0), u(-PI, PI));
                     put(&mut team, i, x, y, t);
                 }
                 assert_near(&mut team, &what("uniform"));
@@ -865,7 +866,7 @@ mod tests {
                 assert!(got[1] > 0.9, "{}: {got:?}", what("two clusters"));
                 // All on one spot, half heading east and half west.
                 for i in 0..n as usize {
-                    let t = if i % 2 == 0 { 0.0 } else { std::f32::consts::PI };
+                    let t = if i % 2 == 0 { 0.0 } else { PI };
                     put(&mut team, i, 1234.5, 876.5, t);
                 }
                 let got = assert_near(&mut team, &what("one spot"));
