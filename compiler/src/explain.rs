@@ -199,7 +199,7 @@ pub const EXPLANATIONS: &[Explanation] = &[
     Explanation {
         code: "S0023",
         title: "a team's fitness with one robot (a warning)",
-        text: "`team sum`, `team mean` or `team min` says how the fitness of a team's robots makes the team's; in a stage whose world (and every variant's) has one robot, it has no effect. The same for a fitness that reads the team's state: with one robot, `team.spread` and `team.grouped` are always 0 and `team.largest` always 1. The file compiles; declare `robots N` in the stage's `world`, or remove the clause (or read the robot's own state, `robot.x` ...).",
+        text: "`team sum`, `team mean` or `team min` says how the fitness of a team's robots makes the team's; in a stage whose world (and every variant's) has one robot, it has no effect. The same for a fitness that reads the team's state: with one robot, `team.spread`, `team.grouped` and `team.nearest` are always 0 and `team.largest`, `team.order` and `team.connected` always 1. The file compiles; declare `robots N` in the stage's `world`, or remove the clause (or read the robot's own state, `robot.x` ...).",
         wrong: concat!(robot!(), "stage s {\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { robots 3 }\n  fitness per action wheels[0], team sum\n  module m { sense ir  behavior forward }\n}\n"),
     },

@@ -20,7 +20,8 @@ use shaping_runtime::program::World;
 
 use serde::{Deserialize, Serialize};
 use shaping_runtime::catalog::{
-    ActuatorKind, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, SENSOR_BEARING_DEG,
+    ActuatorKind, ACT_SIGNAL, CHANNELS, CH_BARRIER, CH_FLOOR, CH_IR, CH_LAMP_DISTANCE, CH_LIGHT, CH_RAB,
+    SENSOR_BEARING_DEG, SIGNALS,
 };
 use shaping_runtime::controller::{Robot, Trace, TraceRow};
 use shaping_runtime::robot::{Link, SerialRobot};
@@ -46,6 +47,35 @@ pub struct Frame {
     pub wheels: [f32; 2],
     /// `[x, y, radius, state]` per object (state 0 floor, 1 held, 2 outside).
     pub objects: Vec<[f32; 4]>,
+    /// The range-and-bearing board, when the body has one.
+    pub board: Option<Box<BoardFrame>>,
+}
+
+/// The channels of the range-and-bearing board: its sectors, then the
+/// signals heard (from [`CH_RAB`] to the percept's end).
+pub const BOARD_CHANNELS: usize = CHANNELS - CH_RAB;
+
+/// What a robot's range-and-bearing board read after an action, and what
+/// the robot broadcast then.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoardFrame {
+    /// The sectors, then the signals heard, as the percept has them from
+    /// [`CH_RAB`].
+    pub read: [f32; BOARD_CHANNELS],
+    /// The values broadcast (a `broadcast` actuator's).
+    pub signal: [f32; SIGNALS],
+}
+
+impl BoardFrame {
+    /// The board in percept `out`, with the broadcast of the actuator
+    /// slots `commanded`.
+    fn of(out: &[f32; CHANNELS], commanded: &[f32; shaping_runtime::catalog::ACT_SLOTS]) -> Box<BoardFrame> {
+        let mut read = [0.0; BOARD_CHANNELS];
+        read.copy_from_slice(&out[CH_RAB..]);
+        let mut signal = [0.0; SIGNALS];
+        signal.copy_from_slice(&commanded[ACT_SIGNAL..ACT_SIGNAL + SIGNALS]);
+        Box::new(BoardFrame { read, signal })
+    }
 }
 
 /// A robot whose world can be drawn: the simulator, or a real robot with
@@ -103,6 +133,7 @@ fn frame_of(
         claw_closed,
         wheels,
         objects,
+        board: None,
     }
 }
 
@@ -230,6 +261,11 @@ pub struct EpisodeColumns {
     /// [`EpisodeWorld::others`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub others: Vec<PoseColumns>,
+    /// The range-and-bearing board after every action, when the body has
+    /// one: for `trace.csv`, not written in `episode.json` (whose format
+    /// stays as it is).
+    #[serde(skip)]
+    pub board: Vec<BoardFrame>,
 }
 
 impl EpisodeColumns {
@@ -273,6 +309,12 @@ impl EpisodeColumns {
         self.arm_down.push(f.arm_down as u8);
         self.claw_closed.push(f.claw_closed as u8);
         self.wheels.push(f.wheels.map(|v| round(v, 3)));
+        if let Some(b) = &f.board {
+            self.board.push(BoardFrame {
+                read: b.read.map(|v| round(v, 3)),
+                signal: b.signal.map(|v| round(v, 3)),
+            });
+        }
     }
 }
 
@@ -612,6 +654,8 @@ struct LifeRecorder<'a> {
     starts: Vec<Pose>,
     scene: Option<Scene>,
     stop: Option<&'a AtomicBool>,
+    /// The body has a range-and-bearing board: the frames keep it.
+    board: bool,
 }
 
 impl LifeRecorder<'_> {
@@ -630,7 +674,11 @@ impl LifeRecorder<'_> {
         }
         let (gripper, world) = robot.seen(i == 0);
         let objects = world.as_ref().filter(|_| i == 0).map(object_rows).unwrap_or_default();
-        self.frames[i].push(frame_of(ctl.percept(), gripper[0], gripper[1], wheels, objects));
+        let mut frame = frame_of(ctl.percept(), gripper[0], gripper[1], wheels, objects);
+        if self.board {
+            frame.board = Some(BoardFrame::of(ctl.percept(), ctl.commanded()));
+        }
+        self.frames[i].push(frame);
         world
     }
 
@@ -746,8 +794,13 @@ pub fn record_life(
 ) -> TeamLife {
     let n = world.robots.max(1) as usize;
     let mut traces = vec![Trace::default(); n];
-    let mut rec =
-        LifeRecorder { frames: vec![Vec::new(); n], starts: vec![Pose::default(); n], scene: None, stop };
+    let mut rec = LifeRecorder {
+        frames: vec![Vec::new(); n],
+        starts: vec![Pose::default(); n],
+        scene: None,
+        stop,
+        board: world.body.rab.is_some(),
+    };
     let result = episode_with(run, world, seed, opts, Some(&mut traces), |sim| sim, &mut rec);
     let actions = result.team.actions;
     for t in &mut traces {

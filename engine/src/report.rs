@@ -7,7 +7,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT};
+use shaping_runtime::catalog::{ActuatorKind, SensorKind, CH_IR, CH_LIGHT, CH_RAB};
 use shaping_runtime::controller::{Trace, TraceRow};
 use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
@@ -61,6 +61,11 @@ enum Source {
     Wheel(usize),
     Arm,
     Claw,
+    /// Channel `i` of the range-and-bearing board (from `CH_RAB`: its
+    /// sectors, then the signals heard).
+    Board(usize),
+    /// Broadcast value `k`.
+    Signal(usize),
 }
 
 impl Source {
@@ -78,6 +83,8 @@ impl Source {
             Source::Wheel(i) => c.wheels.get(k).map(|w| w[i.min(1)]),
             Source::Arm => flag(&c.arm_down),
             Source::Claw => flag(&c.claw_closed),
+            Source::Board(i) => c.board.get(k).and_then(|b| b.read.get(i)).copied(),
+            Source::Signal(i) => c.board.get(k).and_then(|b| b.signal.get(i)).copied(),
         }
         .unwrap_or(f32::NAN)
     }
@@ -98,18 +105,19 @@ fn declared_columns(stage: &Stage) -> Vec<(String, Source)> {
                 SensorKind::Optical => Source::Barrier,
                 SensorKind::Ground => Source::Floor,
                 SensorKind::LampDistance => Source::LampDistance,
-                // Not recorded in `episode.json` yet: no column.
-                SensorKind::RangeBearing | SensorKind::Signal => continue,
+                SensorKind::RangeBearing | SensorKind::Signal => Source::Board(ch.saturating_sub(CH_RAB)),
             };
             out.push((format!("{}[{i}]", s.name), source));
         }
     }
+    let signals = stage.world.body.rab.as_ref().map_or(1, |r| usize::from(r.signals));
+    let broadcast: Vec<Source> = (0..signals).map(Source::Signal).collect();
     for a in &stage.actuators {
         let sources: &[Source] = match a.kind {
             ActuatorKind::Speed => &[Source::Wheel(0), Source::Wheel(1)],
             ActuatorKind::Lift => &[Source::Arm],
             ActuatorKind::Grip => &[Source::Claw],
-            ActuatorKind::Broadcast => &[],
+            ActuatorKind::Broadcast => &broadcast,
         };
         out.extend(sources.iter().enumerate().map(|(i, &src)| (format!("{}[{i}]", a.name), src)));
     }

@@ -405,3 +405,50 @@ fn a_replay_follows_the_robot_asked_for() {
     let err = replay::replay(team(load(&tiny_bat()), 1), &args(1, "one"), &Log::default()).unwrap_err();
     assert_eq!(err.message(), "error: `--robot 1`: stage `first` has one robot, robot 0");
 }
+
+/// `trace.csv` of a team with a range-and-bearing board has a column per
+/// element of its `range_bearing` and `signal` sensors and of its
+/// `broadcast` actuator, as the other declared sensors and actuators:
+/// what the board read after each action and what the robot broadcast.
+/// `episode.json` stays as it is.
+#[test]
+fn the_trace_records_the_range_and_bearing_board() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/aggregation-rab.bat");
+    let program = load(&path);
+    let stage = &program.stages[0];
+    let genome = Genome::zeros(stage.layout.bits as usize);
+    let opts = EpisodeOptions { actions: 30, learning: false, seed: 3 };
+    let rec = episode::record(stage, &genome, &opts).unwrap();
+    let csv = shaping_engine::report::team_trace_csv(&rec.trace, &rec.others, stage, &rec.episode);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no `{name}`"));
+    let board: Vec<usize> = (0..8)
+        .map(|s| col(&format!("rab[{s}]")))
+        .chain((0..8).map(|s| col(&format!("heard[{s}]"))))
+        .chain([col("signal[0]")])
+        .collect();
+    assert!(!header.contains(&"signal[1]"), "one broadcast value");
+    let rows: Vec<Vec<f32>> = lines
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            board.iter().map(|&c| cells[c].parse::<f32>().unwrap()).collect()
+        })
+        .collect();
+    assert_eq!(rows.len(), 10 * rec.result.actions as usize, "every robot's every action");
+    for r in &rows {
+        assert!(r.iter().all(|v| (0.0..=1.0).contains(v)), "{r:?}");
+    }
+    // Ten robots in a 600 mm square perceive each other; `gather` signals 1
+    // when it drives, and is heard.
+    assert!(rows.iter().any(|r| r[..8].iter().any(|&v| v > 0.0)), "someone perceived");
+    let signalled = rows.iter().any(|r| r[16] == 1.0);
+    let heard = rows.iter().any(|r| r[8..16].contains(&1.0));
+    assert!(signalled && heard, "a signal sent is heard: {signalled} {heard}");
+    // Robot 0's columns are the board it sensed: its percept's channels.
+    let one = shaping_engine::report::trace_csv(&rec.trace, stage, &rec.episode);
+    assert!(one.lines().next().unwrap().contains(",rab[0],"));
+    // The board is not in `episode.json`.
+    let json = serde_json::to_string(&rec.episode).unwrap();
+    assert!(!json.contains("board"), "episode.json keeps its format");
+}

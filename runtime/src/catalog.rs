@@ -258,8 +258,11 @@ pub fn channel_bearing_in(channel: usize, sectors: usize) -> Option<f32> {
 // ------------------------------------------------------------ state slots
 
 /// Number of state slots an expression can read (`robot.x` ...,
-/// `distance_to(NAME)`, `team.spread`, `team.grouped`, `team.largest`).
-pub const STATE_SLOTS: usize = ST_LARGEST + 1;
+/// `distance_to(NAME)`, `team.spread` ... `team.connected`).
+pub const STATE_SLOTS: usize = ST_SPREAD + TEAM_SLOTS;
+/// The team's slots, from [`ST_SPREAD`]: `team.spread`, `team.grouped`,
+/// `team.largest`, `team.nearest`, `team.order`, `team.connected`.
+pub const TEAM_SLOTS: usize = 6;
 /// The team's spread (`team.spread`): the mean distance of its robots'
 /// centres to the team's centre (their mean), mm, after the last action
 /// all of them did (0 for one robot). After the targets, so the slots
@@ -272,6 +275,19 @@ pub const ST_GROUPED: usize = ST_SPREAD + 1;
 /// robots joined by bodies within [`crate::state::NEIGHBOUR_GAP`] of each other, and
 /// the robots joined to those (1 for one robot).
 pub const ST_LARGEST: usize = ST_SPREAD + 2;
+/// The mean over the team's robots of the distance from each one's centre
+/// to the nearest other robot's centre, mm (`team.nearest`; 0 for one robot).
+pub const ST_NEAREST: usize = ST_SPREAD + 3;
+/// The length of the mean of the robots' unit heading vectors
+/// (`team.order`): 1 when all head one way, near 0 when their headings
+/// cancel out (1 for one robot).
+pub const ST_ORDER: usize = ST_SPREAD + 4;
+/// The share of the team's robots in its largest group connected by the
+/// range-and-bearing board's links: robots whose bodies are within the
+/// board's range of each other (surface to surface; [`crate::state::LINK_RANGE`]
+/// without a board), and the robots linked to those (`team.connected`; 1
+/// for one robot).
+pub const ST_CONNECTED: usize = ST_SPREAD + 5;
 /// The first slot of the distances to the stage's targets
 /// (`Stage::targets`): slot `ST_TARGETS + i` is target `i`'s.
 pub const ST_TARGETS: usize = 6;

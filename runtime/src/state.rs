@@ -12,13 +12,23 @@ use crate::program::{Action, Behavior, Stage, StepEnd};
 // The slots' numbers live in the catalog, beside the channels' (so an
 // expression knows how many there are without the state).
 pub use crate::catalog::{
-    MAX_TARGETS, STATE_SLOTS, ST_DISTANCE, ST_GROUPED, ST_HEADING, ST_LARGEST, ST_SPREAD, ST_SQUARES,
-    ST_TARGETS, ST_TIME, ST_X, ST_Y,
+    MAX_TARGETS, STATE_SLOTS, ST_CONNECTED, ST_DISTANCE, ST_GROUPED, ST_HEADING, ST_LARGEST, ST_NEAREST,
+    ST_ORDER, ST_SPREAD, ST_SQUARES, ST_TARGETS, ST_TIME, ST_X, ST_Y, TEAM_SLOTS,
 };
 
 /// The gap between two bodies within which robots are neighbours, mm: a
 /// Khepera's proximity sensors see another body about this far.
 pub const NEIGHBOUR_GAP: f32 = 20.0;
+
+/// The gap between two bodies (surface to surface) within which
+/// `team.connected` links two robots whose body has no range-and-bearing
+/// board, mm: the board's default range (`rab_range`).
+pub const LINK_RANGE: f32 = crate::program::RangeBearing::DEFAULT.range;
+
+/// The team's slots for a team of one robot (and what a one-robot life's
+/// expressions read): spread 0, grouped 0, largest 1, nearest 0, order 1,
+/// connected 1.
+pub const TEAM_OF_ONE: [f32; TEAM_SLOTS] = [0.0, 0.0, 1.0, 0.0, 1.0, 1.0];
 
 /// The side of the squares of [`Descriptors::squares_visited`], mm.
 pub const SQUARE_MM: f32 = 50.0;
@@ -135,10 +145,35 @@ pub fn reads_state(stage: &Stage) -> bool {
     reads(stage, |_| true)
 }
 
-/// Some expression of `stage` reads one of the team's groups
-/// (`team.grouped`, `team.largest`): what the team then measures each action.
-pub fn reads_groups(stage: &Stage) -> bool {
-    reads(stage, |slot| slot == ST_GROUPED || slot == ST_LARGEST)
+/// Which of the team's measures the expressions of a stage read: what
+/// the team measures after each action beside `team.spread` (a sum over
+/// the robots, always measured). The others cost a search of the robots'
+/// neighbours, made only for a stage that reads them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TeamReads {
+    /// `team.grouped` or `team.largest`.
+    pub groups: bool,
+    /// `team.nearest`.
+    pub nearest: bool,
+    /// `team.order`.
+    pub order: bool,
+    /// `team.connected`.
+    pub connected: bool,
+}
+
+impl TeamReads {
+    /// Every measure.
+    pub const ALL: TeamReads = TeamReads { groups: true, nearest: true, order: true, connected: true };
+
+    /// What the expressions of `stage` read.
+    pub fn of(stage: &Stage) -> TeamReads {
+        TeamReads {
+            groups: reads(stage, |slot| slot == ST_GROUPED || slot == ST_LARGEST),
+            nearest: reads(stage, |slot| slot == ST_NEAREST),
+            order: reads(stage, |slot| slot == ST_ORDER),
+            connected: reads(stage, |slot| slot == ST_CONNECTED),
+        }
+    }
 }
 
 /// Some expression of `stage` reads a state slot that `slot` accepts.

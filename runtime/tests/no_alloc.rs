@@ -110,7 +110,7 @@ fn an_episode_allocates_the_same_whatever_its_length() {
 }
 
 /// The densest team there is, bodies packed side by side: finding each
-/// robot's neighbours, sensing, moving and the team's groups allocate nothing.
+/// robot's neighbours, sensing, moving and the team's measures allocate nothing.
 #[test]
 fn a_packed_team_never_allocates() {
     use shaping_runtime::sim::{Pose, Team};
@@ -136,8 +136,9 @@ fn a_packed_team_never_allocates() {
                 let turn = if (i as u32 + a).is_multiple_of(5) { 1.0 } else { 0.0 };
                 team.step(i, &Command { wheels: [1.0 - turn, 1.0], ..Command::default() });
             }
-            // The team's state, its groups too (`team.largest` ...).
-            std::hint::black_box(team.state(true));
+            // The team's state, every measure (`team.largest`,
+            // `team.nearest`, `team.connected` ...).
+            std::hint::black_box(team.state(shaping_runtime::state::TeamReads::ALL));
         }
     });
     assert_eq!(info.count_total, 0, "a packed team allocated");

@@ -338,6 +338,39 @@ fn team_groups_are_read_at_the_end() {
     }
 }
 
+/// `team.nearest`, `team.order` and `team.connected` reach the fitness,
+/// measured where the robots end.
+#[test]
+fn team_swarm_measures_are_read_at_the_end() {
+    use shaping_runtime::expr::Op;
+    use shaping_runtime::state::{TeamReads, ST_CONNECTED, ST_NEAREST, ST_ORDER};
+    let mut stage = testkit::bare_stage(
+        "swarm",
+        quiet(World { robots: 6, battery: None, charger: None, ..testkit::arena_world() }),
+    );
+    // team.nearest + 1000 x team.order + 10000 x team.connected.
+    stage.fitness.at_end = Some(testkit::expr(vec![
+        Op::State(ST_NEAREST as u16),
+        Op::State(ST_ORDER as u16),
+        Op::Const(1000.0),
+        Op::Mul,
+        Op::Add,
+        Op::State(ST_CONNECTED as u16),
+        Op::Const(10000.0),
+        Op::Mul,
+        Op::Add,
+    ]));
+    let opts = EpisodeOptions { actions: 5, learning: false, seed: 4 };
+    let res = run_team_episode(&stage, &Genome { bits: vec![] }, &opts, None).unwrap();
+    // No module: the robots stand where they start.
+    let s = Team::new(&stage.world, 4).state(TeamReads::ALL);
+    let (nearest, order, connected) = (s[3], s[4], s[5]);
+    assert!(nearest > 0.0 && order > 0.0 && connected > 0.0, "{s:?}");
+    for r in &res.robots {
+        assert_eq!(r.fitness, nearest + order * 1000.0 + connected * 10000.0);
+    }
+}
+
 #[test]
 fn the_robot_link_refuses_a_team() {
     let mut stage = testkit::collect();

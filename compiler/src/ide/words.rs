@@ -196,7 +196,7 @@ const LIST: &[Word] = &[
     w("objects", C, WORLD, "`objects N diameter D physical|virtual`: objects to collect", WORLD_S),
     w("robots", C, WORLD | CLAUSE, "`robots N`: a team of N clones of the evaluated individual, all starting in the start region (`role NAME robots N`: the robots that play a role)", TEAMS),
     w("role", C, STAGE, "`role NAME robots N { MODULES LINKS FITNESS }`: a role of a heterogeneous team, whose N robots run its own modules, links and genes; in a later stage, `role NAME adds { ... }` adds modules and links to it and `role NAME robots N` changes its robots", ROLES),
-    w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm; `team.grouped`, `team.largest`: the shares of the robots with a neighbour and in the largest group", TEAMS),
+    w("team", C, CLAUSE | EXPR, "`team sum|mean|min` in a fitness: how the robots' fitness makes the team's; `team.spread`: the mean distance of the robots to the team's centre, mm; `team.grouped`, `team.largest`: the shares of the robots with a neighbour and in the largest group; `team.nearest`: the mean distance to the nearest other robot, mm; `team.order`: the length of the mean heading, 0..1; `team.connected`: the share in the largest group linked within `rab_range`", TEAMS),
     w("body", C, WORLD, "`body [khepera | e-puck] { v_max 80 ... }`: the robot's body, from a preset, with single values changed", WORLD_S),
     w("khepera", C, CLAUSE, "`body khepera`: the Khepera's body and sensors (the default)", BODIES),
     w("e-puck", C, CLAUSE, "`body e-puck`: the e-puck's body, its IR sensors' places and bearings and 3 ground sensors", BODIES),

@@ -41,7 +41,7 @@ pub const STATE_FIELDS: [(&str, usize, &str); 6] = [
 ];
 
 /// The fields of `team.FIELD` and their state slots.
-pub const TEAM_FIELDS: [(&str, usize, &str); 3] = [
+pub const TEAM_FIELDS: [(&str, usize, &str); 6] = [
     (
         "spread",
         ST_SPREAD,
@@ -56,6 +56,21 @@ pub const TEAM_FIELDS: [(&str, usize, &str); 3] = [
         "largest",
         shaping_runtime::state::ST_LARGEST,
         "the share of the team's robots in its largest group (bodies within 20 mm of each other), 0..1",
+    ),
+    (
+        "nearest",
+        shaping_runtime::state::ST_NEAREST,
+        "the mean over the team's robots of the distance to the nearest other robot, centre to centre, mm (0 for one robot)",
+    ),
+    (
+        "order",
+        shaping_runtime::state::ST_ORDER,
+        "the length of the mean of the robots' unit heading vectors, 0..1: 1 when all head one way (1 for one robot)",
+    ),
+    (
+        "connected",
+        shaping_runtime::state::ST_CONNECTED,
+        "the share of the team's robots in its largest group linked within the range-and-bearing range (`rab_range`, 300 mm without a board), 0..1",
     ),
 ];
 

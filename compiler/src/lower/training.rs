@@ -449,8 +449,8 @@ impl Lower<'_> {
                 for (field, span) in reads {
                     // The value `team.FIELD` has for one robot (see `TEAM_FIELDS`).
                     let value = match field.as_str() {
-                        "spread" | "grouped" => "0",
-                        "largest" => "1",
+                        "spread" | "grouped" | "nearest" => "0",
+                        "largest" | "order" | "connected" => "1",
                         _ => continue,
                     };
                     self.errors.push(Error::TeamOfOne {

@@ -77,6 +77,20 @@ fn the_documented_team_is_one() {
     assert!(reads(&p.stages[0].fitness.at_end) || reads(&p.stages[0].fitness.per_action));
 }
 
+/// `team.nearest`, `team.order` and `team.connected` read their state slots.
+#[test]
+fn the_teams_swarm_measures_are_fields() {
+    use shaping_runtime::state::{ST_CONNECTED, ST_NEAREST, ST_ORDER};
+    let src = SRC.replace("at end -team.spread / 100", "at end team.nearest - team.order + team.connected");
+    let p = compile_ok(&src, "teams.bat");
+    let at_end = p.stages[1].fitness.at_end.as_ref().expect("an at-end term");
+    let slots: Vec<&Op> = at_end.ops.iter().filter(|op| matches!(op, Op::State(_))).collect();
+    assert_eq!(
+        slots,
+        [&Op::State(ST_NEAREST as u16), &Op::State(ST_ORDER as u16), &Op::State(ST_CONNECTED as u16)]
+    );
+}
+
 /// `team.grouped` and `team.largest` read their state slots.
 #[test]
 fn the_teams_groups_are_fields() {

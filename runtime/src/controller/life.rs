@@ -16,6 +16,7 @@ use super::{tally, ActionReport, Controller, EpisodeOptions, EpisodeResult, Robo
 use crate::catalog::CHANNELS;
 use crate::program::Stage;
 use crate::sim::{Command, Outcome, Pose};
+use crate::state::{TeamReads, TEAM_SLOTS};
 
 /// The bodies a life runs.
 pub trait Bodies {
@@ -38,9 +39,10 @@ pub trait Bodies {
     /// Robot `i`.
     fn member(&mut self, i: usize) -> Self::Member<'_>;
     /// The state every controller is given (`[team.spread, team.grouped,
-    /// team.largest]`; the groups measured when `groups`), or `None`: one
-    /// robot has none, its controller's team slots stay as they start.
-    fn state(&mut self, _groups: bool) -> Option<[f32; 3]> {
+    /// team.largest, team.nearest, team.order, team.connected]`, those
+    /// `reads` leaves out not measured), or `None`: one robot has none,
+    /// its controller's team slots stay as they start.
+    fn state(&mut self, _reads: TeamReads) -> Option<[f32; TEAM_SLOTS]> {
         None
     }
 }
@@ -143,8 +145,8 @@ pub fn live<'s, B: Bodies>(
     let ctls = &mut ctls[..n];
     let mut robots = vec![EpisodeResult::default(); n];
     let mut fitness = vec![0.0f64; n];
-    let groups = crate::state::reads_groups(stage);
-    let state = bodies.state(groups);
+    let reads = TeamReads::of(stage);
+    let state = bodies.state(reads);
     for (i, c) in ctls.iter_mut().enumerate() {
         c.set_learning(opts.learning);
         if let Some(s) = state {
@@ -183,7 +185,7 @@ pub fn live<'s, B: Bodies>(
         }
         actions += 1;
         bodies.end_action();
-        if let Some(s) = bodies.state(groups) {
+        if let Some(s) = bodies.state(reads) {
             for c in ctls.iter_mut() {
                 c.set_team(s);
             }

@@ -95,7 +95,7 @@ use crate::expr::Env;
 use crate::genome::Genome;
 use crate::program::{Behavior, Decode, Event, LearnTarget, LearnWhen, Learning, Param, Stage};
 use crate::sim::{Command, Outcome, Pose, Sim};
-use crate::state::{Descriptors, Odometer, STATE_SLOTS};
+use crate::state::{Descriptors, Odometer, STATE_SLOTS, ST_SPREAD, TEAM_SLOTS};
 
 pub use fast_expr::FastExpr;
 pub use life::{live, team_result, Bodies, Hooks, Solo};
@@ -367,9 +367,9 @@ pub struct Controller<'s> {
     odo: Odometer,
     /// The state the expressions read (`robot.x` ...), filled only when one does.
     state: [f32; STATE_SLOTS],
-    /// `team.spread`, `team.grouped`, `team.largest`, as the team last
-    /// gave them ([`Controller::set_team`]).
-    team: [f32; 3],
+    /// `team.spread` ... `team.connected`, as the team last gave them
+    /// ([`Controller::set_team`]).
+    team: [f32; TEAM_SLOTS],
     reads_state: bool,
     /// Where the stage's targets (`distance_to(NAME)`) are in the world of
     /// the life (`None`: not in it; its distance reads [`FAR`]).
@@ -487,7 +487,7 @@ impl<'s> Controller<'s> {
             at_end: stage.role_fitness(role).at_end.as_ref().map(FastExpr::new),
             odo: Odometer::default(),
             state: [0.0; STATE_SLOTS],
-            team: [0.0, 0.0, 1.0],
+            team: crate::state::TEAM_OF_ONE,
             reads_state: crate::state::reads_state(stage),
             targets: stage.targets.iter().map(|t| crate::world::Place::of(&stage.world, t)).collect(),
         })
@@ -539,17 +539,18 @@ impl<'s> Controller<'s> {
             for (slot, place) in self.state[crate::state::ST_TARGETS..].iter_mut().zip(&self.targets) {
                 *slot = place.map_or(FAR, |p| p.distance(at));
             }
-            self.state[crate::state::ST_SPREAD..=crate::state::ST_LARGEST].copy_from_slice(&self.team);
+            self.state[ST_SPREAD..ST_SPREAD + TEAM_SLOTS].copy_from_slice(&self.team);
         }
     }
 
     /// Gives the team's state the expressions read from now on: its
-    /// spread, the share of its robots grouped and in its largest group
-    /// (`team.spread`, `team.grouped`, `team.largest`).
-    pub fn set_team(&mut self, team: [f32; 3]) {
+    /// spread, the share of its robots grouped and in its largest group,
+    /// the mean distance to the nearest robot, the order of the headings
+    /// and the share connected (`team.spread` ... `team.connected`).
+    pub fn set_team(&mut self, team: [f32; TEAM_SLOTS]) {
         self.team = team;
         if self.reads_state {
-            self.state[crate::state::ST_SPREAD..=crate::state::ST_LARGEST].copy_from_slice(&team);
+            self.state[ST_SPREAD..ST_SPREAD + TEAM_SLOTS].copy_from_slice(&team);
         }
     }
 
@@ -585,6 +586,12 @@ impl<'s> Controller<'s> {
     /// The current percept (after the last action).
     pub fn percept(&self) -> &[f32; CHANNELS] {
         &self.now
+    }
+
+    /// The actuator slots of the last command executed, as expressions read
+    /// them (`wheels[0]`, a broadcast's values, which stay until set again).
+    pub fn commanded(&self) -> &[f32; ACT_SLOTS] {
+        &self.slots
     }
 
     /// The current step of module `m`'s script (`None` for a neural behavior).

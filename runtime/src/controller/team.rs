@@ -21,6 +21,7 @@ use crate::catalog::CHANNELS;
 use crate::genome::Genome;
 use crate::program::{Stage, World};
 use crate::sim::{robot_seed, Command, Outcome, Pose, Sim, Team};
+use crate::state::{TeamReads, TEAM_SLOTS};
 
 /// Robot `i` of a team, as its controller sees it.
 pub struct TeamMember<'t> {
@@ -176,8 +177,8 @@ impl Bodies for TeamBodies<'_> {
     fn member(&mut self, i: usize) -> TeamMember<'_> {
         TeamMember { team: &mut *self.team, i }
     }
-    fn state(&mut self, groups: bool) -> Option<[f32; 3]> {
-        Some(self.team.state(groups))
+    fn state(&mut self, reads: TeamReads) -> Option<[f32; TEAM_SLOTS]> {
+        Some(self.team.state(reads))
     }
 }
 

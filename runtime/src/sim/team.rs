@@ -34,6 +34,7 @@ use super::rng::Xoshiro256pp;
 use super::{Command, Outcome, Sim, CHANNELS};
 use crate::catalog::{CH_RAB, RAB_SECTORS, SIGNALS};
 use crate::program::{RangeBearing, World};
+use crate::state::{TeamReads, TEAM_SLOTS};
 
 /// The channels of the range-and-bearing board, from [`CH_RAB`]: the
 /// sectors, then the heard signals.
@@ -79,6 +80,9 @@ pub struct Team {
     size: Vec<u32>,
     /// The range-and-bearing board, if the robots have one.
     rab: Option<Rab>,
+    /// Centre distance within which `team.connected` links two robots, mm:
+    /// the bodies within the board's range (or [`crate::state::LINK_RANGE`]).
+    link: f32,
 }
 
 impl Team {
@@ -120,6 +124,8 @@ impl Team {
         // that do not overlap cover at most the area around their centres
         // grown by a radius: `area / (pi r^2)` bounds their number.
         let r = s.radius;
+        let link_range = rab.as_ref().map_or(crate::state::LINK_RANGE, |b| b.spec.range.max(0.0));
+        let link = 2.0 * r + link_range;
         let bodies = |area: f32| (area / (std::f32::consts::PI * r * r)).ceil();
         let c = grid.cell;
         let bound = bodies(std::f32::consts::PI * (reach + r).powi(2))
@@ -130,7 +136,7 @@ impl Team {
             sim.others.reserve_exact(room);
         }
         let mut team =
-            Team { sims, at, grid, reach, charger: None, group: vec![0; n], size: vec![0; n], rab };
+            Team { sims, at, grid, reach, charger: None, group: vec![0; n], size: vec![0; n], rab, link };
         team.end_action();
         team.begin_action();
         team
@@ -308,12 +314,121 @@ impl Team {
         self.charger
     }
 
-    /// The team's state as expressions read it: `[team.spread, team.grouped,
-    /// team.largest]`, the groups measured only when `groups` ([0, 1] for
-    /// them otherwise: nothing reads them).
-    pub fn state(&mut self, groups: bool) -> [f32; 3] {
-        let (grouped, largest) = if groups { self.groups(crate::state::NEIGHBOUR_GAP) } else { (0.0, 1.0) };
-        [self.spread(), grouped, largest]
+    /// The team's state as expressions read it: `[team.spread,
+    /// team.grouped, team.largest, team.nearest, team.order,
+    /// team.connected]`, each measure but the spread measured only when
+    /// `reads` has it (a team of one's value otherwise: nothing reads it).
+    /// Without allocating.
+    pub fn state(&mut self, reads: TeamReads) -> [f32; TEAM_SLOTS] {
+        let mut s = crate::state::TEAM_OF_ONE;
+        s[0] = self.spread();
+        if reads.nearest || reads.connected {
+            // The searches beyond the 3 x 3 cells around a robot need each
+            // robot in the cell of where it is now.
+            self.grid.build(&self.at);
+        }
+        if reads.groups {
+            (s[1], s[2]) = self.groups(crate::state::NEIGHBOUR_GAP);
+        }
+        if reads.nearest {
+            s[3] = self.nearest();
+        }
+        if reads.order {
+            s[4] = self.order();
+        }
+        if reads.connected {
+            s[5] = self.connected();
+        }
+        s
+    }
+
+    /// The mean over the robots of the distance from each one's centre to
+    /// the nearest other robot's centre, mm (0 for one robot): found in
+    /// the grid (built where the robots are), ring after ring of cells
+    /// around each robot until no robot beyond can be nearer.
+    pub fn nearest(&self) -> f32 {
+        let n = self.at.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let rings = self.grid.cols.max(self.grid.rows);
+        let mut sum = 0.0f64;
+        for (i, &p) in self.at.iter().enumerate() {
+            let mut best = f32::INFINITY;
+            for k in 0..=rings {
+                self.grid.ring(p, k, |run| {
+                    for e in run {
+                        let d2 = (e.at - p).norm_squared();
+                        if e.robot as usize != i && d2 < best {
+                            best = d2;
+                        }
+                    }
+                });
+                // Every robot not seen yet is in a cell at least `k` cells away.
+                let beyond = k as f32 * self.grid.cell;
+                if best <= beyond * beyond {
+                    break;
+                }
+            }
+            if best.is_finite() {
+                sum += f64::from(best.sqrt());
+            }
+        }
+        (sum / n as f64) as f32
+    }
+
+    /// The length of the mean of the robots' unit heading vectors: 1 when
+    /// they all head one way, 0 when their headings cancel out (1 for one
+    /// robot).
+    pub fn order(&self) -> f32 {
+        let (sx, sy) = self.sims.iter().fold((0.0f64, 0.0f64), |(x, y), s| {
+            let t = f64::from(s.pose().theta);
+            (x + t.cos(), y + t.sin())
+        });
+        (sx.hypot(sy) / self.sims.len() as f64) as f32
+    }
+
+    /// The share of the robots in the largest group connected by links of
+    /// the board's range (robots whose centres are within [`Team::link`]'s
+    /// distance, and the robots linked to those; 1 for one robot): found
+    /// in the grid (built where the robots are), without allocating.
+    pub fn connected(&mut self) -> f32 {
+        let n = self.at.len();
+        let link2 = self.link * self.link;
+        let rings = ((self.link / self.grid.cell).ceil() as usize).min(self.grid.cols.max(self.grid.rows));
+        for (i, g) in self.group.iter_mut().enumerate() {
+            *g = i as u32;
+        }
+        self.size.fill(0);
+        for i in 0..n {
+            let p = self.at[i];
+            let group = &mut self.group;
+            for k in 0..=rings {
+                self.grid.ring(p, k, |run| {
+                    for e in run {
+                        // Each pair once, from its higher robot.
+                        if (e.robot as usize) < i && (e.at - p).norm_squared() <= link2 {
+                            let (a, b) = (root(group, i as u32), root(group, e.robot));
+                            if a != b {
+                                group[a.max(b) as usize] = a.min(b);
+                            }
+                        }
+                    }
+                });
+            }
+        }
+        let mut largest = 0;
+        for i in 0..n {
+            let r = root(&mut self.group, i as u32) as usize;
+            self.size[r] += 1;
+            largest = largest.max(self.size[r]);
+        }
+        largest as f32 / n as f32
+    }
+
+    /// Centre distance within which `team.connected` links two robots, mm.
+    pub fn link(&self) -> f32 {
+        self.link
     }
 
     /// The share of the robots whose body is within `gap` mm of another's,
@@ -329,15 +444,6 @@ impl Team {
         }
         self.size.fill(0);
         let mut with = 0;
-        // The root of robot `i`'s group, halving the path on the way.
-        fn root(group: &mut [u32], mut i: u32) -> u32 {
-            while group[i as usize] != i {
-                let up = group[group[i as usize] as usize];
-                group[i as usize] = up;
-                i = up;
-            }
-            i
-        }
         for i in 0..n {
             let p = self.at[i];
             let mut found = false;
@@ -373,6 +479,17 @@ impl Team {
         let sum: f64 = self.at.iter().map(|p| f64::from((p - c).norm())).sum();
         (sum / n) as f32
     }
+}
+
+/// The root of robot `i`'s group in a union-find forest of parents,
+/// halving the path on the way.
+fn root(group: &mut [u32], mut i: u32) -> u32 {
+    while group[i as usize] != i {
+        let up = group[group[i as usize] as usize];
+        group[i as usize] = up;
+        i = up;
+    }
+    i
 }
 
 /// A uniform grid over the arena: the robots in each cell, by a counting
@@ -475,6 +592,35 @@ impl Grid {
             let (a, b) = (self.start[row + x0] as usize, self.start[row + x1 + 1] as usize);
             f(&self.items[a..b]);
         }
+    }
+
+    /// Calls `f` with the robots in the cells `k` cells away from `p`'s
+    /// (the ring of cells around the `2k - 1` cells across; `p`'s own cell
+    /// for 0), a run of cells at a time. A robot in a cell `k` away is at
+    /// least `(k - 1)` cells' width from `p`, wherever `p` is in its cell.
+    fn ring(&self, p: Point2<f32>, k: usize, mut f: impl FnMut(&[Entry])) {
+        let (x, y) = self.coords(p);
+        let (x, y, k) = (x as isize, y as isize, k as isize);
+        let (cols, rows) = (self.cols as isize, self.rows as isize);
+        let mut run = |cy: isize, x0: isize, x1: isize| {
+            let (x0, x1) = (x0.max(0), x1.min(cols - 1));
+            if (0..rows).contains(&cy) && x0 <= x1 {
+                let row = (cy * cols) as usize;
+                let (a, b) =
+                    (self.start[row + x0 as usize] as usize, self.start[row + x1 as usize + 1] as usize);
+                f(&self.items[a..b]);
+            }
+        };
+        if k == 0 {
+            run(y, x, x);
+            return;
+        }
+        run(y - k, x - k, x + k);
+        for cy in (y - k + 1).max(0)..(y + k).min(rows) {
+            run(cy, x - k, x - k);
+            run(cy, x + k, x + k);
+        }
+        run(y + k, x - k, x + k);
     }
 }
 
@@ -602,5 +748,152 @@ mod tests {
         assert!(team.place(1, super::super::Pose { x: 900.0, y: 900.0, theta: 0.0 }));
         team.end_action();
         assert_eq!(rab(&mut team, 0), [0.0; RAB_CHANNELS]);
+    }
+
+    /// Puts robot `i` at `(x, y)` heading `theta`, overlapping or not (the
+    /// team's measures do not care).
+    fn put(team: &mut Team, i: usize, x: f32, y: f32, theta: f32) {
+        team.sims[i].set_pose_unchecked(super::super::Pose { x, y, theta });
+        team.at[i] = team.sims[i].centre();
+    }
+
+    /// `[team.nearest, team.order, team.connected]` by a search over every
+    /// pair of robots, in f64.
+    fn brute_force(team: &Team) -> [f64; 3] {
+        let n = team.at.len();
+        let d2 = |i: usize, j: usize| {
+            let (p, q) = (team.at[i], team.at[j]);
+            (f64::from(p.x) - f64::from(q.x)).powi(2) + (f64::from(p.y) - f64::from(q.y)).powi(2)
+        };
+        let nearest = if n < 2 {
+            0.0
+        } else {
+            (0..n)
+                .map(|i| (0..n).filter(|&j| j != i).map(|j| d2(i, j)).fold(f64::INFINITY, f64::min).sqrt())
+                .sum::<f64>()
+                / n as f64
+        };
+        let (sx, sy) = team.sims.iter().fold((0.0, 0.0), |(x, y), s| {
+            let t = f64::from(s.pose().theta);
+            (x + t.cos(), y + t.sin())
+        });
+        let order = (sx * sx + sy * sy).sqrt() / n as f64;
+        // The largest component by a walk from every robot not seen yet.
+        let mut seen = vec![false; n];
+        let mut largest = 0;
+        for start in 0..n {
+            if seen[start] {
+                continue;
+            }
+            seen[start] = true;
+            let (mut todo, mut size) = (vec![start], 0);
+            while let Some(i) = todo.pop() {
+                size += 1;
+                for j in 0..n {
+                    // The same test as the team's, on the same f32 numbers.
+                    let close = (team.at[i] - team.at[j]).norm_squared() <= team.link * team.link;
+                    if !seen[j] && close {
+                        seen[j] = true;
+                        todo.push(j);
+                    }
+                }
+            }
+            largest = largest.max(size);
+        }
+        [nearest, order, largest as f64 / n as f64]
+    }
+
+    fn measured(team: &mut Team) -> [f32; 3] {
+        let s = team.state(TeamReads::ALL);
+        [s[3], s[4], s[5]]
+    }
+
+    fn assert_near(team: &mut Team, what: &str) -> [f32; 3] {
+        let got = measured(team);
+        let want = brute_force(team);
+        for (k, name) in ["nearest", "order", "connected"].iter().enumerate() {
+            let tol = 1e-4 * want[k].abs().max(1.0);
+            assert!(
+                (f64::from(got[k]) - want[k]).abs() <= tol,
+                "{what}: team.{name} {} != {}",
+                got[k],
+                want[k]
+            );
+        }
+        got
+    }
+
+    /// `team.nearest`, `team.order` and `team.connected` are what a search
+    /// over every pair finds, on random configurations of 1 to 300 robots
+    /// (uniform, in two far clusters, all on one spot), with a board of a
+    /// short range, of the default range, and without a board.
+    #[test]
+    fn team_measures_match_a_search_over_every_pair() {
+        use crate::program::RangeBearing;
+        use rand::RngCore;
+        use std::f32::consts::PI;
+        let mut rng = Xoshiro256pp::seed_from_u64(11);
+        for (case, &n) in [1u32, 2, 3, 7, 40, 150, 300].iter().enumerate() {
+            for board in [None, Some(60.0), Some(300.0)] {
+                let mut world = World { arena: [3000.0, 2000.0], robots: n, ..arena_world() };
+                world.body.rab = board.map(|range| RangeBearing { range, ..RangeBearing::DEFAULT });
+                let mut team = Team::new(&world, case as u64);
+                assert_eq!(team.len(), n as usize);
+                let r = team.sims[0].radius;
+                assert_eq!(team.link, 2.0 * r + board.unwrap_or(crate::state::LINK_RANGE));
+                let mut u = |lo: f32, hi: f32| lo + (hi - lo) * (rng.next_u32() as f32 / u32::MAX as f32);
+                let what = |kind: &str| format!("{n} robots, board {board:?}, {kind}");
+                // Uniform over the arena, any headings.
+                for i in 0..n as usize {
+                    let (x, y, t) = (u(30.0, 2970.0), u(30.0, 1970.0), u(-PI, PI));
+                    put(&mut team, i, x, y, t);
+                }
+                assert_near(&mut team, &what("uniform"));
+                // Two clusters 150 mm across, far apart (out of each other's
+                // reach), headings near east.
+                let a = (n as usize).div_ceil(3);
+                for i in 0..n as usize {
+                    let (cx, cy) = if i < a { (400.0, 400.0) } else { (2500.0, 1500.0) };
+                    let (x, y, t) = (cx + u(-75.0, 75.0), cy + u(-75.0, 75.0), u(-0.3, 0.3));
+                    put(&mut team, i, x, y, t);
+                }
+                let got = assert_near(&mut team, &what("two clusters"));
+                if team.link > 150.0 * std::f32::consts::SQRT_2 {
+                    // Links longer than a cluster's diagonal: each cluster one group.
+                    let big = a.max(n as usize - a) as f32 / n as f32;
+                    assert!((got[2] - big).abs() < 1e-6, "{}: {got:?}", what("two clusters"));
+                }
+                assert!(got[1] > 0.9, "{}: {got:?}", what("two clusters"));
+                // All on one spot, half heading east and half west.
+                for i in 0..n as usize {
+                    let t = if i % 2 == 0 { 0.0 } else { PI };
+                    put(&mut team, i, 1234.5, 876.5, t);
+                }
+                let got = assert_near(&mut team, &what("one spot"));
+                assert_eq!(got[0], 0.0);
+                assert_eq!(got[2], 1.0);
+                if n == 1 {
+                    // A team of one: its own values.
+                    assert_eq!(team.state(TeamReads::ALL), crate::state::TEAM_OF_ONE);
+                } else if n % 2 == 0 {
+                    assert!(got[1] < 1e-5, "{}: {got:?}", what("one spot"));
+                }
+            }
+        }
+    }
+
+    /// The measures nothing reads are not measured: a team of one's values.
+    #[test]
+    fn team_measures_not_read_are_not_measured() {
+        let world = World { arena: [3000.0, 2000.0], robots: 20, ..arena_world() };
+        let mut team = Team::new(&world, 2);
+        for i in 0..20 {
+            put(&mut team, i, 100.0 + 50.0 * i as f32, 500.0, i as f32);
+        }
+        let none = team.state(TeamReads::default());
+        assert_eq!(none[1..], crate::state::TEAM_OF_ONE[1..]);
+        let all = team.state(TeamReads::ALL);
+        assert_eq!(all[0], none[0], "the spread is always measured");
+        assert!(all[3] > 0.0 && all[4] < 1.0, "{all:?}");
     }
 }
