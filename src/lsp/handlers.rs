@@ -281,6 +281,7 @@ fn completion(text: &str, offset: usize) -> Value {
                 C::Sensor | C::Actuator => K::VARIABLE,
                 C::Module => K::MODULE,
                 C::Stage => K::CLASS,
+                C::Field => K::FIELD,
             }),
             detail: (!c.detail.is_empty()).then_some(c.detail),
             label: c.label,

@@ -191,6 +191,8 @@ pub enum CompletionKind {
     Actuator,
     Module,
     Stage,
+    /// A field of `robot.FIELD` or `team.FIELD`.
+    Field,
 }
 
 /// One completion: the text, its kind, a line saying what it is.
@@ -224,6 +226,9 @@ enum Context {
     Table,
     /// In an expression: functions, operators' words, sensors and actuators.
     Expression,
+    /// After `robot.` or `team.`: the fields of the robot's or the
+    /// team's state.
+    Fields(&'static [(&'static str, usize, &'static str)]),
     /// Only these words.
     Only(&'static [&'static str]),
     /// A new name, a number or punctuation: nothing to offer.
@@ -268,6 +273,14 @@ fn context(text: &str, offset: usize) -> Context {
     let w = |k: usize| back(text, &before, k);
     let kind = |k: usize| before.len().checked_sub(k + 1).map(|i| before[i].kind);
     let block = block_at(text, &before);
+    // `robot.` and `team.`: their fields.
+    if w(0) == "." {
+        match w(1) {
+            "robot" => return Context::Fields(&crate::lower::expr::STATE_FIELDS),
+            "team" => return Context::Fields(&crate::lower::expr::TEAM_FIELDS),
+            _ => {}
+        }
+    }
     if let Some(c) = keyword_context(text, &before, block) {
         return c;
     }
@@ -437,6 +450,7 @@ pub fn complete(text: &str, offset: usize) -> Vec<Completion> {
             list.iter().map(|t| completion(t, K::Keyword, words::word(t).map_or("", |w| w.meaning))).collect()
         }
         Context::Nothing => Vec::new(),
+        Context::Fields(fields) => fields.iter().map(|(f, _, what)| completion(f, K::Field, what)).collect(),
         Context::Sensors => hardware(true).iter().map(|n| completion(n, K::Sensor, "sensor")).collect(),
         Context::Modules => modules(&stages).iter().map(|n| completion(n, K::Module, "module")).collect(),
         Context::InheritedModules => {

@@ -120,3 +120,22 @@ fn a_later_stages_roles_complete_and_hover_their_own_modules() {
     let (_, md) = ide::hover(&later.replace("    link \n", ""), scout).expect("hover");
     assert!(md.contains("role `scout`") && md.contains("scout.brain"), "{md}");
 }
+
+/// After `team.` and `robot.` in a fitness: the fields of the team's and
+/// the robot's state, with their meaning.
+#[test]
+fn completion_after_team_offers_the_team_s_measures() {
+    let text = SRC.replace("fitness per action wheels[0]", "fitness at end team.");
+    let offset = text.find("team.").unwrap() + 5;
+    let got = ide::complete(&text, offset);
+    assert!(got.iter().all(|c| c.kind == CompletionKind::Field), "{got:?}");
+    assert_eq!(labels(&got), ["spread", "grouped", "largest", "nearest", "order", "connected"]);
+    assert!(got[5].detail.contains("rab_range"), "{got:?}");
+    // While the field is typed, too.
+    let text = SRC.replace("fitness per action wheels[0]", "fitness at end team.ne");
+    let offset = text.find("team.ne").unwrap() + 7;
+    assert!(labels(&ide::complete(&text, offset)).contains(&"nearest"));
+    let text = SRC.replace("fitness per action wheels[0]", "fitness at end robot.");
+    let offset = text.find("robot.").unwrap() + 6;
+    assert!(labels(&ide::complete(&text, offset)).contains(&"squares"));
+}
