@@ -105,6 +105,30 @@ fn text_of<'a>(dom: &'a str, id: &str) -> &'a str {
     &dom[start..end]
 }
 
+/// The log a driver script leaves in `data-driven` (a JSON list of
+/// strings) after it drove the report `html`, opened at `hash` in a fresh
+/// profile `profile`, and the page as the driver left it; the page must
+/// log nothing to the console.
+fn driven_log(
+    browser: &Path,
+    dir: &Path,
+    html: &str,
+    driver: &str,
+    hash: &str,
+    profile: &str,
+) -> (Vec<String>, String) {
+    let driven = dir.join("driven.html");
+    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
+    let url = format!("{}{hash}", file_url(&driven));
+    let out = headless(browser, &scratch(profile), &url, "--dump-dom");
+    let console = console_messages(&out);
+    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
+    let dom = String::from_utf8_lossy(&out.stdout).into_owned();
+    let log = body_attr(&dom, "data-driven").expect("the driver ran");
+    let log = serde_json::from_str(&log.replace("&quot;", "\"").replace("&amp;", "&")).unwrap();
+    (log, dom)
+}
+
 fn body_attr<'a>(dom: &'a str, name: &str) -> Option<&'a str> {
     let body = &dom[dom.find("<body")?..];
     let tag = &body[..body.find('>')?];
@@ -254,20 +278,7 @@ window.addEventListener('load', () => {
 });
 </script>
 </body>"#;
-    let driven = dir.join("driven.html");
-    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
-    let url = format!("{}#stage=bigger&action=3", file_url(&driven));
-    let out = headless(&browser, &scratch("profile-controls"), &url, "--dump-dom");
-    let console = console_messages(&out);
-    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let log: Vec<String> = serde_json::from_str(
-        &body_attr(&dom, "data-driven")
-            .expect("the driver ran")
-            .replace("&quot;", "\"")
-            .replace("&amp;", "&"),
-    )
-    .unwrap();
+    let (log, _) = driven_log(&browser, &dir, &html, driver, "#stage=bigger&action=3", "profile-controls");
     let trace = std::fs::read_to_string(dir.join("bigger/trace.csv")).unwrap();
     let last = trace.lines().count() - 2;
     let at = |a: usize| format!("{a} bigger #stage=bigger&action={a}");
@@ -384,20 +395,14 @@ window.addEventListener('load', () => {
 });
 </script>
 </body>"#;
-    let driven = dir.join("driven.html");
-    std::fs::write(&driven, html.replacen("</body>", driver, 1)).unwrap();
-    let url = format!("{}#stage=aggregate&action=12&robot=7", file_url(&driven));
-    let out = headless(&browser, &scratch("profile-team-select"), &url, "--dump-dom");
-    let console = console_messages(&out);
-    assert!(console.is_empty(), "the page logged to the console:\n{}", console.join("\n"));
-    let dom = String::from_utf8_lossy(&out.stdout);
-    let log: Vec<String> = serde_json::from_str(
-        &body_attr(&dom, "data-driven")
-            .expect("the driver ran")
-            .replace("&quot;", "\"")
-            .replace("&amp;", "&"),
-    )
-    .unwrap();
+    let (log, dom) = driven_log(
+        &browser,
+        &dir,
+        &html,
+        driver,
+        "#stage=aggregate&action=12&robot=7",
+        "profile-team-select",
+    );
     assert_eq!(log[0], "10 robot 7 (second)", "one entry per robot, with its role");
     assert_eq!(log[1], "#stage=aggregate&action=12&robot=2", "the address follows the selector");
     follows(&dom, &header, &rows, 2, 12, "first");

@@ -317,7 +317,8 @@ pub fn replay(
     // A team's world is the one its robots started in.
     let scene = if others.is_empty() { Sim::new(&stage.world, seed).scene() } else { team_scene };
     if robot == 0 {
-        report::episode_files(&out, &stage.name, stage, &trace, &others, &ep, &scene, &[], None)?;
+        let lived = report::Lived { trace: &trace, others: &others, scene: &scene };
+        report::episode_files(&out, stage, lived, &ep, &report::Drawing::titled(&stage.name))?;
     } else {
         rundir::write_trace(&out, &report::team_trace_csv(&trace, &others, stage, &ep))?;
         let (mine, rest) = report::followed(&trace, &others, robot);

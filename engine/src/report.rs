@@ -348,27 +348,45 @@ impl TraceWriter {
     }
 }
 
+/// What was recorded of an episode, for its pictures: robot 0's trace, the
+/// team's other robots (none for one robot) and the world's scene.
+#[derive(Clone, Copy)]
+pub struct Lived<'a> {
+    pub trace: &'a Trace,
+    pub others: &'a [OtherRobot],
+    pub scene: &'a Scene,
+}
+
+/// How an episode's pictures are drawn: their title, marks on their time
+/// axis (an action and its label), and `path`: the rows the trajectory
+/// picture draws, and what they are (for its title), when it is not the
+/// whole trace: a test stage draws its first life in the changed world,
+/// over that life's scene (rows out of range or none: the whole trace).
+#[derive(Clone, Default)]
+pub struct Drawing<'a> {
+    pub title: &'a str,
+    pub marks: &'a [(u32, String)],
+    pub path: Option<(Range<usize>, &'a str)>,
+}
+
+impl<'a> Drawing<'a> {
+    /// The whole episode, titled `title`, without marks.
+    pub fn titled(title: &'a str) -> Drawing<'a> {
+        Drawing { title, ..Drawing::default() }
+    }
+}
+
 /// Writes `trace.csv` and the pictures of one episode into `dir`:
 /// `activations` (figure 11), `reinforcement` (figures 5, 10, 13) for every
 /// learning module, and `trajectory`.
-///
-/// `path`: the rows the trajectory picture draws, and what they are (for its
-/// title), when it is not the whole trace: a test stage draws its first life
-/// in the changed world, over that life's scene (rows out of range or none:
-/// the whole trace).
-#[allow(clippy::too_many_arguments)]
 pub fn episode_files(
     dir: &Path,
-    title: &str,
     stage: &Stage,
-    trace: &Trace,
-    others: &[OtherRobot],
+    lived: Lived<'_>,
     episode: &Episode,
-    scene: &Scene,
-    marks: &[(u32, String)],
-    path: Option<(Range<usize>, &str)>,
+    drawing: &Drawing<'_>,
 ) -> Result<(), Error> {
-    episode_files_until(dir, title, stage, trace, others, episode, scene, marks, path, &|| false)
+    episode_files_until(dir, stage, lived, episode, drawing, &|| false)
 }
 
 /// Writes a team's `robots.json` beside its `episode` (of the team's
@@ -390,28 +408,23 @@ pub const STOPPED: &str = "stopped";
 
 /// [`episode_files`], stopping between files once `stop()` is true (with the
 /// error [`STOPPED`]): Ctrl-C during a long test stage's files.
-#[allow(clippy::too_many_arguments)]
 pub fn episode_files_until(
     dir: &Path,
-    title: &str,
     stage: &Stage,
-    trace: &Trace,
-    others: &[OtherRobot],
+    lived: Lived<'_>,
     episode: &Episode,
-    scene: &Scene,
-    marks: &[(u32, String)],
-    path: Option<(Range<usize>, &str)>,
+    drawing: &Drawing<'_>,
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
-    rundir::write_trace(dir, &team_trace_csv(trace, others, stage, episode))?;
-    team_columns(dir, stage, others, episode)?;
-    if trace.rows.is_empty() {
+    rundir::write_trace(dir, &team_trace_csv(lived.trace, lived.others, stage, episode))?;
+    team_columns(dir, stage, lived.others, episode)?;
+    if lived.trace.rows.is_empty() {
         return Ok(());
     }
     if stop() {
         return Err(Error::new(crate::ErrorKind::Interrupted, STOPPED));
     }
-    pictures(dir, title, stage, 0, trace, others, scene, marks, path, stop)
+    pictures(dir, stage, 0, lived, drawing, stop)
 }
 
 /// Robot `robot`'s trace (its rows of every life, in order) and the
@@ -447,7 +460,7 @@ pub fn followed_pictures(
     (trace, others): (&Trace, &[OtherRobot]),
     scene: &Scene,
 ) -> Result<(), Error> {
-    pictures(dir, title, stage, robot, trace, others, scene, &[], None, &|| false)
+    pictures(dir, stage, robot, Lived { trace, others, scene }, &Drawing::titled(title), &|| false)
 }
 
 /// The pictures of one episode whose `trace.csv` is written (see
@@ -460,22 +473,21 @@ pub fn episode_pictures(
     trace: &Trace,
     scene: &Scene,
 ) -> Result<(), Error> {
-    pictures(dir, title, stage, 0, trace, &[], scene, &[], None, &|| false)
+    pictures(dir, stage, 0, Lived { trace, others: &[], scene }, &Drawing::titled(title), &|| false)
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The pictures of an episode as robot `robot` lived it (`lived.trace` is
+/// its trace), drawn as `drawing` says, stopping between them once `stop()`.
 fn pictures(
     dir: &Path,
-    title: &str,
     stage: &Stage,
     robot: usize,
-    trace: &Trace,
-    others: &[OtherRobot],
-    scene: &Scene,
-    marks: &[(u32, String)],
-    path: Option<(Range<usize>, &str)>,
+    lived: Lived<'_>,
+    drawing: &Drawing<'_>,
     stop: &dyn Fn() -> bool,
 ) -> Result<(), Error> {
+    let Lived { trace, others, scene } = lived;
+    let Drawing { title, marks, ref path } = *drawing;
     let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
     let check = || if stop() { Err(Error::new(crate::ErrorKind::Interrupted, STOPPED)) } else { Ok(()) };
     if trace.rows.is_empty() {
@@ -522,7 +534,7 @@ fn pictures(
 
     let (mut scene, what) = match path {
         Some((rows, what)) => {
-            let rows = trace.rows.get(rows).filter(|r| !r.is_empty()).unwrap_or(&trace.rows);
+            let rows = trace.rows.get(rows.clone()).filter(|r| !r.is_empty()).unwrap_or(&trace.rows);
             let part = Trace { modules: trace.modules.clone(), rows: rows.to_vec() };
             (trajectory_scene(scene, &part, others), format!("{title}: trajectory, {what}"))
         }

@@ -1338,18 +1338,9 @@ fn test_files(
     } else {
         format!("the first of the {lives} lives after the change")
     };
-    report::episode_files_until(
-        dir,
-        &stage.name,
-        stage,
-        &ba.trace,
-        &ba.others,
-        &ba.episode,
-        &ba.scene,
-        &marks,
-        Some((first, &what)),
-        &stopped,
-    )?;
+    let lived = report::Lived { trace: &ba.trace, others: &ba.others, scene: &ba.scene };
+    let drawing = report::Drawing { title: &stage.name, marks: &marks, path: Some((first, &what)) };
+    report::episode_files_until(dir, stage, lived, &ba.episode, &drawing, &stopped)?;
     check()?;
     rundir::write_episode(dir, &ba.episode)?;
     check()?;
@@ -1505,7 +1496,8 @@ impl Engine<'_> {
         let rec = episode::record(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
             .map_err(|e| Error::io(format!("error: {e}")))?;
         let (trace, ep) = (&rec.trace, &rec.episode);
-        report::episode_files(dir, &stage.name, stage, trace, &rec.others, ep, &rec.scene, &[], None)?;
+        let lived = report::Lived { trace, others: &rec.others, scene: &rec.scene };
+        report::episode_files(dir, stage, lived, ep, &report::Drawing::titled(&stage.name))?;
         rundir::write_trained_episode(dir, ep, &trained)?;
         self.observer.event(Event::Trained { stage, trained: &trained, recorded, reused: false, dir });
         Ok(trained)
