@@ -74,6 +74,15 @@ pub const TEAM_FIELDS: [(&str, usize, &str); 6] = [
     ),
 ];
 
+/// Where an expression is lowered: the robot's hardware, what it may read,
+/// and whether it is inside `prev` (only sensors have a previous value).
+#[derive(Clone, Copy)]
+struct At<'a> {
+    hw: &'a Hw,
+    scope: &'a Scope<'a>,
+    prev: bool,
+}
+
 enum Val {
     /// Emitted onto the code.
     Num,
@@ -90,7 +99,7 @@ impl Lower<'_> {
     pub(super) fn expr(&mut self, hw: &Hw, e: &ast::Expr, scope: &Scope) -> Option<Expr> {
         let before = self.errors.len();
         let mut ops = Vec::new();
-        let v = self.go(hw, e, scope, false, &mut ops);
+        let v = self.go(At { hw, scope, prev: false }, e, &mut ops);
         self.expect_num(v, e.span, &mut ops);
         if self.errors.len() > before {
             return None;
@@ -136,7 +145,7 @@ impl Lower<'_> {
         }
     }
 
-    fn go(&mut self, hw: &Hw, e: &ast::Expr, scope: &Scope, prev: bool, ops: &mut Vec<Op>) -> Val {
+    fn go(&mut self, at: At, e: &ast::Expr, ops: &mut Vec<Op>) -> Val {
         match &e.kind {
             ExprKind::Number(v, unit) => {
                 if let Some(u) = unit {
@@ -151,13 +160,13 @@ impl Lower<'_> {
                 ops.push(Op::Const(*v as f32));
                 Val::Num
             }
-            ExprKind::Ref(name, index) => self.reference(hw, name, index.as_ref(), e.span, scope, prev, ops),
-            ExprKind::State(field) => self.state("robot", &STATE_FIELDS, field, e.span, scope, prev, ops),
-            ExprKind::Team(field) => self.state("team", &TEAM_FIELDS, field, e.span, scope, prev, ops),
+            ExprKind::Ref(name, index) => self.reference(at, name, index.as_ref(), e.span, ops),
+            ExprKind::State(field) => self.state(at, "robot", &STATE_FIELDS, field, e.span, ops),
+            ExprKind::Team(field) => self.state(at, "team", &TEAM_FIELDS, field, e.span, ops),
             ExprKind::Unary(op, inner) => match op {
-                UnOp::Prev => self.go(hw, inner, scope, true, ops),
+                UnOp::Prev => self.go(At { prev: true, ..at }, inner, ops),
                 UnOp::Neg | UnOp::Not => {
-                    let v = self.go(hw, inner, scope, prev, ops);
+                    let v = self.go(at, inner, ops);
                     if !self.expect_num(v, inner.span, ops) {
                         return Val::Err;
                     }
@@ -166,9 +175,9 @@ impl Lower<'_> {
                 }
             },
             ExprKind::Binary(op, a, b) => {
-                let va = self.go(hw, a, scope, prev, ops);
+                let va = self.go(at, a, ops);
                 let ok_a = self.expect_num(va, a.span, ops);
-                let vb = self.go(hw, b, scope, prev, ops);
+                let vb = self.go(at, b, ops);
                 let ok_b = self.expect_num(vb, b.span, ops);
                 if !(ok_a && ok_b) {
                     return Val::Err;
@@ -192,7 +201,7 @@ impl Lower<'_> {
             ExprKind::Cond(c, a, b) => {
                 let mut ok = true;
                 for part in [c, a, b] {
-                    let v = self.go(hw, part, scope, prev, ops);
+                    let v = self.go(at, part, ops);
                     ok &= self.expect_num(v, part.span, ops);
                 }
                 if !ok {
@@ -201,21 +210,11 @@ impl Lower<'_> {
                 ops.push(Op::Select);
                 Val::Num
             }
-            ExprKind::Call(f, args) => self.call(hw, f, args, e.span, scope, prev, ops),
+            ExprKind::Call(f, args) => self.call(at, f, args, e.span, ops),
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn call(
-        &mut self,
-        hw: &Hw,
-        f: &ast::Name,
-        args: &[ast::Expr],
-        span: Span,
-        scope: &Scope,
-        prev: bool,
-        ops: &mut Vec<Op>,
-    ) -> Val {
+    fn call(&mut self, at: At, f: &ast::Name, args: &[ast::Expr], span: Span, ops: &mut Vec<Op>) -> Val {
         match f.text.as_str() {
             "abs" | "sign" | "sqrt" => {
                 if args.len() != 1 {
@@ -227,7 +226,7 @@ impl Lower<'_> {
                     });
                     return Val::Err;
                 }
-                let v = self.go(hw, &args[0], scope, prev, ops);
+                let v = self.go(at, &args[0], ops);
                 if !self.expect_num(v, args[0].span, ops) {
                     return Val::Err;
                 }
@@ -242,7 +241,7 @@ impl Lower<'_> {
                 let mut n = 0usize;
                 let mut ok = true;
                 for a in args {
-                    match self.go(hw, a, scope, prev, ops) {
+                    match self.go(at, a, ops) {
                         Val::Num => n += 1,
                         Val::Arr(loads, _) => {
                             n += loads.len();
@@ -263,7 +262,7 @@ impl Lower<'_> {
                 });
                 Val::Num
             }
-            "distance_to" => self.distance_to(f, args, span, scope, prev, ops),
+            "distance_to" => self.distance_to(at, f, args, span, ops),
             _ => {
                 self.errors.push(Error::Unknown {
                     span: f.span.into(),
@@ -281,11 +280,10 @@ impl Lower<'_> {
     /// wall, cylinder, lamp or zone of the stage's world, mm (a fitness only).
     fn distance_to(
         &mut self,
+        at: At,
         f: &ast::Name,
         args: &[ast::Expr],
         span: Span,
-        scope: &Scope,
-        prev: bool,
         ops: &mut Vec<Op>,
     ) -> Val {
         let target = match args {
@@ -300,7 +298,7 @@ impl Lower<'_> {
                 return Val::Err;
             }
         };
-        if !scope.state || prev {
+        if !at.scope.state || at.prev {
             self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: "`distance_to` is the simulator's knowledge of the robot: only a fitness reads it"
@@ -354,15 +352,13 @@ impl Lower<'_> {
 
     /// `robot.FIELD` (`of` is `robot`, `fields` [`STATE_FIELDS`]) or
     /// `team.FIELD` ([`TEAM_FIELDS`]).
-    #[allow(clippy::too_many_arguments)]
     fn state(
         &mut self,
+        at: At,
         of: &str,
         fields: &[(&str, usize, &str)],
         field: &ast::Name,
         span: Span,
-        scope: &Scope,
-        prev: bool,
         ops: &mut Vec<Op>,
     ) -> Val {
         let Some(&(_, slot, _)) = fields.iter().find(|f| f.0 == field.text) else {
@@ -379,7 +375,7 @@ impl Lower<'_> {
             });
             return Val::Err;
         };
-        if !scope.state {
+        if !at.scope.state {
             self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: format!(
@@ -391,7 +387,7 @@ impl Lower<'_> {
             });
             return Val::Err;
         }
-        if prev {
+        if at.prev {
             self.errors.push(Error::NotASensor {
                 span: span.into(),
                 message: format!("`prev` reads sensors only, and `{of}.{}` is the {of}'s state", field.text),
@@ -404,23 +400,20 @@ impl Lower<'_> {
         Val::Num
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn reference(
         &mut self,
-        hw: &Hw,
+        at: At,
         name: &ast::Name,
         index: Option<&ast::Index>,
         span: Span,
-        scope: &Scope,
-        prev: bool,
         ops: &mut Vec<Op>,
     ) -> Val {
-        if let Some(s) = hw.sensors.iter().find(|s| s.name == name.text) {
+        if let Some(s) = at.hw.sensors.iter().find(|s| s.name == name.text) {
             let Some((first, last)) = self.elements(&s.name, s.count as usize, index) else {
                 return Val::Err;
             };
             let channels: Vec<u16> = (first..=last).map(|i| s.channel + i as u16).collect();
-            if let Some((module, allowed, sense)) = scope.only {
+            if let Some((module, allowed, sense)) = at.scope.only {
                 let unsensed: Vec<u16> = channels.iter().copied().filter(|c| !allowed.contains(c)).collect();
                 if !unsensed.is_empty() {
                     let elem = s.elements_text(&unsensed);
@@ -437,7 +430,7 @@ impl Lower<'_> {
                 }
             }
             let loads: Vec<Op> =
-                channels.iter().map(|&c| if prev { Op::Prev(c) } else { Op::Chan(c) }).collect();
+                channels.iter().map(|&c| if at.prev { Op::Prev(c) } else { Op::Chan(c) }).collect();
             if index.is_some_and(|i| i.last.is_none()) || s.count == 1 {
                 ops.extend(loads);
                 return Val::Num;
@@ -448,8 +441,8 @@ impl Lower<'_> {
             };
             return Val::Arr(loads, desc);
         }
-        if let Some(a) = hw.actuators.iter().find(|a| a.name == name.text) {
-            if prev {
+        if let Some(a) = at.hw.actuators.iter().find(|a| a.name == name.text) {
+            if at.prev {
                 self.errors.push(Error::Value {
                     span: span.into(),
                     message: format!("`prev` reads sensors only, and `{}` is an actuator", a.name),
@@ -468,7 +461,7 @@ impl Lower<'_> {
             }
             return Val::Arr(loads, format!("the array `{}`", a.name));
         }
-        self.unknown_hardware(hw, "sensor", name);
+        self.unknown_hardware(at.hw, "sensor", name);
         Val::Err
     }
 
