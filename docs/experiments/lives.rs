@@ -32,7 +32,7 @@ use std::process::ExitCode;
 mod common;
 
 use shaping_engine::load::load_built;
-use shaping_engine::run::before_after;
+use shaping_engine::run::{before_after, Lives};
 use shaping_engine::rundir;
 use shaping_runtime::evolve::{self, seed};
 use shaping_runtime::genome::Genome;
@@ -102,9 +102,15 @@ fn run() -> Result<(), String> {
             ));
         }
         let episode = seed::test_seed(s, evolve::test_seed_stage(&program, index), 0);
-        let ba =
-            before_after(&program.stages[parent], stage, &genome, actions, lives, learning, episode, None)
-                .map_err(common::message)?;
+        let ba = before_after(
+            &program.stages[parent],
+            stage,
+            &genome,
+            Lives { actions, count: lives, learning },
+            episode,
+            None,
+        )
+        .map_err(common::message)?;
         let mut rows = ba.trace.rows.iter();
         for (half, results) in [&ba.before, &ba.after].into_iter().enumerate() {
             for (k, r) in results.iter().enumerate() {

@@ -702,9 +702,13 @@ impl Engine<'_> {
             match &stage.run {
                 StageRun::Evolve(_) => {
                     let parent = evolved_parent(&program, index, &finals)?;
-                    let existing = saved.checkpoints[index].take();
-                    let cp = self
-                        .evolve_stage(&program, index, seed, parent, &dir, existing, opts.fresh, evaluator)?;
+                    let start = StageStart {
+                        seed,
+                        parent,
+                        existing: saved.checkpoints[index].take(),
+                        fresh: opts.fresh,
+                    };
+                    let cp = self.evolve_stage(&program, index, start, &dir, evaluator)?;
                     best_episode(stage, &cp, seed, &dir, self.interrupt)?;
                     if let Some((genome, best)) = evolve::best_of(&cp) {
                         results.push(StageOutcome::Evolve {
@@ -728,9 +732,7 @@ impl Engine<'_> {
                         index,
                         seed,
                         parent,
-                        actions: *actions,
-                        lives: *lives,
-                        learning: *learning,
+                        lives: Lives { actions: *actions, count: *lives, learning: *learning },
                     };
                     let summary = self.test_stage(&test, &dir)?;
                     results
@@ -843,21 +845,28 @@ fn evolved_parent<'a>(
     })
 }
 
+/// How an evolved stage starts: the run's seed, the checkpoint of the
+/// stage it extends, its own checkpoint to resume from, and whether the
+/// evaluator starts it afresh.
+struct StageStart<'a> {
+    seed: u64,
+    parent: Option<&'a Checkpoint>,
+    existing: Option<Checkpoint>,
+    fresh: bool,
+}
+
 impl Engine<'_> {
     /// Runs (or resumes) evolved stage `index` to its end and its chosen best,
     /// writing its files into `dir`.
-    #[allow(clippy::too_many_arguments)]
     fn evolve_stage(
         &self,
         program: &Program,
         index: usize,
-        seed: u64,
-        parent: Option<&Checkpoint>,
+        start: StageStart<'_>,
         dir: &Path,
-        existing: Option<Checkpoint>,
-        fresh: bool,
         evaluator: &dyn Evaluate,
     ) -> Result<Checkpoint> {
+        let StageStart { seed, parent, existing, fresh } = start;
         let stage = &program.stages[index];
         let StageRun::Evolve(evo) = &stage.run else {
             unreachable!("evolve_stage is called for evolved stages")
@@ -1145,17 +1154,15 @@ impl BeforeAfter {
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 pub fn before_after(
     parent: &Stage,
     stage: &Stage,
     genome: &Genome,
-    actions: u32,
-    lives: u32,
-    learning: bool,
+    lives: Lives,
     seed: u64,
     stop: Option<&AtomicBool>,
 ) -> Result<BeforeAfter, Error> {
+    let Lives { actions, count: lives, learning } = lives;
     if lives == 0 {
         return Err(Error::new(
             ErrorKind::Invalid,
@@ -1254,9 +1261,16 @@ struct TestRun<'a> {
     index: usize,
     seed: u64,
     parent: &'a Checkpoint,
-    actions: u32,
-    lives: u32,
-    learning: bool,
+    lives: Lives,
+}
+
+/// A test stage's lives: how many in each world, their most actions, and
+/// whether the modules learn during them.
+#[derive(Clone, Copy, Debug)]
+pub struct Lives {
+    pub actions: u32,
+    pub count: u32,
+    pub learning: bool,
 }
 
 impl Engine<'_> {
@@ -1265,20 +1279,18 @@ impl Engine<'_> {
     fn test_stage(&self, t: &TestRun<'_>, dir: &Path) -> Result<TestSummary> {
         let stage = &t.program.stages[t.index];
         let stop = self.interrupt;
-        let (actions, lives, learning) = (t.actions, t.lives, t.learning);
         // Checks that the parent fits and picks its best individual and the episode seed.
         let outcome = evolve::test_subject(t.program, t.index, t.seed, t.parent)
             .map_err(|e| Error::new(ErrorKind::Stale, format!("error: {e}")))?;
         let parent_stage = &t.program.stages[stage.parent.unwrap_or(t.parent.stage)];
-        let ba =
-            before_after(parent_stage, stage, &outcome.genome, actions, lives, learning, outcome.seed, stop)?;
+        let ba = before_after(parent_stage, stage, &outcome.genome, t.lives, outcome.seed, stop)?;
         // Every file is written into `.writing/` first and moved into `dir`
         // once all are: an interruption (or a failure) on the way leaves the
         // files of an earlier run of the stage, if any, as they were.
         let staging = dir.join(".writing");
         let _ = std::fs::remove_dir_all(&staging);
         create_dir(&staging)?;
-        let written = test_files(&staging, stage, parent_stage, &outcome, &ba, lives, learning, stop);
+        let written = test_files(&staging, stage, parent_stage, &outcome, &ba, t.lives, stop);
         let summary = match written {
             Ok(summary) => summary,
             Err(e) => {
@@ -1301,7 +1313,7 @@ impl Engine<'_> {
         self.observer.event(Event::Tested {
             stage: &stage.name,
             summary: &summary,
-            lives,
+            lives: t.lives.count,
             before: &b,
             after: &a,
             dir,
@@ -1313,17 +1325,16 @@ impl Engine<'_> {
 /// Writes a test stage's files into `dir` (`trace.csv`, the pictures,
 /// `episode.json`, `best.genome`, then `summary.json`), stopping between
 /// them once `stop` is set; returns the summary.
-#[allow(clippy::too_many_arguments)]
 fn test_files(
     dir: &Path,
     stage: &Stage,
     parent_stage: &Stage,
     outcome: &evolve::TestSubject,
     ba: &BeforeAfter,
-    lives: u32,
-    learning: bool,
+    lives: Lives,
     stop: Option<&AtomicBool>,
 ) -> Result<TestSummary, Error> {
+    let Lives { count: lives, learning, .. } = lives;
     let stopped = || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let check = || if stopped() { Err(interrupted(report::STOPPED.into())) } else { Ok(()) };
     // The change, and the other lives' starts lightly (unlabelled marks).

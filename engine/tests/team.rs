@@ -180,7 +180,14 @@ fn a_stopped_team_test_stops_at_the_next_action() {
     let (parent, stage) = (&program.stages[0], &program.stages[1]);
     let genome = Genome::zeros(stage.layout.bits as usize);
     let stop = std::sync::atomic::AtomicBool::new(true);
-    let result = shaping_engine::run::before_after(parent, stage, &genome, u32::MAX, 1, true, 1, Some(&stop));
+    let result = shaping_engine::run::before_after(
+        parent,
+        stage,
+        &genome,
+        shaping_engine::run::Lives { actions: u32::MAX, count: 1, learning: true },
+        1,
+        Some(&stop),
+    );
     let err = result.err().expect("stopped");
     assert_eq!(err.kind(), shaping_engine::ErrorKind::Interrupted, "{err}");
     assert!(err.message().contains("stopped in life 1 of 1"), "{err}");

@@ -191,6 +191,28 @@ struct State {
     stats: Stats,
 }
 
+/// What [`Coordinator::hand_out`] hands out: `count` items, run by a
+/// thread of rank 0 with `local` or by another rank; `prepare` may first
+/// send a worker something else (then it takes no item yet), `give` is the
+/// message giving item `k`, `take` reads the answer to item `k` (ending the
+/// run on a wrong one), `late` says what a rank did not do in time.
+struct Items<'a, T> {
+    count: usize,
+    local: &'a (dyn Fn(usize) -> Result<T, String> + Sync),
+    prepare: &'a dyn Fn(&mut State, Rank) -> bool,
+    give: &'a dyn Fn(usize) -> Vec<u8>,
+    take: &'a dyn Fn(&State, Rank, usize, Request) -> T,
+    late: &'a dyn Fn(&State, usize) -> String,
+}
+
+impl<T> Clone for Items<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Items<'_, T> {}
+
 struct Worker {
     pid: u32,
     host: String,
@@ -301,8 +323,18 @@ impl Coordinator {
         let late = |st: &State, _: usize| {
             format!("answer within {} s during {}", self.timeout.as_secs(), st.context)
         };
-        let (results, remote) =
-            self.hand_out(&mut st, bounds.len(), &local, &prepare, &give, &take, &late, &mut |_, _| {});
+        let (results, remote) = self.hand_out(
+            &mut st,
+            &Items {
+                count: bounds.len(),
+                local: &local,
+                prepare: &prepare,
+                give: &give,
+                take: &take,
+                late: &late,
+            },
+            &mut |_, _| {},
+        );
         st.stats.rounds += 1;
         st.stats.episodes += jobs.len() as u64;
         st.stats.remote_episodes +=
@@ -355,33 +387,28 @@ impl Coordinator {
             done += 1;
             eprintln!("{} done on rank {rank} ({done}/{count})", describe(tasks[k]));
         };
-        let (_, remote) =
-            self.hand_out(&mut st, count, &local, &|_, _| false, &give, &take, &late, &mut progress);
+        let (_, remote) = self.hand_out(
+            &mut st,
+            &Items { count, local: &local, prepare: &|_, _| false, give: &give, take: &take, late: &late },
+            &mut progress,
+        );
         st.stats.tasks += count as u64;
         st.stats.remote_tasks += remote.iter().filter(|&&r| r).count() as u64;
         st.stats.wall += started.elapsed();
         Ok(())
     }
 
-    /// Hands `count` items out, one per request, to the other ranks and to a
-    /// thread of rank 0 that runs `local`, until every item is done; returns
-    /// the results in item order and, per item, whether another rank did it.
-    /// `prepare` may first send a worker something else (then it takes no
-    /// item yet), `give` is the message giving item `k`, `take` reads the
-    /// answer to item `k` (ending the run on a wrong one), `late` says what a
-    /// rank did not do in time, `done` hears of every item done and where.
-    #[allow(clippy::too_many_arguments)]
+    /// Hands `items` out, one per request, to the other ranks and to a
+    /// thread of rank 0, until every item is done; returns the results in
+    /// item order and, per item, whether another rank did it. `done_at`
+    /// hears of every item done and where.
     fn hand_out<T: Send>(
         &self,
         st: &mut State,
-        count: usize,
-        local: &(dyn Fn(usize) -> Result<T, String> + Sync),
-        prepare: &dyn Fn(&mut State, Rank) -> bool,
-        give: &dyn Fn(usize) -> Vec<u8>,
-        take: &dyn Fn(&State, Rank, usize, Request) -> T,
-        late: &dyn Fn(&State, usize) -> String,
+        items: &Items<'_, T>,
         done_at: &mut dyn FnMut(usize, Rank),
     ) -> (Vec<T>, Vec<bool>) {
+        let Items { count, local, prepare, give, take, late } = *items;
         let next = AtomicUsize::new(0);
         let mut results: Vec<Option<T>> = (0..count).map(|_| None).collect();
         let mut remote = vec![false; count];

@@ -11,7 +11,7 @@ use shaping_runtime::program::{Param, Program, StageRun};
 use super::data::{self, seed_series, stage_view, ReportData};
 use super::{embedded_json, page};
 use crate::episode::{run_recorded, Episode};
-use crate::run::{before_after, BeforeAfter};
+use crate::run::{before_after, BeforeAfter, Lives};
 use crate::rundir::{parse_generations, GenRow};
 
 fn program() -> Program {
@@ -130,7 +130,7 @@ fn bigger(lives: Option<(u32, u32)>) -> (usize, BeforeAfter) {
         panic!("bigger is a test stage")
     };
     let (actions, lives) = lives.unwrap_or((actions, declared));
-    (i, before_after(parent, stage, &genome, actions, lives, learning, 5, None).unwrap())
+    (i, before_after(parent, stage, &genome, Lives { actions, count: lives, learning }, 5, None).unwrap())
 }
 
 #[test]
