@@ -49,10 +49,12 @@ pub const TEST_MEASURES: [&str; 3] = ["fitness", "grips", "releases_outside"];
 /// ever, the last generation's worst and its best's recharges, grips and
 /// releases outside (the other columns of `generations.csv`), and, with a
 /// criterion, the generation whose best first reaches it and the
-/// evaluations until then (that many generations of the stage's population;
-/// a seed that never reaches it counts as the stage's generations plus one,
-/// after every seed that does); a test stage's fitness, grips and releases
-/// outside.
+/// evaluations until then (the episodes of that many generations: the
+/// population times its episodes per individual, plus every generation of
+/// the evolved stages it extends: the cost of the whole path to the
+/// criterion; a seed that
+/// never reaches it counts as the stage's generations plus one, after every
+/// seed that does); a test stage's fitness, grips and releases outside.
 pub fn read_measures(
     program: &Program,
     stages: &[usize],
@@ -61,10 +63,11 @@ pub fn read_measures(
     criteria: &[(String, f32)],
 ) -> Result<Vec<StageMeasures>, Error> {
     let mut out = Vec::new();
-    for stage in stages.iter().map(|&i| &program.stages[i]) {
+    for (index, stage) in stages.iter().map(|&i| (i, &program.stages[i])) {
         match &stage.run {
             StageRun::Evolve(evo) => {
                 let criterion = criteria.iter().find(|(s, _)| *s == stage.name).map(|c| c.1);
+                let earlier = earlier_evaluations(program, index);
                 let mut v: [Vec<f64>; 10] = Default::default();
                 for &seed in seeds {
                     let sdir = rundir::stage_dir(&rundir::seed_dir(dir, seed), &stage.name);
@@ -87,8 +90,7 @@ pub fn read_measures(
                             .find(|h| h.best >= c)
                             .map_or(f64::from(evo.generations) + 1.0, |h| h.stage_generation as f64 + 1.0);
                         v[8].push(generations);
-                        // EXPERIMENTS.md's count: a generation evaluates the population.
-                        v[9].push(generations * f64::from(evo.population));
+                        v[9].push(earlier + generations * episodes(evo));
                     }
                 }
                 let measures = EVOLVE_MEASURES
@@ -208,6 +210,26 @@ pub fn tests(groups: &[(String, Vec<StageMeasures>)]) -> Tests {
     }
 }
 
+/// The episodes a generation of `evo` runs: its population times the
+/// episodes of each individual.
+fn episodes(evo: &shaping_runtime::program::Evolution) -> f64 {
+    f64::from(evo.population) * f64::from(evo.evaluations)
+}
+
+/// The evaluations (episodes) of the evolved stages stage `index` extends,
+/// before its own: every generation of each (a training stage's life is
+/// not counted).
+fn earlier_evaluations(program: &Program, index: usize) -> f64 {
+    program
+        .lineage(index)
+        .skip(1)
+        .filter_map(|i| match &program.stages[i].run {
+            StageRun::Evolve(e) => Some(f64::from(e.generations) * episodes(e)),
+            _ => None,
+        })
+        .sum()
+}
+
 /// Digits a measure's values are shown with.
 pub(crate) fn digits(measure: &str) -> usize {
     match measure {
@@ -240,8 +262,8 @@ pub fn markdown(t: &Tests, heading: &str) -> String {
         let _ = writeln!(
             md,
             "A seed that never reaches a criterion counts as reaching it at the stage's generations plus one \
-             (evaluations: that many generations of the stage's population, the count EXPERIMENTS.md uses, \
-             without the earlier stages').\n"
+             (evaluations: the episodes of that many generations, the population times its episodes per \
+             individual, plus every generation of the evolved stages it extends).\n"
         );
     }
     let mut head = vec!["stage", "measure", "group", "seeds", "median [95% interval]"];

@@ -90,6 +90,13 @@ fn two_experiments_are_compared_measure_by_measure() {
     for pair in json["measures"].as_array().unwrap().iter().flat_map(|m| m["pairs"].as_array().unwrap()) {
         assert!(pair["p_value"].is_number() && pair["a12"].is_number(), "{pair}");
     }
+    // A criterion on `second` counts `first`'s 6 generations of 12 before its own.
+    let t: Tests =
+        compare(&CompareOptions { criterion: vec!["second=0".into()], ..opts(&[&a, &b]) }).unwrap();
+    let evaluations = t.measures.iter().find(|m| m.measure == "evaluations_reaching_criterion").unwrap();
+    assert_eq!(evaluations.stage, "second");
+    // A best of at least 0 is reached in the stage's first generation.
+    assert_eq!(evaluations.groups[0].median, Some(6.0 * 12.0 + 12.0));
 }
 
 /// A sweep's `summary.json` holds the same tests as `compare` of its points.
