@@ -115,6 +115,30 @@ $B experiment examples/shaped-team-scratch.bat --seeds $SEEDS --out $R/shaped-te
 $B compare $R/shaped-team $R/shaped-team-scratch --stage check
 $B compare $R/shaped-team $R/shaped-team-scratch --stage escort --criterion escort=0.43
 
+# When shaping pays (EXPERIMENTS.md, "a ladder of batteries", stated before
+# it ran): khepera.bat against scratch-full.bat (its stage renamed
+# `collect`) with the battery at 200, 120 and 80 actions, both ending with
+# the same test `exam`. Printed: per rung, the tests of the evaluations to
+# a best of 3.0 (the whole path) and of exam's fitness.
+for b in 200 120 80; do
+  exam='stage exam extends collect {\n  test best for 20 lives of 300 actions with learning\n}\n'
+  sed -e "s#battery 200 actions, recharge 20 actions#battery $b actions, recharge 20 actions#" \
+    examples/khepera.bat > $R/ladder-$b-shaped.bat
+  sed -e "s#battery 200 actions, recharge 20 actions#battery $b actions, recharge 20 actions#" \
+    -e 's#^stage full {#stage collect {#' examples/scratch-full.bat > $R/ladder-$b-scratch.bat
+  for f in shaped scratch; do
+    printf "\n$exam" >> $R/ladder-$b-$f.bat
+    [ "$(grep -c "battery $b actions, recharge 20 actions" $R/ladder-$b-$f.bat)" = 1 ]
+    [ "$(grep -c '^stage collect\|^stage exam extends collect {' $R/ladder-$b-$f.bat)" = 2 ]
+    $B experiment $R/ladder-$b-$f.bat --seeds $SEEDS --out $R/ladder-$b-$f --fresh --no-report \
+      --criterion collect=3 > /dev/null
+  done
+  echo "== ladder: battery $b actions"
+  $B compare $R/ladder-$b-shaped $R/ladder-$b-scratch --stage collect --criterion collect=3 \
+    | grep -E 'reaching criterion|^Groups'
+  $B compare $R/ladder-$b-shaped $R/ladder-$b-scratch --stage exam | grep -E '\| exam \| fitness'
+done
+
 # Teams (EXPERIMENTS.md, "Teams: aggregation and cooperative collect"):
 # aggregation.bat's 10 robots, and team-collect.bat's 4 robots with 16
 # objects against one robot with 4 objects in khepera.bat's arena (the same
