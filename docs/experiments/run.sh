@@ -145,6 +145,9 @@ done
 # file with three changes, each checked).
 $B experiment examples/aggregation.bat --seeds $SEEDS --out $R/aggregation --fresh > /dev/null
 $B experiment examples/aggregation-roles.bat --seeds $SEEDS --out $R/aggregation-roles --fresh > /dev/null
+# The same task with the range-and-bearing board (aggregation-rab.bat), the
+# same budget.
+$B experiment examples/aggregation-rab.bat --seeds $SEEDS --out $R/aggregation-rab --fresh > /dev/null
 # Twice the generations for the clones and the roles: does the roles'
 # longer genome catch up?
 for f in aggregation aggregation-roles; do
@@ -219,6 +222,8 @@ $T/examples/walkers examples/aggregation.bat --lives 100 --picture $D/aggregatio
 $T/examples/walkers examples/aggregation.bat --lives 20 --run $R/aggregation --seeds $SEEDS > $R/aggregation-lives.txt
 $T/examples/walkers examples/aggregation-roles.bat --lives 20 --run $R/aggregation-roles --seeds $SEEDS \
   > $R/aggregation-roles-lives.txt
+$T/examples/walkers examples/aggregation-rab.bat --lives 20 --run $R/aggregation-rab --seeds $SEEDS \
+  > $R/aggregation-rab-lives.txt
 for f in aggregation aggregation-roles; do
   $T/examples/walkers $R/$f-120.bat --lives 20 --run $R/$f-120 --seeds $SEEDS > $R/$f-120-lives.txt
 done
@@ -309,6 +314,10 @@ grep -A5 '^over the seeds' $R/aggregation-lives.txt
 echo "== teams: aggregation by two roles of 5 robots"
 grep -E '^seed [0-9]+ \(' $R/aggregation-roles-lives.txt
 grep -A5 '^over the seeds' $R/aggregation-roles-lives.txt
+echo "== teams: aggregation with the range-and-bearing board (aggregation-rab.bat)"
+grep -E '^seed [0-9]+ \(' $R/aggregation-rab-lives.txt
+grep -A5 '^over the seeds' $R/aggregation-rab-lives.txt
+$B compare $R/aggregation $R/aggregation-rab --stage aggregate | grep -E '\| chosen best \|'
 echo "== teams: aggregation with 120 generations, the clones then the roles"
 grep -A1 '^over the seeds' $R/aggregation-120-lives.txt
 grep -A1 '^over the seeds' $R/aggregation-roles-120-lives.txt
