@@ -528,3 +528,17 @@ for run in ("shaped-team", "shaped-team-scratch"):
         recharges.append(d["after"]["recharges"])
     print(f"  {run}, per life: a scout {' '.join(f'{x:.2f}' for x in scouts)}; a guard "
           f"{' '.join(f'{x:.2f}' for x in guards)}; recharges in 20 lives {' '.join(map(str, recharges))}")
+
+
+print("\n== when shaping pays: objects released outside per fresh life (walkers.rs, 20 lives per seed, learning on)")
+# Added after the ladder ran, beside its stated final test `exam` (whose
+# lives carry what learning acquired from life to life): each seed's chosen
+# best in 20 fresh lives, each starting from the genome, as in evolution.
+for b in (200, 120, 80):
+    out = {}
+    for f in ("shaped", "scratch"):
+        with open(f"{R}/ladder-{b}-{f}-lives.txt") as fh:
+            out[f] = [float(m.group(1)) for m in re.finditer(r"^seed \d+ \(medians.*objects out per life ([0-9.]+)", fh.read(), re.M)]
+        print(f"  battery {b}, {f}: {' '.join(f'{x:.2f}' for x in out[f])}; median {statistics.median(out[f]):.3f}")
+    u, p, a12 = mann_whitney(out["shaped"], out["scratch"])
+    print(f"  battery {b}: U = {u:g}, p = {p:.4f}, A12 = {a12:.3f} (above 0.5: shaped releases more)")

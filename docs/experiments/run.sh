@@ -211,7 +211,8 @@ for f in khepera/fitness-seeds scratch-full/fitness-seeds avoid-1/avoid/reinforc
   figure11/activations figure11/trajectory \
   khepera-practice/fitness-seeds practice-figure11/activations practice-figure11/trajectory \
   khepera-practice/seed-1/bigger/reinforcement aggregation-replay/trajectory team-collect-replay/trajectory \
-  shaped-team/seed-1/check/trajectory shaped-team-scratch/seed-1/check/trajectory; do
+  shaped-team/seed-1/check/trajectory shaped-team-scratch/seed-1/check/trajectory \
+  ladder-80-shaped/fitness-seeds ladder-80-scratch/fitness-seeds; do
   cp "$R/$f.png" "$D/$(echo "$f" | tr '/' '-').png"
 done
 
@@ -224,6 +225,12 @@ $T/examples/walkers examples/aggregation-roles.bat --lives 20 --run $R/aggregati
   > $R/aggregation-roles-lives.txt
 $T/examples/walkers examples/aggregation-rab.bat --lives 20 --run $R/aggregation-rab --seeds $SEEDS \
   > $R/aggregation-rab-lives.txt
+for b in 200 120 80; do
+  for f in shaped scratch; do
+    $T/examples/walkers $R/ladder-$b-$f.bat --stage collect --lives 20 --run $R/ladder-$b-$f --seeds $SEEDS \
+      > $R/ladder-$b-$f-lives.txt
+  done
+done
 for f in aggregation aggregation-roles; do
   $T/examples/walkers $R/$f-120.bat --lives 20 --run $R/$f-120 --seeds $SEEDS > $R/$f-120-lives.txt
 done
