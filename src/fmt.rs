@@ -50,8 +50,12 @@ pub fn fmt(files: &[PathBuf], check: bool, error_format: ErrorFormat) -> Result<
 
 fn fmt_stdin(check: bool, error_format: ErrorFormat) -> Result<(), CliError> {
     let bytes = shaping_engine::files::read_input(std::io::stdin(), "standard input")?;
-    let src = String::from_utf8(bytes)
-        .map_err(|e| CliError::io(format!("error: standard input is not UTF-8 text: {e}")))?;
+    let src = String::from_utf8(bytes).map_err(|e| {
+        CliError::new(
+            shaping_engine::ErrorKind::Invalid,
+            format!("error: standard input is not UTF-8 text: {e}"),
+        )
+    })?;
     let out = format_one(&src, "<stdin>", error_format)?;
     if check {
         if out != src {
@@ -70,7 +74,7 @@ fn format_one(src: &str, name: &str, error_format: ErrorFormat) -> Result<String
             diag::render(&d, error_format).trim_end()
         )),
         FormatError::Changed(why) => {
-            CliError::io(format!("error: `{name}` was left as it is: {why} (a bug of `shaping fmt`)"))
+            CliError::internal(format!("error: `{name}` was left as it is: {why} (a bug of `shaping fmt`)"))
         }
     })
 }

@@ -452,7 +452,7 @@ fn layout(
                 "genes": shaping_compiler::layout_rows(&program, index),
             });
             let json = serde_json::to_string_pretty(&layout)
-                .map_err(|e| CliError::io(format!("error: cannot serialise the layout: {e}")))?;
+                .map_err(|e| CliError::internal(format!("error: cannot serialise the layout: {e}")))?;
             outln!("{json}")
         }
     }
@@ -464,7 +464,8 @@ fn run_here_or_on_ranks(args: run::RunArgs, rank_timeout: u64) -> Result<(), Cli
     #[cfg(feature = "mpi")]
     if cluster::launcher().is_some() {
         if args.robot.is_some() {
-            return Err(CliError::io("error: `--robot` evaluates on one robot; run it without `mpirun`"));
+            let message = "error: `--robot` evaluates on one robot; run it without `mpirun`";
+            return Err(CliError::invalid_setting("--robot", None, message));
         }
         let (jobs, quiet) = (args.jobs, args.quiet || args.json);
         return cluster::with_mpi(jobs, rank_timeout, quiet, None, |c| run::run(args, Some(c)));
@@ -496,7 +497,7 @@ fn compare(opts: shaping_engine::compare::CompareOptions, json: bool) -> Result<
     let tests = shaping_engine::compare::compare(&opts)?;
     if json {
         let text = serde_json::to_string_pretty(&tests)
-            .map_err(|e| CliError::io(format!("error: cannot serialise the comparison: {e}")))?;
+            .map_err(|e| CliError::internal(format!("error: cannot serialise the comparison: {e}")))?;
         return print_text(&text);
     }
     print_text(&shaping_engine::compare::markdown(&tests, "# Comparison"))
@@ -521,16 +522,20 @@ fn build(
     error_format: ErrorFormat,
 ) -> Result<(), CliError> {
     if load::same_entry(file, output) {
-        return Err(CliError::io(format!(
-            "error: `{}` is the file being built; give `-o` another file (e.g. `{}`)",
-            output.display(),
-            file.with_extension("json").display()
-        )));
+        return Err(CliError::invalid_setting(
+            "-o",
+            Some(&output.display().to_string()),
+            format!(
+                "error: `{}` is the file being built; give `-o` another file (e.g. `{}`)",
+                output.display(),
+                file.with_extension("json").display()
+            ),
+        ));
     }
     load::replaceable_program(output)?;
     let program = load::load_program(file, error_format)?;
     let json = serde_json::to_string_pretty(&program)
-        .map_err(|e| CliError::io(format!("error: cannot serialise the program: {e}")))?;
+        .map_err(|e| CliError::internal(format!("error: cannot serialise the program: {e}")))?;
     load::write_atomic(output, json.as_bytes())?;
     eprintln!("wrote {} ({} stages)", output.display(), program.stages.len());
     Ok(())
@@ -547,7 +552,7 @@ fn refuse_without_mpi(command: &Command) -> Result<(), CliError> {
         Some((_, Some(size))) if size <= 1 => Ok(()),
         Some((var, size)) => {
             let n = size.map_or_else(|| "several".to_string(), |n| n.to_string());
-            Err(CliError::io(format!(
+            Err(CliError::new(shaping_engine::ErrorKind::Invalid, format!(
                 "error: this `shaping` was built without MPI support, but an MPI launcher started it as one of {n} processes (`{var}` is set); rebuild it with `cargo build --release --features mpi`, or run it without `mpirun`"
             )))
         }
@@ -561,11 +566,14 @@ fn single_values(sets: Vec<sweep::Set>, command: &str) -> Result<Vec<sweep::Assi
     sets.into_iter()
         .map(|s| match <[String; 1]>::try_from(s.values) {
             Ok([v]) => Ok((s.target, v)),
-            Err(values) => Err(CliError::io(format!(
-                "error: `--set {}={}`: `{command}` takes one value (`experiment` sweeps several)",
-                s.target,
-                values.join(",")
-            ))),
+            Err(values) => {
+                let message = format!(
+                    "error: `--set {}={}`: `{command}` takes one value (`experiment` sweeps several)",
+                    s.target,
+                    values.join(",")
+                );
+                Err(CliError::invalid_setting(&s.target, Some(&values.join(",")), message))
+            }
         })
         .collect()
 }

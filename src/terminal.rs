@@ -54,7 +54,9 @@ impl Observer for Terminal {
             None => {}
             Some(Ok(line)) => self.print_json(line.clone()),
             Some(Err(e)) => {
-                self.failed.borrow_mut().get_or_insert(CliError::io(format!("error: cannot serialise: {e}")));
+                self.failed
+                    .borrow_mut()
+                    .get_or_insert(CliError::internal(format!("error: cannot serialise: {e}")));
             }
         };
         match event {

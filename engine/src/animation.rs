@@ -75,7 +75,7 @@ pub fn frames_of_team(
     let mut objects = base.objects.clone();
     let mut changes = c.objects.iter().peekable();
     let mut out = Vec::new();
-    let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
+    let to_err = Error::from;
     let mut path = Vec::with_capacity(end);
     // A team's other robots in the first world, their paths so far.
     let mut others = vec![Vec::with_capacity(end); episode.robots_in(0) - 1];
@@ -323,8 +323,7 @@ pub fn gif(frames: &[Rgb]) -> Result<Vec<u8>, String> {
 
 /// Writes the frames to `path` as an animated GIF.
 pub fn write_gif(path: &Path, frames: &[Rgb]) -> Result<(), Error> {
-    let bytes =
-        gif(frames).map_err(|e| Error::io(format!("error: cannot write `{}`: {e}", path.display())))?;
+    let bytes = gif(frames).map_err(|e| Error::file(crate::ErrorKind::Internal, "write", path, e))?;
     write_atomic(path, &bytes)
 }
 
@@ -337,7 +336,12 @@ pub fn find_program(program: &str) -> Option<PathBuf> {
 /// `ffmpeg` on the `PATH`, or the error `--mp4` gives without it.
 pub fn ffmpeg() -> Result<PathBuf, Error> {
     find_program("ffmpeg").ok_or_else(|| {
-        Error::io("error: `--mp4` needs the program `ffmpeg`, which is not on the PATH; install it, or write a GIF with `--gif`")
+        let subject = crate::Subject::File { path: "ffmpeg".into(), operation: "run".into() };
+        Error::new(
+            crate::ErrorKind::NotFound,
+            "error: `--mp4` needs the program `ffmpeg`, which is not on the PATH; install it, or write a GIF with `--gif`",
+        )
+        .about(subject)
     })
 }
 
@@ -345,13 +349,14 @@ pub fn ffmpeg() -> Result<PathBuf, Error> {
 /// temporary file beside it, renamed when `ffmpeg` succeeded).
 pub fn write_mp4(path: &Path, frames: &[Rgb]) -> Result<(), Error> {
     let ffmpeg = ffmpeg()?;
-    let first = frames.first().ok_or_else(|| Error::io("error: no frames to animate"))?;
+    let first =
+        frames.first().ok_or_else(|| Error::new(crate::ErrorKind::Invalid, "error: no frames to animate"))?;
     // H.264 in yuv420p needs even sides.
     let (w, h) = (first.width + first.width % 2, first.height + first.height % 2);
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(format!(".{}.partial", std::process::id()));
     let tmp = PathBuf::from(tmp);
-    let fail = |m: String| Error::io(format!("error: cannot write `{}`: {m}", path.display()));
+    let fail = |m: String| Error::file(crate::ErrorKind::Io, "write", path, m);
     let mut child = Command::new(&ffmpeg)
         .args(["-y", "-loglevel", "error", "-f", "rawvideo", "-pixel_format", "rgb24"])
         .args(["-video_size", &format!("{w}x{h}"), "-framerate", FPS, "-i", "-"])

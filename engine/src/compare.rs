@@ -324,8 +324,7 @@ pub struct CompareOptions {
 
 /// The seeds of an experiment directory: its `seed-N/` directories, in order.
 fn seeds_of(dir: &Path) -> Result<Vec<u64>, Error> {
-    let entries = std::fs::read_dir(dir)
-        .map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", dir.display())))?;
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::of_io("read", dir, &e))?;
     let mut seeds: Vec<u64> = entries
         .filter_map(|e| e.ok())
         .filter(|e| e.path().is_dir())

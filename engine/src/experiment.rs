@@ -335,7 +335,7 @@ fn sweep_plot(stem: &Path, title: &str, table: &[(Vec<Assignment>, Vec<StageFigu
         &series,
         (&axis, &labels),
     )
-    .map_err(|e| Error::io(format!("error: {e}")))
+    .map_err(Error::from)
 }
 
 /// The sweep's `summary.md`: one row per point, the median (min .. max)
@@ -467,7 +467,7 @@ fn summarise(
             &runs,
             &starts,
         )
-        .map_err(|e| Error::io(format!("error: {e}")))?;
+        .map_err(Error::from)?;
     }
     let _ = writeln!(
         md,

@@ -35,11 +35,11 @@ use std::sync::Mutex;
 
 use shaping_runtime::evolve::fingerprint::fnv1a;
 
-use crate::error::{Error, ErrorKind, Result};
+use crate::error::{Error, ErrorKind, Result, Subject};
 
 /// Reads a file, mapping I/O errors to a message that names the path.
 pub fn read_bytes(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::io(format!("error: cannot read `{}`: {e}", path.display())))
+    std::fs::read(path).map_err(|e| Error::of_io("read", path, &e))
 }
 
 /// The largest input read whole: a source file, a built program, standard
@@ -53,15 +53,14 @@ pub fn read_input(mut reader: impl std::io::Read, name: &str) -> Result<Vec<u8>>
     (&mut reader)
         .take(MAX_INPUT_BYTES + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| Error::io(format!("error: cannot read `{name}`: {e}")))?;
+        .map_err(|e| Error::of_io("read", Path::new(name), &e))?;
     if bytes.len() as u64 > MAX_INPUT_BYTES {
-        return Err(Error::new(
-            ErrorKind::Invalid,
-            format!(
-                "error: `{name}` is larger than {} MiB, the most an input may hold",
-                MAX_INPUT_BYTES >> 20
-            ),
-        ));
+        let message = format!(
+            "error: `{name}` is larger than {} MiB, the most an input may hold",
+            MAX_INPUT_BYTES >> 20
+        );
+        let subject = Subject::File { path: name.into(), operation: "read".to_string() };
+        return Err(Error::new(ErrorKind::Invalid, message).about(subject));
     }
     Ok(bytes)
 }
@@ -74,8 +73,7 @@ pub fn read_input_file(path: &Path) -> Result<Vec<u8>> {
 
 /// Creates a directory and its parents.
 pub fn create_dir(path: &Path) -> Result<()> {
-    std::fs::create_dir_all(path)
-        .map_err(|e| Error::io(format!("error: cannot create directory `{}`: {e}", path.display())))
+    std::fs::create_dir_all(path).map_err(|e| Error::of_io("create directory", path, &e))
 }
 
 /// Writes a file atomically (see the module's documentation). Under a
@@ -85,7 +83,7 @@ pub fn create_dir(path: &Path) -> Result<()> {
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<()> {
     check_locks(path)?;
     static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let fail = |e: std::io::Error| Error::io(format!("error: cannot write `{}`: {e}", path.display()));
+    let fail = |e: std::io::Error| Error::of_io("write", path, &e);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -160,6 +158,7 @@ fn check_locks(path: &Path) -> Result<()> {
         let now = std::fs::symlink_metadata(&h.lock).ok().and_then(|m| file_id(&m));
         if now != h.id {
             let what = if now.is_none() { "was removed" } else { "was replaced" };
+            let subject = Subject::Lock { dir: h.dir.clone(), holder: String::new() };
             return Err(Error::new(
                 ErrorKind::Locked,
                 format!(
@@ -170,7 +169,8 @@ fn check_locks(path: &Path) -> Result<()> {
                     h.dir.display(),
                     path.display()
                 ),
-            ));
+            )
+            .about(subject));
         }
     }
     Ok(())
@@ -196,8 +196,7 @@ impl DirLock {
         create_dir(dir)?;
         let path = dir.join(Self::FILE);
         // The lock file itself is opened without following a link there.
-        let mut file = open_lock_file(&path)
-            .map_err(|e| Error::io(format!("error: cannot open the lock `{}`: {e}", path.display())))?;
+        let mut file = open_lock_file(&path).map_err(|e| Error::of_io("open the lock", &path, &e))?;
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
@@ -213,16 +212,15 @@ impl DirLock {
                     (false, true) => format!("another run of this process ({holder})"),
                     (false, false) => format!("another process ({holder})"),
                 };
-                return Err(Error::new(
-                    ErrorKind::Locked,
-                    format!(
-                        "error: `{}` is in use by {who}; wait for it to finish (or stop it), or choose another `--out`",
-                        dir.display()
-                    ),
-                ));
+                let message = format!(
+                    "error: `{}` is in use by {who}; wait for it to finish (or stop it), or choose another `--out`",
+                    dir.display()
+                );
+                let subject = Subject::Lock { dir: dir.to_path_buf(), holder: holder.to_string() };
+                return Err(Error::new(ErrorKind::Locked, message).about(subject));
             }
             Err(std::fs::TryLockError::Error(e)) => {
-                return Err(Error::io(format!("error: cannot lock `{}`: {e}", path.display())));
+                return Err(Error::of_io("lock", &path, &e));
             }
         }
         // Who holds it, for the refusal of the next one.
@@ -353,11 +351,12 @@ fn read_seals(dir: &Path) -> Result<Option<Seals>> {
     let bytes = match std::fs::read(&path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(Error::io(format!("error: cannot read `{}`: {e}", path.display()))),
+        Err(e) => return Err(Error::of_io("read", &path, &e)),
     };
     let corrupt = |why: &str| {
-        Error::new(
-            ErrorKind::Corrupt,
+        Error::damaged(
+            &path,
+            why,
             format!(
                 "error: the seals `{}` are corrupt ({why}): the files beside them cannot be checked; delete it to \
                  read them unchecked (with a warning), or run the stage again (`--fresh`)",
@@ -380,7 +379,7 @@ fn read_seals(dir: &Path) -> Result<Option<Seals>> {
 
 fn write_seals(dir: &Path, seals: &Seals) -> Result<()> {
     let json = serde_json::to_string_pretty(seals)
-        .map_err(|e| Error::io(format!("error: cannot serialise the seals: {e}")))?;
+        .map_err(|e| Error::internal(format!("error: cannot serialise the seals: {e}")))?;
     write_atomic(&dir.join(SEALS), seal(&json).as_bytes())
 }
 
@@ -428,11 +427,10 @@ pub fn write_sealed(dir: &Path, files: &[(&str, &[u8])]) -> Result<()> {
 /// removed.
 pub fn move_sealed(from: &Path, to: &Path) -> Result<()> {
     let fail = |e: std::io::Error| {
-        Error::io(format!(
-            "error: cannot move the files of `{}` into `{}`: {e}",
-            from.display(),
-            to.display()
-        ))
+        let message =
+            format!("error: cannot move the files of `{}` into `{}`: {e}", from.display(), to.display());
+        Error::new(ErrorKind::Io, message)
+            .about(Subject::File { path: from.to_path_buf(), operation: "move".into() })
     };
     let new = read_seals(from)?.unwrap_or_default();
     let mut seals = read_seals(to).ok().flatten().unwrap_or_default();
@@ -481,7 +479,7 @@ pub fn read_checked(path: &Path, advice: &str, unsealed: Unsealed<'_>) -> Result
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(Error::io(format!("error: cannot read `{}`: {e}", path.display()))),
+        Err(e) => return Err(Error::of_io("read", path, &e)),
     };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -494,8 +492,9 @@ pub fn read_checked(path: &Path, advice: &str, unsealed: Unsealed<'_>) -> Result
         return Ok(Some(Checked { bytes, sealed: false }));
     };
     if !sums.contains(&checksum_hex(&bytes)) {
-        return Err(Error::new(
-            ErrorKind::Corrupt,
+        return Err(Error::damaged(
+            path,
+            "its checksum does not match its contents",
             format!(
                 "error: `{}` is corrupt: its checksum does not match its contents (sealed in `{}`): it was changed \
                  after the run wrote it; {advice}",

@@ -54,7 +54,7 @@ pub mod sweep;
 mod entry;
 
 pub use entry::Engine;
-pub use error::{Error, ErrorKind, Result};
+pub use error::{Error, ErrorKind, Result, Subject};
 
 /// The longest part of a training life that a run records (from its
 /// start) for `trace.csv`, `episode.json` and the pictures.

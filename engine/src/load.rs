@@ -69,7 +69,7 @@ pub fn load_program(path: &Path, format: ErrorFormat) -> Result<(Program, Option
     // The compiler's output always validates (a property test checks it);
     // validating here too makes every command run only validated programs.
     program.validate().map_err(|e| {
-        Error::io(format!("error: internal error: `{name}` compiled to an invalid program: {e}"))
+        Error::internal(format!("error: internal error: `{name}` compiled to an invalid program: {e}"))
     })?;
     Ok((program, warnings))
 }
@@ -457,11 +457,15 @@ pub fn replaceable_program(out: &Path) -> Result<()> {
     if built {
         return Ok(());
     }
-    Err(Error::io(format!(
-        "error: `{}` exists and is not a program `shaping build` wrote; `build -o` replaces only such a file \
-         (choose a new file, e.g. one ending in `.json`)",
-        out.display()
-    )))
+    Err(Error::invalid_setting(
+        "-o",
+        Some(&out.display().to_string()),
+        format!(
+            "error: `{}` exists and is not a program `shaping build` wrote; `build -o` replaces only such a file \
+             (choose a new file, e.g. one ending in `.json`)",
+            out.display()
+        ),
+    ))
 }
 
 #[cfg(test)]

@@ -155,6 +155,23 @@ impl fmt::Display for PlotError {
     }
 }
 
+/// A picture that cannot be drawn: its data ([`crate::ErrorKind::Invalid`])
+/// or the system ([`crate::ErrorKind::Io`]), about its file.
+impl From<PlotError> for crate::Error {
+    fn from(e: PlotError) -> crate::Error {
+        let (kind, operation) = match &e {
+            PlotError::Input { .. } => (crate::ErrorKind::Invalid, "plot"),
+            PlotError::Io { source, .. } if source.kind() == io::ErrorKind::NotFound => {
+                (crate::ErrorKind::NotFound, "write")
+            }
+            PlotError::Io { .. } => (crate::ErrorKind::Io, "write"),
+            PlotError::Draw { .. } => (crate::ErrorKind::Io, "draw"),
+        };
+        let subject = crate::Subject::File { path: e.path().to_path_buf(), operation: operation.to_string() };
+        crate::Error::new(kind, format!("error: {e}")).about(subject)
+    }
+}
+
 impl std::error::Error for PlotError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {

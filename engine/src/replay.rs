@@ -54,20 +54,28 @@ pub fn in_named_variant(stage: &Stage, name: &str) -> Result<Stage, Error> {
         return Ok(stage.in_variant(v));
     }
     if names.is_empty() {
-        return Err(Error::io(format!(
-            "error: `--variant {name}`: stage `{}` declares no variants (`variants mean {{ ... }}` in its world)",
-            stage.name
-        )));
+        return Err(Error::invalid_setting(
+            "--variant",
+            Some(name),
+            format!(
+                "error: `--variant {name}`: stage `{}` declares no variants (`variants mean {{ ... }}` in its world)",
+                stage.name
+            ),
+        ));
     }
     let listed: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
     let hint = shaping_compiler::diag::did_you_mean(name, names.iter().copied())
         .map(|h| format!("; {h}"))
         .unwrap_or_default();
-    Err(Error::io(format!(
-        "error: `--variant {name}`: stage `{}` has no variant `{name}` (its variants: {}){hint}",
-        stage.name,
-        listed.join(", ")
-    )))
+    Err(Error::invalid_setting(
+        "--variant",
+        Some(name),
+        format!(
+            "error: `--variant {name}`: stage `{}` has no variant `{name}` (its variants: {}){hint}",
+            stage.name,
+            listed.join(", ")
+        ),
+    ))
 }
 
 /// Refuses `--robot N` of a stage whose team has no robot `N`.
@@ -81,7 +89,8 @@ fn check_robot(stage: &Stage, robot: u32) -> Result<(), Error> {
     } else {
         format!("{robots} robots, 0 to {}", robots - 1)
     };
-    Err(Error::io(format!("error: `--robot {robot}`: stage `{}` has {has}", stage.name)))
+    let message = format!("error: `--robot {robot}`: stage `{}` has {has}", stage.name);
+    Err(Error::invalid_setting("--robot", Some(&robot.to_string()), message))
 }
 
 /// Reads `--genome`: an argument made only of `0`, `1`, `_` and blanks is
@@ -95,15 +104,21 @@ pub fn parse_genome(arg: &str) -> Result<Genome, Error> {
     };
     let blank = |c: char| c == '_' || c.is_whitespace();
     if arg.chars().all(|c| c.is_ascii_digit() || blank(c)) {
-        return Err(Error::io(format!(
-            "error: `--genome {arg}` is not a genome: character {position} is `{c}`; a genome is a string of 0 and 1 (or the path of a file holding one)"
-        )));
+        return Err(Error::invalid_setting(
+            "--genome",
+            Some(arg),
+            format!(
+                "error: `--genome {arg}` is not a genome: character {position} is `{c}`; a genome is a string of 0 and 1 (or the path of a file holding one)"
+            ),
+        ));
     }
     let path = Path::new(arg);
     if !path.is_file() {
-        return Err(Error::io(format!(
-            "error: `--genome {arg}` is neither a string of 0 and 1 (character {position} is `{c}`) nor a file"
-        )));
+        return Err(Error::invalid_setting(
+            "--genome",
+            Some(arg),
+            format!("error: `--genome {arg}` is neither a string of 0 and 1 (character {position} is `{c}`) nor a file"),
+        ));
     }
     read_genome(path)
 }
@@ -173,6 +188,7 @@ pub fn choose(
     let trained = run::bind_training(&mut program, Some(&run_dir), seed, observer)?;
     let stage = &program.stages[index];
     let training_seed = trained.iter().find(|(i, _)| *i == index).map(|(_, t)| t.run_seed);
+    let genome_arg = genome;
     let genome = match genome {
         Some(g) => parse_genome(g)?,
         None if training_seed.is_some() => Genome::zeros(0),
@@ -183,12 +199,17 @@ pub fn choose(
             let dir = rundir::stage_dir(&run_dir, &program.stages[source].name);
             let path = rundir::best_genome_path(&dir);
             if !path.exists() {
-                return Err(Error::io(format!(
-                    "error: no evolved individual at `{}`; run `shaping run {}{}` first, or pass `--genome`",
-                    path.display(),
-                    file.display(),
-                    run.map_or_else(String::new, |d| format!(" --out {}", d.display()))
-                )));
+                let subject = crate::Subject::File { path: path.clone(), operation: "read".into() };
+                return Err(Error::new(
+                    crate::ErrorKind::NotFound,
+                    format!(
+                        "error: no evolved individual at `{}`; run `shaping run {}{}` first, or pass `--genome`",
+                        path.display(),
+                        file.display(),
+                        run.map_or_else(String::new, |d| format!(" --out {}", d.display()))
+                    ),
+                )
+                .about(subject));
             }
             // From the program as it is: the checkpoint, where there is one,
             // must still fit, and `best.genome` be its best.
@@ -202,12 +223,22 @@ pub fn choose(
         }
     };
     if genome.bits.len() != stage.layout.bits as usize {
-        return Err(Error::io(format!(
+        let message = format!(
             "error: the genome has {} bits but stage `{}` needs {}",
             genome.bits.len(),
             stage.name,
             stage.layout.bits
-        )));
+        );
+        // An argument that cannot be used, or a saved genome of another program.
+        return Err(match genome_arg {
+            Some(g) => Error::invalid_setting("--genome", Some(g), message),
+            None => {
+                let source = program.evolved_at_or_above(index).unwrap_or(index);
+                let path =
+                    rundir::best_genome_path(&rundir::stage_dir(&run_dir, &program.stages[source].name));
+                Error::stale(&path, format!("{} bits, not {}", genome.bits.len(), stage.layout.bits), message)
+            }
+        });
     }
     Ok(Chosen { program, index, genome, training_seed })
 }
@@ -237,8 +268,9 @@ fn not_of_this_program(
     } else {
         String::new()
     };
-    Err(Error::new(
-        crate::ErrorKind::Stale,
+    Err(Error::stale(
+        &rundir::checkpoint_path(dir),
+        e.to_string(),
         format!(
             "error: the best individual in `{}` is not of this program: {e}; {theirs}run `{}` again into another \
              `--out` and replay that",
@@ -306,7 +338,7 @@ pub fn replay(
     });
     load::check_recording(stage, actions)?;
     let recorded = episode::record(stage, &genome, &EpisodeOptions { actions, learning, seed })
-        .map_err(|e| Error::io(format!("error: {e}")))?;
+        .map_err(|e| Error::new(crate::ErrorKind::Invalid, format!("error: {e}")))?;
     let episode::Recorded { result: r, trace, others, episode: ep, scene: team_scene } = recorded;
     let mut crowding = run::Crowding::default();
     crowding.add(r.placement_failures);

@@ -45,7 +45,7 @@ pub fn fitness_plot(dir: &Path, title: &str, history: &[GenStats]) -> Result<(),
     }
     let (points, starts) = fitness_points(history);
     plot::fitness_curves(&rundir::picture_path(dir, Picture::Fitness), title, &points, &starts, false)
-        .map_err(|e| Error::io(format!("error: {e}")))
+        .map_err(Error::from)
 }
 
 /// Where the value of one declared sensor or actuator element comes from in
@@ -279,8 +279,7 @@ impl TraceWriter {
     /// Creates `path` (emptied if it exists) and writes the header of the
     /// trace of `stage`.
     pub fn create(path: &Path, stage: &Stage) -> Result<TraceWriter, Error> {
-        let file = File::create(path)
-            .map_err(|e| Error::io(format!("error: cannot write `{}`: {e}", path.display())))?;
+        let file = File::create(path).map_err(|e| Error::of_io("write", path, &e))?;
         let modules: Vec<String> = stage.modules.iter().map(|m| m.name.clone()).collect();
         let declared = declared_columns(stage);
         let pending = trace_header(&modules, &declared);
@@ -326,7 +325,7 @@ impl TraceWriter {
         match file.write_all(self.pending.as_bytes()) {
             Ok(()) => self.pending.clear(),
             Err(e) => {
-                self.error = Some(Error::io(format!("error: cannot write `{}`: {e}", self.path.display())));
+                self.error = Some(Error::of_io("write", &self.path, &e));
                 self.file = None;
             }
         }
@@ -340,9 +339,7 @@ impl TraceWriter {
             return Err(e);
         }
         match &self.file {
-            Some(file) => file
-                .sync_all()
-                .map_err(|e| Error::io(format!("error: cannot write `{}`: {e}", self.path.display()))),
+            Some(file) => file.sync_all().map_err(|e| Error::of_io("write", &self.path, &e)),
             None => Ok(()),
         }
     }
@@ -488,7 +485,7 @@ fn pictures(
 ) -> Result<(), Error> {
     let Lived { trace, others, scene } = lived;
     let Drawing { title, marks, ref path } = *drawing;
-    let to_err = |e: plot::PlotError| Error::io(format!("error: {e}"));
+    let to_err = Error::from;
     let check = || if stop() { Err(Error::new(crate::ErrorKind::Interrupted, STOPPED)) } else { Ok(()) };
     if trace.rows.is_empty() {
         return Ok(());

@@ -369,18 +369,25 @@ fn stale(path: &Path, e: &evolve::EvolveError) -> Error {
         }
         _ => "pass `--fresh` to start again, or choose another `--out`".to_string(),
     };
-    Error::new(ErrorKind::Stale, format!("error: cannot resume from `{}`: {e}; {hint}", path.display()))
+    Error::stale(path, e.to_string(), format!("error: cannot resume from `{}`: {e}; {hint}", path.display()))
 }
 
 /// A saved result of another seed than the run's.
 fn other_seed(path: &Path, saved: u64, seed: u64) -> Error {
-    Error::new(
-        ErrorKind::Stale,
+    Error::stale(
+        path,
+        format!("seed {saved}, not {seed}"),
         format!(
             "error: `{}` belongs to a run with seed {saved} (this run has seed {seed}); pass `--seed {saved}` to resume it, `--fresh` to start again, or another `--out`",
             path.display()
         ),
     )
+}
+
+/// A stage the program cannot run or train as it is (the runtime's
+/// refusal: a genome of another layout, a setup that does not fit).
+fn unusable(e: impl std::fmt::Display) -> Error {
+    Error::new(ErrorKind::Invalid, format!("error: {e}"))
 }
 
 /// The error of a run stopped by its interruption flag.
@@ -426,8 +433,7 @@ fn precheck(
                     if binding && t.run_seed == seed {
                         let path = rundir::trained_path(&dir);
                         evolve::train::check(&bound, i, &t).map_err(|e| stale(&path, &e))?;
-                        evolve::train::bind(&mut bound, i, &t)
-                            .map_err(|e| Error::io(format!("error: {e}")))?;
+                        evolve::train::bind(&mut bound, i, &t).map_err(unusable)?;
                     } else {
                         binding = false;
                     }
@@ -493,8 +499,9 @@ fn check_owner(
             _ => return Ok(()),
         },
     };
-    Err(Error::new(
-        ErrorKind::Stale,
+    Err(Error::stale(
+        out,
+        format!("a run of {theirs}"),
         format!(
             "error: `{}` holds a run of {theirs} (a run directory belongs to one program); choose another `--out`, \
              or pass `--fresh` to replace that run with this one",
@@ -554,8 +561,9 @@ fn check_described(
         }
         None => String::new(),
     };
-    Err(Error::new(
-        ErrorKind::Stale,
+    Err(Error::stale(
+        &rundir::program_path(out),
+        why.join("; "),
         format!(
             "error: this run would rewrite `{}` with another definition of {stage} {} ({}) without running {it}, \
              and {them} results in {} would no longer be of the program described there; {sets}pass `--fresh` \
@@ -689,8 +697,7 @@ impl Engine<'_> {
             rundir::create_stage_dir(&dir)?;
             if let StageRun::Train { .. } = program.stages[index].run {
                 let trained = self.train_step(&program, index, seed, &dir, saved.trained[index].take())?;
-                evolve::train::bind(&mut program, index, &trained)
-                    .map_err(|e| Error::io(format!("error: {e}")))?;
+                evolve::train::bind(&mut program, index, &trained).map_err(unusable)?;
                 results.push(StageOutcome::Train {
                     stage: program.stages[index].name.clone(),
                     actions: trained.result.actions,
@@ -810,8 +817,7 @@ fn best_episode(
     let StageRun::Evolve(evo) = &stage.run else { return Ok(()) };
     let Some((genome, _)) = evolve::best_of(cp) else { return Ok(()) };
     let opts = EpisodeOptions { actions: evo.actions, learning: true, seed };
-    let recorded =
-        episode::record_until(stage, &genome, &opts, stop).map_err(|e| Error::io(format!("error: {e}")))?;
+    let recorded = episode::record_until(stage, &genome, &opts, stop).map_err(unusable)?;
     let Some(recorded) = recorded else {
         return Err(interrupted(format!(
             "interrupted: stage `{}` stopped while recording its best's episode (`episode.json`); the stage is saved \
@@ -972,8 +978,12 @@ impl Engine<'_> {
         {
             self.observer.event(Event::Warning(w));
         }
-        let (genome, fitness) = evolve::best_of(cp)
-            .ok_or_else(|| Error::io(format!("error: stage `{}` evaluated no individual", stage.name)))?;
+        let (genome, fitness) = evolve::best_of(cp).ok_or_else(|| {
+            Error::new(
+                ErrorKind::Evaluation,
+                format!("error: stage `{}` evaluated no individual", stage.name),
+            )
+        })?;
         rundir::write_evolved(dir, &genome, cp, &report::variant_names(stage))?;
         report::fitness_plot(dir, &format!("{}: fitness per generation", stage.name), &cp.history)?;
         self.observer.event(Event::Evolved {
@@ -1018,8 +1028,7 @@ impl Engine<'_> {
                 }
                 cp
             }
-            None => evolve::start_stage(program, index, seed, parent)
-                .map_err(|e| Error::io(format!("error: {e}")))?,
+            None => evolve::start_stage(program, index, seed, parent).map_err(unusable)?,
         };
         let probe = Genome::zeros(stage.layout.bits as usize);
         shaping_runtime::controller::validate(stage, &probe).map_err(|e| {
@@ -1170,7 +1179,7 @@ pub fn before_after(
         ));
     }
     let mut run = TeamRun::new(stage, genome, seed)
-        .map_err(|e| Error::io(format!("error: stage `{}`: {e}", stage.name)))?;
+        .map_err(|e| Error::new(ErrorKind::Invalid, format!("error: stage `{}`: {e}", stage.name)))?;
     let opts = EpisodeOptions { actions, learning, seed };
     let mut trace = Trace::default();
     let mut others = Vec::new();
@@ -1494,8 +1503,7 @@ impl Engine<'_> {
             self.observer.event(Event::Trained { stage, trained: &t, recorded, reused: true, dir });
             return Ok(t);
         }
-        let trained =
-            evolve::train_stage(program, index, seed, None).map_err(|e| Error::io(format!("error: {e}")))?;
+        let trained = evolve::train_stage(program, index, seed, None).map_err(unusable)?;
         self.warn_training(stage, &trained, dir);
         // The same life recorded again (the same episode seed and genome), for
         // `trace.csv`, the pictures and `episode.json`: its first
@@ -1504,8 +1512,8 @@ impl Engine<'_> {
         // millions).
         let episode_seed = evolve::train::training_seed(seed, index);
         let opts = EpisodeOptions { actions: recorded, learning: true, seed: episode_seed };
-        let rec = episode::record(stage, &Genome::zeros(stage.layout.bits as usize), &opts)
-            .map_err(|e| Error::io(format!("error: {e}")))?;
+        let rec =
+            episode::record(stage, &Genome::zeros(stage.layout.bits as usize), &opts).map_err(unusable)?;
         let (trace, ep) = (&rec.trace, &rec.episode);
         let lived = report::Lived { trace, others: &rec.others, scene: &rec.scene };
         report::episode_files(dir, stage, lived, ep, &report::Drawing::titled(&stage.name))?;
@@ -1563,11 +1571,9 @@ pub fn bind_training(
         };
         let trained = match saved {
             Some(t) => t,
-            None => {
-                evolve::train_stage(program, i, seed, None).map_err(|e| Error::io(format!("error: {e}")))?
-            }
+            None => evolve::train_stage(program, i, seed, None).map_err(unusable)?,
         };
-        evolve::train::bind(program, i, &trained).map_err(|e| Error::io(format!("error: {e}")))?;
+        evolve::train::bind(program, i, &trained).map_err(unusable)?;
         all.push((i, trained));
     }
     Ok(all)

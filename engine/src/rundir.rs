@@ -29,7 +29,7 @@ use shaping_runtime::genome::Genome;
 use shaping_runtime::program::Program;
 
 use crate::episode::Episode;
-use crate::error::{Error, ErrorKind, Result};
+use crate::error::{Error, ErrorKind, Result, Subject};
 use crate::files::{read_bytes, read_checked, seal, unseal, write_atomic, write_sealed, Sealed, Unsealed};
 
 mod generations;
@@ -81,8 +81,9 @@ pub fn stage_dir(out: &Path, stage: &str) -> PathBuf {
 pub fn create_stage_dir(dir: &Path) -> Result<()> {
     if let Ok(meta) = std::fs::symlink_metadata(dir) {
         if meta.file_type().is_symlink() {
-            return Err(Error::new(
-                ErrorKind::Invalid,
+            return Err(Error::invalid_setting(
+                "--out",
+                Some(&dir.display().to_string()),
                 format!(
                     "error: `{}` is a symbolic link; a run writes only into directories of its own, never through \
                      a link: remove it, or choose another `--out`",
@@ -118,8 +119,9 @@ pub fn check_replay_out(out: &Path) -> Result<()> {
 /// (`who`: "a replay", "`drive`"), by default into `STAGE/{sub}` of the run.
 pub fn check_output_dir(out: &Path, who: &str, sub: &str) -> Result<()> {
     let refuse = |what: String| {
-        Error::new(
-            ErrorKind::Invalid,
+        Error::invalid_setting(
+            "--out",
+            Some(&out.display().to_string()),
             format!(
                 "error: `{}` is {what}; {who} never writes into a run's directories: choose another `--out` \
                  (by default {who} writes into `STAGE/{sub}` of the run)",
@@ -263,12 +265,12 @@ pub fn seed_dir(dir: &Path, seed: u64) -> PathBuf {
 
 /// Serialises to pretty JSON.
 pub fn to_json<T: Serialize>(value: &T) -> Result<String> {
-    serde_json::to_string_pretty(value).map_err(|e| Error::io(format!("error: cannot serialise: {e}")))
+    serde_json::to_string_pretty(value).map_err(|e| Error::internal(format!("error: cannot serialise: {e}")))
 }
 
 /// Serialises to compact JSON.
 pub fn compact_json<T: Serialize>(value: &T) -> Result<String> {
-    serde_json::to_string(value).map_err(|e| Error::io(format!("error: cannot serialise: {e}")))
+    serde_json::to_string(value).map_err(|e| Error::internal(format!("error: cannot serialise: {e}")))
 }
 
 /// Reads a saved result that carries a checksum ([`seal`]) and is sealed
@@ -309,7 +311,8 @@ fn parse_sealed<T: DeserializeOwned>(
 ) -> Result<T> {
     let name = path.display();
     let corrupt = |why: String| {
-        Error::new(ErrorKind::Corrupt, format!("error: {what} `{name}` is corrupt ({why}); {advice}"))
+        let message = format!("error: {what} `{name}` is corrupt ({why}); {advice}");
+        Error::damaged(path, why, message)
     };
     let text = std::str::from_utf8(bytes).map_err(|e| corrupt(format!("not UTF-8: {e}")))?;
     let body = match unseal(text) {
@@ -450,7 +453,7 @@ pub fn write_robots(dir: &Path, robots: &crate::episode::TeamColumns) -> Result<
 pub fn remove_robots(dir: &Path) -> Result<()> {
     match std::fs::remove_file(robots_path(dir)) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-            Err(Error::io(format!("error: cannot remove `{}`: {e}", robots_path(dir).display())))
+            Err(Error::of_io("remove", &robots_path(dir), &e))
         }
         _ => Ok(()),
     }
@@ -463,15 +466,20 @@ pub fn read_robots(dir: &Path, u: Unsealed<'_>) -> Result<Option<crate::episode:
     let path = robots_path(dir);
     let Some(f) = read_checked(&path, REWRITE, u)? else { return Ok(None) };
     let t: crate::episode::TeamColumns = serde_json::from_slice(&f.bytes).map_err(|e| {
-        Error::io(format!("error: `{}` is not a team's columns written by shaping: {e}", path.display()))
+        let problem = format!("not a team's columns written by shaping: {e}");
+        Error::damaged(&path, &problem, format!("error: `{}` is {problem}", path.display()))
     })?;
     if t.format != crate::episode::ROBOTS_FORMAT {
-        return Err(Error::io(format!(
-            "error: `{}` has format {}, this shaping reads format {}; replay the stage again",
-            path.display(),
-            t.format,
-            crate::episode::ROBOTS_FORMAT
-        )));
+        return Err(Error::damaged(
+            &path,
+            format!("format {}", t.format),
+            format!(
+                "error: `{}` has format {}, this shaping reads format {}; replay the stage again",
+                path.display(),
+                t.format,
+                crate::episode::ROBOTS_FORMAT
+            ),
+        ));
     }
     Ok(Some(t))
 }
@@ -485,7 +493,7 @@ pub fn write_trace(dir: &Path, csv: &str) -> Result<()> {
 /// the keys the order the files have always had (see [`summary`]).
 fn summary_text<T: Serialize>(summary: &T) -> Result<String> {
     let value = serde_json::to_value(summary)
-        .map_err(|e| Error::io(format!("error: cannot serialise a summary: {e}")))?;
+        .map_err(|e| Error::internal(format!("error: cannot serialise a summary: {e}")))?;
     to_json(&value)
 }
 
@@ -495,9 +503,8 @@ fn summary_text<T: Serialize>(summary: &T) -> Result<String> {
 /// naming the file and the key (`what` says which summary it should be).
 fn read_summary<T: DeserializeOwned>(path: &Path, what: &str, unsealed: Unsealed<'_>) -> Result<Option<T>> {
     let Some(file) = read_checked(path, REWRITE, unsealed)? else { return Ok(None) };
-    let bad = |why: String| {
-        Error::new(ErrorKind::Corrupt, format!("error: `{}` is not {what}: {why}", path.display()))
-    };
+    let bad =
+        |why: String| Error::damaged(path, &why, format!("error: `{}` is not {what}: {why}", path.display()));
     let value: serde_json::Value = serde_json::from_slice(&file.bytes).map_err(|e| bad(e.to_string()))?;
     if !value.is_object() {
         return Err(bad("it is not a JSON object".into()));
@@ -506,8 +513,9 @@ fn read_summary<T: DeserializeOwned>(path: &Path, what: &str, unsealed: Unsealed
         None => {}
         Some(Some(n)) if n <= u64::from(SUMMARY_FORMAT) => {}
         Some(Some(n)) => {
-            return Err(Error::new(
-                ErrorKind::Corrupt,
+            return Err(Error::damaged(
+                path,
+                format!("summary format {n}"),
                 format!(
                     "error: `{}` has summary format {n}, this shaping reads format {SUMMARY_FORMAT} and before;                      a newer shaping wrote it",
                     path.display()
@@ -530,8 +538,9 @@ pub fn read_test_summary(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Te
     let path = summary_path(dir);
     let summary: Option<TestSummary> = read_summary(&path, "a test stage's summary", unsealed)?;
     if summary.as_ref().is_some_and(|s| s.lives == 0) {
-        return Err(Error::new(
-            ErrorKind::Corrupt,
+        return Err(Error::damaged(
+            &path,
+            "`lives` is not a whole number of 1 or more",
             format!(
                 "error: `{}` is not a test stage's summary: `lives` is not a whole number of 1 or more",
                 path.display()
@@ -567,7 +576,7 @@ pub fn read_generations(dir: &Path, unsealed: Unsealed<'_>) -> Result<Option<Gen
     let path = generations_path(dir);
     let Some(file) = read_checked(&path, REWRITE, unsealed)? else { return Ok(None) };
     let text = String::from_utf8(file.bytes).map_err(|_| {
-        Error::new(ErrorKind::Corrupt, format!("error: `{}` is not UTF-8 text", path.display()))
+        Error::damaged(&path, "not UTF-8 text", format!("error: `{}` is not UTF-8 text", path.display()))
     })?;
     parse_generations(&text, &path).map(Some)
 }
@@ -609,12 +618,13 @@ fn parse_genome(bytes: &[u8], path: &Path) -> Result<Genome> {
         let before: String = text.chars().take(position - 1).collect();
         let line = before.matches('\n').count() + 1;
         let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
-        Error::new(
-            ErrorKind::Corrupt,
+        let problem = format!("line {line}, column {column} is `{}`", c.escape_debug());
+        Error::damaged(
+            path,
+            &problem,
             format!(
-                "error: `{}` does not hold a genome: line {line}, column {column} is `{}`; a genome is a string of 0 and 1",
-                path.display(),
-                c.escape_debug()
+                "error: `{}` does not hold a genome: {problem}; a genome is a string of 0 and 1",
+                path.display()
             ),
         )
     })
@@ -638,8 +648,9 @@ pub fn read_best(dir: &Path) -> Result<Genome> {
 /// the checkpoint beside it.
 pub fn check_best(dir: &Path, genome: &Genome, cp: &Checkpoint) -> Result<()> {
     match evolve::best_of(cp) {
-        Some((best, _)) if best != *genome => Err(Error::new(
-            ErrorKind::Corrupt,
+        Some((best, _)) if best != *genome => Err(Error::damaged(
+            &best_genome_path(dir),
+            "not the best individual of the checkpoint beside it",
             format!(
                 "error: `{}` is not the best individual of the checkpoint beside it (`{}`): it was changed \
                  after the run wrote it; delete it and run the same command again to write it anew",
@@ -669,14 +680,14 @@ pub fn checked_best_with(
 ) -> Result<(Checkpoint, Genome, f32)> {
     let path = checkpoint_path(dir);
     let cp = read_checkpoint_with(dir, unsealed)?.ok_or_else(|| {
-        Error::new(
-            ErrorKind::Io,
-            format!("error: there is no checkpoint `{}`: run the stage first", path.display()),
-        )
+        let message = format!("error: there is no checkpoint `{}`: run the stage first", path.display());
+        Error::new(ErrorKind::NotFound, message)
+            .about(Subject::File { path: path.clone(), operation: "read".into() })
     })?;
     evolve::check_resume_of(program, index, &cp).map_err(|e| {
-        Error::new(
-            ErrorKind::Stale,
+        Error::stale(
+            &path,
+            e.to_string(),
             format!(
                 "error: the best individual in `{}` is not of this program: {e}; run the file again (`shaping run` with `--fresh`)",
                 dir.display()
@@ -684,7 +695,11 @@ pub fn checked_best_with(
         )
     })?;
     let (genome, fitness) = evolve::best_of(&cp).ok_or_else(|| {
-        Error::new(ErrorKind::Corrupt, format!("error: `{}` holds no evaluated individual", path.display()))
+        Error::damaged(
+            &path,
+            "no evaluated individual",
+            format!("error: `{}` holds no evaluated individual", path.display()),
+        )
     })?;
     let best = best_genome_path(dir);
     if best.exists() {
@@ -749,7 +764,7 @@ pub fn write_source(out: &Path, file: Option<&str>) -> Result<()> {
         }
         None => match std::fs::remove_file(source_path(out)) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                Err(Error::io(format!("error: cannot remove `{}`: {e}", source_path(out).display())))
+                Err(Error::of_io("remove", &source_path(out), &e))
             }
             _ => Ok(()),
         },
@@ -765,10 +780,7 @@ pub fn seed_test_summary(out: &Path, seed: u64, stage: &str, unsealed: Unsealed<
 
 /// A file that a seed's run must have written.
 pub fn missing(path: &Path) -> Error {
-    Error::new(
-        ErrorKind::Io,
-        format!("error: cannot read `{}`: the seed's run did not write it", path.display()),
-    )
+    Error::file(ErrorKind::NotFound, "read", path, "the seed's run did not write it")
 }
 
 #[cfg(test)]

@@ -95,15 +95,17 @@ pub fn point_dir_name(point: &[Assignment], sets: &[Set]) -> String {
 pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
     for (i, s) in sets.iter().enumerate() {
         if sets[..i].iter().any(|t| t.target == s.target) {
-            return Err(Error::new(
-                ErrorKind::Invalid,
+            return Err(Error::invalid_setting(
+                &s.target,
+                None,
                 format!("error: `--set {}` is given twice", s.target),
             ));
         }
         if let Some(v) = s.values.iter().enumerate().find_map(|(k, v)| s.values[..k].contains(v).then_some(v))
         {
-            return Err(Error::new(
-                ErrorKind::Invalid,
+            return Err(Error::invalid_setting(
+                &s.target,
+                Some(v.as_str()),
                 format!("error: `--set {}`: the value `{v}` is given twice", s.target),
             ));
         }
@@ -114,7 +116,9 @@ pub fn check_sets(sets: &[Set]) -> Result<(), Error> {
 /// Applies a point's settings to `program` and validates the result.
 pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
     for (target, text) in point {
-        let fail = |m: String| Error::new(ErrorKind::Invalid, format!("error: `--set {target}={text}`: {m}"));
+        let fail = |m: String| {
+            Error::invalid_setting(target, Some(text), format!("error: `--set {target}={text}`: {m}"))
+        };
         let (stage, path) = target.split_once('.').ok_or_else(|| fail("no stage in the target".into()))?;
         let indices: Vec<usize> = if stage == "*" {
             let having: Vec<usize> =
@@ -143,9 +147,13 @@ pub fn apply(program: &mut Program, point: &[Assignment]) -> Result<(), Error> {
             set(program, i, path, &value).map_err(fail)?;
         }
     }
-    program
-        .validate()
-        .map_err(|e| Error::new(ErrorKind::Invalid, format!("error: `--set {}`: {e}", point_name(point))))
+    program.validate().map_err(|e| {
+        let message = format!("error: `--set {}`: {e}", point_name(point));
+        match point {
+            [(target, value)] => Error::invalid_setting(target, Some(value), message),
+            _ => Error::new(ErrorKind::Invalid, message),
+        }
+    })
 }
 
 /// The settings that make `file` (a file's program, with any settings

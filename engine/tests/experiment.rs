@@ -203,6 +203,8 @@ fn a_team_is_set_and_one_too_large_is_refused() {
         let err = apply(&mut tiny(), &set(target, value)).unwrap_err();
         // A setting that cannot be used: `Invalid` (Python's ValueError), not a file's failure.
         assert_eq!(err.kind(), ErrorKind::Invalid, "--set {target}={value}");
+        // The setting as data, as given.
+        assert_eq!(err.setting(), Some((target, Some(value))), "--set {target}={value}");
         let err = err.to_string();
         for w in wanted {
             assert!(err.contains(w), "--set {target}={value}: `{w}` missing from:\n{err}");

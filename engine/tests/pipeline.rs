@@ -122,6 +122,9 @@ fn a_second_run_into_a_directory_in_use_is_refused_and_the_first_finishes_unharm
     assert_eq!(err.kind(), ErrorKind::Locked, "{err}");
     assert!(err.message().contains("is in use by another run of this process"), "{err}");
     assert!(err.message().contains(&format!("process {}", std::process::id())), "{err}");
+    // The directory and its holder as data.
+    assert_eq!(err.path(), Some(dir.path()), "{err}");
+    assert!(err.holder().is_some_and(|h| h.ends_with(&format!("process {}", std::process::id()))), "{err}");
     barrier.wait();
     first.join().unwrap().unwrap();
     assert_eq!(files(dir.path()), files(straight.path()), "the first run's files are a straight run's");
@@ -179,6 +182,8 @@ fn a_checkpoint_changed_by_one_digit_is_refused_not_resumed() {
     assert_eq!(err.kind(), ErrorKind::Corrupt, "{err}");
     assert!(err.message().contains("checkpoint.json"), "{err}");
     assert!(err.message().contains("checksum does not match"), "{err}");
+    assert_eq!(err.path(), Some(path.as_path()), "{err}");
+    assert_eq!(err.problem(), Some("its checksum does not match its contents"), "{err}");
     assert_eq!(std::fs::read_to_string(&path).unwrap(), damaged, "the damaged file is kept");
 }
 

@@ -40,6 +40,9 @@ fn an_unknown_stage_is_refused_and_a_replay_writes_its_pictures() {
     // Nothing run yet: what to do.
     let err = error(replay::replay(tiny(), &opts(&tiny_bat(), d, &d.join("none")), &Log::default()));
     assert!(err.message().contains("shaping run"), "{err}");
+    // The file that is missing, as data: `best.genome` of the evolved stage.
+    assert_eq!(err.kind(), ErrorKind::NotFound, "{err}");
+    assert_eq!(err.path(), Some(d.join("second/best.genome").as_path()), "{err}");
 
     run(tiny(), &options(d)).unwrap();
     let pics = d.join("pics");
@@ -60,6 +63,14 @@ fn an_unknown_stage_is_refused_and_a_replay_writes_its_pictures() {
     };
     let err = error(replay::replay(tiny(), &short, &Log::default()));
     assert!(err.message().contains("bits"), "{err}");
+    // An argument that cannot be used, named with its value.
+    assert_eq!(err.kind(), ErrorKind::Invalid, "{err}");
+    assert_eq!(err.setting(), Some(("--genome", Some("0101"))), "{err}");
+
+    let far = ReplayOptions { stage: Some("second".into()), robot: 7, ..opts(&tiny_bat(), d, &pics) };
+    let err = error(replay::replay(tiny(), &far, &Log::default()));
+    assert_eq!(err.message(), "error: `--robot 7`: stage `second` has one robot, robot 0");
+    assert_eq!((err.kind(), err.setting()), (ErrorKind::Invalid, Some(("--robot", Some("7")))), "{err}");
 }
 
 /// A stage with nothing evolved replays without a genome, and its avoid

@@ -40,7 +40,7 @@ pub fn with_mpi(
     body: impl FnOnce(&Coordinator) -> Result<(), CliError>,
 ) -> Result<(), CliError> {
     let Some((universe, _)) = mpi::initialize_with_threading(Threading::Funneled) else {
-        return Err(CliError::io("error: MPI was already initialised"));
+        return Err(CliError::internal("error: MPI was already initialised"));
     };
     let world = universe.world();
     let (rank, size) = (world.rank(), world.size() as usize);

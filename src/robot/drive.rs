@@ -69,7 +69,7 @@ pub fn has_gripper(stage: &Stage) -> bool {
 /// A stage a Khepera can run (`robot::unfit_for_robot`).
 pub fn check_robot_world(stage: &Stage) -> Result<(), CliError> {
     shaping_runtime::robot::unfit_for_robot(stage)
-        .map_or(Ok(()), |m| Err(CliError::io(format!("error: {m}"))))
+        .map_or(Ok(()), |m| Err(CliError::new(shaping_engine::ErrorKind::Invalid, format!("error: {m}"))))
 }
 
 /// The action period: `--period`, else the world's action length.
@@ -225,8 +225,10 @@ pub fn drive(args: DriveArgs) -> Result<(), CliError> {
     let stage = &program.stages[index];
     let seed = episode.seed;
     let (sim_seed, rng) = episode_rngs(seed);
-    let mut ctl = Controller::new(stage, &genome, rng)
-        .map_err(|e| CliError::io(format!("error: the genome does not fit stage `{}`: {e}", stage.name)))?;
+    let mut ctl = Controller::new(stage, &genome, rng).map_err(|e| {
+        let message = format!("error: the genome does not fit stage `{}`: {e}", stage.name);
+        CliError::new(shaping_engine::ErrorKind::Invalid, message)
+    })?;
 
     let flag = interrupt_flag()?;
     let period = period(stage, args.period_ms);

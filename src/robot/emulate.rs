@@ -161,15 +161,18 @@ mod pty {
                 let _ = std::fs::remove_file(port);
             }
             Ok(_) => {
-                return Err(CliError::io(format!(
-                    "error: `{}` exists and is not a symbolic link; choose another `--port`",
-                    port.display()
-                )))
+                return Err(CliError::invalid_setting(
+                    "--port",
+                    Some(&port.display().to_string()),
+                    format!(
+                        "error: `{}` exists and is not a symbolic link; choose another `--port`",
+                        port.display()
+                    ),
+                ))
             }
             Err(_) => {}
         }
-        std::os::unix::fs::symlink(&slave_path, port)
-            .map_err(|e| CliError::io(format!("error: cannot create `{}`: {e}", port.display())))?;
+        std::os::unix::fs::symlink(&slave_path, port).map_err(|e| CliError::of_io("create", port, &e))?;
         Ok((master, slave, Symlink(port.to_path_buf())))
     }
 
@@ -188,15 +191,13 @@ mod pty {
         let program = match &args.file {
             Some(f) => load::load_program(f, args.error_format)?,
             None => shaping_compiler::compile(DEFAULT_FILE, "khepera.bat")
-                .map_err(|_| CliError::io("error: the built-in example does not compile"))?,
+                .map_err(|_| CliError::internal("error: the built-in example does not compile"))?,
         };
         let index = match args.stage.as_deref() {
             Some(_) => load::stage_index(&program, args.stage.as_deref())?,
-            None => program
-                .stages
-                .len()
-                .checked_sub(1)
-                .ok_or_else(|| CliError::io("error: the program has no stages"))?,
+            None => program.stages.len().checked_sub(1).ok_or_else(|| {
+                CliError::new(shaping_engine::ErrorKind::Invalid, "error: the program has no stages")
+            })?,
         };
         let stage = &program.stages[index];
         let seed = args.seed.unwrap_or_else(|| shaping_engine::run::run_seed(&program, None));

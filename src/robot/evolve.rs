@@ -126,8 +126,12 @@ impl Evaluate for RobotRun {
         let log = dir.join("robot-episodes.jsonl");
         if fresh && log.exists() {
             let old = dir.join("robot-episodes.jsonl.old");
-            std::fs::rename(&log, &old)
-                .map_err(|e| CliError::io(format!("error: cannot move `{}` aside: {e}", log.display())))?;
+            std::fs::rename(&log, &old).map_err(|e| {
+                let message = format!("error: cannot move `{}` aside: {e}", log.display());
+                let subject =
+                    shaping_engine::Subject::File { path: log.clone(), operation: "move aside".into() };
+                CliError::new(ErrorKind::Io, message).about(subject)
+            })?;
             eprintln!("stage {}: starting again; the earlier episodes are in {}", stage.name, old.display());
         }
         {
@@ -140,12 +144,16 @@ impl Evaluate for RobotRun {
                 for (n, line) in bytes.split(|&b| b == b'\n').enumerate() {
                     if let Ok(e) = serde_json::from_slice::<Episode>(line) {
                         if e.program != Some(program) {
-                            return Err(CliError::io(format!(
-                                "error: line {} of `{}` is an episode of another version of stage `{}`; pass `--fresh` to start again (the log is kept as `robot-episodes.jsonl.old`), or choose another `--out`",
-                                n + 1,
-                                log.display(),
-                                stage.name
-                            )));
+                            return Err(CliError::stale(
+                                &log,
+                                format!("line {} is an episode of another version of stage `{}`", n + 1, stage.name),
+                                format!(
+                                    "error: line {} of `{}` is an episode of another version of stage `{}`; pass `--fresh` to start again (the log is kept as `robot-episodes.jsonl.old`), or choose another `--out`",
+                                    n + 1,
+                                    log.display(),
+                                    stage.name
+                                ),
+                            ));
                         }
                         let learned = e.learned.as_deref().and_then(Genome::from_bitstring);
                         st.done.insert(

@@ -40,6 +40,11 @@ pub struct SerialPort {
     pub bytes: u64,
 }
 
+/// The robot's port at `path`, which could not be opened.
+fn opening(path: &Path) -> shaping_engine::Subject {
+    shaping_engine::Subject::File { path: path.to_path_buf(), operation: "open".into() }
+}
+
 impl SerialPort {
     /// Opens `path` at `baud` with 8 data bits, 2 stop bits (the Khepera's
     /// setting), no parity and no flow control; an answer must come within
@@ -64,14 +69,18 @@ impl SerialPort {
                 serialport::ErrorKind::NoDevice => CliError::io(format!(
                     "error: the robot's port `{name}` is in use by another program: {}",
                     e.description
-                )),
-                serialport::ErrorKind::InvalidInput | serialport::ErrorKind::Unknown => {
-                    CliError::io(format!(
+                ))
+                .about(opening(path)),
+                serialport::ErrorKind::InvalidInput | serialport::ErrorKind::Unknown => CliError::new(
+                    shaping_engine::ErrorKind::Invalid,
+                    format!(
                         "error: `{name}` is not a serial port (or refuses {baud} baud): {}",
                         e.description
-                    ))
-                }
-                _ => CliError::io(format!("error: cannot open the robot's port `{name}`: {}", e.description)),
+                    ),
+                )
+                .about(opening(path)),
+                _ => CliError::io(format!("error: cannot open the robot's port `{name}`: {}", e.description))
+                    .about(opening(path)),
             })?;
         let _ = port.clear(ClearBuffer::All);
         Ok(SerialPort {

@@ -39,10 +39,15 @@ fn read_team(dir: &Path, ep: &Episode, u: Unsealed<'_>) -> Result<Option<TeamCol
                 .all(|v| v.len() == r.modules.len() && v.iter().all(|m| m.len() == n))
     };
     if t.robots.len() != ep.actions.others.len() || !t.robots.iter().all(fits) {
-        return Err(Error::io(format!(
-            "error: `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
-            rundir::robots_path(dir).display()
-        )));
+        let path = rundir::robots_path(dir);
+        return Err(Error::damaged(
+            &path,
+            "not of the episode beside it",
+            format!(
+                "error: `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
+                path.display()
+            ),
+        ));
     }
     t.robots.truncate(MAX_FOLLOWED - 1);
     Ok(Some(t))
@@ -186,20 +191,25 @@ pub struct FitnessSeries {
 fn read_sealed(path: &Path, u: Unsealed<'_>) -> Result<Vec<u8>, Error> {
     read_checked(path, rundir::REWRITE, u)?
         .map(|f| f.bytes)
-        .ok_or_else(|| Error::io(format!("error: cannot read `{}`: there is no such file", path.display())))
+        .ok_or_else(|| Error::file(crate::ErrorKind::NotFound, "read", path, "there is no such file"))
 }
 
 fn read_episode(path: &Path, u: Unsealed<'_>) -> Result<Episode, Error> {
     let bytes = read_sealed(path, u)?;
     let ep: Episode = serde_json::from_slice(&bytes).map_err(|e| {
-        Error::io(format!("error: `{}` is not an episode written by shaping: {e}", path.display()))
+        let problem = format!("not an episode written by shaping: {e}");
+        Error::damaged(path, &problem, format!("error: `{}` is {problem}", path.display()))
     })?;
     if ep.format != EPISODE_FORMAT {
-        return Err(Error::io(format!(
-            "error: `{}` has episode format {}, this shaping reads format {EPISODE_FORMAT}; replay the stage again",
-            path.display(),
-            ep.format
-        )));
+        return Err(Error::damaged(
+            path,
+            format!("episode format {}", ep.format),
+            format!(
+                "error: `{}` has episode format {}, this shaping reads format {EPISODE_FORMAT}; replay the stage again",
+                path.display(),
+                ep.format
+            ),
+        ));
     }
     let n = ep.actions.x.len();
     let c = &ep.actions;
@@ -210,10 +220,14 @@ fn read_episode(path: &Path, u: Unsealed<'_>) -> Result<Episode, Error> {
         && c.performance.len() == ep.modules.len()
         && c.activation.iter().chain(&c.reinforcement).chain(&c.performance).all(|v| v.len() == n);
     if per_action.iter().any(|&k| k != n) || !per_module || ep.worlds.is_empty() {
-        return Err(Error::io(format!(
-            "error: `{}` is inconsistent (columns of different lengths, or no world)",
-            path.display()
-        )));
+        return Err(Error::damaged(
+            path,
+            "columns of different lengths, or no world",
+            format!(
+                "error: `{}` is inconsistent (columns of different lengths, or no world)",
+                path.display()
+            ),
+        ));
     }
     Ok(ep)
 }
@@ -858,7 +872,8 @@ fn summary_json(dir: &Path, u: Unsealed<'_>) -> Result<Option<ExperimentSummary>
 
 /// A summary as the report's data holds it.
 fn to_value<T: serde::Serialize>(summary: &T) -> Result<serde_json::Value, Error> {
-    serde_json::to_value(summary).map_err(|e| Error::io(format!("error: cannot serialise a summary: {e}")))
+    serde_json::to_value(summary)
+        .map_err(|e| Error::internal(format!("error: cannot serialise a summary: {e}")))
 }
 
 fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
@@ -908,12 +923,17 @@ fn sweep(dir: &Path, summary: ExperimentSummary, u: Unsealed<'_>) -> Result<Repo
         _ => Some(p),
     });
     let Some(best) = best else {
-        return Err(Error::io(format!("error: the sweep in `{}` has no points", dir.display())));
+        return Err(Error::damaged(
+            dir,
+            "no points",
+            format!("error: the sweep in `{}` has no points", dir.display()),
+        ));
     };
     let point_dir = dir.join(&best.dir);
     let seeds = seed_dirs(&point_dir, u)?;
     if seeds.is_empty() {
-        return Err(Error::io(format!("error: the point `{}` has no seed directories", point_dir.display())));
+        let message = format!("error: the point `{}` has no seed directories", point_dir.display());
+        return Err(Error::damaged(&point_dir, "no seed directories", message));
     }
     let mut data = experiment(&point_dir, &seeds, u)?;
     data.kind = "sweep";
@@ -938,7 +958,9 @@ pub fn collect(dir: &Path) -> Result<ReportData, Error> {
 /// before runs sealed their files), for a warning.
 pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
     if !dir.is_dir() {
-        return Err(Error::io(format!("error: `{}` is not a directory", dir.display())));
+        let kind = if dir.exists() { crate::ErrorKind::Invalid } else { crate::ErrorKind::NotFound };
+        let subject = crate::Subject::File { path: dir.to_path_buf(), operation: "read".into() };
+        return Err(Error::new(kind, format!("error: `{}` is not a directory", dir.display())).about(subject));
     }
     let here = rundir::program_path(dir);
     if here.exists() {
@@ -947,12 +969,16 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
             // A replay: one episode of one stage.
             let ep = read_episode(&rundir::episode_path(dir), u)?;
             let (index, _) = program.stage(&ep.stage).ok_or_else(|| {
-                Error::io(format!(
-                    "error: `{}` replays stage `{}`, which `{}` does not have",
-                    dir.display(),
-                    ep.stage,
-                    here.display()
-                ))
+                Error::damaged(
+                    &rundir::episode_path(dir),
+                    format!("stage `{}` is not in `{}`", ep.stage, here.display()),
+                    format!(
+                        "error: `{}` replays stage `{}`, which `{}` does not have",
+                        dir.display(),
+                        ep.stage,
+                        here.display()
+                    ),
+                )
             })?;
             let st = &program.stages[index];
             let genome = read_genome(&rundir::genome_file_path(dir), st, u)?;
@@ -1011,10 +1037,15 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
             return Ok(data);
         }
     }
-    Err(Error::io(format!(
-        "error: `{}` is not a run, stage, experiment, sweep or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
-        dir.display()
-    )))
+    let subject = crate::Subject::File { path: dir.to_path_buf(), operation: "read".into() };
+    Err(Error::new(
+        crate::ErrorKind::Invalid,
+        format!(
+            "error: `{}` is not a run, stage, experiment, sweep or replay directory: no `program.json` in it or its parent (runs write one since this version of shaping; run the stage again)",
+            dir.display()
+        ),
+    )
+    .about(subject))
 }
 
 fn experiment(dir: &Path, seeds: &[(u64, PathBuf)], u: Unsealed<'_>) -> Result<ReportData, Error> {

@@ -28,7 +28,7 @@ fn escape_html(s: &str) -> String {
 /// escaped, so no `</script>` or `<!--` can end it early.
 pub fn embedded_json(data: &ReportData) -> Result<String, Error> {
     let json = serde_json::to_string(data)
-        .map_err(|e| Error::io(format!("error: cannot serialise the report's data: {e}")))?;
+        .map_err(|e| Error::internal(format!("error: cannot serialise the report's data: {e}")))?;
     Ok(json.replace('<', "\\u003c"))
 }
 
@@ -50,7 +50,7 @@ pub fn page(data: &ReportData) -> Result<String, Error> {
         ("{{script}}", SCRIPT),
     ] {
         let Some(at) = rest.find(mark) else {
-            return Err(Error::io(format!("error: the report template has no `{mark}`")));
+            return Err(Error::internal(format!("error: the report template has no `{mark}`")));
         };
         out.push_str(&rest[..at]);
         out.push_str(value);
@@ -85,11 +85,15 @@ pub fn write_with(dir: &Path, out: Option<&Path>, unsealed: Unsealed<'_>) -> Res
 fn replaceable(out: &Path) -> Result<(), Error> {
     let Ok(meta) = std::fs::metadata(out) else { return Ok(()) };
     if meta.is_dir() {
-        return Err(Error::io(format!(
-            "error: `{}` is a directory; give `-o` the file to write (e.g. `{}`)",
-            out.display(),
-            crate::rundir::report_path(out).display()
-        )));
+        return Err(Error::invalid_setting(
+            "-o",
+            Some(&out.display().to_string()),
+            format!(
+                "error: `{}` is a directory; give `-o` the file to write (e.g. `{}`)",
+                out.display(),
+                crate::rundir::report_path(out).display()
+            ),
+        ));
     }
     let mut head = Vec::new();
     let read = std::fs::File::open(out)
@@ -98,11 +102,15 @@ fn replaceable(out: &Path) -> Result<(), Error> {
     if read.is_ok() && is_report(&head) {
         return Ok(());
     }
-    Err(Error::io(format!(
-        "error: `{}` exists and is not a report; `shaping report -o` replaces only an earlier report \
-         (choose a new file, e.g. one ending in `.html`)",
-        out.display()
-    )))
+    Err(Error::invalid_setting(
+        "-o",
+        Some(&out.display().to_string()),
+        format!(
+            "error: `{}` exists and is not a report; `shaping report -o` replaces only an earlier report \
+             (choose a new file, e.g. one ending in `.html`)",
+            out.display()
+        ),
+    ))
 }
 
 /// The beginning of a page [`page`] made.
