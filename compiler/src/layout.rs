@@ -5,7 +5,10 @@ use std::fmt::Write as _;
 
 use serde::Serialize;
 
-use shaping_runtime::program::{Behavior, GeneRole, Network, Param, Part, Program, Stage, StageRun, World};
+use shaping_runtime::catalog::ActuatorKind;
+use shaping_runtime::program::{
+    Behavior, GeneRole, Network, NeuralBehavior, Param, Part, Program, Stage, StageRun, World,
+};
 
 /// The name of percept channel `c` in a stage: `ir[3]`, `battery`.
 fn channel_name(stage: &Stage, c: u16) -> String {
@@ -179,7 +182,10 @@ fn describe(program: Option<&Program>, stage: &Stage, gene: u32) -> LayoutRow {
             if pos >= before {
                 let out = (pos - before) / per_out;
                 row.output = Some(out as u16);
-                format!("behavior out{out} {text}")
+                match signal_of(stage, nb, out) {
+                    Some(signal) => format!("behavior out{out} ({signal}) {text}"),
+                    None => format!("behavior out{out} {text}"),
+                }
             } else {
                 format!("behavior {text}")
             }
@@ -188,6 +194,14 @@ fn describe(program: Option<&Program>, stage: &Stage, gene: u32) -> LayoutRow {
         None => text,
     };
     row
+}
+
+/// The broadcast value output `out` of a neural behavior sets, as
+/// `signal[0]` (the actuator's name), if it is a signal output.
+fn signal_of(stage: &Stage, nb: &NeuralBehavior, out: usize) -> Option<String> {
+    let k = out.checked_sub(nb.wheel_outputs().into())?;
+    let a = stage.actuators.iter().find(|a| a.kind == ActuatorKind::Broadcast)?;
+    Some(format!("{}[{k}]", a.name))
 }
 
 /// The genome layout of stage `stage` (index into `program.stages`) as a

@@ -459,3 +459,65 @@ fn the_trace_records_the_range_and_bearing_board() {
     let json = serde_json::to_string(&rec.episode).unwrap();
     assert!(!json.contains("board"), "episode.json keeps its format");
 }
+
+/// A neural behavior with `broadcast signal` sets what its robot
+/// broadcasts from its network's last output (here a bias of 1 and no
+/// weights: sigmoid(1) = 0.731 at every action), and the other robot hears
+/// it: from its second action on, its `heard` channel reads that value in
+/// one sector (the board is measured after every robot acted, and read at
+/// the next action). The listener, whose script sends nothing, is not
+/// heard.
+#[test]
+fn a_neural_broadcast_is_heard_by_the_other_robot() {
+    let zeros = |n: usize| vec!["0"; n].join(", ");
+    let source = format!(
+        "robot r {{
+  sensor ir[8]    proximity
+  sensor heard[8] signal
+  actuator wheels[2] speed
+  actuator signal broadcast
+}}
+stage s {{
+  world {{ arena 300mm x 300mm  robots 2  body {{ rab_range 400mm }} }}
+  evolve {{ population 4  generations 1  actions 30 }}
+  fitness at end 1 - team.spread / 400, team mean
+  role talker robots 1 {{
+    module speak {{
+      sense ir
+      behavior neural {{ outputs linear  broadcast signal  weights fixed [{}, 1, {}] }}
+    }}
+  }}
+  role listener robots 1 {{
+    module sit {{ sense heard  behavior wait }}
+  }}
+}}
+",
+        zeros(18),
+        zeros(8)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let (_, program) = write_bat(dir.path(), "talk.bat", &source);
+    let stage = &program.stages[0];
+    let opts = EpisodeOptions { actions: 30, learning: false, seed: 4 };
+    let rec = episode::record(stage, &Genome::zeros(stage.layout.bits as usize), &opts).unwrap();
+    let talker = &rec.episode.actions.board;
+    let listener = &rec.others[0].sensed.board;
+    assert_eq!(rec.others[0].robot, 1);
+    assert_eq!((talker.len(), listener.len()), (30, 30), "a board per action of each robot");
+    let sent = 1.0 / (1.0 + (-1.0f32).exp());
+    let near = |a: f32, b: f32| (a - b).abs() < 6e-4;
+    // Channels from `CH_RAB`: 8 sectors, then `heard`'s 8 (one value).
+    let heard = |b: &episode::BoardFrame| b.read[8..16].to_vec();
+    for (a, (t, l)) in talker.iter().zip(listener).enumerate() {
+        assert!(near(t.signal[0], sent), "action {a}: the talker sends {}", t.signal[0]);
+        assert_eq!(l.signal[0], 0.0, "action {a}: the listener sends nothing");
+        assert!(heard(t).iter().all(|&v| v == 0.0), "action {a}: the talker hears {:?}", heard(t));
+        let h = heard(l);
+        if a == 0 {
+            assert!(h.iter().all(|&v| v == 0.0), "nothing is heard before the first broadcast: {h:?}");
+        } else {
+            assert_eq!(h.iter().filter(|&&v| near(v, sent)).count(), 1, "action {a}: {h:?}");
+            assert_eq!(h.iter().filter(|&&v| v == 0.0).count(), 7, "action {a}: {h:?}");
+        }
+    }
+}

@@ -651,6 +651,24 @@ pub struct NeuralBehavior {
     pub inputs: Vec<u16>,
     pub net: Network,
     pub decode: Decode,
+    /// The values of the `broadcast` actuator the network sets (`broadcast
+    /// NAME`): its last `signals` outputs, after the wheels' (those of
+    /// `decode`), each output the value broadcast (0..1; while learning by
+    /// CRBP, its sampled bit, as the wheels of a `Linear` decoding). 0: the
+    /// network broadcasts nothing.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub signals: u16,
+}
+
+impl NeuralBehavior {
+    /// The outputs that drive the wheels (`decode`'s), before the signals'.
+    pub fn wheel_outputs(&self) -> u16 {
+        self.net.outputs.saturating_sub(self.signals)
+    }
+}
+
+fn is_zero(n: &u16) -> bool {
+    *n == 0
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -111,6 +111,7 @@ pub fn avoid_behavior(init: f32, speed: f32) -> Behavior {
         inputs: chans(CH_IR, 8),
         net: Network { inputs: 8, hidden: 0, outputs: 2, recurrent: false, params },
         decode: Decode::Table(vec![[-speed, -speed], [-speed, speed], [speed, -speed], [speed, speed]]),
+        signals: 0,
     })
 }
 

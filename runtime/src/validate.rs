@@ -667,7 +667,19 @@ fn modules(at: &At, s: &Stage) -> R {
                 let at = at.field("behavior");
                 at.field("inputs").inputs(&nb.inputs)?;
                 network(&at.field("net"), s, &nb.net, nb.inputs.len())?;
-                let outputs = nb.net.outputs;
+                if nb.signals > 0 {
+                    let values = s.world.body.rab.as_ref().map_or(0, |r| u16::from(r.signals));
+                    at.field("signals").ensure(values == nb.signals, || {
+                        format!("{} signal outputs, but the robot broadcasts {values} values", nb.signals)
+                    })?;
+                    at.field("signals").ensure(nb.signals < nb.net.outputs, || {
+                        format!(
+                            "{} signal outputs of {} outputs leave none for the wheels",
+                            nb.signals, nb.net.outputs
+                        )
+                    })?;
+                }
+                let outputs = nb.wheel_outputs();
                 match &nb.decode {
                     Decode::Table(t) => {
                         let at = at.field("decode");

@@ -308,6 +308,7 @@ fn neural_stage(reinforce: Expr, learning: Option<Learning>, params: Vec<Param>)
             inputs: vec![0, 1],
             net: Network { inputs: 2, hidden: 0, outputs: 2, recurrent: false, params },
             decode: Decode::Table(vec![[-1.0, -1.0], [-1.0, 1.0], [1.0, -1.0], [1.0, 1.0]]),
+            signals: 0,
         }),
         learning,
         reinforce: Some(reinforce),
@@ -785,6 +786,44 @@ fn decode_tables_must_have_a_row_per_bit_pattern() {
     let opts = EpisodeOptions { actions: 1, learning: false, seed: 1 };
     let err = try_run_episode(&s, &g, &opts, None).unwrap_err().to_string();
     assert!(err.contains("`modules[0].behavior.decode`: 3 rows for 2 outputs"), "{err}");
+}
+
+/// A neural behavior with a signal output (`broadcast NAME`): its last
+/// output is the value broadcast (sigmoid(1) here), or its sampled bit
+/// while CRBP learns; the wheels read the outputs before it. A program
+/// whose robot broadcasts fewer values than the behavior's signal outputs
+/// is refused, naming the field.
+#[test]
+fn a_signal_output_sets_the_broadcast() {
+    // Outputs 0 and 1: bias 1 (bits 1, 1: the table's last row); output 2: bias 1.
+    let params = [1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0].into_iter().map(Param::Fixed).collect();
+    let mut s = neural_stage(expr(vec![Op::Const(0.0)]), None, params);
+    let Behavior::Neural(nb) = &mut s.modules[0].behavior else { unreachable!() };
+    nb.net.outputs = 3;
+    nb.signals = 1;
+    let g = Genome::zeros(0);
+    let opts = EpisodeOptions { actions: 1, learning: false, seed: 1 };
+    let err = try_run_episode(&s, &g, &opts, None).unwrap_err().to_string();
+    assert!(
+        err.contains("`modules[0].behavior.signals`: 1 signal outputs, but the robot broadcasts 0 values"),
+        "{err}"
+    );
+    s.world.body.rab = Some(RangeBearing { signals: 1, ..RangeBearing::DEFAULT });
+    try_run_episode(&s, &g, &opts, None).expect("a valid stage");
+    let mut c = controller(&s, 1);
+    c.set_learning(false);
+    let mut robot = Puppet::default();
+    c.start(&mut robot);
+    let cmd = c.act(&mut robot).command;
+    assert_eq!(cmd.wheels, [1.0, 1.0], "the wheels from the first two outputs");
+    assert_eq!(cmd.signal, Some([sigmoid(1.0), 0.0, 0.0, 0.0]));
+    // Learning: the sampled bit, 1 with probability 0.73.
+    s.modules[0].learning = Some(testkit::crbp(LearnTarget::Behavior, 0.1, 0.1, 30));
+    let mut c = controller(&s, 1);
+    c.start(&mut robot);
+    let sent: Vec<f32> = (0..40).map(|_| c.act(&mut robot).command.signal.unwrap()[0]).collect();
+    assert!(sent.iter().all(|&v| v == 0.0 || v == 1.0), "{sent:?}");
+    assert!(sent.contains(&0.0) && sent.contains(&1.0), "both bits sampled: {sent:?}");
 }
 
 #[test]

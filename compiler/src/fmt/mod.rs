@@ -945,6 +945,9 @@ impl F<'_> {
                     };
                     items.push(self.item_after_keyword(span, Doc::Text(t)));
                 }
+                if let Some(b) = &n.broadcast {
+                    items.push(self.item_after_keyword(b.span, Doc::Text(format!("broadcast {}", b.text))));
+                }
                 if let Some(w) = &n.weights {
                     items.push(
                         self.item_after_keyword(w.span(), Doc::Text(format!("weights {}", self.weights(w)))),

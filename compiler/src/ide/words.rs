@@ -176,6 +176,7 @@ const LIST: &[Word] = &[
     w("recharge", C, STEP | WORLD | EVENT, "a step: stand still and recharge; in a world: `recharge N actions`; a fitness event", SCRIPTS),
     w("outputs", C, NEURAL, "`outputs sign(N) -> M | M ...` or `outputs linear`: how the outputs drive the wheels", NEURAL_S),
     w("linear", C, CLAUSE, "`outputs linear [scale S]`: two outputs are the wheel speeds", NEURAL_S),
+    w("broadcast", C, NEURAL, "`broadcast NAME` in a neural behavior: one more output per value of the `broadcast` actuator NAME, the value it sends (as an actuator kind: `actuator NAME[1..4] broadcast`, values other robots hear)", NEURAL_S),
     w("scale", C, CLAUSE, "`scale S`: the factor of linear outputs", NEURAL_S),
     // learning
     w("crbp", C, CLAUSE, "`crbp(REWARD, PUNISH[, error difference])`: complementary reinforcement back-propagation", LEARNING),

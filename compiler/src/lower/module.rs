@@ -675,7 +675,15 @@ impl Lower<'_> {
             },
             None => 0,
         };
-        let Some((outputs, decode)) = self.outputs(hw, n) else { return (None, None) };
+        let Some((wheels, decode)) = self.outputs(hw, n) else { return (None, None) };
+        let signals = match &n.broadcast {
+            Some(name) => match self.broadcast_outputs(hw, name) {
+                Some(k) => k,
+                None => return (None, None),
+            },
+            None => 0,
+        };
+        let outputs = wheels + signals;
         let recurrent = n.recurrent && hidden > 0;
         let count = Network::param_count_of(inputs.len(), hidden as usize, outputs as usize, recurrent);
         let (params, genes) = match &n.weights {
@@ -698,7 +706,47 @@ impl Lower<'_> {
             }
         };
         let net = Network { inputs: inputs.len() as u16, hidden, outputs, recurrent, params };
-        (Some(NeuralBehavior { inputs, net, decode }), genes)
+        (Some(NeuralBehavior { inputs, net, decode, signals }), genes)
+    }
+
+    /// `broadcast NAME` in a neural behavior: one output per value of the
+    /// `broadcast` actuator NAME.
+    fn broadcast_outputs(&mut self, hw: &Hw, name: &ast::Name) -> Option<u16> {
+        match hw.actuators.iter().find(|a| a.name == name.text) {
+            Some(a) if a.kind == ActuatorKind::Broadcast => Some(a.count),
+            Some(a) => {
+                let broadcast = hw.actuators.iter().find(|a| a.kind == ActuatorKind::Broadcast);
+                self.value_error(
+                    name.span,
+                    format!(
+                        "`{}` is a `{}` actuator, not a `broadcast`",
+                        a.name,
+                        catalog::actuator_info(a.kind).keyword
+                    ),
+                    "not a broadcast",
+                    Some(match broadcast {
+                        Some(b) => {
+                            format!("the robot broadcasts with `{}`: write `broadcast {}`", b.name, b.name)
+                        }
+                        None => "declare one in the robot: `actuator signal broadcast`".into(),
+                    }),
+                );
+                None
+            }
+            None if hw.sensors.iter().any(|s| s.name == name.text) => {
+                self.value_error(
+                    name.span,
+                    format!("`{}` is a sensor, not an actuator", name.text),
+                    "not an actuator",
+                    Some("`broadcast NAME` names a `broadcast` actuator of the robot".into()),
+                );
+                None
+            }
+            None => {
+                self.unknown_hardware(hw, "actuator", name);
+                None
+            }
+        }
     }
 
     /// A neural behavior's outputs and how they decode into wheel speeds:

@@ -586,15 +586,34 @@ impl ActionDecl {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct NeuralDecl {
     pub sense: Option<(Vec<SensorRef>, Span)>,
     pub hidden: Option<Quantity>,
     /// `hidden N recurrent`
     pub recurrent: bool,
     pub outputs: Option<OutputsDecl>,
+    /// `broadcast NAME`: the `broadcast` actuator the network's extra
+    /// outputs set.
+    pub broadcast: Option<Box<Name>>,
     pub weights: Option<WeightSource>,
     pub span: Span,
+}
+
+/// As derived, but without `broadcast` when there is none: the parse
+/// snapshots of files written before it stay as they are.
+impl std::fmt::Debug for NeuralDecl {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut d = f.debug_struct("NeuralDecl");
+        d.field("sense", &self.sense)
+            .field("hidden", &self.hidden)
+            .field("recurrent", &self.recurrent)
+            .field("outputs", &self.outputs);
+        if let Some(b) = &self.broadcast {
+            d.field("broadcast", b);
+        }
+        d.field("weights", &self.weights).field("span", &self.span).finish()
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]

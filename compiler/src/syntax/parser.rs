@@ -802,6 +802,7 @@ impl Builder {
             Rule::range_setting => "range",
             Rule::sense => "sense",
             Rule::outputs => "outputs",
+            Rule::neural_broadcast => "broadcast",
             _ => return,
         };
         let key = if p.as_rule() == Rule::neural_weights { Rule::weights_source } else { p.as_rule() };
@@ -1072,6 +1073,7 @@ impl Builder {
             hidden: None,
             recurrent: false,
             outputs: None,
+            broadcast: None,
             weights: None,
             span: sp,
         };
@@ -1087,6 +1089,7 @@ impl Builder {
                     n.recurrent = h.next().is_some();
                 }
                 Rule::neural_weights => n.weights = c.into_inner().next().map(weight_source),
+                Rule::neural_broadcast => n.broadcast = c.into_inner().nth(1).map(|x| Box::new(name(x))),
                 Rule::outputs => {
                     if let Some(o) = c.into_inner().next() {
                         let osp = span(&o);

@@ -276,7 +276,13 @@ impl Robot for Sim {
 #[derive(Clone, Debug)]
 enum Gen<'s> {
     Script(ScriptRun),
-    Neural { net: Net, decode: &'s Decode, bits: Vec<u8> },
+    /// `signals`: the network's last outputs set the broadcast values.
+    Neural {
+        net: Net,
+        decode: &'s Decode,
+        bits: Vec<u8>,
+        signals: usize,
+    },
 }
 
 #[derive(Clone, Debug)]
@@ -443,6 +449,7 @@ impl<'s> Controller<'s> {
                     ),
                     decode: &nb.decode,
                     bits: vec![0; nb.net.outputs as usize],
+                    signals: nb.signals.into(),
                 },
             };
             let script_reinforces = matches!(&gen, Gen::Script(s) if s.delivers_reinforcement());
@@ -721,13 +728,18 @@ impl<'s> Controller<'s> {
                 let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
                 s.command(&env, &mut r)
             }
-            Gen::Neural { net, decode, bits } => {
+            Gen::Neural { net, decode, bits, signals } => {
                 let y = net.forward(&self.now, 0.0);
                 for (b, &p) in bits.iter_mut().zip(y) {
                     let on = if learn { self.rng.random::<f32>() < p } else { p > 0.5 };
                     *b = on as u8;
                 }
-                Command { wheels: decode_wheels(decode, bits, y, learn), ..Command::default() }
+                let w = y.len() - *signals;
+                Command {
+                    wheels: decode_wheels(decode, &bits[..w], &y[..w], learn),
+                    signal: (*signals > 0).then(|| decode_signals(&bits[w..], &y[w..], learn)),
+                    ..Command::default()
+                }
             }
         };
 
@@ -959,6 +971,17 @@ fn decode_wheels(decode: &Decode, bits: &[u8], y: &[f32], sampled: bool) -> [f32
             [v(0), v(1)]
         }
     }
+}
+
+/// The broadcast values of a neural behavior's signal outputs: each output
+/// as it is (0..1), or while learning its sampled bit, so that CRBP
+/// reinforces what was sent; the values past the outputs 0.
+fn decode_signals(bits: &[u8], y: &[f32], sampled: bool) -> [f32; SIGNALS] {
+    let mut v = [0.0; SIGNALS];
+    for (k, v) in v.iter_mut().enumerate().take(y.len()) {
+        *v = if sampled { f32::from(bits[k]) } else { y[k] };
+    }
+    v
 }
 
 /// Adds one action's report to a life's counts and its sum of per-action terms.
