@@ -591,21 +591,30 @@ impl Lower<'_> {
         }
     }
 
-    /// A role's fitness that reads the arm or the claw, which no module of
-    /// the role commands but another role's does: for the role's robots, a
-    /// constant.
+    /// A role's fitness that reads the arm, the claw or the broadcast,
+    /// which no module of the role commands but another role's does: for
+    /// the role's robots, a constant.
     fn check_role_fitness_actuators(&mut self, st: &StageSt, r: usize, fitness: &Fitness, span: Span) {
-        use shaping_runtime::catalog::{ACT_ARM, ACT_CLAW};
+        use shaping_runtime::catalog::{ACT_ARM, ACT_CLAW, ACT_SIGNAL, SIGNALS};
         use shaping_runtime::expr::Op;
+        // The actuator's slots: the broadcast has one per value.
+        let slots = |slot: usize| if slot == ACT_SIGNAL { slot..slot + SIGNALS } else { slot..slot + 1 };
         let read = |slot: usize| {
-            fitness.per_action.iter().chain(&fitness.at_end).any(|e| e.ops.contains(&Op::Act(slot as u16)))
+            fitness
+                .per_action
+                .iter()
+                .chain(&fitness.at_end)
+                .any(|e| slots(slot).any(|k| e.ops.contains(&Op::Act(k as u16))))
         };
         let commands = |m: &ModuleSt, slot: usize| match &m.behavior {
             Some(Behavior::Script(sc)) => sc.steps.iter().any(|x| match x.action {
                 Action::Arm(_) => slot == ACT_ARM,
                 Action::Claw(_) => slot == ACT_CLAW,
+                Action::Signal(_) => slot == ACT_SIGNAL,
                 _ => false,
             }),
+            // A network with broadcast outputs (`broadcast NAME`).
+            Some(Behavior::Neural(nb)) => slot == ACT_SIGNAL && nb.signals > 0,
             _ => false,
         };
         let mut start = 0usize;
@@ -621,7 +630,12 @@ impl Lower<'_> {
         let by = |k: usize, slot: usize| {
             ranges.get(k).is_some_and(|rg| st.modules[rg.clone()].iter().any(|m| commands(m, slot)))
         };
-        for (slot, kind) in [(ACT_ARM, ActuatorKind::Lift), (ACT_CLAW, ActuatorKind::Grip)] {
+        let kinds = [
+            (ACT_ARM, ActuatorKind::Lift),
+            (ACT_CLAW, ActuatorKind::Grip),
+            (ACT_SIGNAL, ActuatorKind::Broadcast),
+        ];
+        for (slot, kind) in kinds {
             if !read(slot) || by(r, slot) {
                 continue;
             }
