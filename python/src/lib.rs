@@ -75,6 +75,10 @@ fn not_found_type(py: Python<'_>) -> PyResult<&Bound<'_, pyo3::types::PyType>> {
             "__doc__",
             "A file or directory that does not exist: a FileNotFoundError and a ShapingError.",
         )?;
+        // Its text stays the command line's message: an OSError with a
+        // `filename` would print `[Errno 2] ...: 'PATH'` instead.
+        let text = py.eval(c"lambda self: str(self.args[0]) if self.args else ''", None, None)?;
+        dict.set_item("__str__", text)?;
         let made = builtins.getattr("type")?.call1(("NotFoundError", bases, dict))?;
         Ok(made.cast_into::<pyo3::types::PyType>()?.unbind())
     })?;
@@ -93,12 +97,35 @@ fn kind_name(kind: ErrorKind) -> &'static str {
         ErrorKind::Invalid => "invalid",
         ErrorKind::Locked => "locked",
         ErrorKind::Evaluation => "evaluation",
+        ErrorKind::Internal => "internal",
         _ => "other",
     }
 }
 
+/// The engine error's data on its exception: `path` (the file or
+/// directory), `operation`, `problem` (of a damaged or stale file),
+/// `holder` (of a lock), `setting` and `value` (of a setting or an
+/// argument), each `None` where the error has none; a `NotFoundError`'s
+/// `filename` and `errno` as a `FileNotFoundError`'s.
+fn set_data(py: Python<'_>, err: &PyErr, e: &shaping_engine::Error) -> PyResult<()> {
+    let value = err.value(py);
+    let path = e.path().map(|p| p.display().to_string());
+    value.setattr("path", path.clone())?;
+    value.setattr("operation", e.operation())?;
+    value.setattr("problem", e.problem())?;
+    value.setattr("holder", e.holder())?;
+    value.setattr("setting", e.setting().map(|(key, _)| key))?;
+    value.setattr("value", e.setting().and_then(|(_, v)| v))?;
+    if e.kind() == ErrorKind::NotFound {
+        value.setattr("filename", path)?;
+        value.setattr("errno", py.import("errno")?.getattr("ENOENT")?)?;
+    }
+    Ok(())
+}
+
 /// The `ShapingError` (the subclass of its kind) with the engine error's
-/// message and kind; a file that does not exist raises `NotFoundError`.
+/// message, kind and data ([`set_data`]); a file that does not exist
+/// raises `NotFoundError`.
 fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
     let message = e.message().to_string();
     let err = match e.kind() {
@@ -114,15 +141,22 @@ fn shaping_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
         _ => ShapingError::new_err(message),
     };
     let _ = err.value(py).setattr("kind", kind_name(e.kind()));
+    if let Err(failed) = set_data(py, &err, e) {
+        return failed;
+    }
     err
 }
 
 /// The error a run, an experiment or a setting raises: `ValueError` for a
 /// setting or an argument that cannot be used (`ErrorKind::Invalid`: an
-/// unknown `set` key, a bad value, `seeds=0`), else `ShapingError`.
+/// unknown `set` key, a bad value, `seeds=0`; with the error's data,
+/// [`set_data`]), else `ShapingError`.
 fn engine_error(py: Python<'_>, e: &shaping_engine::Error) -> PyErr {
     match e.kind() {
-        ErrorKind::Invalid => value_error(e.message()),
+        ErrorKind::Invalid => {
+            let err = value_error(e.message());
+            set_data(py, &err, e).err().unwrap_or(err)
+        }
         _ => shaping_error(py, e),
     }
 }

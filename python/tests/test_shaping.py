@@ -2,6 +2,7 @@
 the `shaping` command line (SHAPING_BIN, else target/{debug,release}/shaping,
 else `shaping` on PATH; skipped without it, failing under CI=true)."""
 
+import errno
 import json
 import os
 import re
@@ -112,10 +113,31 @@ def test_a_missing_file_raises_with_the_cli_message(tmp_path):
         shaping.compile(missing)
     assert e.value.kind == "not_found"
     assert isinstance(e.value, shaping.NotFoundError) and isinstance(e.value, shaping.ShapingError)
+    # The file as data, as a FileNotFoundError names it.
+    assert e.value.filename == e.value.path == str(missing)
+    assert e.value.errno == errno.ENOENT and e.value.operation == "read"
+    assert e.value.setting is None and e.value.problem is None
     out = shaping_cli("check", missing)
     assert str(e.value).strip() == out.stderr.strip()
     with pytest.raises(shaping.ShapingError):
         shaping.check(missing)
+
+
+def test_a_damaged_checkpoint_raises_corrupt_error_naming_the_file_and_the_problem(tmp_path):
+    out = tmp_path / "r"
+    args = dict(out=out, stage="first", set={"first.evolve.generations": 1}, report=False)
+    shaping.run(TINY, **args)
+    path = out / "first" / "checkpoint.json"
+    text = path.read_text()
+    # One bit of the population's first genome, flipped.
+    at = text.index('"bits": [') + len('"bits": [')
+    digit = min(i for i in (text.find("0", at), text.find("1", at)) if i >= 0)
+    path.write_text(text[:digit] + ("1" if text[digit] == "0" else "0") + text[digit + 1 :])
+    with pytest.raises(shaping.CorruptError) as e:
+        shaping.run(TINY, **args)
+    assert e.value.kind == "corrupt"
+    assert (e.value.path, e.value.problem) == (str(path), "its checksum does not match its contents")
+    assert (e.value.setting, e.value.operation) == (None, None)
 
 
 def test_a_stage_that_does_not_exist():
@@ -315,6 +337,8 @@ def test_run_set_and_bad_arguments(tmp_path):
         assert res.returncode == 2
         assert str(e.value).strip() == res.stderr.strip()
         assert not isinstance(e.value, shaping.ShapingError)
+        # The setting as data, as given.
+        assert (e.value.setting, e.value.value) == (key, str(value))
     with pytest.raises(ValueError, match="one value"):
         shaping.run(TINY, out=tmp_path / "e", set={"first.evolve.generations": [1, 2]})
     with pytest.raises(ValueError, match="STAGE.SECTION.FIELD"):

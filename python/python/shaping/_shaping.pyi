@@ -41,12 +41,23 @@ class ShapingError(Exception):
     """An error of shaping: the text is the command line's message.
 
     ``kind`` is one of "diagnostics", "io", "not_found", "corrupt", "stale",
-    "interrupted", "memory", "invalid", "locked", "evaluation"; a file with
-    errors also has ``diagnostics`` (a list of :class:`Diagnostic`).
+    "interrupted", "memory", "invalid", "locked", "evaluation", "internal"
+    (a bug of shaping); a file with errors also has ``diagnostics`` (a list
+    of :class:`Diagnostic`). The error's data, each None where it has none:
+    ``path`` (the file or directory it is about), ``operation`` (what
+    failed on it: "read", "write", ...), ``problem`` (what is wrong with a
+    damaged or stale file), ``holder`` (who holds a locked directory),
+    ``setting`` and ``value`` (a setting or an argument, as given).
     """
 
     kind: str
     diagnostics: list[Diagnostic]
+    path: str | None
+    operation: str | None
+    problem: str | None
+    holder: str | None
+    setting: str | None
+    value: str | None
 
 class CompileError(ShapingError):
     """A file with errors (kind "diagnostics"): ``diagnostics`` has them."""
@@ -64,7 +75,8 @@ class EvaluationError(ShapingError):
     """Evaluation failed: a robot link, a rank of a cluster (kind "evaluation")."""
 
 class NotFoundError(FileNotFoundError, ShapingError):
-    """A file or directory that does not exist (kind "not_found")."""
+    """A file or directory that does not exist (kind "not_found"):
+    ``filename`` and ``path`` name it, ``errno`` is ``errno.ENOENT``."""
 
 @final
 class Diagnostic:
