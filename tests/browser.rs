@@ -306,26 +306,28 @@ window.addEventListener('load', () => {
 /// its `trace.csv`'s header and rows (every robot's, a `robot` column
 /// first).
 fn team_run(dir: &Path, extra: &[&str]) -> (PathBuf, Vec<String>, Vec<Vec<String>>) {
-    let file = root().join("examples/aggregation-roles.bat");
     let sets =
         ["aggregate.evolve.generations=1", "aggregate.evolve.population=4", "aggregate.evolve.actions=60"];
+    team_replay(&root().join("examples/aggregation-roles.bat"), &sets, dir, extra)
+}
+
+/// [`team_run`] of `file`, a team's stage `aggregate`, with settings `sets`.
+fn team_replay(
+    file: &Path,
+    sets: &[&str],
+    dir: &Path,
+    extra: &[&str],
+) -> (PathBuf, Vec<String>, Vec<Vec<String>>) {
     let sets: Vec<String> = sets.iter().flat_map(|s| ["--set".to_string(), s.to_string()]).collect();
     if !dir.join("aggregate/best.genome").exists() {
-        let out = shaping()
-            .arg("run")
-            .arg(&file)
-            .arg("--out")
-            .arg(dir)
-            .arg("--quiet")
-            .args(&sets)
-            .output()
-            .unwrap();
+        let out =
+            shaping().arg("run").arg(file).arg("--out").arg(dir).arg("--quiet").args(&sets).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     }
     let replay = dir.join("replay");
     let out = shaping()
         .arg("replay")
-        .arg(&file)
+        .arg(file)
         .arg("--run")
         .arg(dir)
         .arg("--out")
@@ -422,4 +424,134 @@ window.addEventListener('load', () => {
     let dom = String::from_utf8_lossy(&out.stdout);
     assert_eq!(body_attr(&dom, "data-errors"), None);
     follows(&dom, &header, &rows, 4, 9, "first");
+}
+
+/// The readout's board and the drawing of who hears whom, as the page
+/// left them after `driver`'s steps: per step, the board table's rows
+/// (`name: values`), then `data-hears` and `data-heard` of the body
+/// (`-` when absent), then whether the table is hidden.
+const BOARD_DRIVER: &str = r#"<script>
+window.addEventListener('load', () => {
+  const log = [];
+  const look = () => {
+    const t = document.getElementById('r-board');
+    const rows = [...t.tBodies[0].rows].map((r) => r.cells[0].textContent + ': ' + r.cells[1].textContent);
+    const d = document.body.dataset;
+    log.push(JSON.stringify([rows, d.hears === undefined ? '-' : d.hears, d.heard === undefined ? '-' : d.heard, t.hidden]));
+  };
+  look();
+  const sel = document.getElementById('robot');
+  sel.value = '3'; sel.dispatchEvent(new Event('change'));
+  look();
+  document.body.dataset.driven = JSON.stringify(log);
+});
+</script>
+</body>"#;
+
+/// One step of [`BOARD_DRIVER`]'s log: the board's rows, `data-hears`,
+/// `data-heard` and whether the table is hidden.
+fn board_step(entry: &str) -> (Vec<String>, String, String, bool) {
+    serde_json::from_str(entry).unwrap()
+}
+
+/// The report of a team with a range-and-bearing board
+/// (`examples/aggregation-rab.bat`, briefly evolved): at an action, the
+/// readout shows the followed robot's board as `trace.csv` has it (its
+/// `rab`, `heard` and `signal` values), and the arena draws a line
+/// between every two robots within the board's range on where they were
+/// after the previous action (as the board read then; no walls there to
+/// hide them), which the test counts from `trace.csv` itself; both follow
+/// the robot selected. A team without a board (`aggregation-roles.bat`)
+/// has neither.
+#[test]
+fn the_report_shows_the_board_and_draws_who_hears_whom() {
+    let Some(browser) = browser_or_skip() else { return };
+    let dir = scratch("board");
+    let file = root().join("examples/aggregation-rab.bat");
+    let sets = [
+        "aggregate.evolve.generations=1",
+        "aggregate.evolve.population=4",
+        "aggregate.evolve.actions=60",
+        "aggregate.evolve.evaluations=1",
+    ];
+    let (page, _, _) = team_replay(&file, &sets, &dir, &[]);
+    let program =
+        shaping_compiler::compile(&std::fs::read_to_string(&file).unwrap(), "aggregation-rab.bat").unwrap();
+    let body = &program.stages[0].world.body;
+    let reach = 2.0 * f64::from(body.radius) + f64::from(body.rab.as_ref().unwrap().range);
+    let trace = std::fs::read_to_string(dir.join("replay/trace.csv")).unwrap();
+    let header: Vec<&str> = trace.lines().next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = trace.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row = |robot: usize, action: usize| {
+        rows.iter()
+            .find(|r| r[col("robot")] == robot.to_string() && r[col("action")] == action.to_string())
+            .unwrap_or_else(|| panic!("no row of robot {robot} at action {action}"))
+    };
+    let at = |robot: usize, action: usize| {
+        let r = row(robot, action);
+        (r[col("x")].parse::<f64>().unwrap(), r[col("y")].parse::<f64>().unwrap())
+    };
+    // What the readout must show of robot `robot` at `action`: per row,
+    // its name and values (the page shows them to 2 decimals).
+    let board = |robot: usize, action: usize| -> Vec<(String, Vec<f64>)> {
+        let r = row(robot, action);
+        let values = |n: usize, name: &str| {
+            (0..n).map(|i| r[col(&format!("{name}[{i}]"))].parse::<f64>().unwrap()).collect::<Vec<_>>()
+        };
+        [("rab", 8), ("heard", 8), ("signal", 1)]
+            .iter()
+            .map(|&(name, n)| (name.to_string(), values(n, name)))
+            .collect()
+    };
+    // The pairs within reach after action `action - 1`, and those of `robot`.
+    let action = 30;
+    let near = |i: usize, j: usize| {
+        let ((xi, yi), (xj, yj)) = (at(i, action - 1), at(j, action - 1));
+        (xi - xj).hypot(yi - yj) <= reach
+    };
+    let pairs = (0..10).flat_map(|i| (i + 1..10).map(move |j| (i, j))).filter(|&(i, j)| near(i, j)).count();
+    let heard = |robot: usize| {
+        (0..10).filter(|&j| j != robot && near(robot, j)).map(|j| j.to_string()).collect::<Vec<_>>()
+    };
+    assert!(pairs > 0 && pairs < 45, "some pairs in range, not all: {pairs}");
+
+    let html = std::fs::read_to_string(page).unwrap();
+    let hash = format!("#stage=aggregate&action={action}&robot=0");
+    let (log, _) = driven_log(&browser, &dir, &html, BOARD_DRIVER, &hash, "profile-board");
+    for (step, robot) in [(0, 0usize), (1, 3)] {
+        let (shown, hears, list, hidden) = board_step(&log[step]);
+        let want = board(robot, action);
+        assert_eq!(shown.len(), want.len() + 1, "{shown:?}");
+        for (line, (name, values)) in shown.iter().zip(&want) {
+            let (n, v) = line.split_once(": ").unwrap();
+            let v: Vec<f64> = v.split(' ').map(|x| x.parse().unwrap()).collect();
+            assert_eq!(n, name, "{shown:?}");
+            assert_eq!(v.len(), values.len(), "{line}");
+            for (got, csv) in v.iter().zip(values) {
+                assert!(
+                    (got - csv).abs() <= 0.005 + 1e-9,
+                    "robot {robot}'s {name} at action {action}: page {line}, trace.csv {values:?}"
+                );
+            }
+        }
+        let h = heard(robot);
+        let range = if h.is_empty() { "none".to_string() } else { format!("robots {}", h.join(", ")) };
+        assert_eq!(shown[want.len()], format!("in range: {range}"));
+        assert!(!hidden, "the board's table is shown");
+        assert_eq!(hears, pairs.to_string(), "a line per pair in range (robot {robot} followed)");
+        assert_eq!(list, h.join(" "), "the robots robot {robot} hears");
+    }
+
+    // A team without a board: no table, no lines.
+    let plain = scratch("board-none");
+    let (page, _, _) = team_run(&plain, &[]);
+    let html = std::fs::read_to_string(page).unwrap();
+    let (log, _) =
+        driven_log(&browser, &plain, &html, BOARD_DRIVER, "#stage=aggregate&action=30", "profile-board-none");
+    for entry in &log {
+        let (shown, hears, list, hidden) = board_step(entry);
+        assert!(shown.is_empty() && hidden, "no board: {shown:?}");
+        assert_eq!((hears.as_str(), list.as_str()), ("-", "-"), "no line drawn without a board");
+    }
 }

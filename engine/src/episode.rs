@@ -543,6 +543,25 @@ pub struct TeamColumns {
     pub role: Option<String>,
     /// Robots 1, 2, ... in order.
     pub robots: Vec<RobotColumns>,
+    /// The range-and-bearing board of every robot (0, 1, ...), when the
+    /// body has one (`report::board_columns`): for the report's readout,
+    /// which `episode.json` (without the board) cannot give.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub board: Option<BoardColumns>,
+}
+
+/// The range-and-bearing board of a team's episode, robot by robot (in
+/// `robots.json`, [`TeamColumns::board`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoardColumns {
+    /// The columns, as `trace.csv` names them: the `range_bearing` sensor's,
+    /// the `signal` sensor's and the `broadcast` actuator's elements
+    /// (`rab[0]`, ..., `heard[0]`, ..., `signal[0]`), as declared.
+    pub names: Vec<String>,
+    /// Robot `j`'s values at action `a`, one per name, as `trace.csv` has
+    /// them: `robots[j][a]`; empty at an action the robot did not live
+    /// (a world it was not in).
+    pub robots: Vec<Vec<Vec<f32>>>,
 }
 
 /// One robot of a team ([`TeamColumns`]).
@@ -606,7 +625,7 @@ impl TeamColumns {
             })
             .collect();
         let role = stage.roles.first().map(|r| r.name.clone());
-        Some(TeamColumns { format: ROBOTS_FORMAT, follow, role, robots })
+        Some(TeamColumns { format: ROBOTS_FORMAT, follow, role, robots, board: None })
     }
 }
 

@@ -358,8 +358,10 @@ pub fn replay(
     }
     // Robot `robot`'s columns, for the report and the animations to follow
     // (robot 0's are `episode.json`'s own).
-    let team =
-        (robot != 0).then(|| TeamColumns::of(stage, &others, ep.actions.x.len(), args.robot)).flatten();
+    let team = (robot != 0)
+        .then(|| TeamColumns::of(stage, &others, ep.actions.x.len(), args.robot))
+        .flatten()
+        .map(|t| TeamColumns { board: report::board_columns(stage, &ep, &others), ..t });
     if let Some(team) = &team {
         rundir::write_robots(&out, team)?;
     }

@@ -13,7 +13,7 @@ use shaping_runtime::evolve::GenStats;
 use shaping_runtime::program::{LearnTarget, Stage};
 use shaping_runtime::sim::{ObjectState, Scene};
 
-use crate::episode::{Episode, EpisodeColumns, Frame, OtherRobot, TeamColumns};
+use crate::episode::{BoardColumns, Episode, EpisodeColumns, Frame, OtherRobot, TeamColumns};
 use crate::error::Error;
 use crate::plot;
 use crate::rundir::{self, Picture};
@@ -171,6 +171,37 @@ pub fn team_trace_csv(trace: &Trace, others: &[OtherRobot], stage: &Stage, episo
         }
     }
     s
+}
+
+/// The range-and-bearing board of a team's episode (robot 0's columns
+/// `episode`, the `others`): every robot's values of `trace.csv`'s board
+/// columns at every action; `None` when the stage declares no board.
+pub fn board_columns(stage: &Stage, episode: &Episode, others: &[OtherRobot]) -> Option<BoardColumns> {
+    let (names, sources): (Vec<String>, Vec<Source>) = declared_columns(stage)
+        .into_iter()
+        .filter(|(_, src)| matches!(src, Source::Board(_) | Source::Signal(_)))
+        .unzip();
+    if names.is_empty() {
+        return None;
+    }
+    let n = episode.actions.x.len();
+    let values = |c: &EpisodeColumns, k: usize| -> Vec<f32> {
+        if c.board.get(k).is_none() {
+            return Vec::new();
+        }
+        sources.iter().map(|s| s.at(c, k)).collect()
+    };
+    let most = others.iter().map(|o| o.robot).max().unwrap_or(0);
+    let mut robots = vec![vec![Vec::new(); n]; most + 1];
+    robots[0] = (0..n).map(|a| values(&episode.actions, a)).collect();
+    for o in others {
+        for (k, r) in o.trace.rows.iter().enumerate() {
+            if let Some(slot) = robots[o.robot].get_mut(r.action as usize) {
+                *slot = values(&o.sensed, k);
+            }
+        }
+    }
+    Some(BoardColumns { names, robots })
 }
 
 /// Row `r` of `robot`'s role, its winner and per-module values placed
@@ -395,7 +426,10 @@ pub fn team_columns(
     episode: &Episode,
 ) -> Result<(), Error> {
     match TeamColumns::of(stage, others, episode.actions.x.len(), 0) {
-        Some(team) => rundir::write_robots(dir, &team),
+        Some(mut team) => {
+            team.board = board_columns(stage, episode, others);
+            rundir::write_robots(dir, &team)
+        }
         None => rundir::remove_robots(dir),
     }
 }

@@ -430,7 +430,7 @@ fn the_trace_records_the_range_and_bearing_board() {
     let mut lines = csv.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap_or_else(|| panic!("no `{name}`"));
-    let board: Vec<usize> = (0..8)
+    let board_cols: Vec<usize> = (0..8)
         .map(|s| col(&format!("rab[{s}]")))
         .chain((0..8).map(|s| col(&format!("heard[{s}]"))))
         .chain([col("signal[0]")])
@@ -439,7 +439,7 @@ fn the_trace_records_the_range_and_bearing_board() {
     let rows: Vec<Vec<f32>> = lines
         .map(|l| {
             let cells: Vec<&str> = l.split(',').collect();
-            board.iter().map(|&c| cells[c].parse::<f32>().unwrap()).collect()
+            board_cols.iter().map(|&c| cells[c].parse::<f32>().unwrap()).collect()
         })
         .collect();
     assert_eq!(rows.len(), 10 * rec.result.actions as usize, "every robot's every action");
@@ -458,6 +458,36 @@ fn the_trace_records_the_range_and_bearing_board() {
     // The board is not in `episode.json`.
     let json = serde_json::to_string(&rec.episode).unwrap();
     assert!(!json.contains("board"), "episode.json keeps its format");
+    // `robots.json` holds every robot's board for the report's readout:
+    // robot `j`'s values at action `a` are `trace.csv`'s board columns of
+    // its row there.
+    let n = rec.result.actions as usize;
+    let board = shaping_engine::report::board_columns(stage, &rec.episode, &rec.others).expect("a board");
+    let names: Vec<String> = (0..8)
+        .map(|s| format!("rab[{s}]"))
+        .chain((0..8).map(|s| format!("heard[{s}]")))
+        .chain(["signal[0]".to_string()])
+        .collect();
+    assert_eq!(board.names, names);
+    assert_eq!(board.robots.len(), 10);
+    let robot_col = col("robot");
+    let action_col = col("action");
+    for l in csv.lines().skip(1) {
+        let cells: Vec<&str> = l.split(',').collect();
+        let (j, a): (usize, usize) = (cells[robot_col].parse().unwrap(), cells[action_col].parse().unwrap());
+        let want: Vec<f32> = board_cols.iter().map(|&c| cells[c].parse().unwrap()).collect();
+        assert_eq!(board.robots[j][a], want, "robot {j}, action {a}");
+    }
+    assert!(board.robots.iter().all(|r| r.len() == n));
+    // A stage without a board has none.
+    let plain = load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/aggregation.bat"));
+    let plain_rec =
+        episode::record(&plain.stages[0], &Genome::zeros(plain.stages[0].layout.bits as usize), &opts)
+            .unwrap();
+    assert_eq!(
+        shaping_engine::report::board_columns(&plain.stages[0], &plain_rec.episode, &plain_rec.others),
+        None
+    );
 }
 
 /// A neural behavior with `broadcast signal` sets what its robot

@@ -53,6 +53,62 @@ fn read_team(dir: &Path, ep: &Episode, u: Unsealed<'_>) -> Result<Option<TeamCol
     Ok(Some(t))
 }
 
+/// The range-and-bearing board of episode `ep`, from its team's
+/// `robots.json` (`team`, as [`read_team`] read it; see
+/// [`ReportData::boards`]), for the robots the page can follow; `None`
+/// without a team or a board. A board that is not of the episode (other
+/// robots, other lengths) is an error naming the file in `dir`.
+fn read_board(
+    dir: &Path,
+    program: &Program,
+    ep: &Episode,
+    team: Option<&mut TeamColumns>,
+) -> Result<Option<BoardView>, Error> {
+    let Some(mut columns) = team.and_then(|t| t.board.take()) else { return Ok(None) };
+    let n = ep.actions.x.len();
+    let width = columns.names.len();
+    let fits = columns.robots.len() == 1 + ep.actions.others.len()
+        && columns.robots.iter().all(|r| r.len() == n && r.iter().all(|v| v.is_empty() || v.len() == width));
+    if !fits {
+        return Err(Error::io(format!(
+            "error: the board in `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
+            rundir::robots_path(dir).display()
+        )));
+    }
+    columns.robots.truncate(MAX_FOLLOWED);
+    let worlds = ep
+        .worlds
+        .iter()
+        .map(|w| {
+            let rab = program.stage(&w.stage).and_then(|(_, s)| s.world.body.rab.as_ref());
+            BoardWorld { range: rab.map_or(0.0, |r| r.range), occlusion: rab.is_some_and(|r| r.occlusion) }
+        })
+        .collect();
+    Ok(Some(BoardView { worlds, columns }))
+}
+
+/// The range-and-bearing board of an episode, for the page: what each
+/// robot's board read and sent at each action (the readout), and, per
+/// world, what the replay needs to draw who hears whom.
+#[derive(Clone, Debug, Serialize)]
+pub struct BoardView {
+    /// One per world of the episode (`Episode::worlds`, in order).
+    pub worlds: Vec<BoardWorld>,
+    #[serde(flatten)]
+    pub columns: crate::episode::BoardColumns,
+}
+
+/// The board in one world of an episode.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct BoardWorld {
+    /// How far robots perceive and hear each other, body surface to body
+    /// surface, mm (`rab_range`; 0 in a world without a board).
+    pub range: f32,
+    /// Inner walls and cylinders between two robots' centres hide them
+    /// from each other (`rab_occlusion`).
+    pub occlusion: bool,
+}
+
 /// Version of the data embedded in a report.
 pub const REPORT_FORMAT: u32 = 1;
 
@@ -80,6 +136,11 @@ pub struct ReportData {
     /// (`robots.json`, at most [`MAX_FOLLOWED`] robots in all), which the
     /// page's readout and timeline can follow; `None` for one robot.
     pub robots: Vec<Option<TeamColumns>>,
+    /// One per episode, in order: its range-and-bearing board, for robot 0
+    /// and the robots of `robots` (taken out of its `robots.json`, so that
+    /// the page holds it once), which the readout shows and the replay
+    /// draws; `None` without a board.
+    pub boards: Vec<Option<BoardView>>,
     /// The `summary.json` of the sweep this experiment is a point of (or,
     /// for a sweep's own directory, of the sweep): every point's settings
     /// and figures, listed by the page.
@@ -657,9 +718,9 @@ pub fn seed_series(stage: &str, seeds: &[Vec<GenRow>]) -> FitnessSeries {
     s
 }
 
-/// A run directory's stage views, its episodes and their teams' columns
-/// (one per episode).
-type RunStages = (Vec<StageView>, Vec<Episode>, Vec<Option<TeamColumns>>);
+/// A run directory's stage views, its episodes, their teams' columns and
+/// their boards (one per episode).
+type RunStages = (Vec<StageView>, Vec<Episode>, Vec<Option<TeamColumns>>, Vec<Option<BoardView>>);
 
 /// The stages of one run directory, with genomes, results and episodes.
 fn run_stages(
@@ -671,6 +732,7 @@ fn run_stages(
     let mut views = Vec::new();
     let mut episodes = Vec::new();
     let mut teams = Vec::new();
+    let mut boards = Vec::new();
     for (i, st) in program.stages.iter().enumerate() {
         let dir = rundir::stage_dir(run, &st.name);
         if only.is_some_and(|o| o != i) || only.is_none() && !dir.is_dir() {
@@ -714,11 +776,13 @@ fn run_stages(
         let ep = rundir::episode_path(&dir);
         if ep.exists() {
             let ep = read_episode(&ep, u)?;
-            teams.push(read_team(&dir, &ep, u)?);
+            let mut team = read_team(&dir, &ep, u)?;
+            boards.push(read_board(&dir, program, &ep, team.as_mut())?);
+            teams.push(team);
             episodes.push(ep);
         }
     }
-    Ok((views, episodes, teams))
+    Ok((views, episodes, teams, boards))
 }
 
 /// The words for `n` of `m` episodes (or lives) whose placement overlapped,
@@ -890,6 +954,7 @@ fn base(kind: &'static str, program: &Program, dir: &Path) -> ReportData {
         fitness: Vec::new(),
         episodes: Vec::new(),
         robots: Vec::new(),
+        boards: Vec::new(),
         sweep: None,
         sweep_point: None,
         tests: None,
@@ -989,14 +1054,16 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
                 genome.as_ref().map(|g| (g, rundir::names::GENOME.to_string())),
             ));
             data.episodes_note = format!("replay of stage `{}`, seed {}", ep.stage, ep.seed);
-            data.robots.push(read_team(dir, &ep, u)?);
+            let mut team = read_team(dir, &ep, u)?;
+            data.boards.push(read_board(dir, &program, &ep, team.as_mut())?);
+            data.robots.push(team);
             data.episodes.push(ep);
             return Ok(data);
         }
         let mut data = base("run", &program, dir);
         let fitness = run_fitness(&program, dir, u)?;
         data.fitness = series_of(&program, &fitness, None);
-        (data.stages, data.episodes, data.robots) = run_stages(&program, dir, None, u)?;
+        (data.stages, data.episodes, data.robots, data.boards) = run_stages(&program, dir, None, u)?;
         data.episodes_note = "the best individual of each stage".into();
         return Ok(data);
     }
@@ -1032,7 +1099,8 @@ pub fn collect_with(dir: &Path, u: Unsealed<'_>) -> Result<ReportData, Error> {
             let mut data = base("stage", &program, dir);
             let fitness = run_fitness(&program, run, u)?;
             data.fitness = series_of(&program, &fitness, Some(index));
-            (data.stages, data.episodes, data.robots) = run_stages(&program, run, Some(index), u)?;
+            (data.stages, data.episodes, data.robots, data.boards) =
+                run_stages(&program, run, Some(index), u)?;
             data.episodes_note = format!("the best individual of stage `{name}`");
             return Ok(data);
         }
@@ -1077,7 +1145,7 @@ fn experiment(dir: &Path, seeds: &[(u64, PathBuf)], u: Unsealed<'_>) -> Result<R
     order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let pick = order[(order.len() - 1) / 2].1;
     let (seed, run) = &seeds[pick];
-    (data.stages, data.episodes, data.robots) = run_stages(&program, run, None, u)?;
+    (data.stages, data.episodes, data.robots, data.boards) = run_stages(&program, run, None, u)?;
     data.shown_seed = Some(*seed);
     data.episodes_note = format!(
         "seed {seed}, the median of {} seeds by the final best fitness{}; genomes and episodes of that seed",

@@ -16,7 +16,7 @@
 
   const D = JSON.parse(document.getElementById('data').textContent);
   // A team's other robots' columns (robots.json), beside their episode.
-  D.episodes.forEach((e, i) => { e._team = (D.robots || [])[i] || null; });
+  D.episodes.forEach((e, i) => { e._team = (D.robots || [])[i] || null; e._board = (D.boards || [])[i] || null; });
   // An episode without a single action (a flat battery) has nothing to show.
   D.episodes = D.episodes.filter((e) => e.actions.x.length > 0);
   const $ = (id) => document.getElementById(id);
@@ -112,6 +112,57 @@
     const v = Object.assign({}, ep, { actions, worlds, modules: mine.modules, _: null, _views: null, _nums: nums, _robot: k, _role: mine.role || null });
     ep._views[k] = v;
     return v;
+  }
+
+  // The range-and-bearing board at action `a` of `ep` (as robot `ep._robot`
+  // lived it): the robots' numbers and where they are, and the pairs that
+  // perceive and hear each other in what the board read at `a`: within
+  // its range (gap between the bodies) and, with occlusion, no inner wall
+  // or cylinder across, on where the robots were after the previous action
+  // (their starts at a world's first action), as the board was measured.
+  // Every pair up to 300 robots; beyond, only the followed robot's.
+  // `null` without a board.
+  function hearing(ep, a) {
+    const b = ep._board, wi = ep._.world[a], w = ep.worlds[wi];
+    if (!b || !b.worlds[wi] || !(b.worlds[wi].range > 0)) return null;
+    const c = ep.actions, others = c.others || [], starts = w.others || [];
+    const first = a === w.from, k = a - 1;
+    const me = ep._robot || 0;
+    const robots = [{ num: me, x: first ? w.start[0] : c.x[k], y: first ? w.start[1] : c.y[k], at: [c.x[a], c.y[a]] }];
+    for (let j = 0; j < others.length && j < starts.length; j++) {
+      const o = others[j];
+      robots.push({ num: ep._nums ? ep._nums[j] : j + 1, x: first ? starts[j][0] : o.x[k], y: first ? starts[j][1] : o.y[k], at: [o.x[a], o.y[a]] });
+    }
+    const reach = 2 * w.body_radius + b.worlds[wi].range;
+    const hidden = (p, q) => b.worlds[wi].occlusion && (
+      (w.walls || []).some(([u, v]) => crosses(p, q, u, v)) ||
+      (w.cylinders || []).some(([cx, cy, r]) => segDist2([cx, cy], p, q) < r * r));
+    const pairs = [];
+    const all = robots.length <= 300;
+    for (let i = 0; i < robots.length; i++) {
+      for (let j = i + 1; j < robots.length; j++) {
+        if (!all && i !== 0) break;
+        const p = robots[i], q = robots[j];
+        const dx = q.x - p.x, dy = q.y - p.y;
+        if (dx * dx + dy * dy > reach * reach || hidden([p.x, p.y], [q.x, q.y])) continue;
+        pairs.push([i, j]);
+      }
+    }
+    const heard = pairs.filter(([i]) => i === 0).map(([, j]) => robots[j].num).sort((x, y) => x - y);
+    return { robots, pairs, heard };
+  }
+  const cross = (o, p, q) => (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]);
+  // Whether segments p-q and u-v cross (as the simulator's shading test).
+  function crosses(p, q, u, v) {
+    const d1 = cross(u, v, p), d2 = cross(u, v, q), d3 = cross(p, q, u), d4 = cross(p, q, v);
+    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+  }
+  // The squared distance from point `c` to segment p-q.
+  function segDist2(c, p, q) {
+    const dx = q[0] - p[0], dy = q[1] - p[1], l2 = dx * dx + dy * dy;
+    const t = l2 > 0 ? Math.max(0, Math.min(1, ((c[0] - p[0]) * dx + (c[1] - p[1]) * dy) / l2)) : 0;
+    const ex = p[0] + t * dx - c[0], ey = p[1] + t * dy - c[1];
+    return ex * ex + ey * ey;
   }
 
   function prepare(ep) {
@@ -221,6 +272,22 @@
       g.beginPath(); g.arc(X(ox), Y(oy), Math.max(r * s, 2), 0, 2 * Math.PI);
       g.fillStyle = st === 1 ? '#1e8a4c' : '#8fb996'; g.fill();
       g.strokeStyle = '#2d5a36'; g.lineWidth = 1; g.stroke();
+    }
+    // Who hears whom: a line between the robots that perceive each other
+    // on the board read at this action, the followed robot's darker.
+    const hear = hearing(ep, a);
+    if (hear) {
+      g.lineWidth = 1;
+      for (const [i, j] of hear.pairs) {
+        const p = hear.robots[i].at, q = hear.robots[j].at;
+        g.strokeStyle = i === 0 ? 'rgba(42, 98, 201, 0.75)' : 'rgba(42, 98, 201, 0.22)';
+        g.beginPath(); g.moveTo(X(p[0]), Y(p[1])); g.lineTo(X(q[0]), Y(q[1])); g.stroke();
+      }
+      document.body.dataset.hears = String(hear.pairs.length);
+      document.body.dataset.heard = hear.heard.join(' ');
+    } else {
+      delete document.body.dataset.hears;
+      delete document.body.dataset.heard;
     }
     // A team's other robots: each one's trail in this world, its body and heading, its number.
     const others = w.others || [];
@@ -433,6 +500,7 @@
     if (c.recharged[a]) ev.push('recharged');
     if (c.collided[a]) ev.push('collision');
     $('r-events').textContent = ev.join(', ');
+    boardReadout(ep, a);
     const body = $('r-modules').tBodies[0];
     body.textContent = '';
     ep.modules.forEach((name, m) => {
@@ -452,6 +520,27 @@
     document.body.dataset.action = String(a);
     document.body.dataset.stage = ep.stage;
     document.body.dataset.robot = String(robot);
+  }
+
+  // The readout's board: what the followed robot's range-and-bearing
+  // sensors read at this action and what it broadcast, one row per
+  // sensor and actuator, and the robots it perceives (as drawn).
+  function boardReadout(ep, a) {
+    const b = ep._board, box = $('r-board'), body = box.tBodies[0];
+    const vals = b && (b.robots[ep._robot || 0] || [])[a];
+    box.hidden = !b;
+    body.textContent = '';
+    if (!b) return;
+    const rows = [];
+    b.names.forEach((n, i) => {
+      const name = n.slice(0, n.lastIndexOf('['));
+      if (!rows.length || rows[rows.length - 1][0] !== name) rows.push([name, []]);
+      rows[rows.length - 1][1].push(vals && vals.length ? fmt(vals[i], 2) : '–');
+    });
+    for (const [name, v] of rows) body.append(el('tr', {}, el('td', { text: name }), el('td', { cls: 'num', text: v.join(' ') })));
+    const hear = hearing(ep, a);
+    const heard = hear ? (hear.heard.length ? 'robots ' + hear.heard.join(', ') : 'none') : '–';
+    body.append(el('tr', {}, el('td', { text: 'in range' }), el('td', { cls: 'num', text: heard })));
   }
 
   function render() {
@@ -585,7 +674,8 @@
       return;
     }
     $('ep-note').textContent = 'The episodes of ' + D.episodes_note + '. ' +
-      'Trail and timeline in the colour of the module that drove each action; red rays: proximity readings; green: objects (dark: held).';
+      'Trail and timeline in the colour of the module that drove each action; red rays: proximity readings; green: objects (dark: held).' +
+      (D.episodes.some((e) => e._board) ? ' Blue lines: robots within range of each other\u2019s range-and-bearing board at that action (dark: the followed robot\u2019s).' : '');
     selectEpisodeTab = tabs($('ep-tabs'), D.episodes.map((e) => e.stage + (e.worlds.length > 1 ? ' (before / after the change)' : '')), (i) => { play(false); selectEpisode(i, 0); writeHash(); });
     $('b-first').addEventListener('click', () => seek(0));
     $('b-last').addEventListener('click', () => seek(R.ep._.n - 1));

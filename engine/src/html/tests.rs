@@ -284,6 +284,7 @@ fn sample_data(title: &str) -> ReportData {
         fitness: Vec::new(),
         episodes: vec![ep],
         robots: vec![None],
+        boards: vec![None],
         sweep: None,
         sweep_point: None,
         tests: None,
