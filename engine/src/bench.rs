@@ -102,7 +102,7 @@ pub fn bench(mut program: Program, index: usize, runs: usize) -> Result<Bench> {
     crate::run::bind_training(&mut program, None, seed, &crate::run::Silent)?;
     let stage = &program.stages[index];
     let runs = runs.max(1);
-    let robots = stage.world.robots.max(1);
+    let robots = stage.robots();
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let genome = Genome { bits: (0..stage.layout.bits).map(|_| rng.random_range(0..2u8)).collect() };
 

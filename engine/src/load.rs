@@ -145,7 +145,7 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
                     let population = limits::population_bytes(e.population.into(), s.layout.bits.into());
                     // The best's episode, in the stage's own world.
                     let (objects, items) = world_size(&s.world);
-                    let robots = u64::from(s.world.robots.max(1));
+                    let robots = u64::from(s.robots());
                     let recorded = u64::from(e.actions).saturating_mul(robots);
                     population.saturating_add(recording_bytes(recorded, 1, modules, objects, items))
                 }
@@ -159,7 +159,7 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
                     };
                     let lives = 2 * u64::from(*lives);
                     // A team's every robot is recorded.
-                    let robots = u64::from(s.world.robots.max(parent.world.robots).max(1));
+                    let robots = u64::from(s.robots().max(parent.robots()));
                     let recorded = lives.saturating_mul((*actions).into()).saturating_mul(robots);
                     recording_bytes(recorded, lives, modules, objects, items)
                 }
@@ -167,7 +167,7 @@ pub fn memory_estimate(program: &Program, stages: &[usize]) -> u64 {
                 StageRun::Train { actions } => {
                     let (objects, items) = world_size(&s.world);
                     let recorded = u64::from((*actions).min(RECORDED_TRAINING_ACTIONS));
-                    let robots = u64::from(s.world.robots.max(1));
+                    let robots = u64::from(s.robots());
                     recording_bytes(recorded.saturating_mul(robots), 1, modules, objects, items)
                 }
             }
@@ -352,7 +352,7 @@ fn check_memory_within(
             let stage = &program.stages[biggest];
             // What to make smaller: a team's robots too (every robot of its
             // best's episode is recorded).
-            let robots = if stage.world.robots > 1 { ", the number of robots" } else { "" };
+            let robots = if stage.robots() > 1 { ", the number of robots" } else { "" };
             let what = match stage.run {
                 StageRun::Evolve(_) => format!("the population, the genome{robots} or the number of actions"),
                 StageRun::Test { .. } => format!("the number of lives{robots} or of actions"),
@@ -387,7 +387,7 @@ fn check_recording_within(
 ) -> Result<()> {
     let (objects, items) = world_size(&stage.world);
     // A team's every robot is recorded.
-    let recorded = u64::from(actions).saturating_mul(u64::from(stage.world.robots.max(1)));
+    let recorded = u64::from(actions).saturating_mul(u64::from(stage.robots()));
     let need = recording_bytes(recorded, 1, stage.modules.len() as u64, objects, items);
     match available {
         Some(have) if need > have.bytes => {

@@ -80,7 +80,7 @@ pub fn in_named_variant(stage: &Stage, name: &str) -> Result<Stage, Error> {
 
 /// Refuses `--robot N` of a stage whose team has no robot `N`.
 fn check_robot(stage: &Stage, robot: u32) -> Result<(), Error> {
-    let robots = stage.world.robots.max(1);
+    let robots = stage.robots();
     if robot < robots {
         return Ok(());
     }

@@ -688,16 +688,10 @@ fn put_evolve(s: &mut Stage, rest: &str, path: &str, value: &Value) -> Result<()
     Ok(())
 }
 
-/// Writes `value` into the robots of role `r` of stage `s`, and the team
-/// it makes into every world of the stage.
+/// Writes `value` into the robots of role `r` of stage `s` (and the team
+/// it makes into every world of the stage).
 fn put_role_robots(s: &mut Stage, r: usize, value: &Value) -> Result<(), String> {
-    s.roles[r].robots = value.whole()?;
-    // The team is its roles' robots, in every world.
-    let robots = s.roles.iter().map(|r| r.robots).sum();
-    s.world.robots = robots;
-    for x in s.variants.iter_mut().flat_map(|v| v.list.iter_mut()) {
-        x.world.robots = robots;
-    }
+    s.set_role_robots(r, value.whole()?);
     Ok(())
 }
 

@@ -158,6 +158,31 @@ pub enum ItemKind {
 }
 
 impl Stage {
+    /// The team's size: its roles' robots, or without roles the world's
+    /// `robots` (at least 1). Read this, not `world.robots`: with roles,
+    /// the roles are the truth and every world's count is derived from
+    /// them ([`Stage::set_role_robots`]).
+    pub fn robots(&self) -> u32 {
+        if self.roles.is_empty() {
+            self.world.robots.max(1)
+        } else {
+            self.roles.iter().fold(0u32, |n, r| n.saturating_add(r.robots))
+        }
+    }
+
+    /// Sets how many robots play role `role`, and derives from the roles
+    /// the team of every world of the stage (its own and its variants').
+    pub fn set_role_robots(&mut self, role: usize, robots: u32) {
+        if let Some(r) = self.roles.get_mut(role) {
+            r.robots = robots;
+        }
+        let team = self.robots();
+        self.world.robots = team;
+        for x in self.variants.iter_mut().flat_map(|v| v.list.iter_mut()) {
+            x.world.robots = team;
+        }
+    }
+
     /// The number of worlds an individual is evaluated in: its variants, or 1.
     pub fn variant_count(&self) -> usize {
         self.variants.as_ref().map_or(1, |v| v.list.len().max(1))
@@ -259,7 +284,12 @@ pub struct World {
     pub items: Items,
     /// Robots in the world: a team of clones of the evaluated individual,
     /// each with its own controller, battery and gripper, all starting in
-    /// the start region (left out of files while 1, one robot).
+    /// the start region (left out of files while 1, one robot). In a stage
+    /// with roles it is derived from them (the compiler and
+    /// [`Stage::set_role_robots`] write it; validation refuses a file where
+    /// it differs): the simulator reads a world without its stage, and
+    /// `program.json` keeps the key so that its bytes stay as they were.
+    /// A stage's team is [`Stage::robots`].
     #[serde(default = "one_robot", skip_serializing_if = "is_one_robot")]
     pub robots: u32,
 }

@@ -421,6 +421,21 @@ fn each_robot_runs_its_roles_modules() {
 }
 
 #[test]
+fn a_teams_size_is_derived_from_its_roles() {
+    let mut stage = two_roles();
+    assert_eq!(stage.robots(), stage.roles.iter().map(|r| r.robots).sum::<u32>());
+    stage.set_role_robots(1, 5);
+    assert_eq!(stage.roles[1].robots, 5);
+    assert_eq!(stage.robots(), stage.roles[0].robots + 5);
+    assert_eq!(stage.world.robots, stage.robots(), "the world's team follows the roles");
+    shaping_runtime::validate::stage(&stage).expect("the roles and the world agree");
+    // Without roles, the world says.
+    stage.roles.clear();
+    stage.world.robots = 0;
+    assert_eq!(stage.robots(), 1, "at least one robot");
+}
+
+#[test]
 fn a_roles_genes_are_its_own() {
     let stage = two_roles();
     let opts = EpisodeOptions { actions: 60, learning: true, seed: 3 };

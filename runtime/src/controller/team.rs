@@ -91,7 +91,7 @@ impl<'s> TeamRun<'s> {
     /// `i`'s controller has the random stream of seed [`robot_seed`]`(seed, i)`.
     pub fn new(stage: &'s Stage, genome: &Genome, seed: u64) -> Result<TeamRun<'s>, ControllerError> {
         let mut run = TeamRun { stage, genome: genome.clone(), seed, ctls: Vec::new() };
-        run.grow(stage.world.robots.max(1) as usize)?;
+        run.grow(stage.robots() as usize)?;
         Ok(run)
     }
 

@@ -28,10 +28,10 @@ use crate::sim::{Pose, Sim};
 /// objects, and the two would disagree).
 pub fn unfit_for_robot(stage: &Stage) -> Option<String> {
     let name = &stage.name;
-    if stage.world.robots > 1 {
+    if stage.robots() > 1 {
         return Some(format!(
             "stage `{name}` has a team of {} robots; the robot link drives one robot on one serial port (`robots 1`, the default)",
-            stage.world.robots
+            stage.robots()
         ));
     }
     if stage.world.objects.as_ref().is_some_and(|o| !o.virtual_ && o.count > 0) {
