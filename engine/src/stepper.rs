@@ -200,16 +200,16 @@ pub fn check_team(stage: &Stage) -> Result<(), Error> {
 /// team's, decided here and nowhere else (as `episode_with` decides a
 /// run's). One robot reads the team state of a team of one.
 enum Bodies {
-    Solo(Sim),
-    Team(Team),
+    Solo(Box<Sim>),
+    Team(Box<Team>),
 }
 
 impl Bodies {
     fn new(world: &World, seed: u64) -> Bodies {
         if world.robots > 1 {
-            Bodies::Team(Team::new(world, seed))
+            Bodies::Team(Box::new(Team::new(world, seed)))
         } else {
-            Bodies::Solo(Sim::new(world, seed))
+            Bodies::Solo(Box::new(Sim::new(world, seed)))
         }
     }
 

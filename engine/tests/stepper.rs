@@ -324,16 +324,16 @@ fn a_team_s_rewards_add_up_to_each_robot_s_fitness_in_its_episode() {
                     assert_eq!(s.truncated, a == 399, "{file}: action {a}");
                 }
             }
-            for i in 0..n {
-                let want = result.robots[i].fitness;
+            for (i, (total, robot)) in totals.iter().zip(&result.robots).enumerate() {
+                let want = robot.fitness;
                 assert!(
-                    (totals[i] - f64::from(want)).abs() < 1e-4,
-                    "{file}, seed {seed}, robot {i}: rewards {} against the run's {want}",
-                    totals[i]
+                    (total - f64::from(want)).abs() < 1e-4,
+                    "{file}, seed {seed}, robot {i}: rewards {total} against the run's {want}"
                 );
                 assert_eq!(env.pose(i), team.sim(i).pose(), "{file}: robot {i}");
-                assert_eq!(env.descriptors(i), result.robots[i].descriptors, "{file}: robot {i}");
+                assert_eq!(env.descriptors(i), robot.descriptors, "{file}: robot {i}");
             }
+            assert_eq!(result.robots.len(), n);
             assert!(env.ended(0) && env.ended(9));
             // The team's life has ended: a further step is refused.
             let err = env.step(&vec![0.0; n * dims], &mut obs).unwrap_err();
