@@ -15,8 +15,17 @@ R2 ``vec_env_vs_bench``: environment steps per second of
 controller actions per second that ``shaping bench`` measures for that
 stage (one thread).
 
-Rounds alternate between the two sides; the medians are compared. The last
-line is one JSON object with both ratios (goals: R1 >= 0.9, R2 >= 0.5).
+R3 ``parallel_env_vs_bench``: robot-steps per second of a team of 100
+robots of ``examples/aggregation.bat`` (its arena 4,900 mm square, 490 mm
+times the square root of the robots) stepped by
+``shaping.gym.make_parallel_vec(..., num_envs=1, jobs=1)`` with random
+actions drawn with numpy (no Python per robot), divided by the
+``robot_steps_per_sec`` that ``shaping bench`` measures for the same team
+(``--set``, one thread).
+
+Rounds alternate between the sides; the medians are compared. The last
+line is one JSON object with the ratios (goals: R1 >= 0.9, R2 >= 0.5,
+R3 >= 0.5).
 The ``shaping`` binary is SHAPING_BIN, else target/release/shaping, else
 ``shaping`` on PATH; build it with ``cargo build --release``.
 """
@@ -97,6 +106,29 @@ def bench_rate(cli: str) -> tuple[float, dict]:
     return float(line["controller_actions_per_sec"]), line
 
 
+AGGREGATION = ROOT / "examples" / "aggregation.bat"
+TEAM = 100
+TEAM_ARENA = 4900
+
+
+def team_env_rate(envs, steps: int, rng) -> float:
+    low, high = envs.single_action_space.low, envs.single_action_space.high
+    shape = (envs.num_envs, len(envs.agents), len(low))
+    t = time.perf_counter()
+    for _ in range(steps):
+        envs.step(rng.uniform(low, high, size=shape).astype(np.float32))
+    return steps * envs.num_envs * len(envs.agents) / (time.perf_counter() - t)
+
+
+def team_bench_rate(cli: str) -> float:
+    sets = [f"aggregate.world.robots={TEAM}", f"aggregate.world.arena={TEAM_ARENA}x{TEAM_ARENA}"]
+    args = [cli, "bench", str(AGGREGATION), "--stage", "aggregate", "--runs", "3"]
+    for x in sets:
+        args += ["--set", x]
+    out = subprocess.run(args, capture_output=True, text=True, check=True)
+    return float(json.loads(out.stdout.strip().splitlines()[-1])["robot_steps_per_sec"])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rounds", type=int, default=5)
@@ -115,7 +147,20 @@ def main() -> None:
     rng = np.random.default_rng(0)
     vec_env_rate(envs, 20, rng)
 
-    rates = {"evaluate": [], "run": [], "vec_env": [], "bench": []}
+    # The same team as the bench's: the file with 100 robots in a 4,900 mm arena.
+    team_dir = tempfile.TemporaryDirectory()
+    team_file = Path(team_dir.name) / "aggregation-100.bat"
+    text = AGGREGATION.read_text()
+    text = text.replace("robots 10\n", f"robots {TEAM}\n").replace(
+        "arena 600mm x 600mm", f"arena {TEAM_ARENA}mm x {TEAM_ARENA}mm"
+    )
+    team_file.write_text(text)
+    teams = shaping.gym.make_parallel_vec(team_file, "aggregate", num_envs=1, jobs=1)
+    assert len(teams.agents) == TEAM
+    teams.reset(seed=0)
+    team_env_rate(teams, 5, rng)
+
+    rates = {"evaluate": [], "run": [], "vec_env": [], "bench": [], "team_env": [], "team_bench": []}
     last_bench = {}
     for r in range(args.rounds):
         rates["run"].append(run_rate(RUN_POPULATION, args.jobs, evaluator.episodes))
@@ -123,9 +168,12 @@ def main() -> None:
         rate, last_bench = bench_rate(cli)
         rates["bench"].append(rate)
         rates["vec_env"].append(vec_env_rate(envs, 300, rng))
+        rates["team_bench"].append(team_bench_rate(cli))
+        rates["team_env"].append(team_env_rate(teams, 300, rng))
         print(
             f"round {r + 1}: evaluate {rates['evaluate'][-1]:,.0f} episodes/s, run {rates['run'][-1]:,.0f}; "
-            f"vec env {rates['vec_env'][-1]:,.0f} steps/s, bench {rates['bench'][-1]:,.0f} actions/s",
+            f"vec env {rates['vec_env'][-1]:,.0f} steps/s, bench {rates['bench'][-1]:,.0f} actions/s; "
+            f"team env {rates['team_env'][-1]:,.0f} robot-steps/s, bench {rates['team_bench'][-1]:,.0f}",
             flush=True,
         )
     med = {k: statistics.median(v) for k, v in rates.items()}
@@ -133,13 +181,17 @@ def main() -> None:
         f"medians over {args.rounds} rounds: evaluate {med['evaluate']:,.0f} and run {med['run']:,.0f} "
         f"episodes/s ({evaluator.episodes} per individual, jobs {args.jobs or 'all cores'}); "
         f"make_vec(num_envs=1024, jobs=1) {med['vec_env']:,.0f} steps/s and shaping bench "
-        f"{med['bench']:,.0f} controller actions/s (sim_moving_share {last_bench.get('sim_moving_share')})"
+        f"{med['bench']:,.0f} controller actions/s (sim_moving_share {last_bench.get('sim_moving_share')}); "
+        f"make_parallel_vec({TEAM} robots, num_envs=1, jobs=1) {med['team_env']:,.0f} robot-steps/s and "
+        f"shaping bench {med['team_bench']:,.0f} robot-steps/s"
     )
+    team_dir.cleanup()
     print(
         json.dumps(
             {
                 "evaluate_vs_run": round(med["evaluate"] / med["run"], 3),
                 "vec_env_vs_bench": round(med["vec_env"] / med["bench"], 3),
+                "parallel_env_vs_bench": round(med["team_env"] / med["team_bench"], 3),
             }
         )
     )

@@ -25,6 +25,7 @@ pub mod syntax;
 
 pub use diag::{Diagnostics, Error};
 pub use layout::{layout_rows, module_label, render_graph, render_layout, role_text, LayoutRow};
+pub use lower::measure;
 pub use shaping_runtime::program::Program;
 
 /// Compiles the source of one architecture file. `file_name` names the

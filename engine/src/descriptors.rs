@@ -15,8 +15,11 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use shaping_runtime::controller::{run_episode, EpisodeOptions, EpisodeResult};
+use shaping_runtime::controller::{
+    run_episode, run_team_episode_measured, EpisodeOptions, EpisodeResult, TeamResult,
+};
 use shaping_runtime::evolve::{seed, Episode, Evaluation, Events};
+use shaping_runtime::expr::Expr;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Stage, StageRun};
 pub use shaping_runtime::state::{Descriptors, SQUARE_MM};
@@ -31,12 +34,77 @@ pub fn episode(stage: &Stage, genome: &Genome, opts: &EpisodeOptions) -> (Episod
 
 /// What one individual's evaluation produced: its [`Evaluation`] as a run
 /// computes it, the collisions (summed over its episodes, like the events)
-/// and its [`Descriptors`].
+/// and its [`Descriptors`] (of a team: robot 0's), and each robot's own.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Described {
     pub evaluation: Evaluation,
     pub collisions: u32,
     pub descriptors: Descriptors,
+    /// Each robot's, robot 0's first (one for a single robot).
+    pub robots: Vec<Robot>,
+}
+
+/// What one robot of an individual's team did over the individual's
+/// episodes, combined as the team's are: its own fitness (the mean), its
+/// events and collisions (summed), its final pose (the last episode's),
+/// its path length and squares visited (the means), and the value of each
+/// measure at the end of its lives ([`evaluate_measured`], the mean).
+/// A robot that a variant's world lacks counts only the episodes it was in.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Robot {
+    pub fitness: f32,
+    pub events: Events,
+    pub collisions: u32,
+    pub descriptors: Descriptors,
+    pub measures: Vec<f32>,
+}
+
+/// A robot's sums over the episodes it was in, for [`Robot`].
+#[derive(Clone, Debug, Default)]
+struct RobotSums {
+    episodes: u32,
+    fitness: f64,
+    events: Events,
+    collisions: u32,
+    last: Descriptors,
+    path: f64,
+    squares: f64,
+    measures: Vec<f64>,
+}
+
+impl RobotSums {
+    fn add(&mut self, r: &EpisodeResult, measures: impl Iterator<Item = f32>) {
+        self.episodes += 1;
+        self.fitness += f64::from(r.fitness);
+        self.events.grips = self.events.grips.saturating_add(r.grips);
+        self.events.releases_outside = self.events.releases_outside.saturating_add(r.releases_outside);
+        self.events.recharges = self.events.recharges.saturating_add(r.recharges);
+        self.collisions = self.collisions.saturating_add(r.collisions);
+        self.last = r.descriptors;
+        self.path += f64::from(r.descriptors.path_length);
+        self.squares += f64::from(r.descriptors.squares_visited);
+        for (k, v) in measures.enumerate() {
+            if let Some(m) = self.measures.get_mut(k) {
+                *m += f64::from(v);
+            }
+        }
+    }
+
+    fn robot(&self) -> Robot {
+        let n = f64::from(self.episodes.max(1));
+        let mean = |v: f64| if self.episodes == 0 { f32::NAN } else { (v / n) as f32 };
+        Robot {
+            fitness: mean(self.fitness),
+            events: self.events,
+            collisions: self.collisions,
+            descriptors: Descriptors {
+                path_length: mean(self.path),
+                squares_visited: mean(self.squares),
+                ..self.last
+            },
+            measures: self.measures.iter().map(|&m| mean(m)).collect(),
+        }
+    }
 }
 
 /// The episodes of individual `individual` of generation
@@ -92,7 +160,22 @@ pub fn evaluate_unless(
     episodes: &[Episode],
     stop: &AtomicBool,
 ) -> Option<Described> {
+    evaluate_measured(stage, genome, episodes, &[], stop)
+}
+
+/// [`evaluate_unless`], and each robot's value of each of `measures`
+/// (expressions a fitness `at end` may be, read at the end of each of its
+/// lives as that term is: [`Robot::measures`], in order). The measures
+/// change nothing else of the evaluation.
+pub fn evaluate_measured(
+    stage: &Stage,
+    genome: &Genome,
+    episodes: &[Episode],
+    measures: &[Expr],
+    stop: &AtomicBool,
+) -> Option<Described> {
     let actions = actions(stage);
+    let mut robots: Vec<RobotSums> = Vec::new();
     let mut sum = 0.0f64;
     let mut events = Events::default();
     let (mut collisions, mut placement_failures) = (0u32, 0u32);
@@ -109,7 +192,21 @@ pub fn evaluate_unless(
         let Some(world) = worlds.stage(e) else {
             return Some(Described { evaluation: Evaluation::not_run(), ..Described::default() });
         };
-        let (r, d) = episode(world, genome, &EpisodeOptions { actions, learning: true, seed: e.seed });
+        let opts = EpisodeOptions { actions, learning: true, seed: e.seed };
+        let (team, values) = match run_team_episode_measured(world, genome, &opts, measures, || false) {
+            Ok(Some((t, v))) => (t, v),
+            // As `run_episode`: an empty result.
+            _ => (TeamResult::default(), Vec::new()),
+        };
+        for (i, robot) in team.robots.iter().enumerate() {
+            if robots.len() <= i {
+                robots
+                    .resize(i + 1, RobotSums { measures: vec![0.0; measures.len()], ..RobotSums::default() });
+            }
+            robots[i].add(robot, values.iter().map(|v| v.get(i).copied().unwrap_or(f32::NAN)));
+        }
+        let r = team.team;
+        let d = r.descriptors;
         sum += f64::from(r.fitness);
         if let Some(p) = e.variant.and_then(|v| per.get_mut(v)) {
             p.0 += f64::from(r.fitness);
@@ -141,6 +238,7 @@ pub fn evaluate_unless(
             squares_visited: (squares / n) as f32,
             ..last
         },
+        robots: robots.iter().map(RobotSums::robot).collect(),
     })
 }
 
@@ -192,6 +290,51 @@ mod tests {
             assert!(p.path_length >= 0.0 && p.squares_visited >= 1.0);
             // Deterministic.
             assert_eq!(evaluate(stage, &genome, &[Episode::plain(s)]), d);
+        }
+    }
+
+    /// A team: robot 0's descriptors are the team's, the robots' events
+    /// add up to the team's, each robot's fitness is its own (the team's is
+    /// their mean), and measures read what the fitness reads: `robot.x`
+    /// each robot's final x, the fitness's own expression its fitness.
+    #[test]
+    fn a_team_s_robots_are_described_and_measured() {
+        let src =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/aggregation.bat"))
+                .unwrap();
+        let program = shaping_compiler::compile(&src, "aggregation.bat").unwrap();
+        let mut stage = program.stages[0].clone();
+        let exprs: Vec<Expr> = ["robot.x", "1 - team.spread / 400", "robot.distance", "team.order"]
+            .iter()
+            .map(|t| shaping_compiler::measure(&mut stage, "measure", t).unwrap())
+            .collect();
+        for k in 0..3 {
+            let genome = random_genome(stage.layout.bits, k);
+            let s = episodes(&stage, 0, 9, 0, k as usize);
+            assert_eq!(s.len(), 3);
+            let plain = evaluate(&stage, &genome, &s);
+            let d = evaluate_measured(&stage, &genome, &s, &exprs, &AtomicBool::new(false)).unwrap();
+            // Measures change nothing else.
+            assert_eq!(d.evaluation, plain.evaluation);
+            assert_eq!(d.robots.len(), 10);
+            assert_eq!(d.robots[0].descriptors, d.descriptors);
+            let collisions: u32 = d.robots.iter().map(|r| r.collisions).sum();
+            assert_eq!(collisions, d.collisions);
+            let mean = d.robots.iter().map(|r| f64::from(r.fitness)).sum::<f64>() / 10.0;
+            assert!((mean - f64::from(d.evaluation.fitness)).abs() < 1e-4, "{mean} {:?}", d.evaluation);
+            // The final x is the last episode's, a measure the mean of its episodes'.
+            let last = evaluate_measured(&stage, &genome, &s[2..], &exprs, &AtomicBool::new(false)).unwrap();
+            for r in &last.robots {
+                assert_eq!(r.measures[0], r.descriptors.x, "{r:?}");
+            }
+            for (r, l) in d.robots.iter().zip(&last.robots) {
+                assert_eq!(r.descriptors.x, l.descriptors.x);
+                assert!((r.measures[1] - r.fitness).abs() < 1e-5, "{r:?}");
+                assert!((r.measures[2] - r.descriptors.path_length).abs() < 1e-2, "{r:?}");
+                assert!((0.0..=1.0).contains(&r.measures[3]));
+                // Every robot reads the team's terms alike.
+                assert_eq!(r.measures[3], d.robots[0].measures[3]);
+            }
         }
     }
 

@@ -230,3 +230,222 @@ fn a_stepper_refuses_a_team() {
     program.stages[nav].world.robots = 1;
     assert!(Stepper::new(stage(&program, "navigation")).is_ok());
 }
+
+fn example(file: &str) -> Program {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples").join(file);
+    let (mut program, _) =
+        shaping_engine::load::load_program(&path, shaping_engine::diag::ErrorFormat::Plain).unwrap();
+    let seed = shaping_engine::run::run_seed(&program, None);
+    shaping_engine::run::bind_training(&mut program, None, seed, &shaping_engine::run::Silent).unwrap();
+    program
+}
+
+/// Every robot's commands of a team's life, action by action.
+struct Commands(Vec<Vec<Command>>);
+
+impl<'s, B: shaping_runtime::controller::Bodies> shaping_runtime::controller::Hooks<'s, B> for Commands {
+    fn acted(
+        &mut self,
+        i: usize,
+        _: &Controller<'s>,
+        report: &shaping_runtime::controller::ActionReport,
+        _: Option<&shaping_runtime::controller::TraceRow>,
+        _: &B::Member<'_>,
+    ) {
+        if i == 0 {
+            self.0.push(Vec::new());
+        }
+        if let Some(a) = self.0.last_mut() {
+            a.push(report.command);
+        }
+    }
+}
+
+/// A team's life driven from outside: given the commands a run's
+/// controllers gave, each robot's rewards add up to its fitness in the
+/// run's episode, and the team stepper's robots end where the run's do.
+#[test]
+fn a_team_s_rewards_add_up_to_each_robot_s_fitness_in_its_episode() {
+    use shaping_engine::stepper::TeamStepper;
+    use shaping_runtime::controller::{TeamBodies, TeamRun};
+    for (file, names) in [
+        ("aggregation.bat", vec!["robot_0", "robot_9"]),
+        ("aggregation-roles.bat", vec!["first_0", "second_4"]),
+        ("aggregation-rab.bat", vec!["robot_0", "robot_9"]),
+    ] {
+        let program = example(file);
+        let st = stage(&program, "aggregate");
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for seed in [3u64, 8] {
+            let genome = shaping_runtime::genome::Genome {
+                bits: (0..st.layout.bits).map(|_| rng.random_range(0..2u8)).collect(),
+            };
+            let opts = EpisodeOptions { actions: 400, learning: true, seed };
+            let mut run = TeamRun::new(&st, &genome, seed).unwrap();
+            let mut team = shaping_runtime::sim::Team::new(&st.world, seed);
+            let mut commands = Commands(Vec::new());
+            let result = run.run_in(&mut TeamBodies { team: &mut team }, &opts, None, &mut commands);
+            assert_eq!(commands.0.len(), 400, "{file}");
+
+            let mut env = TeamStepper::new(st.clone()).unwrap();
+            let n = env.robots();
+            assert_eq!(n, 10);
+            assert_eq!(env.names()[0], names[0]);
+            assert_eq!(env.names()[9], names[1]);
+            let dims = env.spaces().controls.len();
+            let width = env.spaces().channels.len();
+            let mut obs = vec![0.0; n * width];
+            env.reset(seed, &mut obs);
+            let mut totals = vec![0.0f64; n];
+            // An agent sets its broadcast at every action; a controller's
+            // command that leaves it alone keeps the last one.
+            let mut broadcast = vec![[0.0f32; shaping_runtime::catalog::SIGNALS]; n];
+            for (a, cmds) in commands.0.iter().enumerate() {
+                let mut actions = vec![0.0f32; n * dims];
+                for (i, c) in cmds.iter().enumerate() {
+                    if let Some(s) = c.signal {
+                        broadcast[i] = s;
+                    }
+                    let row = &mut actions[i * dims..(i + 1) * dims];
+                    for (k, name) in env.spaces().action.clone().iter().enumerate() {
+                        row[k] = match name.as_str() {
+                            "wheels[0]" => c.wheels[0],
+                            "wheels[1]" => c.wheels[1],
+                            other => {
+                                let k = other.trim_start_matches("signal[").trim_end_matches(']');
+                                broadcast[i][k.parse::<usize>().unwrap()]
+                            }
+                        };
+                    }
+                }
+                let steps = env.step(&actions, &mut obs).unwrap().to_vec();
+                for (t, s) in totals.iter_mut().zip(&steps) {
+                    *t += f64::from(s.reward);
+                    assert_eq!(s.truncated, a == 399, "{file}: action {a}");
+                }
+            }
+            for (i, (total, robot)) in totals.iter().zip(&result.robots).enumerate() {
+                let want = robot.fitness;
+                assert!(
+                    (total - f64::from(want)).abs() < 1e-4,
+                    "{file}, seed {seed}, robot {i}: rewards {total} against the run's {want}"
+                );
+                assert_eq!(env.pose(i), team.sim(i).pose(), "{file}: robot {i}");
+                assert_eq!(env.descriptors(i), robot.descriptors, "{file}: robot {i}");
+            }
+            assert_eq!(result.robots.len(), n);
+            assert!(env.ended(0) && env.ended(9));
+            // The team's life has ended: a further step is refused.
+            let err = env.step(&vec![0.0; n * dims], &mut obs).unwrap_err();
+            assert!(err.message().contains("reset"), "{}", err.message());
+        }
+    }
+}
+
+/// A team stepper refuses a stage of one robot (naming the one-robot
+/// stepper), and a malformed row of one robot, naming its agent and the
+/// element, moving no robot.
+#[test]
+fn a_team_stepper_refuses_one_robot_and_bad_rows() {
+    use shaping_engine::stepper::TeamStepper;
+    let program = khepera();
+    let err = TeamStepper::new(stage(&program, "navigation")).err().expect("one robot is refused");
+    assert_eq!(err.kind(), ErrorKind::Invalid);
+    assert!(err.message().contains("`navigation` has one robot"), "{err}");
+    assert!(err.message().contains("shaping.gym.make"), "{err}");
+    let program = example("aggregation-roles.bat");
+    let mut env = TeamStepper::new(stage(&program, "aggregate")).unwrap();
+    let (n, dims, width) = (env.robots(), env.spaces().controls.len(), env.spaces().channels.len());
+    let mut obs = vec![0.0; n * width];
+    let err = env.step(&vec![0.0; n * dims], &mut obs).unwrap_err();
+    assert!(err.message().contains("reset"), "{err}");
+    env.reset(1, &mut obs);
+    let first = obs.clone();
+    let mut actions = vec![0.0; n * dims];
+    actions[6 * dims + 1] = -1.5;
+    let err = env.step(&actions, &mut obs).unwrap_err();
+    assert!(err.message().contains("`second_1` (robot 6)"), "{err}");
+    assert!(err.message().contains("(`wheels[1]`) is -1.5, outside -1..1"), "{err}");
+    assert_eq!(obs, first);
+    assert_eq!(env.actions(), 0);
+    let err = env.step(&[0.0; 3], &mut obs).unwrap_err();
+    assert!(err.message().contains("10 rows (one per robot) of 2"), "{err}");
+    env.keep_path(true);
+    env.reset(1, &mut obs);
+    env.step(&vec![0.5; n * dims], &mut obs).unwrap();
+    let picture = env.picture().unwrap();
+    assert_eq!(picture.others.len(), 9);
+    assert_eq!(picture.path.len(), 2);
+    assert_eq!(picture.roles.len(), 2);
+}
+
+/// Worlds of a team stepped together: each world is the team stepper of
+/// its stream's episode seed, whatever the threads; a world whose team's
+/// life ended starts again on the next step; a bad row names its world
+/// and agent.
+#[test]
+fn teams_stepped_together_are_each_a_team_stepper() {
+    use rand::RngCore;
+    use shaping_engine::stepper::{TeamStepper, VecTeamStepper};
+    let program = example("aggregation-rab.bat");
+    let st = stage(&program, "aggregate");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut envs = VecTeamStepper::new(st.clone(), 3).unwrap();
+            let (robots, dims) = (envs.robots(), envs.spaces().controls.len());
+            let mut rng = ChaCha8Rng::seed_from_u64(2);
+            let mut out = VecStep::default();
+            envs.reset(7, &mut out);
+            let mut all = vec![out.clone()];
+            let mut actions = Vec::new();
+            for _ in 0..402 {
+                let a: Vec<f32> = (0..3 * robots * dims)
+                    .map(|i| {
+                        if i % dims < 2 {
+                            rng.random_range(-1.0..=1.0)
+                        } else {
+                            rng.random_range(0.0..=1.0)
+                        }
+                    })
+                    .collect();
+                envs.step(&a, &mut out).unwrap();
+                all.push(out.clone());
+                actions.push(a);
+            }
+            (all, actions)
+        })
+    };
+    let (one, actions) = run(1);
+    assert_eq!(one, run(2).0);
+    let robots = 10;
+    let (dims, width) = (3, TeamStepper::new(st.clone()).unwrap().spaces().channels.len());
+    for w in 0..3 {
+        let mut seeds = ChaCha8Rng::seed_from_u64(7);
+        seeds.set_stream(w as u64);
+        let mut env = TeamStepper::new(st.clone()).unwrap();
+        let mut obs = vec![0.0; robots * width];
+        env.reset(seeds.next_u64(), &mut obs);
+        let rows = |v: &VecStep| v.observations[w * robots * width..(w + 1) * robots * width].to_vec();
+        assert_eq!(rows(&one[0]), obs);
+        for (s, a) in actions.iter().enumerate().take(400) {
+            let steps = env.step(&a[w * robots * dims..(w + 1) * robots * dims], &mut obs).unwrap().to_vec();
+            assert_eq!(rows(&one[s + 1]), obs, "world {w}, step {s}");
+            let rewards: Vec<f32> = steps.iter().map(|x| x.reward).collect();
+            assert_eq!(one[s + 1].rewards[w * robots..(w + 1) * robots], rewards[..]);
+        }
+        assert!(one[400].truncated[w * robots..(w + 1) * robots].iter().all(|&t| t));
+        // The step after: a new life, in the world of the stream's next seed.
+        env.reset(seeds.next_u64(), &mut obs);
+        assert_eq!(rows(&one[401]), obs);
+        assert!(one[401].rewards[w * robots..(w + 1) * robots].iter().all(|&r| r == 0.0));
+    }
+    let mut envs = VecTeamStepper::new(st, 2).unwrap();
+    let mut out = VecStep::default();
+    envs.reset(0, &mut out);
+    let mut a = vec![0.0; 2 * robots * dims];
+    a[(robots + 4) * dims + 2] = 1.2;
+    let err = envs.step(&a, &mut out).unwrap_err();
+    assert!(err.message().contains("world 1, the action of `robot_4` (robot 4)"), "{err}");
+    assert!(err.message().contains("(`signal[0]`) is 1.2"), "{err}");
+}

@@ -428,15 +428,17 @@ fn load(py: Python<'_>, path: &Path) -> PyResult<Compiled> {
             }
             Ok(program)
         }
-        Err(e) => {
-            let err = shaping_error(py, &e);
-            if let Some(d) = e.diagnosed() {
-                let _ =
-                    err.value(py).setattr("diagnostics", diagnostics_from(d, &path.display().to_string()));
-            }
-            Err(err)
-        }
+        Err(e) => Err(compile_error(py, &e, &path.display().to_string())),
     }
+}
+
+/// The `CompileError` of diagnostics about `file`, with its `diagnostics`.
+fn compile_error(py: Python<'_>, e: &shaping_engine::Error, file: &str) -> PyErr {
+    let err = shaping_error(py, e);
+    if let Some(d) = e.diagnosed() {
+        let _ = err.value(py).setattr("diagnostics", diagnostics_from(d, file));
+    }
+    err
 }
 
 #[pymethods]
@@ -739,6 +741,77 @@ fn genomes_of(genomes: &Bound<'_, PyAny>, bits: usize, what: &str) -> PyResult<V
     )))
 }
 
+/// The most robots of a stage's team, its variants' included.
+fn team_size(stage: &shaping_runtime::program::Stage) -> usize {
+    let variants = stage.variants.iter().flat_map(|v| &v.list).map(|v| v.world.robots);
+    variants.chain([stage.world.robots]).max().unwrap_or(1).max(1) as usize
+}
+
+/// Whether a measure reads anything of a robot's own (a sensor, an
+/// actuator, `robot.x`, `distance_to(...)`) rather than only the team's
+/// terms (`team.spread` ...), which every robot reads alike.
+fn per_robot(e: &shaping_runtime::expr::Expr) -> bool {
+    use shaping_runtime::expr::Op;
+    use shaping_runtime::state::{ST_SPREAD, TEAM_SLOTS};
+    e.ops.iter().any(|op| match *op {
+        Op::Chan(_) | Op::Prev(_) | Op::Act(_) => true,
+        Op::State(s) => !(ST_SPREAD..ST_SPREAD + TEAM_SLOTS).contains(&usize::from(s)),
+        _ => false,
+    })
+}
+
+/// An array of shape (n, team) of `f` of each individual's robots.
+fn columns<'py, T: numpy::Element + Copy>(
+    py: Python<'py>,
+    results: &[Described],
+    team: usize,
+    f: &dyn Fn(&Described, usize) -> T,
+) -> PyResult<Bound<'py, numpy::PyArray2<T>>> {
+    let flat: Vec<T> = results.iter().flat_map(|d| (0..team).map(move |i| f(d, i))).collect();
+    PyArray1::from_vec(py, flat).reshape([results.len(), team])
+}
+
+/// `evaluate`'s `robots`: each robot's descriptors, events and fitness,
+/// arrays of shape (n, team) (a robot an individual's episodes lacked:
+/// NaN, and 0 events).
+fn robot_arrays<'py>(py: Python<'py>, results: &[Described], team: usize) -> PyResult<Bound<'py, PyDict>> {
+    use descriptors::Robot;
+    let out = PyDict::new(py);
+    type Column<T> = (&'static str, fn(&Robot) -> T);
+    let floats: [Column<f32>; 6] = [
+        ("fitness", |r| r.fitness),
+        ("x", |r| r.descriptors.x),
+        ("y", |r| r.descriptors.y),
+        ("heading", |r| r.descriptors.heading),
+        ("path_length", |r| r.descriptors.path_length),
+        ("squares_visited", |r| r.descriptors.squares_visited),
+    ];
+    for (name, f) in floats {
+        out.set_item(name, columns(py, results, team, &|d, i| d.robots.get(i).map_or(f32::NAN, f))?)?;
+    }
+    let counts: [Column<u32>; 4] = [
+        ("recharges", |r| r.events.recharges),
+        ("grips", |r| r.events.grips),
+        ("releases_outside", |r| r.events.releases_outside),
+        ("collisions", |r| r.collisions),
+    ];
+    for (name, f) in counts {
+        out.set_item(name, columns(py, results, team, &|d, i| d.robots.get(i).map_or(0, f))?)?;
+    }
+    Ok(out)
+}
+
+/// The measures of one `evaluate` call: the stage with the targets they
+/// add, their names and their code.
+struct Measures {
+    stage: shaping_runtime::program::Stage,
+    names: Vec<String>,
+    exprs: Vec<shaping_runtime::expr::Expr>,
+}
+
+/// The most measures one call takes.
+const MAX_MEASURES: usize = 256;
+
 /// What an `Evaluator` is pickled as: its program's JSON (the training
 /// stages' weights bound), its stage's index, its seed and its jobs.
 type EvaluatorState = (String, usize, u64, Option<usize>);
@@ -847,19 +920,22 @@ impl Evaluator {
     /// raises ValueError naming the argument; a batch larger than the
     /// memory available, MemoryError. Ctrl-C stops it within about a
     /// second (KeyboardInterrupt; nothing is returned).
-    #[pyo3(signature = (genomes, generation=None, individuals=None))]
+    #[pyo3(signature = (genomes, generation=None, individuals=None, measures=None))]
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
         generation: Option<&Bound<'py, PyAny>>,
         individuals: Option<&Bound<'py, PyAny>>,
+        measures: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let generation = match generation {
             Some(g) if !g.is_none() => count_arg(g, "generation", u64::from(u32::MAX))? as u32,
             _ => 0,
         };
-        let stage = &self.program.stages[self.index];
+        let measured = self.measures(py, measures)?;
+        let stage = measured.as_ref().map_or(&self.program.stages[self.index], |m| &m.stage);
+        let (names, exprs) = measured.as_ref().map_or((&[][..], &[][..]), |m| (&m.names[..], &m.exprs[..]));
         let genomes = genomes_of(genomes, stage.layout.bits as usize, "evaluating")?;
         let individuals = individuals_of(individuals, genomes.len())?;
         let (index, seed) = (self.index, self.seed);
@@ -875,7 +951,7 @@ impl Evaluator {
                     .zip(individuals.par_iter())
                     .map(|(g, &i)| {
                         let episodes = descriptors::episodes(stage, index, seed, generation, i as usize);
-                        descriptors::evaluate_unless(stage, g, &episodes, stop)
+                        descriptors::evaluate_measured(stage, g, &episodes, exprs, stop)
                     })
                     .collect::<Option<Vec<Described>>>()
             })
@@ -901,6 +977,24 @@ impl Evaluator {
             "placement_failures",
             PyArray1::from_vec(py, u32s(&|d| d.evaluation.placement_failures)),
         )?;
+        let team = team_size(stage);
+        if team > 1 {
+            out.set_item("robots", robot_arrays(py, &results, team)?)?;
+        }
+        if !names.is_empty() {
+            let m = PyDict::new(py);
+            for (k, (name, e)) in names.iter().zip(exprs).enumerate() {
+                let value = |d: &Described, i: usize| {
+                    d.robots.get(i).and_then(|r| r.measures.get(k)).copied().unwrap_or(f32::NAN)
+                };
+                if team > 1 && per_robot(e) {
+                    m.set_item(name, columns(py, &results, team, &|d, i| value(d, i))?)?;
+                } else {
+                    m.set_item(name, PyArray1::from_vec(py, f32s(&|d| value(d, 0))))?;
+                }
+            }
+            out.set_item("measures", m)?;
+        }
         Ok(out)
     }
 
@@ -926,6 +1020,45 @@ impl Evaluator {
             self.episodes(),
             self.seed
         )
+    }
+}
+
+impl Evaluator {
+    /// `measures`: None, or a dict of names to expressions, each compiled
+    /// as a fitness `at end` term of the stage (the compiler's lowering); a
+    /// bad expression raises CompileError naming the measure, a bad
+    /// argument ValueError.
+    fn measures(&self, py: Python<'_>, measures: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Measures>> {
+        let Some(measures) = measures.filter(|m| !m.is_none()) else { return Ok(None) };
+        let dict = measures.cast::<PyDict>().map_err(|_| {
+            value_error("error: measures must be a dict of names to expressions, e.g. {\"x\": \"robot.x\"}")
+        })?;
+        if dict.len() > MAX_MEASURES {
+            return Err(value_error(format!(
+                "error: measures holds {} expressions, at most {MAX_MEASURES} are taken in one call",
+                dict.len()
+            )));
+        }
+        let mut stage = self.program.stages[self.index].clone();
+        let (mut names, mut exprs) = (Vec::new(), Vec::new());
+        for (k, v) in dict.iter() {
+            let name: String =
+                k.extract().map_err(|_| value_error("error: measures: the names must be strings"))?;
+            let text: String = v.extract().map_err(|_| {
+                value_error(format!(
+                    "error: measure `{name}` must be an expression as a string (e.g. \"robot.x\")"
+                ))
+            })?;
+            let file = format!("measure {name}");
+            let e = shaping_compiler::measure(&mut stage, &file, &text).map_err(|d| {
+                let trimmed = text.trim();
+                let rendered = shaping_engine::diag::Rendered::new(&d, ErrorFormat::Plain, &file, trimmed);
+                compile_error(py, &shaping_engine::Error::diagnostics(rendered), &file)
+            })?;
+            names.push(name);
+            exprs.push(e);
+        }
+        Ok(Some(Measures { stage, names, exprs }))
     }
 }
 
@@ -1172,13 +1305,149 @@ impl Stepper {
     /// A picture of the world now and the path of the life so far: an
     /// array of shape (height, width, 3) of uint8.
     fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
-        let scene = self.inner.scene().ok_or_else(|| value_error("error: reset before rendering"))?;
-        let picture = shaping_engine::report::picture(&scene, self.inner.path().to_vec());
-        let rgb = py
-            .detach(|| shaping_engine::plot::trajectory_rgb(&picture))
-            .map_err(|e| ShapingError::new_err(format!("error: {e}")))?;
-        let flat = PyArray1::from_vec(py, rgb.pixels);
-        flat.reshape([rgb.height as usize, rgb.width as usize, 3])
+        rgb_of(py, self.inner.picture())
+    }
+}
+
+/// The picture of a stepper's world as an array of shape (height, width, 3).
+fn rgb_of<'py>(
+    py: Python<'py>,
+    picture: Option<shaping_engine::plot::TrajectoryScene>,
+) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+    let picture = picture.ok_or_else(|| value_error("error: reset before rendering"))?;
+    let rgb = py
+        .detach(|| shaping_engine::plot::trajectory_rgb(&picture))
+        .map_err(|e| ShapingError::new_err(format!("error: {e}")))?;
+    let flat = PyArray1::from_vec(py, rgb.pixels);
+    flat.reshape([rgb.height as usize, rgb.width as usize, 3])
+}
+
+/// A stage's team driven one action at a time, every robot in one call
+/// (`shaping.gym.make_parallel` wraps it in a PettingZoo environment).
+#[pyclass(module = "shaping")]
+struct TeamStepper {
+    inner: shaping_engine::stepper::TeamStepper,
+    obs: Vec<f32>,
+}
+
+#[pymethods]
+impl TeamStepper {
+    /// The team of stage `stage` of `program`; `keep_path` keeps every
+    /// robot's poses of each life for `render`. A stage with one robot
+    /// raises ShapingError (step it with `shaping.gym.make`).
+    #[new]
+    #[pyo3(signature = (program, stage, keep_path=false))]
+    fn new(program: &Program, stage: &str, keep_path: bool) -> PyResult<TeamStepper> {
+        let mut inner = shaping_engine::stepper::TeamStepper::new(stepped_stage(program, stage)?)
+            .map_err(|e| Python::attach(|py| shaping_error(py, &e)))?;
+        inner.keep_path(keep_path);
+        let obs = vec![0.0; inner.robots() * inner.spaces().channels.len()];
+        Ok(TeamStepper { inner, obs })
+    }
+
+    /// Each robot's agent name: its role and its index in the role
+    /// (`guard_0`), or `robot_i` without roles.
+    #[getter]
+    fn agents(&self) -> Vec<String> {
+        self.inner.names().to_vec()
+    }
+
+    /// Each robot's role (its index in `Program.roles`; 0 without roles).
+    #[getter]
+    fn roles(&self) -> Vec<usize> {
+        (0..self.inner.robots()).map(|i| self.inner.stage().role_of(i)).collect()
+    }
+
+    /// The names of the observation's elements (every robot's).
+    #[getter]
+    fn observation_names(&self) -> Vec<String> {
+        self.inner.spaces().observation.clone()
+    }
+
+    /// The names of the action's elements (every robot's).
+    #[getter]
+    fn action_names(&self) -> Vec<String> {
+        self.inner.spaces().action.clone()
+    }
+
+    /// The lowest and highest value of each action element.
+    #[getter]
+    fn action_bounds(&self) -> (Vec<f32>, Vec<f32>) {
+        self.inner.spaces().action_bounds()
+    }
+
+    /// The length of a life, in actions.
+    #[getter]
+    fn life(&self) -> u32 {
+        self.inner.life()
+    }
+
+    /// Starts a life of the team in the world of episode seed `seed`;
+    /// returns the observations, shape (robots, observation).
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, numpy::PyArray2<f32>>> {
+        self.inner.reset(seed, &mut self.obs);
+        self.observations(py)
+    }
+
+    /// Runs one action of the team with the GIL released: row i of
+    /// `actions` (float32, shape (robots, action)) is robot i's (ignored
+    /// once its life has ended). Returns the observations, the rewards,
+    /// terminated and truncated (one row or element per robot; those of a
+    /// robot whose life had ended are its last observation, 0, False,
+    /// False) and a dict of the robots' poses and batteries. A malformed
+    /// row raises ValueError naming the agent and the element.
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: numpy::PyReadonlyArray2<'py, f32>,
+    ) -> PyResult<(
+        Bound<'py, numpy::PyArray2<f32>>,
+        Bound<'py, PyArray1<f32>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyDict>,
+    )> {
+        let (n, dims) = (self.inner.robots(), self.inner.spaces().controls.len());
+        if actions.shape() != [n, dims] {
+            return Err(value_error(format!(
+                "error: the actions must be an array of shape ({n}, {dims}) (a row per robot), not {:?}",
+                actions.shape()
+            )));
+        }
+        let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
+        let (inner, obs) = (&mut self.inner, &mut self.obs);
+        py.detach(|| inner.step(flat, obs).map(|_| ())).map_err(|e| invalid(&e))?;
+        let steps = self.inner.steps();
+        let info = PyDict::new(py);
+        let poses: Vec<f32> = (0..n)
+            .flat_map(|i| {
+                let p = self.inner.pose(i);
+                [p.x, p.y, p.theta]
+            })
+            .collect();
+        info.set_item("pose", PyArray1::from_vec(py, poses).reshape([n, 3])?)?;
+        info.set_item("battery", PyArray1::from_vec(py, (0..n).map(|i| self.inner.battery(i)).collect()))?;
+        Ok((
+            self.observations(py)?,
+            PyArray1::from_vec(py, steps.iter().map(|s| s.reward).collect()),
+            PyArray1::from_vec(py, steps.iter().map(|s| s.terminated).collect()),
+            PyArray1::from_vec(py, steps.iter().map(|s| s.truncated).collect()),
+            info,
+        ))
+    }
+
+    /// A picture of the world now and every robot's path of the life so
+    /// far: an array of shape (height, width, 3) of uint8.
+    fn render<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        rgb_of(py, self.inner.picture())
+    }
+}
+
+impl TeamStepper {
+    fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray2<f32>>> {
+        let width = self.inner.spaces().channels.len();
+        PyArray1::from_slice(py, &self.obs).reshape([self.inner.robots(), width])
     }
 }
 
@@ -1205,6 +1474,17 @@ const VEC_ITEM_BYTES: u64 = 64;
 /// The most robots of one `VecStepper` (far beyond what a step's latency allows).
 const MAX_NUM_ENVS: u64 = 1 << 32;
 
+/// The memory one robot of stage `index` takes in a batch of worlds
+/// (`VEC_ROBOT_BYTES`, its rows and its world's items).
+fn vec_robot_bytes(program: &Program, index: usize) -> u64 {
+    let st = &program.program.stages[index];
+    let width = shaping_engine::stepper::Spaces::of(st).channels.len() + 8;
+    let w = &st.world;
+    let items = w.items.walls.len() + w.items.cylinders.len() + w.items.lamps.len() + w.items.zones.len();
+    let objects = w.objects.as_ref().map_or(0, |o| u64::from(o.count));
+    VEC_ROBOT_BYTES + 8 * width as u64 + VEC_ITEM_BYTES * (items as u64 + objects)
+}
+
 #[pymethods]
 impl VecStepper {
     /// `num_envs` robots of stage `stage` of `program`, stepped on `jobs`
@@ -1225,16 +1505,7 @@ impl VecStepper {
         }? as usize;
         let jobs = jobs_arg(jobs)?;
         let index = stage_index(&program.program, stage)?;
-        let per_robot = {
-            let st = &program.program.stages[index];
-            let width = shaping_engine::stepper::Spaces::of(st).channels.len() + 8;
-            let w = &st.world;
-            let items =
-                w.items.walls.len() + w.items.cylinders.len() + w.items.lamps.len() + w.items.zones.len();
-            let objects = w.objects.as_ref().map_or(0, |o| u64::from(o.count));
-            VEC_ROBOT_BYTES + 8 * width as u64 + VEC_ITEM_BYTES * (items as u64 + objects)
-        };
-        let need = (num_envs as u64).saturating_mul(per_robot);
+        let need = (num_envs as u64).saturating_mul(vec_robot_bytes(program, index));
         check_room(need, &format!("stepping {num_envs} robots"), "pass a smaller num_envs")?;
         let pool = Pool::new(jobs)?;
         let inner = shaping_engine::stepper::VecStepper::new(stepped_stage(program, stage)?, num_envs)
@@ -1286,6 +1557,115 @@ impl VecStepper {
             PyArray1::from_slice(py, &self.out.terminated),
             PyArray1::from_slice(py, &self.out.truncated),
         ))
+    }
+}
+
+/// Many worlds of a stage's team stepped together in Rust
+/// (`shaping.gym.make_parallel_vec`).
+#[pyclass(module = "shaping")]
+struct VecTeamStepper {
+    inner: shaping_engine::stepper::VecTeamStepper,
+    out: shaping_engine::stepper::VecStep,
+    pool: Pool,
+}
+
+#[pymethods]
+impl VecTeamStepper {
+    /// `num_envs` worlds of the team of stage `stage` of `program`,
+    /// stepped on `jobs` threads (None: one per core). A `num_envs` that is
+    /// not a positive integer, or a bad `jobs`, raises ValueError; more
+    /// robots than the memory available holds, MemoryError; a stage with
+    /// one robot, ShapingError.
+    #[new]
+    #[pyo3(signature = (program, stage, num_envs, jobs=None))]
+    fn new(
+        program: &Program,
+        stage: &str,
+        num_envs: &Bound<'_, PyAny>,
+        jobs: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<VecTeamStepper> {
+        let num_envs = match count_arg(num_envs, "num_envs", MAX_NUM_ENVS) {
+            Ok(0) => Err(value_error("error: num_envs must be at least 1")),
+            other => other,
+        }? as usize;
+        let jobs = jobs_arg(jobs)?;
+        let index = stage_index(&program.program, stage)?;
+        let robots = u64::from(program.program.stages[index].world.robots.max(1));
+        let need = (num_envs as u64).saturating_mul(robots).saturating_mul(vec_robot_bytes(program, index));
+        check_room(
+            need,
+            &format!("stepping {num_envs} teams of {robots} robots"),
+            "pass a smaller num_envs",
+        )?;
+        let pool = Pool::new(jobs)?;
+        let inner = shaping_engine::stepper::VecTeamStepper::new(stepped_stage(program, stage)?, num_envs)
+            .map_err(|e| Python::attach(|py| shaping_error(py, &e)))?;
+        Ok(VecTeamStepper { inner, out: Default::default(), pool })
+    }
+
+    /// The number of worlds.
+    #[getter]
+    fn num_envs(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Each robot's agent name in a world.
+    #[getter]
+    fn agents(&self) -> Vec<String> {
+        self.inner.names().to_vec()
+    }
+
+    /// Starts a life of every world (world w's lives from stream w of
+    /// `seed`); returns the observations, shape (num_envs, robots, observation).
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+        self.inner.reset(seed, &mut self.out);
+        self.observations(py)
+    }
+
+    /// Steps every world with its robots' rows of `actions` (float32,
+    /// shape (num_envs, robots, action)), with the GIL released; returns
+    /// the observations, and the rewards, terminated and truncated of shape
+    /// (num_envs, robots). A world whose team's life ended at the last step
+    /// starts again instead (its actions ignored, rewards 0).
+    #[allow(clippy::type_complexity)]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: numpy::PyReadonlyArray3<'py, f32>,
+    ) -> PyResult<(
+        Bound<'py, numpy::PyArray3<f32>>,
+        Bound<'py, numpy::PyArray2<f32>>,
+        Bound<'py, numpy::PyArray2<bool>>,
+        Bound<'py, numpy::PyArray2<bool>>,
+    )> {
+        let (n, robots, dims) = (self.inner.len(), self.inner.robots(), self.inner.spaces().controls.len());
+        if actions.shape() != [n, robots, dims] {
+            return Err(value_error(format!(
+                "error: the actions must be an array of shape ({n}, {robots}, {dims}), not {:?}",
+                actions.shape()
+            )));
+        }
+        let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
+        let pool = self.pool.get()?;
+        let (inner, out) = (&mut self.inner, &mut self.out);
+        py.detach(|| pool.install(|| inner.step(flat, out))).map_err(|e| invalid(&e))?;
+        Ok((
+            self.observations(py)?,
+            PyArray1::from_slice(py, &self.out.rewards).reshape([n, robots])?,
+            PyArray1::from_slice(py, &self.out.terminated).reshape([n, robots])?,
+            PyArray1::from_slice(py, &self.out.truncated).reshape([n, robots])?,
+        ))
+    }
+}
+
+impl VecTeamStepper {
+    fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, numpy::PyArray3<f32>>> {
+        let width = self.inner.spaces().channels.len();
+        PyArray1::from_slice(py, &self.out.observations).reshape([
+            self.inner.len(),
+            self.inner.robots(),
+            width,
+        ])
     }
 }
 
@@ -1856,6 +2236,8 @@ fn _shaping(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Experiment>()?;
     m.add_class::<Stepper>()?;
     m.add_class::<VecStepper>()?;
+    m.add_class::<TeamStepper>()?;
+    m.add_class::<VecTeamStepper>()?;
     m.add_function(wrap_pyfunction!(check, m)?)?;
     m.add_function(wrap_pyfunction!(compile, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;

@@ -30,6 +30,8 @@ CHILD = textwrap.dedent(
     tiny = os.path.join(root, "tests", "cli", "tiny.bat")
     program = shaping.compile(khepera)
     ev = program.evaluator("navigation", seed=1, jobs=1)
+    aggregation = os.path.join(root, "examples", "aggregation.bat")
+    team = shaping._shaping.TeamStepper(shaping.compile(aggregation), "aggregate")
     scratch = tempfile.mkdtemp()
 
     INTS = [0, 1, -1, 2, 7, 2**31, 2**32, 2**63, 2**64, -(2**63), 10**30, 1.5, float("nan"), float("inf"),
@@ -81,6 +83,11 @@ CHILD = textwrap.dedent(
         lambda: ev.evaluate(np.zeros((2, ev.bits), np.uint8),
                             individuals=rng.choice([np.array([0, 1]), np.array([-1, 0]), np.array([2**40, 0]),
                                                     np.array([0.5, 1.0]), np.array([0]), "01", None])),
+        lambda: ev.evaluate(np.zeros((1, ev.bits), np.uint8),
+                            measures=rng.choice([None, {}, {"x": "robot.x"}, {"x": rng.choice(STRINGS)},
+                                                 {rng.choice(STRINGS): "1"}, {"d": "(" * 200 + "1"},
+                                                 {"m": "max(" + "ir," * 3000 + "ir)"}, {"t": "team.nope"},
+                                                 {"b": "1e39"}, ["robot.x"], "robot.x"])),
         lambda: genes.encode(program, rng.choice(STRINGS), reals()),
         lambda: genes.encode(program, "navigation", reals(), base=rng.choice([None, np.zeros(3, np.uint8)])),
         lambda: genes.decode(program, rng.choice(STRINGS), genome_arrays()),
@@ -99,6 +106,11 @@ CHILD = textwrap.dedent(
         calls += [
             lambda: sgym.make(rng.choice([khepera, tiny, "/nonexistent.bat"]), rng.choice(STRINGS)),
             lambda: sgym.make_vec(khepera, "navigation", num_envs=rng.choice(INTS + [10**9])),
+            lambda: sgym.make_parallel_vec(rng.choice([khepera, aggregation]), rng.choice(STRINGS + ["aggregate"]),
+                                           num_envs=rng.choice(INTS + [10**9])),
+            lambda: shaping._shaping.TeamStepper(program, rng.choice(STRINGS)),
+            lambda: team.step(np.full((10, 2), rng.choice([0.0, 2.0, np.nan]), np.float32)),
+            lambda: team.reset(rng.choice([0, 1, 2**63])),
         ]
     except ImportError:
         pass

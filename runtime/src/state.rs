@@ -165,6 +165,29 @@ impl TeamReads {
     /// Every measure.
     pub const ALL: TeamReads = TeamReads { groups: true, nearest: true, order: true, connected: true };
 
+    /// What `exprs` read.
+    pub fn of_exprs(exprs: &[Expr]) -> TeamReads {
+        let reads = |slot: &dyn Fn(usize) -> bool| {
+            exprs.iter().any(|e| e.ops.iter().any(|op| matches!(*op, Op::State(v) if slot(v as usize))))
+        };
+        TeamReads {
+            groups: reads(&|slot| slot == ST_GROUPED || slot == ST_LARGEST),
+            nearest: reads(&|slot| slot == ST_NEAREST),
+            order: reads(&|slot| slot == ST_ORDER),
+            connected: reads(&|slot| slot == ST_CONNECTED),
+        }
+    }
+
+    /// The measures either reads.
+    pub fn or(self, other: TeamReads) -> TeamReads {
+        TeamReads {
+            groups: self.groups || other.groups,
+            nearest: self.nearest || other.nearest,
+            order: self.order || other.order,
+            connected: self.connected || other.connected,
+        }
+    }
+
     /// What the expressions of `stage` read.
     pub fn of(stage: &Stage) -> TeamReads {
         TeamReads {

@@ -9,6 +9,7 @@
 
 pub(crate) mod expr;
 mod genes;
+mod measure;
 pub(crate) mod module;
 mod roles;
 pub(crate) mod training;
@@ -28,6 +29,7 @@ use crate::syntax::Span;
 pub use expr::Scope;
 #[cfg(test)]
 use genes::network_roles;
+pub use measure::measure;
 
 /// A sensor of the robot at some stage.
 #[derive(Clone, Debug)]

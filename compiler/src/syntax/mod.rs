@@ -7,4 +7,4 @@ mod parser;
 mod recover;
 
 pub use crate::span::{self, Span};
-pub use parser::{parse, parse_for_check, parse_recovering, RESERVED};
+pub use parser::{parse, parse_expr, parse_for_check, parse_recovering, RESERVED};

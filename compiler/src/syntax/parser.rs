@@ -59,6 +59,66 @@ pub fn parse_for_check(src: &str) -> Result<(File, UnitErrors), Vec<Error>> {
     }
 }
 
+/// Parses `src` as one expression and nothing else (a measure given from
+/// outside a file: Python's `evaluate(measures=...)`), with the file's
+/// limits; its spans are offsets into `src`.
+pub fn parse_expr(src: &str) -> Result<Expr, Vec<Error>> {
+    if let Some(err) = check_lines(src).or_else(|| check_nesting(src)) {
+        return Err(vec![err]);
+    }
+    pest::set_call_limit(std::num::NonZeroUsize::new(CALL_LIMIT));
+    pest::set_error_detail(true);
+    let pairs = BatParser::parse(Rule::expr, src).map_err(|e| vec![syntax_error(src, e)])?;
+    if let Some(err) = check_numbers(&pairs) {
+        return Err(vec![err]);
+    }
+    let Some(p) = pairs.clone().next() else {
+        return Err(vec![Error::Syntax {
+            span: Span::new(0, 0).into(),
+            message: "expected an expression, found nothing".into(),
+            label: "empty".into(),
+            others: Vec::new(),
+            help: None,
+        }]);
+    };
+    let end = span(&p).end;
+    let rest = &src[end..];
+    let trailing = rest.len() - rest.trim_start().len();
+    if end + trailing < src.len() {
+        let (at, found) = token_at(src, end + trailing);
+        let word = found.trim_matches('`');
+        // An operator that did not parse has no operand after it (`1 +`).
+        let operator = word.starts_with(['+', '-', '*', '/', '<', '>', '=', '!', '?', ':'])
+            || word == "and"
+            || word == "or";
+        let (message, help) = if operator {
+            (
+                format!("expected an expression after {found}, found the end of the expression"),
+                "an operand is missing".to_string(),
+            )
+        } else {
+            (
+                format!("expected an operator or the end of the expression, found {found}"),
+                "a measure is one expression, as a fitness `at end` term is".to_string(),
+            )
+        };
+        return Err(vec![Error::Syntax {
+            span: at.into(),
+            message,
+            label: "unexpected here".into(),
+            others: Vec::new(),
+            help: Some(help),
+        }]);
+    }
+    let mut b = Builder { pratt: pratt(), errors: Vec::new() };
+    let e = b.expr(p);
+    if b.errors.is_empty() {
+        Ok(e)
+    } else {
+        Err(b.errors)
+    }
+}
+
 /// The errors of unknown units, each with the span of its quantity.
 pub type UnitErrors = Vec<(Span, Error)>;
 

@@ -22,6 +22,8 @@ __all__ = [
     "Experiment",
     "Stepper",
     "VecStepper",
+    "TeamStepper",
+    "VecTeamStepper",
     "check",
     "compile",
     "run",
@@ -163,7 +165,8 @@ class Evaluator:
         genomes: npt.ArrayLike,
         generation: Optional[int] = None,
         individuals: Optional[npt.ArrayLike] = None,
-    ) -> dict[str, np.ndarray]:
+        measures: Optional[Mapping[str, str]] = None,
+    ) -> dict[str, Any]:
         """Evaluates each row of ``genomes`` (shape ``(n, bits)``, 0 and 1, integer or bool dtype).
 
         Returns arrays of shape ``(n,)``: ``fitness`` (float32, the mean
@@ -182,6 +185,26 @@ class Evaluator:
         (KeyboardInterrupt). A wrong shape, dtype or value raises
         ValueError naming the argument; a batch larger than the memory
         available, MemoryError.
+
+        A team (``robots N`` above 1): the arrays above are the team's
+        (``fitness`` its aggregate, the events and collisions summed over
+        its robots, ``x`` ... ``squares_visited`` robot 0's), and
+        ``robots`` is a dict of each robot's own, arrays of shape
+        ``(n, robots)``: ``fitness`` (its own fitness, the mean over the
+        episodes), ``x``, ``y``, ``heading``, ``path_length``,
+        ``squares_visited``, ``recharges``, ``grips``,
+        ``releases_outside``, ``collisions``, combined over the episodes as
+        above. One robot: no ``robots`` key.
+
+        ``measures`` maps names to expressions a fitness ``at end`` term of
+        the stage may be (its sensors and actuators, ``robot.x`` ...,
+        ``team.spread`` ..., ``distance_to(NAME)``), each compiled by the
+        compiler's lowering and read at the end of each robot's lives as
+        that term is; ``result["measures"][name]`` is its mean over the
+        episodes: shape ``(n,)`` for one robot or an expression of the
+        team's terms only (every robot reads them alike), else
+        ``(n, robots)``. A bad expression raises :class:`CompileError`
+        whose ``diagnostics`` point into it (file ``measure NAME``).
         """
     def __reduce__(self) -> tuple[Any, ...]:
         """Pickled as its program with the training stages' weights bound: nothing is trained again."""
@@ -316,6 +339,58 @@ class VecStepper:
     @property
     def num_envs(self) -> int: ...
     def reset(self, seed: int) -> npt.NDArray[np.float32]: ...
+    def step(
+        self, actions: npt.NDArray[np.float32]
+    ) -> tuple[
+        npt.NDArray[np.float32], npt.NDArray[np.float32], npt.NDArray[np.bool_], npt.NDArray[np.bool_]
+    ]: ...
+
+@final
+class TeamStepper:
+    """A stage's team driven one action at a time (see ``shaping.gym.make_parallel``)."""
+
+    def __new__(cls, program: Program, stage: str, keep_path: bool = False) -> TeamStepper:
+        """A stage with one robot raises :class:`ShapingError` (use :class:`Stepper`)."""
+    @property
+    def agents(self) -> list[str]:
+        """Each robot's agent name: ``ROLE_K`` (its index in its role) or ``robot_I``."""
+    @property
+    def roles(self) -> list[int]:
+        """Each robot's role, an index in ``Program.roles`` (0 without roles)."""
+    @property
+    def observation_names(self) -> list[str]: ...
+    @property
+    def action_names(self) -> list[str]: ...
+    @property
+    def action_bounds(self) -> tuple[list[float], list[float]]: ...
+    @property
+    def life(self) -> int: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]:
+        """The first observations, shape ``(robots, observation)``."""
+    def step(
+        self, actions: npt.NDArray[np.float32]
+    ) -> tuple[
+        npt.NDArray[np.float32],
+        npt.NDArray[np.float32],
+        npt.NDArray[np.bool_],
+        npt.NDArray[np.bool_],
+        dict[str, Any],
+    ]:
+        """One action of every robot whose life goes on (row i of ``actions``, shape ``(robots, action)``)."""
+    def render(self) -> npt.NDArray[np.uint8]: ...
+
+@final
+class VecTeamStepper:
+    """Many worlds of a stage's team stepped together in Rust (see ``shaping.gym.make_parallel_vec``)."""
+
+    def __new__(cls, program: Program, stage: str, num_envs: int, jobs: Optional[int] = None) -> VecTeamStepper:
+        """``num_envs``: a positive integer (else ValueError); ``jobs``: 1 to 1024; a stage with one robot raises :class:`ShapingError`."""
+    @property
+    def num_envs(self) -> int: ...
+    @property
+    def agents(self) -> list[str]: ...
+    def reset(self, seed: int) -> npt.NDArray[np.float32]:
+        """The first observations, shape ``(num_envs, robots, observation)``."""
     def step(
         self, actions: npt.NDArray[np.float32]
     ) -> tuple[

@@ -22,7 +22,8 @@
 
 The robot is driven by the agent alone: the stage's modules, their
 learning and the genome are not used. ``make_vec`` steps all its robots in
-Rust in one call.
+Rust in one call. ``make_parallel`` is a team's PettingZoo environment
+(one agent per robot).
 
 Needs ``gymnasium`` (``pip install "shaping[gym]"``, from this repository
 ``pip install "./python[gym]"``); without it, ``shaping.gym`` raises
@@ -46,9 +47,9 @@ from gymnasium import spaces  # noqa: E402
 from gymnasium.vector import AutoresetMode, VectorEnv  # noqa: E402
 
 from . import Program, compile
-from ._shaping import Stepper, VecStepper
+from ._shaping import Stepper, TeamStepper, VecStepper, VecTeamStepper
 
-__all__ = ["ENV_ID", "ShapingEnv", "ShapingVecEnv", "make", "make_vec"]
+__all__ = ["ENV_ID", "ShapingEnv", "ShapingTeamVecEnv", "ShapingVecEnv", "make", "make_parallel", "make_parallel_vec", "make_vec"]
 
 ENV_ID = "shaping/Stage-v0"
 """The id under which Gymnasium knows the environment:
@@ -174,6 +175,43 @@ class ShapingVecEnv(VectorEnv):
         return obs, rewards, terminated, truncated, {}
 
 
+class ShapingTeamVecEnv:
+    """``num_envs`` worlds of a stage's team stepped together in Rust (see
+    ``shaping.gym.make_parallel_vec``): arrays in and out, one row per
+    world and robot, no Python per robot."""
+
+    def __init__(self, program: Program, stage: str, num_envs: int, jobs: int | None = None) -> None:
+        self.program = program
+        self.stage = stage
+        self._worlds = VecTeamStepper(program, stage, num_envs, jobs)
+        probe = TeamStepper(program, stage)
+        self.num_envs: int = self._worlds.num_envs
+        self.agents: list[str] = self._worlds.agents
+        self.observation_names: list[str] = probe.observation_names
+        self.action_names: list[str] = probe.action_names
+        low, high = (np.asarray(b, dtype=np.float32) for b in probe.action_bounds)
+        self.single_observation_space = spaces.Box(0.0, 1.0, shape=(len(self.observation_names),), dtype=np.float32)
+        self.single_action_space = spaces.Box(low, high, dtype=np.float32)
+        self._seeds, _ = gymnasium.utils.seeding.np_random(None)
+
+    def reset(self, seed: int | None = None):
+        """Starts a life of every world; world w's worlds come from stream
+        w of ``seed`` (or of a seed drawn from the environment's generator).
+        Returns the observations, shape ``(num_envs, robots, observation)``, and ``{}``."""
+        if seed is not None:
+            self._seeds, _ = gymnasium.utils.seeding.np_random(seed)
+        return self._worlds.reset(int(self._seeds.integers(0, 2**63))), {}
+
+    def step(self, actions: Any):
+        """``actions``: shape ``(num_envs, robots, action)``. Returns the
+        observations, rewards, terminated, truncated (``(num_envs,
+        robots)``) and ``{}``. A world whose team's life ended at the last
+        step starts again instead (its actions ignored, rewards 0)."""
+        a = _action(actions, (self.num_envs, len(self.agents), len(self.action_names)))
+        obs, rewards, terminated, truncated = self._worlds.step(a)
+        return obs, rewards, terminated, truncated, {}
+
+
 def make(
     path: str | os.PathLike[str] | Program,
     stage: str,
@@ -182,6 +220,54 @@ def make(
     """A Gymnasium environment of stage ``stage`` of the ``.bat`` file
     ``path`` (or of a compiled :class:`shaping.Program`)."""
     return ShapingEnv(path, stage, render_mode=render_mode)
+
+
+def make_parallel(
+    path: str | os.PathLike[str] | Program,
+    stage: str,
+    render_mode: str | None = None,
+):
+    """A PettingZoo parallel environment of the team of stage ``stage``
+    (a world of ``robots N``): one agent per robot, named by its role and
+    its index in the role (``guard_0``; ``robot_0`` ... without roles),
+    each with the stage's observation and action spaces (every role has
+    the robot's hardware), the whole team stepped in Rust in one call.
+
+    An agent's reward is its robot's own fitness for the action (its role's
+    terms and bonuses; its ``at end`` term when its life ends): a robot's
+    rewards add up to its fitness in a run of the same episode, and the
+    team's fitness is their ``team sum``, ``mean`` or ``min``. An agent is
+    ``terminated`` when its battery is empty (its robot stays as an
+    obstacle) and ``truncated`` at the stage's length of life; the others
+    go on. ``render_mode="rgb_array"`` draws every robot and its path.
+    A stage with one robot raises ShapingError: use :func:`make`.
+
+    Needs ``pettingzoo`` (``pip install "shaping[pettingzoo]"``).
+    """
+    if importlib.util.find_spec("pettingzoo") is None:
+        raise ImportError('shaping.gym.make_parallel needs pettingzoo, which is not installed: pip install "shaping[pettingzoo]"')
+    from ._parallel import make as make_team
+
+    return make_team(path, stage, render_mode=render_mode)
+
+
+def make_parallel_vec(
+    path: str | os.PathLike[str] | Program,
+    stage: str,
+    num_envs: int,
+    jobs: int | None = None,
+):
+    """``num_envs`` worlds of the team of stage ``stage`` stepped together
+    in Rust in one call on ``jobs`` threads, for batched training: arrays
+    of one row per world and robot (observations ``(num_envs, robots,
+    observation)``, actions ``(num_envs, robots, action)``, rewards and
+    ends ``(num_envs, robots)``), each robot's as in :func:`make_parallel`.
+    A world whose team's life ended starts a new one on the next step (its
+    actions are ignored, its rewards 0); within a life, the row of a robot
+    whose life ended is ignored. World w's worlds come from stream w of
+    the seed. A stage with one robot raises ShapingError (use
+    :func:`make_vec`)."""
+    return ShapingTeamVecEnv(_program(path), stage, num_envs, jobs=jobs)
 
 
 def make_vec(

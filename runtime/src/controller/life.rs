@@ -125,6 +125,12 @@ pub trait Hooks<'s, B: Bodies> {
     fn after_action(&mut self, _bodies: &B) -> bool {
         true
     }
+    /// The team's measures read from outside the stage (a caller's
+    /// measures, [`super::run_team_episode_measured`]), measured besides
+    /// those the stage reads.
+    fn reads(&self) -> TeamReads {
+        TeamReads::default()
+    }
 }
 
 impl<'s, B: Bodies> Hooks<'s, B> for () {}
@@ -145,7 +151,7 @@ pub fn live<'s, B: Bodies>(
     let ctls = &mut ctls[..n];
     let mut robots = vec![EpisodeResult::default(); n];
     let mut fitness = vec![0.0f64; n];
-    let reads = TeamReads::of(stage);
+    let reads = TeamReads::of(stage).or(hooks.reads());
     let state = bodies.state(reads);
     for (i, c) in ctls.iter_mut().enumerate() {
         c.set_learning(opts.learning);

@@ -103,8 +103,8 @@ pub use net::{sigmoid, Net};
 pub use perf::Rolling;
 pub use script::ScriptRun;
 pub use team::{
-    episode_with, run_team_episode, run_team_episode_until, StopWhen, TeamBodies, TeamMember, TeamResult,
-    TeamRun,
+    episode_with, run_team_episode, run_team_episode_measured, run_team_episode_until, StopWhen, TeamBodies,
+    TeamMember, TeamResult, TeamRun,
 };
 
 /// How to run one episode.
@@ -887,8 +887,7 @@ impl<'s> Controller<'s> {
     /// per-action terms `fitness`, the placements and the descriptors.
     fn finish<R: Robot>(&self, sim: &R, mut res: EpisodeResult, mut fitness: f64) -> EpisodeResult {
         if let Some(e) = &self.at_end {
-            let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
-            fitness += f64::from(e.eval(&env));
+            fitness += f64::from(self.at_end_value(e));
         }
         let counts = [res.grips, res.releases_outside, res.recharges, res.collisions];
         for points in fitness_bonus_points(self.role_fitness, counts) {
@@ -898,6 +897,22 @@ impl<'s> Controller<'s> {
         res.placement_failures = sim.placement_failures();
         res.descriptors = self.descriptors(sim);
         res
+    }
+
+    /// The value of `e` read as the fitness's `at end` term reads it at the
+    /// end of a life: the last percept, the one before it, the last command
+    /// and the robot's state (filled only where the stage reads it, or
+    /// after [`Controller::read_state`]).
+    pub fn at_end_value(&self, e: &FastExpr) -> f32 {
+        let env = Env { now: &self.now, prev: &self.before, act: &self.slots, state: &self.state };
+        e.eval(&env)
+    }
+
+    /// Fills the robot's state (`robot.x` ..., `team.spread` ...) after
+    /// each action even where the stage's own expressions do not read it,
+    /// for expressions read from outside ([`Controller::at_end_value`]).
+    pub fn read_state(&mut self) {
+        self.reads_state = true;
     }
 
     /// The genome with the learned weights that are genes (activation networks

@@ -14,10 +14,11 @@
 //! ([`Controller::for_role`]), all decoded from the one genome.
 
 use super::{
-    episode_rngs, Bodies, Controller, ControllerError, EpisodeOptions, EpisodeResult, Hooks, Robot, Solo,
-    Trace,
+    episode_rngs, Bodies, Controller, ControllerError, EpisodeOptions, EpisodeResult, FastExpr, Hooks, Robot,
+    Solo, Trace,
 };
 use crate::catalog::CHANNELS;
+use crate::expr::Expr;
 use crate::genome::Genome;
 use crate::program::{Stage, World};
 use crate::sim::{robot_seed, Command, Outcome, Pose, Sim, Team};
@@ -229,11 +230,45 @@ pub(crate) fn episode_in<R: Robot>(
     robot: impl FnOnce(Sim) -> R,
     stop: impl Fn() -> bool,
 ) -> Result<Option<TeamResult>, ControllerError> {
+    Ok(measured(stage, genome, opts, traces, robot, stop, &[])?.map(|(res, _)| res))
+}
+
+/// [`run_team_episode_until`], and the value of each of `measures` at the
+/// end of each robot's life, read as the fitness's `at end` term is
+/// (`values[m][i]`: measure `m` of robot `i`). The measures read the
+/// robot's state and the team's measures whatever the stage reads; they
+/// change nothing of the episode (Python's `evaluate(measures=...)`).
+#[allow(clippy::type_complexity)]
+pub fn run_team_episode_measured(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    measures: &[Expr],
+    stop: impl Fn() -> bool,
+) -> Result<Option<(TeamResult, Vec<Vec<f32>>)>, ControllerError> {
+    measured(stage, genome, opts, None, |sim| sim, stop, measures)
+}
+
+#[allow(clippy::type_complexity)]
+fn measured<R: Robot>(
+    stage: &Stage,
+    genome: &Genome,
+    opts: &EpisodeOptions,
+    traces: Option<&mut [Trace]>,
+    robot: impl FnOnce(Sim) -> R,
+    stop: impl Fn() -> bool,
+    measures: &[Expr],
+) -> Result<Option<(TeamResult, Vec<Vec<f32>>)>, ControllerError> {
     if stop() {
         return Ok(None);
     }
     let mut run = TeamRun::new(stage, genome, opts.seed)?;
-    let mut hooks = StopWhen { stop, stopped: false };
+    if !measures.is_empty() {
+        for c in &mut run.ctls {
+            c.read_state();
+        }
+    }
+    let mut hooks = StopWhen { stop, stopped: false, reads: TeamReads::of_exprs(measures) };
     let mut res = episode_with(&mut run, &stage.world, opts.seed, opts, traces, robot, &mut hooks);
     if hooks.stopped {
         return Ok(None);
@@ -241,20 +276,32 @@ pub(crate) fn episode_in<R: Robot>(
     if stage.inheritance == crate::program::Inheritance::Lamarckian {
         res.team.learned = Some(run.write_back(genome));
     }
-    Ok(Some(res))
+    let values = measures
+        .iter()
+        .map(|m| {
+            let e = FastExpr::new(m);
+            run.ctls.iter().take(res.robots.len()).map(|c| c.at_end_value(&e)).collect()
+        })
+        .collect();
+    Ok(Some((res, values)))
 }
 
 /// Hooks that end a life once `stop` returns true, asked after each action
-/// (`stopped` says whether it did).
+/// (`stopped` says whether it did), and measure the team's `reads` besides
+/// the stage's.
 pub struct StopWhen<F> {
     pub stop: F,
     pub stopped: bool,
+    pub reads: TeamReads,
 }
 
 impl<'s, B: Bodies, F: Fn() -> bool> Hooks<'s, B> for StopWhen<F> {
     fn after_action(&mut self, _: &B) -> bool {
         self.stopped = (self.stop)();
         !self.stopped
+    }
+    fn reads(&self) -> TeamReads {
+        self.reads
     }
 }
 
