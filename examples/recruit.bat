@@ -22,7 +22,7 @@
 
 robot khepera {
   sensor ir[8]       proximity
-  sensor floor       ground     // 0 on the food, 1 elsewhere
+  sensor floor       ground  // 0 on the food, 1 elsewhere
   sensor rab[8]      range_bearing
   sensor heard[8]    signal
   actuator wheels[2] speed

@@ -35,9 +35,8 @@ fn main() -> ExitCode {
 
 fn run(dir: &Path, stage: &str) -> Result<(), String> {
     let entries = std::fs::read_dir(dir).map_err(|e| format!("cannot read `{}`: {e}", dir.display()))?;
-    let mut seeds: Vec<u64> = entries
-        .filter_map(|e| e.ok()?.file_name().to_str()?.strip_prefix("seed-")?.parse().ok())
-        .collect();
+    let mut seeds: Vec<u64> =
+        entries.filter_map(|e| e.ok()?.file_name().to_str()?.strip_prefix("seed-")?.parse().ok()).collect();
     seeds.sort_unstable();
     if seeds.len() < 2 {
         return Err(format!("`{}` has fewer than 2 `seed-N` runs", dir.display()));
@@ -45,13 +44,14 @@ fn run(dir: &Path, stage: &str) -> Result<(), String> {
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for s in &seeds {
         let path = dir.join(format!("seed-{s}")).join(stage).join("summary.json");
-        let text = std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
         let v: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| format!("`{}` is not JSON: {e}", path.display()))?;
         let fitness = |side: &str| {
-            v[side]["fitness"]
-                .as_f64()
-                .ok_or_else(|| format!("`{}` has no `{side}.fitness`: is `{stage}` a test stage?", path.display()))
+            v[side]["fitness"].as_f64().ok_or_else(|| {
+                format!("`{}` has no `{side}.fitness`: is `{stage}` a test stage?", path.display())
+            })
         };
         let (b, a) = (fitness("before")?, fitness("after")?);
         println!("seed {s} before {b:.3} after {a:.3}");

@@ -591,8 +591,11 @@ fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(),
         "world.body.wheel_noise" => w.body.wheel_noise = r32,
         "world.body.sensor_noise" => w.body.sensor_noise = r32,
         "world.body.rab_signals" => {
-            w.body.rab.as_mut().ok_or_else(|| format!("stage `{name}` has no range-and-bearing board"))?.silenced =
-                value.word() == "off"
+            w.body
+                .rab
+                .as_mut()
+                .ok_or_else(|| format!("stage `{name}` has no range-and-bearing board"))?
+                .silenced = value.word() == "off"
         }
         _ => return Err(format!("`{path}` is not a setting")),
     }

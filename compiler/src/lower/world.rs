@@ -1238,7 +1238,12 @@ impl Lower<'_> {
                             rab.silenced = w.text == "off"
                         }
                     }
-                    _ => self.value_error(set.span, format!("`{n}` is `on` or `off`"), "not `on` or `off`", None),
+                    _ => self.value_error(
+                        set.span,
+                        format!("`{n}` is `on` or `off`"),
+                        "not `on` or `off`",
+                        None,
+                    ),
                 }
                 continue;
             }
