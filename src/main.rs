@@ -179,7 +179,7 @@ enum Command {
         /// elitism, evaluations, keep, selection, inheritance; `world.`
         /// arena, charger, lamp, battery, recharge, objects, diameter, robots;
         /// `world.body.` radius, wheel_base, v_max, action, wheel_noise,
-        /// sensor_noise; `variants.` aggregate, draw; `fitness.team`; `test.actions`,
+        /// sensor_noise, rab_signals; `variants.` aggregate, draw; `fitness.team`; `test.actions`,
         /// `test.lives`; `train.actions`; `MODULE.` reward,
         /// punish, window, threshold, range. STAGE may be `*` (every stage).
         #[arg(long = "set", value_name = "STAGE.SECTION.FIELD=V1,V2,...", value_parser = sweep::parse_set)]

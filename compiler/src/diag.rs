@@ -580,6 +580,18 @@ pub enum Error {
         #[help]
         help: String,
     },
+
+    /// A warning: `rab_signals off` in a body whose robot broadcasts
+    /// nothing: there is nothing to silence.
+    #[error("{message}")]
+    #[diagnostic(code(S0052), severity(Warning))]
+    SilencedNothing {
+        #[label("silences nothing")]
+        span: SourceSpan,
+        message: String,
+        #[help]
+        help: String,
+    },
 }
 
 impl Error {

@@ -370,6 +370,12 @@ pub const EXPLANATIONS: &[Explanation] = &[
         text: "`rab_range`, `rab_noise`, `rab_bearing_noise` and `rab_occlusion` set the range-and-bearing board of a body, which a robot has only when it declares a `range_bearing` or `signal` sensor or a `broadcast` actuator. Without one, the settings change nothing. The file compiles; declare the hardware, or leave the settings out.",
         wrong: concat!(robot!(), "stage s {\n  world { robots 2  body { rab_range 200mm } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
+    },    Explanation {
+        code: "S0052",
+        title: "broadcasts silenced where none is sent (a warning)",
+        text: "`rab_signals off` in a world's `body` holds every broadcast value heard at 0, while the robots still set their broadcasts: the ablation of signalling, the genome unchanged. A robot without an `actuator NAME broadcast` sends nothing, so the setting changes nothing. The file compiles; declare the actuator, or leave the setting out.",
+        wrong: concat!("robot r { sensor ir[8] proximity  sensor rab[8] range_bearing  actuator wheels[2] speed }\n", "stage s {\n  world { robots 2  body { rab_signals off } }\n  fitness per action wheels[0]\n  module m { sense rab  behavior toward(rab) }\n}\n"),
+        right: concat!("robot r { sensor ir[8] proximity  sensor rab[8] range_bearing  actuator wheels[2] speed }\n", "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense rab  behavior toward(rab) }\n}\n"),
     },
 ];
 

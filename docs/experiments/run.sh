@@ -148,6 +148,18 @@ $B experiment examples/aggregation-roles.bat --seeds $SEEDS --out $R/aggregation
 # The same task with the range-and-bearing board (aggregation-rab.bat), the
 # same budget.
 $B experiment examples/aggregation-rab.bat --seeds $SEEDS --out $R/aggregation-rab --fresh > /dev/null
+# Foraging with recruitment (recruit.bat, EXPERIMENTS.md "Recruitment"):
+# its tests with signals and with every broadcast heard as 0 (the ablation,
+# same lives), and a team evolved without the broadcast (the `heard`
+# sensor, the actuator, the network's broadcast and the silent test removed).
+$B experiment examples/recruit.bat --seeds $SEEDS --out $R/recruit --fresh > /dev/null
+sed -e '/sensor heard\[8\] *signal/d' -e '/actuator signal *broadcast/d' -e 's/, heard//' \
+  -e 's/  broadcast signal//' -e '/^\/\/ The same lives with every broadcast/,$d' examples/recruit.bat > $R/recruit-mute.bat
+[ "$(grep -v '^//' $R/recruit-mute.bat | grep -c 'signal$\|broadcast$\|broadcast signal \|heard\|rab_signals')" = 0 ]
+grep -q 'toward(rab) }' $R/recruit-mute.bat
+$B experiment $R/recruit-mute.bat --seeds $SEEDS --out $R/recruit-mute --fresh > /dev/null
+$B compare $R/recruit $R/recruit-mute --stage forage_test | grep -E '\| forage_test \| fitness'
+cargo run --release --quiet --example ablation -- $R/recruit forage_silent
 # Twice the generations for the clones and the roles: does the roles'
 # longer genome catch up?
 for f in aggregation aggregation-roles; do

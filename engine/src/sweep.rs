@@ -285,6 +285,7 @@ const FIELDS: &[(&str, Kind)] = &[
     ("world.body.action", Kind::Real(Some("ms"))),
     ("world.body.wheel_noise", Kind::Real(None)),
     ("world.body.sensor_noise", Kind::Real(None)),
+    ("world.body.rab_signals", Kind::Word(&["on", "off"])),
 ];
 
 /// A module's settings: its CRBP rates, window and threshold, and the range
@@ -514,6 +515,10 @@ fn get(s: &Stage, path: &str) -> Result<Value, String> {
         "world.body.action" => real(w.body.action_ms),
         "world.body.wheel_noise" => real(w.body.wheel_noise),
         "world.body.sensor_noise" => real(w.body.sensor_noise),
+        "world.body.rab_signals" => {
+            let rab = w.body.rab.as_ref().ok_or_else(|| missing(s, "range-and-bearing board"))?;
+            Ok(Value::Word(if rab.silenced { "off" } else { "on" }.into()))
+        }
         _ => {
             let (name, field) = path.rsplit_once('.').ok_or_else(|| format!("`{path}` is not a setting"))?;
             if let (Some(role), "robots") = (s.roles.iter().find(|r| r.name == name), field) {
@@ -585,6 +590,13 @@ fn put_world(w: &mut World, name: &str, path: &str, value: &Value) -> Result<(),
         "world.body.action" => w.body.action_ms = r32,
         "world.body.wheel_noise" => w.body.wheel_noise = r32,
         "world.body.sensor_noise" => w.body.sensor_noise = r32,
+        "world.body.rab_signals" => {
+            w.body
+                .rab
+                .as_mut()
+                .ok_or_else(|| format!("stage `{name}` has no range-and-bearing board"))?
+                .silenced = value.word() == "off"
+        }
         _ => return Err(format!("`{path}` is not a setting")),
     }
     Ok(())

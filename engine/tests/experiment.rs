@@ -212,6 +212,29 @@ fn a_team_is_set_and_one_too_large_is_refused() {
     }
 }
 
+/// `world.body.rab_signals=off` silences the board of the stage and of
+/// the stages that inherit it; a world without a board refuses it, and
+/// only `on` and `off` are taken.
+#[test]
+fn rab_signals_is_set_on_a_board_and_refused_without_one() {
+    use shaping_engine::sweep::apply;
+    use shaping_runtime::program::RangeBearing;
+    let set = |t: &str, v: &str| vec![(t.to_string(), v.to_string())];
+    let mut p = tiny();
+    let err = apply(&mut p.clone(), &set("first.world.body.rab_signals", "off")).unwrap_err().to_string();
+    assert!(err.contains("no range-and-bearing board"), "{err}");
+    for s in &mut p.stages {
+        s.world.body.rab = Some(RangeBearing { signals: 1, ..RangeBearing::DEFAULT });
+    }
+    apply(&mut p, &set("first.world.body.rab_signals", "off")).unwrap();
+    assert!(p.stages.iter().all(|s| s.world.body.rab.as_ref().unwrap().silenced));
+    apply(&mut p, &set("second.world.body.rab_signals", "on")).unwrap();
+    let silenced: Vec<bool> = p.stages.iter().map(|s| s.world.body.rab.as_ref().unwrap().silenced).collect();
+    assert_eq!(silenced, [true, false]);
+    let err = apply(&mut p, &set("first.world.body.rab_signals", "mute")).unwrap_err().to_string();
+    assert!(err.contains("`mute` is not one of on, off"), "{err}");
+}
+
 /// In a stage with roles, `ROLE.robots` sets a role's robots (and the
 /// team's), `world.robots` is refused with the roles' settings named, and a
 /// module's settings are `ROLE.MODULE.FIELD`.

@@ -464,11 +464,17 @@ pub struct RangeBearing {
     /// Inner walls and cylinders between two robots' centres hide them
     /// from each other (as they shade a lamp).
     pub occlusion: bool,
+    /// Every broadcast is heard as 0 (`rab_signals off`): the robots still
+    /// set their broadcast values, which expressions read, but no `signal`
+    /// sensor hears them (the ablation of signalling, with the genome as
+    /// it is). Written only when set, so files without it keep their bytes.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub silenced: bool,
 }
 
 impl RangeBearing {
     /// The defaults: 8 sectors, 300 mm, 0.02 proximity noise, 5 degrees
-    /// bearing noise, occluded by walls and cylinders.
+    /// bearing noise, occluded by walls and cylinders, broadcasts heard.
     pub const DEFAULT: RangeBearing = RangeBearing {
         sectors: 8,
         signals: 0,
@@ -476,6 +482,7 @@ impl RangeBearing {
         range_noise: 0.02,
         bearing_noise: 5.0,
         occlusion: true,
+        silenced: false,
     };
 }
 

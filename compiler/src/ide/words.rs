@@ -236,6 +236,7 @@ const LIST: &[Word] = &[
     w("rab_noise", C, BODY, "`rab_noise 0.02`: noise added to a perceived robot's proximity", WORLD_S),
     w("rab_bearing_noise", C, BODY, "`rab_bearing_noise 5`: noise, in degrees, added to a perceived robot's bearing", WORLD_S),
     w("rab_occlusion", C, BODY, "`rab_occlusion on|off`: inner walls and cylinders hide robots from the range-and-bearing board", WORLD_S),
+    w("rab_signals", C, BODY, "`rab_signals on|off`: off, every broadcast is heard as 0 (the robots still set it): the ablation of signalling", WORLD_S),
     w("facing", C, CLAUSE, "`proximity at [...] facing [B0, ..., B7]`: where the 8 IR sensors look, degrees counter-clockwise from the heading", BODIES),
     // evolution settings
     w("population", C, EVOLVE, "`population N`: individuals per generation", EVOLUTION),

@@ -15,7 +15,7 @@ use crate::diag::{did_you_mean, Error};
 use crate::syntax::ast::{self, Unit};
 
 /// The settings of `body { }`.
-pub(crate) const BODY_SETTINGS: [&str; 10] = [
+pub(crate) const BODY_SETTINGS: [&str; 11] = [
     "radius",
     "wheel_base",
     "v_max",
@@ -26,6 +26,7 @@ pub(crate) const BODY_SETTINGS: [&str; 10] = [
     "rab_noise",
     "rab_bearing_noise",
     "rab_occlusion",
+    "rab_signals",
 ];
 
 impl Lower<'_> {
@@ -744,7 +745,8 @@ impl Lower<'_> {
     /// the warning `S0047`). A range beyond the arena's diagonal is
     /// `S0043`; a `signal` sensor that is not whole sectors of the values
     /// broadcast `S0044`; a broadcast that no robot hears the warning
-    /// `S0045`.
+    /// `S0045`; broadcasts silenced (`rab_signals off`) where the robot
+    /// broadcasts nothing the warning `S0052`.
     pub(super) fn rab_board(&mut self, st: &mut StageSt, s: u16, stage: Span) {
         let sensor = |k| st.sensors.iter().find(|x| x.kind == k);
         let rab = sensor(catalog::SensorKind::RangeBearing);
@@ -767,6 +769,13 @@ impl Lower<'_> {
         let board = world.body.rab.get_or_insert(RangeBearing::DEFAULT);
         board.sectors = sectors as u8;
         board.signals = signals as u8;
+        if board.silenced && signals == 0 && st.world.spans.contains_key("body") {
+            self.errors.push(Error::SilencedNothing {
+                span: body_span.into(),
+                message: "`rab_signals off` silences the broadcasts, but the robot sends none".into(),
+                help: "declare a `broadcast` actuator, or leave the setting out".into(),
+            });
+        }
         let diagonal = world.arena[0].hypot(world.arena[1]);
         if board.range > diagonal {
             self.errors.push(Error::RabRange {
@@ -1219,15 +1228,19 @@ impl Lower<'_> {
         self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
             let n = set.name.text.as_str();
-            if n == "rab_occlusion" {
+            if n == "rab_occlusion" || n == "rab_signals" {
                 let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
                 match &set.value {
                     ast::SettingValue::Word(w) if w.text == "on" || w.text == "off" => {
-                        rab.occlusion = w.text == "on"
+                        if n == "rab_occlusion" {
+                            rab.occlusion = w.text == "on"
+                        } else {
+                            rab.silenced = w.text == "off"
+                        }
                     }
                     _ => self.value_error(
                         set.span,
-                        "`rab_occlusion` is `on` or `off`".into(),
+                        format!("`{n}` is `on` or `off`"),
                         "not `on` or `off`",
                         None,
                     ),

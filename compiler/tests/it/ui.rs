@@ -90,10 +90,11 @@ fn kind(e: &Error) -> &'static str {
         Error::Unheard { .. } => "Unheard",
         Error::SignalValues { .. } => "SignalValues",
         Error::RabUnused { .. } => "RabUnused",
+        Error::SilencedNothing { .. } => "SilencedNothing",
     }
 }
 
-const KINDS: [&str; 47] = [
+const KINDS: [&str; 48] = [
     "Syntax",
     "TooComplex",
     "LineTooLong",
@@ -141,6 +142,7 @@ const KINDS: [&str; 47] = [
     "Unheard",
     "SignalValues",
     "RabUnused",
+    "SilencedNothing",
 ];
 
 #[test]

@@ -203,7 +203,8 @@ impl Team {
     /// Ends an action every robot has acted in: with a range-and-bearing
     /// board, measures every robot's readings on where the robots are and
     /// what they broadcast now (a robot whose battery is empty is seen
-    /// and broadcasts 0). Nothing without a board.
+    /// and broadcasts 0; with the broadcasts silenced, `rab_signals off`,
+    /// every value is heard as 0). Nothing without a board.
     pub fn end_action(&mut self) {
         let Some(rab) = &mut self.rab else { return };
         self.grid.build(&self.at);
@@ -214,7 +215,7 @@ impl Team {
         }
         let Rab { spec, signal, read } = rab;
         let sectors = usize::from(spec.sectors).clamp(1, RAB_SECTORS);
-        let signals = usize::from(spec.signals).min(SIGNALS);
+        let signals = if spec.silenced { 0 } else { usize::from(spec.signals).min(SIGNALS) };
         let width = std::f32::consts::TAU / sectors as f32;
         let range = spec.range.max(f32::MIN_POSITIVE);
         let apart = 2.0 * self.sims[0].radius;
@@ -739,6 +740,26 @@ mod tests {
         assert_eq!(heard[RAB_SECTORS..].iter().filter(|&&v| v != 0.0).count(), 1, "{heard:?}");
         // Robot 1 hears nothing: robot 0 sent nothing.
         assert_eq!(rab(&mut team, 1)[RAB_SECTORS..], [0.0; RAB_CHANNELS - RAB_SECTORS]);
+    }
+
+    /// With the broadcasts silenced (`rab_signals off`), the talker still
+    /// sets its value, but the listener hears 0 in every signal channel,
+    /// while it still perceives the talker; heard again once turned on.
+    #[test]
+    fn a_silenced_board_hears_nothing_but_still_perceives() {
+        let mut team = pair(false, 3);
+        team.rab.as_mut().unwrap().spec.silenced = true;
+        team.begin_action();
+        team.prepare(1);
+        team.step(1, &Command { signal: Some([0.5, 0.75, 0.0, 0.0]), ..Command::default() });
+        team.end_action();
+        assert_eq!(team.signal(1)[..2], [0.5, 0.75]);
+        let heard = rab(&mut team, 0);
+        assert_eq!(heard[RAB_SECTORS..], [0.0; RAB_CHANNELS - RAB_SECTORS], "{heard:?}");
+        assert!(heard[0] > 0.6, "{heard:?}");
+        team.rab.as_mut().unwrap().spec.silenced = false;
+        team.end_action();
+        assert_eq!(rab(&mut team, 0)[RAB_SECTORS + 8], 0.75);
     }
 
     /// A robot alone reads 0 on every channel of the board.
