@@ -584,7 +584,7 @@ pub enum Error {
     /// A warning: `rab_signals off` in a body whose robot broadcasts
     /// nothing: there is nothing to silence.
     #[error("{message}")]
-    #[diagnostic(code(S0052), severity(Warning))]
+    #[diagnostic(code(S0048), severity(Warning))]
     SilencedNothing {
         #[label("silences nothing")]
         span: SourceSpan,

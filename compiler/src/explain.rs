@@ -371,7 +371,7 @@ pub const EXPLANATIONS: &[Explanation] = &[
         wrong: concat!(robot!(), "stage s {\n  world { robots 2  body { rab_range 200mm } }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
         right: concat!(robot!(), "stage s {\n  world { robots 2 }\n  fitness per action wheels[0]\n  module m { sense ir  behavior forward }\n}\n"),
     },    Explanation {
-        code: "S0052",
+        code: "S0048",
         title: "broadcasts silenced where none is sent (a warning)",
         text: "`rab_signals off` in a world's `body` holds every broadcast value heard at 0, while the robots still set their broadcasts: the ablation of signalling, the genome unchanged. A robot without an `actuator NAME broadcast` sends nothing, so the setting changes nothing. The file compiles; declare the actuator, or leave the setting out.",
         wrong: concat!("robot r { sensor ir[8] proximity  sensor rab[8] range_bearing  actuator wheels[2] speed }\n", "stage s {\n  world { robots 2  body { rab_signals off } }\n  fitness per action wheels[0]\n  module m { sense rab  behavior toward(rab) }\n}\n"),

@@ -746,7 +746,7 @@ impl Lower<'_> {
     /// `S0043`; a `signal` sensor that is not whole sectors of the values
     /// broadcast `S0044`; a broadcast that no robot hears the warning
     /// `S0045`; broadcasts silenced (`rab_signals off`) where the robot
-    /// broadcasts nothing the warning `S0052`.
+    /// broadcasts nothing the warning `S0048`.
     pub(super) fn rab_board(&mut self, st: &mut StageSt, s: u16, stage: Span) {
         let sensor = |k| st.sensors.iter().find(|x| x.kind == k);
         let rab = sensor(catalog::SensorKind::RangeBearing);
