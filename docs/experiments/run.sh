@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Regenerates every number and picture of EXPERIMENTS.md (about 12 minutes on
-# two idle cores). Results go to runs/experiments/; the pictures EXPERIMENTS.md
-# shows are copied next to this script; the numbers are printed.
+# Regenerates every number and picture of EXPERIMENTS.md (about 55 minutes
+# of CPU time, so about half an hour on two idle cores: measured, 34 minutes
+# before the ladder, aggregation-rab and recruit were added, which add about
+# 20). Results go to runs/experiments/; the pictures EXPERIMENTS.md shows
+# are copied next to this script; the numbers are printed.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet
