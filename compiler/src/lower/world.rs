@@ -1305,7 +1305,16 @@ impl Lower<'_> {
                             help: "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`".into(),
                         });
                     } else if let Some(v) = self.length(q, "the range-and-bearing range") {
-                        rab.range = v;
+                        if v < 1.0 {
+                            // A positive range too short for the board's resolution.
+                            self.errors.push(Error::RabRange {
+                                span: q.span.into(),
+                                message: "a range-and-bearing range under 1 mm perceives nothing".into(),
+                                help: "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`".into(),
+                            });
+                        } else {
+                            rab.range = v;
+                        }
                     }
                 }
                 "rab_noise" => {
