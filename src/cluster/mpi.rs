@@ -489,16 +489,7 @@ impl Coordinator {
                 {
                     self.fatal(st, "an evaluation on rank 0 failed".into());
                 }
-                if let Some((&rank, &(k, _))) =
-                    outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout)
-                {
-                    let msg = format!(
-                        "{} did not {}: it died or hangs (`--rank-timeout` sets the limit)",
-                        self.who(st, rank),
-                        late(st, k)
-                    );
-                    self.fatal(st, msg);
-                }
+                self.check_late(st, &outstanding, late);
                 self.check_term(st, &outstanding);
                 if !busy {
                     std::thread::sleep(POLL);
@@ -506,6 +497,24 @@ impl Coordinator {
             }
         });
         (results.into_iter().flatten().collect(), remote)
+    }
+
+    /// Ends the run when a rank has held its item longer than the timeout
+    /// (`late` says what it did not do).
+    fn check_late(
+        &self,
+        st: &mut State,
+        outstanding: &HashMap<Rank, (usize, Instant)>,
+        late: &dyn Fn(&State, usize) -> String,
+    ) {
+        if let Some((&rank, &(k, _))) = outstanding.iter().find(|(_, (_, t))| t.elapsed() > self.timeout) {
+            let msg = format!(
+                "{} did not {}: it died or hangs (`--rank-timeout` sets the limit)",
+                self.who(st, rank),
+                late(st, k)
+            );
+            self.fatal(st, msg);
+        }
     }
 
     /// Makes `program` the one batches refer to (a new version when it changed).

@@ -1224,6 +1224,24 @@ impl Lower<'_> {
         }
     }
 
+    /// The range of `rab_range`, in mm (`S0043` for one under 1 mm: the
+    /// board perceives nothing there).
+    fn rab_range(&mut self, q: &ast::Quantity) -> Option<f32> {
+        let help =
+            "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`";
+        let message = if q.value <= 0.0 {
+            "a range-and-bearing range of 0 perceives nothing"
+        } else {
+            match self.length(q, "the range-and-bearing range") {
+                Some(v) if v >= 1.0 => return Some(v),
+                Some(_) => "a range-and-bearing range under 1 mm perceives nothing",
+                None => return None,
+            }
+        };
+        self.errors.push(Error::RabRange { span: q.span.into(), message: message.into(), help: help.into() });
+        None
+    }
+
     fn body_settings(&mut self, body: &mut Body, settings: &[&ast::Setting]) {
         self.repeated("body setting", settings.iter().map(|s| (s.name.text.clone(), s.span)));
         for set in settings {
@@ -1297,25 +1315,9 @@ impl Lower<'_> {
                     body.sensor_noise = self.plain(q, "`sensor_noise`", 0.0, 1.0).unwrap_or(body.sensor_noise)
                 }
                 "rab_range" => {
+                    let range = self.rab_range(q);
                     let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);
-                    if q.value <= 0.0 {
-                        self.errors.push(Error::RabRange {
-                            span: q.span.into(),
-                            message: "a range-and-bearing range of 0 perceives nothing".into(),
-                            help: "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`".into(),
-                        });
-                    } else if let Some(v) = self.length(q, "the range-and-bearing range") {
-                        if v < 1.0 {
-                            // A positive range too short for the board's resolution.
-                            self.errors.push(Error::RabRange {
-                                span: q.span.into(),
-                                message: "a range-and-bearing range under 1 mm perceives nothing".into(),
-                                help: "give the distance, body to body, within which robots perceive each other: `rab_range 300mm`".into(),
-                            });
-                        } else {
-                            rab.range = v;
-                        }
-                    }
+                    rab.range = range.unwrap_or(rab.range);
                 }
                 "rab_noise" => {
                     let rab = body.rab.get_or_insert(RangeBearing::DEFAULT);

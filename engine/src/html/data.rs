@@ -70,10 +70,15 @@ fn read_board(
     let fits = columns.robots.len() == 1 + ep.actions.others.len()
         && columns.robots.iter().all(|r| r.len() == n && r.iter().all(|v| v.is_empty() || v.len() == width));
     if !fits {
-        return Err(Error::io(format!(
-            "error: the board in `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
-            rundir::robots_path(dir).display()
-        )));
+        let path = rundir::robots_path(dir);
+        return Err(Error::damaged(
+            &path,
+            "the board is not of the episode beside it",
+            format!(
+                "error: the board in `{}` is not of the episode beside it (other robots, or columns of other lengths); replay the stage again",
+                path.display()
+            ),
+        ));
     }
     columns.robots.truncate(MAX_FOLLOWED);
     let worlds = ep
