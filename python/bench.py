@@ -25,7 +25,10 @@ actions drawn with numpy (no Python per robot), divided by the
 
 Rounds alternate between the sides; the medians are compared. The last
 line is one JSON object with the ratios (goals: R1 >= 0.9, R2 >= 0.5,
-R3 >= 0.5).
+R3 >= 0.5) and ``bench_build``, the build of the ``shaping`` binary: the
+package is always a release build, so with a debug binary (as
+``python/ci.sh`` runs it, to see that the bench runs) R2 and R3 compare
+it with a slow bench and are not figures.
 The ``shaping`` binary is SHAPING_BIN, else target/release/shaping, else
 ``shaping`` on PATH; build it with ``cargo build --release``.
 """
@@ -98,11 +101,13 @@ def vec_env_rate(envs, steps: int, rng) -> float:
     return steps * envs.num_envs / (time.perf_counter() - t)
 
 
+def bench_line(args: list[str]) -> dict:
+    out = subprocess.run(args, capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
 def bench_rate(cli: str) -> tuple[float, dict]:
-    out = subprocess.run(
-        [cli, "bench", str(KHEPERA), "--stage", STAGE, "--runs", "3"], capture_output=True, text=True, check=True
-    )
-    line = json.loads(out.stdout.strip().splitlines()[-1])
+    line = bench_line([cli, "bench", str(KHEPERA), "--stage", STAGE, "--runs", "3"])
     return float(line["controller_actions_per_sec"]), line
 
 
@@ -125,8 +130,7 @@ def team_bench_rate(cli: str) -> float:
     args = [cli, "bench", str(AGGREGATION), "--stage", "aggregate", "--runs", "3"]
     for x in sets:
         args += ["--set", x]
-    out = subprocess.run(args, capture_output=True, text=True, check=True)
-    return float(json.loads(out.stdout.strip().splitlines()[-1])["robot_steps_per_sec"])
+    return float(bench_line(args)["robot_steps_per_sec"])
 
 
 def main() -> None:
@@ -186,12 +190,16 @@ def main() -> None:
         f"shaping bench {med['team_bench']:,.0f} robot-steps/s"
     )
     team_dir.cleanup()
+    build = last_bench.get("build", "unknown")
+    if build != "release":
+        print(f"the `shaping` binary ({cli}) is a {build} build: vec_env_vs_bench and parallel_env_vs_bench are not figures")
     print(
         json.dumps(
             {
                 "evaluate_vs_run": round(med["evaluate"] / med["run"], 3),
                 "vec_env_vs_bench": round(med["vec_env"] / med["bench"], 3),
                 "parallel_env_vs_bench": round(med["team_env"] / med["team_bench"], 3),
+                "bench_build": build,
             }
         )
     )

@@ -383,6 +383,10 @@ fn bench_prints_one_json_line() {
     assert_eq!(v["controller_episodes_per_run"], 200, "{v}");
     assert!(v["stage_actions"].as_u64().unwrap() > 0, "{v}");
     assert!(v["sim_episode_actions"].as_u64().unwrap() > 0, "{v}");
+    // The build that measured (these tests run a debug one) and the peak memory.
+    assert_eq!(v["build"], if cfg!(debug_assertions) { "debug" } else { "release" }, "{v}");
+    let mb = v["peak_memory_mb"].as_f64().unwrap();
+    assert!(mb > 1.0 && mb < 1000.0, "{v}");
     // `--set` as `run` has it: applied, or refused saying why.
     let out =
         run(shaping().arg("bench").arg(tiny()).args(["--runs", "1", "--set", "second.world.arena=300x300"]));

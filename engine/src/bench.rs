@@ -50,7 +50,8 @@ pub struct Bench {
     pub controller_actions_per_episode: f64,
     /// The bench's own life length for the controller runs (a life ends
     /// there or when its battery is empty): [`EPISODE_ACTIONS`], shorter
-    /// for a large team, whatever the stage declares.
+    /// for a large team but at least [`TEAM_ACTIONS`], whatever the stage
+    /// declares.
     pub controller_episode_actions: u32,
     /// The life length the stage declares (`evolve { actions N }`), which
     /// the controller runs do not use.
@@ -82,9 +83,23 @@ pub struct Bench {
 pub const SIM_ROBOT_STEPS: u64 = 200_000;
 /// Episodes and actions each controller run makes with one robot; a team
 /// runs fewer (and shorter ones beyond 200 robots) for about as many
-/// robot-actions.
+/// robot-actions, but never lives shorter than [`TEAM_ACTIONS`].
 pub const EPISODES: u64 = 200;
 pub const EPISODE_ACTIONS: u32 = 300;
+/// The shortest life a team's controller runs time, in actions: shorter
+/// ones would time placing the team more than its robots sensing,
+/// deciding and acting (a team of 10,000 made 6-action lives before).
+pub const TEAM_ACTIONS: u32 = 100;
+
+/// The episodes of a timed controller run and their length in actions, for
+/// a team of `robots`: about [`EPISODES`] x [`EPISODE_ACTIONS`]
+/// robot-actions, but lives of at least [`TEAM_ACTIONS`] for a team.
+pub fn controller_lives(robots: u32) -> (u64, u32) {
+    let n = u64::from(robots.max(1));
+    let episodes = (EPISODES / n).max(1);
+    let actions = EPISODE_ACTIONS.min((EPISODES * u64::from(EPISODE_ACTIONS) / (n * episodes)).max(1) as u32);
+    (episodes, if n == 1 { actions } else { actions.max(TEAM_ACTIONS) })
+}
 
 /// The engine's one median ([`crate::stats::median`]) of the runs' rates.
 fn median(v: Vec<f64>) -> f64 {
@@ -110,9 +125,7 @@ pub fn bench(mut program: Program, index: usize, runs: usize) -> Result<Bench> {
 
     // Controller and simulator: whole episodes of a random individual, as
     // evolution runs them; and how far its robot (robot 0) went.
-    let n = u64::from(robots);
-    let episodes = (EPISODES / n).max(1);
-    let actions = EPISODE_ACTIONS.min((EPISODES * u64::from(EPISODE_ACTIONS) / (n * episodes)).max(1) as u32);
+    let (episodes, actions) = controller_lives(robots);
     let mut ctl_rates = Vec::with_capacity(runs);
     let mut episode_rates = Vec::with_capacity(runs);
     // Lives' lengths over all runs; robot 0's path and actions in run 0's.

@@ -4,7 +4,7 @@
 mod common;
 
 use common::tiny;
-use shaping_engine::bench::{bench, SIM_ROBOT_STEPS};
+use shaping_engine::bench::{bench, controller_lives, SIM_ROBOT_STEPS, TEAM_ACTIONS};
 
 /// A team of 4 in `tiny.bat`'s first stage, with and without its battery
 /// (200 actions: the team is made anew as its robots run out).
@@ -40,4 +40,18 @@ fn a_single_robot_bench_has_one_robot_step_per_step() {
     assert_eq!((b.robots, b.robot_steps, b.actions), (1, SIM_ROBOT_STEPS, SIM_ROBOT_STEPS));
     assert_eq!(b.robot_steps_per_sec, b.sim_steps_per_sec);
     assert!(b.sim_moving_share > 0.9, "{b:?}");
+}
+
+/// The controller runs' lives: one robot's 200 of 300 actions; a team's
+/// fewer for as many robot-actions, but never shorter than 100 actions,
+/// so that a large team's bench times its robots acting, not its placing.
+#[test]
+fn a_large_teams_controller_lives_are_100_actions_or_more() {
+    assert_eq!(controller_lives(1), (200, 300));
+    assert_eq!(controller_lives(10), (20, 300));
+    assert_eq!(controller_lives(100), (2, 300));
+    assert_eq!(controller_lives(400), (1, 150));
+    for robots in [1_000, 10_000, 100_000] {
+        assert_eq!(controller_lives(robots), (1, TEAM_ACTIONS), "{robots} robots");
+    }
 }

@@ -155,6 +155,7 @@ pub fn live<'s, B: Bodies>(
     let state = bodies.state(reads);
     for (i, c) in ctls.iter_mut().enumerate() {
         c.set_learning(opts.learning);
+        c.set_life_length(opts.actions);
         if let Some(s) = state {
             c.set_team(s);
         }

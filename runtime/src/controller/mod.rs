@@ -371,6 +371,9 @@ pub struct Controller<'s> {
     at_end: Option<FastExpr>,
     /// The life so far: pose, distance, squares, actions.
     odo: Odometer,
+    /// The length of the lives it lives, for the room the odometer keeps
+    /// ([`Controller::set_life_length`]).
+    life_actions: u32,
     /// The state the expressions read (`robot.x` ...), filled only when one does.
     state: [f32; STATE_SLOTS],
     /// `team.spread` ... `team.connected`, as the team last gave them
@@ -493,6 +496,7 @@ impl<'s> Controller<'s> {
             fitness: stage.role_fitness(role).per_action.as_ref().map(FastExpr::new),
             at_end: stage.role_fitness(role).at_end.as_ref().map(FastExpr::new),
             odo: Odometer::default(),
+            life_actions: 1024,
             state: [0.0; STATE_SLOTS],
             team: crate::state::TEAM_OF_ONE,
             reads_state: crate::state::reads_state(stage),
@@ -503,6 +507,13 @@ impl<'s> Controller<'s> {
     /// Turns local learning on or off (on after `new`).
     pub fn set_learning(&mut self, on: bool) {
         self.learning = on;
+    }
+
+    /// Lives of `actions` actions follow (1,024 unless said): the odometer
+    /// keeps room for as many squares, up to 1,024, so that a life does not
+    /// allocate, and a team of thousands does not hold room it never uses.
+    pub fn set_life_length(&mut self, actions: u32) {
+        self.life_actions = actions.min(1024);
     }
 
     /// Starts a life: forgets what belonged to the previous one (a script
@@ -531,7 +542,7 @@ impl<'s> Controller<'s> {
         self.forced = None;
         self.forbidden.fill(false);
         self.holding = false;
-        self.odo.start(sim.position(), 1024);
+        self.odo.start(sim.position(), self.life_actions);
         self.observe_state(sim);
         sim.sense(&mut self.now);
         self.before = self.now;
