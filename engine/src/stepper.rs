@@ -168,13 +168,15 @@ pub struct Step {
 /// Refuses a stage whose world has a team (`robots` above 1): an agent
 /// drives one robot, and the others would have no controller.
 pub fn check(stage: &Stage) -> Result<(), Error> {
-    if stage.world.robots > 1 {
+    if stage.robots() > 1 {
         return Err(Error::new(
             ErrorKind::Invalid,
             format!(
                 "error: stage `{}` has a team of {} robots, but a stepper drives one robot (one agent, one robot): \
-                 step a stage whose world has one robot, or run the team with `shaping run`",
-                stage.name, stage.world.robots
+                 step the team with `shaping.gym.make_parallel` (one agent per robot), run it with `shaping run`, \
+                 or step a stage whose world has one robot",
+                stage.name,
+                stage.robots()
             ),
         ));
     }
@@ -183,7 +185,7 @@ pub fn check(stage: &Stage) -> Result<(), Error> {
 
 /// Refuses a stage whose world has one robot: a team stepper drives a team.
 pub fn check_team(stage: &Stage) -> Result<(), Error> {
-    if stage.world.robots <= 1 {
+    if stage.robots() <= 1 {
         return Err(Error::new(
             ErrorKind::Invalid,
             format!(

@@ -180,7 +180,7 @@ def test_the_vector_environment_is_deterministic_and_resets_each_robot():
 
 def test_a_team_is_refused():
     # One agent drives one robot: a stage with a team of 10 is refused.
-    with pytest.raises(shaping.ShapingError, match="team of 10 robots"):
+    with pytest.raises(shaping.ShapingError, match="team of 10 robots.*make_parallel"):
         shaping.gym.make(ROOT / "examples" / "aggregation.bat", "aggregate")
 
 
