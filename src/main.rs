@@ -234,8 +234,10 @@ enum Command {
     /// line); with `world.robots` N > 1, N robots acting in turn in one world
     /// (`robot_steps_per_sec`). The bench picks its own life lengths, printed
     /// in the line: controller lives of `controller_episode_actions` (300,
-    /// fewer for a large team; the stage's own is `stage_actions`), and
-    /// simulated worlds that live at most `sim_episode_actions`.
+    /// fewer for a large team but at least 100; the stage's own is
+    /// `stage_actions`), and simulated worlds that live at most
+    /// `sim_episode_actions`. The line also says the build (`debug` or
+    /// `release`) and the peak memory (`peak_memory_mb`).
     Bench {
         file: PathBuf,
         #[arg(long)]
