@@ -162,6 +162,8 @@ grep -q 'toward(rab) }' $R/recruit-mute.bat
 $B experiment $R/recruit-mute.bat --seeds $SEEDS --out $R/recruit-mute --fresh > /dev/null
 $B compare $R/recruit $R/recruit-mute --stage forage_test | grep -E '\| forage_test \| fitness'
 cargo run --release --quiet --example ablation -- $R/recruit forage_silent
+# What the signal means: broadcasts on and off the food, hearing, approach.
+python3 $D/recruit_meaning.py $R/recruit
 # Twice the generations for the clones and the roles: does the roles'
 # longer genome catch up?
 for f in aggregation aggregation-roles; do
