@@ -896,6 +896,13 @@ fn report_names_a_damaged_file_and_warns_about_unsealed_ones() {
     assert_eq!(r.status.code(), Some(2), "{}", text(&r.stderr));
     assert!(text(&r.stderr).contains("`drive` never writes into a run's directories"), "{}", text(&r.stderr));
     assert_eq!(std::fs::read(runs.join("second/episode.json")).unwrap(), episode);
+    // A life of no actions, or of more than a life may have, as `replay` refuses.
+    let (replay, drive) = (&["replay"][..], &["drive", "--port", "/dev/no-such-port"][..]);
+    for (command, actions) in [(replay, "0"), (drive, "0"), (drive, "4000000000")] {
+        let r = run(shaping().arg(command[0]).arg(tiny()).args(&command[1..]).args(["--actions", actions]));
+        assert_eq!(r.status.code(), Some(2), "{command:?} --actions {actions}: {}", text(&r.stderr));
+        assert!(text(&r.stderr).contains("--actions <ACTIONS>"), "{}", text(&r.stderr));
+    }
 }
 
 /// A run directory belongs to one file: a run of another file into it is

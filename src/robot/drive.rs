@@ -40,7 +40,7 @@ pub struct DriveArgs {
     #[arg(long, default_value_t = 9600)]
     pub baud: u32,
     /// Actions to run (default: the stage's life length).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(shaping_runtime::limits::MAX_ACTIONS)))]
     pub actions: Option<u32>,
     /// Output directory (default: `<run>/<stage>/drive`).
     #[arg(long)]
