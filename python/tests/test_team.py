@@ -2,6 +2,8 @@
 measure a fitness `at end` may be, and `shaping.gym.make_parallel` is a
 PettingZoo parallel environment of a stage's team."""
 
+import csv
+import json
 import warnings
 from pathlib import Path
 
@@ -9,6 +11,7 @@ import numpy as np
 import pytest
 
 import shaping
+from test_shaping import shaping_cli  # the CLI, as test_shaping.py calls it
 
 ROOT = Path(__file__).resolve().parents[2]
 AGGREGATION = ROOT / "examples" / "aggregation.bat"
@@ -104,6 +107,159 @@ def test_measures_of_one_episode_equal_the_descriptors():
         np.testing.assert_array_equal(m[k], a[k])
     np.testing.assert_array_equal(m["squares"], a["squares_visited"])
     assert np.all((m["battery"] >= 0) & (m["battery"] <= 1))
+
+
+# The episode seeds of an evaluation, as `runtime/src/evolve/seed.rs`
+# derives them (its module doc): h = splitmix64(run seed), then h =
+# splitmix64(h ^ p) for the domain tag "EVAL" and the stage's index, the
+# generation, the individual and the episode. `replay --seed` takes such a
+# seed as it is.
+_MASK = (1 << 64) - 1
+
+
+def _splitmix64(x):
+    z = (x + 0x9E3779B97F4A7C15) & _MASK
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
+    return z ^ (z >> 31)
+
+
+def _episode_seed(run_seed, stage, generation, individual, episode):
+    h = _splitmix64(run_seed)
+    for p in (0x4556414C, stage, generation, individual, episode):
+        h = _splitmix64(h ^ p)
+    return h
+
+
+def _replayed(tmp_path, genome, seed, name):
+    """One life of `genome` in stage `aggregate` of aggregation-rab.bat, as
+    `shaping replay` traces it: each robot's start (`episode.json`) and
+    its rows of `trace.csv`, action after action."""
+    out = tmp_path / name
+    res = shaping_cli("replay", RAB, "--stage", "aggregate", "--genome", "".join(map(str, genome)),
+                      "--seed", seed, "--out", out)
+    assert res.returncode == 0, res.stderr
+    world = json.loads((out / "episode.json").read_text())["worlds"][0]
+    starts = [world["start"], *world["others"]]
+    with open(out / "trace.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    robots = []
+    for i, start in enumerate(starts):
+        mine = [r for r in rows if int(r["robot"]) == i]
+        assert [int(r["action"]) for r in mine] == list(range(len(mine)))
+        robots.append({
+            "xy": np.array([start[:2]] + [[float(r["x"]), float(r["y"])] for r in mine]),
+            "theta": float(mine[-1]["theta"]),
+            "rab": np.array([float(mine[-1][f"rab[{k}]"]) for k in range(8)]),
+        })
+    assert len(robots) == 10 and len(rows) == 10 * 400
+    return robots
+
+
+# trace.csv prints x and y with 2 decimals, theta with 4: a printed
+# position is within 0.005 mm of the robot's in x and in y, so within
+# 0.005 * sqrt(2) of it; a distance between two printed positions within
+# 0.01 * sqrt(2) of the distance between the robots'. It prints the sensors
+# with 4 decimals, but they are the episode's columns (`episode.json`),
+# rounded to 3 (`EpisodeColumns::push_frame`): within 0.0005. A mean over
+# episodes, cast to float32 as `evaluate` returns it, may be 1e-4 further.
+XY = 0.005
+THETA = 0.00005
+SENSOR = 0.0005
+DISTANCE = 0.01 * 2**0.5
+
+
+def _squares(xy):
+    """The 50 mm squares the printed positions `xy` lie in, counted once, as
+    `runtime/src/state.rs` counts them (`square_of`, `SQUARE_MM`): the fewest
+    and the most the robot's own positions can have been in (the same
+    number unless a printed position is within 0.005 mm of a square's side)."""
+    sure, unsure = set(), []
+    for x, y in xy:
+        xs = {int(np.floor((x - XY) / 50)), int(np.floor((x + XY) / 50))}
+        ys = {int(np.floor((y - XY) / 50)), int(np.floor((y + XY) / 50))}
+        cells = {(a, b) for a in xs for b in ys}
+        if len(cells) == 1:
+            sure |= cells
+        else:
+            unsure.append(cells)
+    extra = set().union(*unsure) - sure if unsure else set()
+    fewest = len(sure) + (1 if any(not (c & sure) for c in unsure) else 0)
+    return fewest, len(sure) + len(extra)
+
+
+def test_a_team_s_descriptors_and_measures_are_those_of_its_trace(tmp_path):
+    """Issue 50: every robot's descriptors and the measures `evaluate` gives
+    are those of the lives the CLI traces. An individual's evaluation is
+    its episodes (the stage's `evaluations 3`), each replayed with `--seed`
+    its episode seed: the final pose is the last episode's last row, the
+    path length, the squares visited and each measure the mean over the
+    episodes of what the trace gives."""
+    seed, generation, individual = 5, 2, 7
+    ev = shaping.compile(RAB).evaluator("aggregate", seed=seed, jobs=1)
+    genome = random_genomes(1, ev.bits, seed=11)
+    measures = {"x": "robot.x", "y": "robot.y", "distance": "robot.distance",
+                "squares": "robot.squares", "spread": "team.spread", "nearest": "team.nearest",
+                "rab": "max(rab)", "rab2": "rab[2]"}
+    a = ev.evaluate(genome, generation=generation, individuals=[individual], measures=measures)
+    robots, m = a["robots"], a["measures"]
+    assert ev.episodes == 3
+    lives = [_replayed(tmp_path, genome[0], _episode_seed(seed, 0, generation, individual, e), f"e{e}")
+             for e in range(ev.episodes)]
+    last = lives[-1]
+    # Each robot's final pose: its last row of the last episode's trace.
+    for i, r in enumerate(last):
+        x, y = r["xy"][-1]
+        assert abs(robots["x"][0, i] - x) <= XY + 1e-6, (i, robots["x"][0, i], x)
+        assert abs(robots["y"][0, i] - y) <= XY + 1e-6, (i, robots["y"][0, i], y)
+        turn = (robots["heading"][0, i] - r["theta"] + np.pi) % (2 * np.pi) - np.pi
+        assert abs(turn) <= THETA + 1e-6, (i, robots["heading"][0, i], r["theta"])
+        assert abs(m["x"][0, i] - np.mean([life[i]["xy"][-1][0] for life in lives])) <= XY + 1e-4, i
+        assert abs(m["y"][0, i] - np.mean([life[i]["xy"][-1][1] for life in lives])) <= XY + 1e-4, i
+    # Each robot's path from its start (`episode.json`; trace.csv's rows are
+    # the poses after each action) and the squares it was in, start included.
+    for i in range(10):
+        paths, moves, fewest, most = [], [], [], []
+        for life in lives:
+            steps = np.diff(life[i]["xy"], axis=0)
+            paths.append(np.hypot(steps[:, 0], steps[:, 1]).sum())
+            moves.append(int(np.count_nonzero(np.any(steps != 0, axis=1))))
+            lo, hi = _squares(life[i]["xy"])
+            fewest.append(lo)
+            most.append(hi)
+        # A step between two equal printed positions is 0 (the robot did not
+        # move: a collision undid its move); each other step within DISTANCE.
+        tolerance = DISTANCE * max(moves) + 1e-3
+        assert abs(robots["path_length"][0, i] - np.mean(paths)) <= tolerance, (i, robots["path_length"][0, i],
+                                                                                np.mean(paths), tolerance)
+        assert abs(m["distance"][0, i] - np.mean(paths)) <= tolerance, i
+        # (float32's rounding of the mean aside.)
+        squares = robots["squares_visited"][0, i]
+        assert np.mean(fewest) - 1e-5 <= squares <= np.mean(most) + 1e-5, (i, squares, fewest, most)
+        if fewest == most:
+            assert robots["squares_visited"][0, i] == pytest.approx(np.mean(fewest), abs=1e-5), i
+        assert m["squares"][0, i] == pytest.approx(robots["squares_visited"][0, i], abs=1e-5), i
+    # The team's measures, from every robot's last row: the mean distance to
+    # the robots' mean centre, the mean distance to the nearest other robot.
+    spreads, nearests = [], []
+    for life in lives:
+        at = np.array([r["xy"][-1] for r in life])
+        spreads.append(np.hypot(*(at - at.mean(axis=0)).T).mean())
+        gaps = np.hypot(*(at[:, None, :] - at[None, :, :]).transpose(2, 0, 1))
+        np.fill_diagonal(gaps, np.inf)
+        nearests.append(gaps.min(axis=1).mean())
+    assert m["spread"].shape == (1,) and m["nearest"].shape == (1,)
+    assert abs(m["spread"][0] - np.mean(spreads)) <= DISTANCE + 1e-4, (m["spread"][0], spreads)
+    assert abs(m["nearest"][0] - np.mean(nearests)) <= DISTANCE + 1e-4, (m["nearest"][0], nearests)
+    assert abs(a["fitness"][0] - (1 - np.mean(spreads) / 400)) <= (DISTANCE + 1e-4) / 400
+    # The range-and-bearing board each robot read at its last action.
+    for i in range(10):
+        best = np.mean([life[i]["rab"].max() for life in lives])
+        assert abs(m["rab"][0, i] - best) <= SENSOR + 1e-6, (i, m["rab"][0, i], best)
+        sector = np.mean([life[i]["rab"][2] for life in lives])
+        assert abs(m["rab2"][0, i] - sector) <= SENSOR + 1e-6, (i, m["rab2"][0, i], sector)
+    # Not a still team: the test would say little of robots that never move.
+    assert np.all(robots["path_length"][0] > 10) and np.any(last[0]["rab"] > 0)
 
 
 def test_a_bad_measure_raises_the_compiler_s_diagnostic():
