@@ -1,9 +1,8 @@
 #!/usr/bin/env bash
-# Regenerates every number and picture of EXPERIMENTS.md (about 55 minutes
-# of CPU time, so about half an hour on two idle cores: measured, 34 minutes
-# before the ladder, aggregation-rab and recruit were added, which add about
-# 20). Results go to runs/experiments/; the pictures EXPERIMENTS.md shows
-# are copied next to this script; the numbers are printed.
+# Regenerates every number and picture of EXPERIMENTS.md (about 50 minutes
+# of CPU time: measured at e957a7e, 49 minutes, 47 on two cores shared with
+# other work). Results go to runs/experiments/; the pictures EXPERIMENTS.md
+# shows are copied next to this script; the numbers are printed.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release --quiet

@@ -22,8 +22,9 @@
 //! drives one robot.
 //!
 //! [`Stepper`] is one robot; [`VecStepper`] is many, stepped on the
-//! threads of the caller's rayon pool in one call, each resetting itself
-//! on the step after its life ended. Both are deterministic by seed.
+//! threads of the caller's rayon pool in one call (called outside a pool,
+//! on the calling thread alone), each resetting itself on the step after
+//! its life ended. Both are deterministic by seed.
 
 use std::sync::Arc;
 
@@ -887,7 +888,7 @@ impl<E: Lived> Batch<E> {
                 };
             }
         }
-        self.slots.par_iter_mut().with_min_len(32usize.div_ceil(self.robots)).for_each(|slot| {
+        let one = |slot: &mut Slot<E>| {
             if slot.pending {
                 slot.pending = false;
                 slot.env.lives_mut().reset(slot.seeds.next_u64(), &mut slot.obs);
@@ -897,7 +898,14 @@ impl<E: Lived> Batch<E> {
                 lives.run(&slot.cmds, &mut slot.obs, &mut slot.steps);
                 slot.pending = lives.members.iter().all(|m| m.ended);
             }
-        });
+        };
+        // Outside a rayon pool, or with one world, on the calling thread:
+        // rayon would hand the work to a pool thread and wait for it.
+        if rayon::current_thread_index().is_some() && self.slots.len() > 1 {
+            self.slots.par_iter_mut().with_min_len(32usize.div_ceil(self.robots)).for_each(one);
+        } else {
+            self.slots.iter_mut().for_each(one);
+        }
         self.gather(out);
         Ok(())
     }
@@ -956,12 +964,12 @@ impl VecStepper {
     }
 
     /// Steps every robot with its row of `actions` (`n` rows of the
-    /// action's length), in parallel on the current rayon pool. A robot
-    /// whose life ended at the previous step starts a new one instead: its
-    /// row of `actions` is ignored, its reward is 0 and it is neither
-    /// terminated nor truncated (Gymnasium's "next step" autoreset). A
-    /// malformed action is an [`ErrorKind::Invalid`] error naming its row,
-    /// and no robot moves.
+    /// action's length), in parallel on the current rayon pool (outside
+    /// one, on this thread). A robot whose life ended at the previous step
+    /// starts a new one instead: its row of `actions` is ignored, its
+    /// reward is 0 and it is neither terminated nor truncated (Gymnasium's
+    /// "next step" autoreset). A malformed action is an
+    /// [`ErrorKind::Invalid`] error naming its row, and no robot moves.
     pub fn step(&mut self, actions: &[f32], out: &mut VecStep) -> Result<(), Error> {
         self.batch.step(actions, out, |w, _, e| format!("error: row {w} of the actions: {e}"))
     }
@@ -1024,9 +1032,10 @@ impl VecTeamStepper {
     }
 
     /// Steps every world with its robots' rows of `actions`, the worlds in
-    /// parallel on the current rayon pool. A malformed row (of a robot
-    /// whose life goes on) is an [`ErrorKind::Invalid`] error naming the
-    /// world, the agent and the element, and no robot moves.
+    /// parallel on the current rayon pool (outside one, on this thread). A
+    /// malformed row (of a robot whose life goes on) is an
+    /// [`ErrorKind::Invalid`] error naming the world, the agent and the
+    /// element, and no robot moves.
     pub fn step(&mut self, actions: &[f32], out: &mut VecStep) -> Result<(), Error> {
         let names = &self.names;
         self.batch.step(actions, out, |w, i, e| {

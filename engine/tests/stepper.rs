@@ -135,11 +135,11 @@ fn bad_actions_are_refused_naming_the_element() {
     assert_eq!(env.actions(), 1);
 }
 
-/// `steps` steps of `n` robots with random actions on `threads` threads:
-/// the observations, rewards and ends of every step.
+/// `steps` steps of `n` robots with random actions on `threads` threads
+/// (0: outside any pool, on this thread): the observations, rewards and
+/// ends of every step.
 fn vec_run(stage: &Arc<Stage>, n: usize, steps: usize, threads: usize) -> Vec<VecStep> {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| {
+    let run = || {
         let mut envs = VecStepper::new(stage.clone(), n).unwrap();
         let dims = envs.spaces().action.len();
         let mut rng = ChaCha8Rng::seed_from_u64(11);
@@ -156,7 +156,11 @@ fn vec_run(stage: &Arc<Stage>, n: usize, steps: usize, threads: usize) -> Vec<Ve
             all.push(out.clone());
         }
         all
-    })
+    };
+    if threads == 0 {
+        return run();
+    }
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(run)
 }
 
 #[test]
@@ -165,6 +169,7 @@ fn robots_stepped_together_are_deterministic_and_start_again_after_a_life() {
     let nav = stage(&program, "navigation");
     let one = vec_run(&nav, 40, 320, 1);
     assert_eq!(one, vec_run(&nav, 40, 320, 2));
+    assert_eq!(one, vec_run(&nav, 40, 320, 0));
     // Lives of 300 actions: every robot's life ended (by the battery or at
     // 300), and on the step after, it started again: reward 0, not ended,
     // a fresh observation (a full battery).

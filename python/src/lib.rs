@@ -212,6 +212,17 @@ impl Pool {
         Ok(pool)
     }
 
+    /// Runs `f` on the pool; on the calling thread when the pool has one
+    /// thread or the work is one piece (`one`), where handing it to a pool
+    /// thread would cost two context switches a call (tens of us: more
+    /// than a step of 100 robots).
+    fn run<T: Send>(&self, one: bool, f: impl FnOnce() -> T + Send) -> PyResult<T> {
+        if one || self.jobs == Some(1) {
+            return Ok(f());
+        }
+        Ok(self.get()?.install(f))
+    }
+
     /// The pool of this process.
     fn get(&self) -> PyResult<Arc<rayon::ThreadPool>> {
         let pid = std::process::id();
@@ -1548,9 +1559,8 @@ impl VecStepper {
             )));
         }
         let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
-        let pool = self.pool.get()?;
-        let (inner, out) = (&mut self.inner, &mut self.out);
-        py.detach(|| pool.install(|| inner.step(flat, out))).map_err(|e| invalid(&e))?;
+        let (pool, inner, out) = (&self.pool, &mut self.inner, &mut self.out);
+        py.detach(|| pool.run(n == 1, || inner.step(flat, out)))?.map_err(|e| invalid(&e))?;
         Ok((
             self.observations(py)?,
             PyArray1::from_slice(py, &self.out.rewards),
@@ -1646,9 +1656,8 @@ impl VecTeamStepper {
             )));
         }
         let flat = actions.as_slice().map_err(|e| value_error(format!("the actions: {e}")))?;
-        let pool = self.pool.get()?;
-        let (inner, out) = (&mut self.inner, &mut self.out);
-        py.detach(|| pool.install(|| inner.step(flat, out))).map_err(|e| invalid(&e))?;
+        let (pool, inner, out) = (&self.pool, &mut self.inner, &mut self.out);
+        py.detach(|| pool.run(n == 1, || inner.step(flat, out)))?.map_err(|e| invalid(&e))?;
         Ok((
             self.observations(py)?,
             PyArray1::from_slice(py, &self.out.rewards).reshape([n, robots])?,
