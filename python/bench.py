@@ -92,12 +92,19 @@ def run_rate(population: int, jobs: int | None, episodes: int) -> float:
     return population * episodes / (marks["evolve_end"] - marks["evolve_start"])
 
 
+def draw(rng, low, high, shape):
+    """Random actions in the box ``[low, high]``, float32: numpy's
+    ``random`` scaled (``uniform`` with array bounds took 18 us of a
+    100-robot step, more than the step's half in Rust)."""
+    return (rng.random(shape, dtype=np.float32) * (high - low) + low).astype(np.float32, copy=False)
+
+
 def vec_env_rate(envs, steps: int, rng) -> float:
     low, high = envs.single_action_space.low, envs.single_action_space.high
     shape = (envs.num_envs, len(low))
     t = time.perf_counter()
     for _ in range(steps):
-        envs.step(rng.uniform(low, high, size=shape).astype(np.float32))
+        envs.step(draw(rng, low, high, shape))
     return steps * envs.num_envs / (time.perf_counter() - t)
 
 
@@ -121,7 +128,7 @@ def team_env_rate(envs, steps: int, rng) -> float:
     shape = (envs.num_envs, len(envs.agents), len(low))
     t = time.perf_counter()
     for _ in range(steps):
-        envs.step(rng.uniform(low, high, size=shape).astype(np.float32))
+        envs.step(draw(rng, low, high, shape))
     return steps * envs.num_envs * len(envs.agents) / (time.perf_counter() - t)
 
 

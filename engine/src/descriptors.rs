@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use shaping_runtime::controller::{
     run_episode, run_team_episode_measured, EpisodeOptions, EpisodeResult, TeamResult,
 };
-use shaping_runtime::evolve::{seed, Episode, Evaluation, Events};
+use shaping_runtime::evolve::{drawn_variants, seed, Episode, Evaluation, Events};
 use shaping_runtime::expr::Expr;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Stage, StageRun};
@@ -113,8 +113,9 @@ impl RobotSums {
 /// generation of the stage ([`seed::episode_seed`]`(seed, stage,
 /// generation, individual, e)`, `e` from 0 to the stage's `evaluations` -
 /// 1; one episode if it declares none). In a stage with variants, those
-/// episodes in every variant ([`Episode::in_variant`]), variant after
-/// variant (a run draws some with `draw N`; here all are run).
+/// episodes in each variant the run evaluates that generation in
+/// ([`Episode::in_variant`]; every variant, or the generation's `draw N`:
+/// [`drawn_variants`]), variant after variant.
 pub fn episodes(stage: &Stage, index: usize, seed: u64, generation: u32, individual: usize) -> Vec<Episode> {
     let episodes = match &stage.run {
         StageRun::Evolve(evo) => evo.evaluations.max(1),
@@ -123,7 +124,8 @@ pub fn episodes(stage: &Stage, index: usize, seed: u64, generation: u32, individ
     let one = |e| seed::episode_seed(seed, index, generation, individual, e);
     match &stage.variants {
         None => (0..episodes).map(|e| Episode::plain(one(e))).collect(),
-        Some(v) => (0..v.list.len())
+        Some(_) => drawn_variants(stage, seed, index, generation)
+            .into_iter()
             .flat_map(|k| (0..episodes).map(move |e| Episode::in_variant(one(e), k)))
             .collect(),
     }

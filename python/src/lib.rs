@@ -909,6 +909,32 @@ impl Evaluator {
         self.seed
     }
 
+    /// The episodes `evaluate` gives individual `individual` of generation
+    /// `generation`: a list of `(seed, variant)`, the episode seed and the
+    /// name of the world's variant (`None`: the stage's own world), in the
+    /// order they are lived. `shaping replay FILE --stage S --genome G
+    /// --seed SEED [--variant VARIANT]` lives one of them and traces it.
+    /// A bad `individual` or `generation` raises ValueError.
+    #[pyo3(signature = (individual=None, generation=None))]
+    fn episode_seeds(
+        &self,
+        individual: Option<&Bound<'_, PyAny>>,
+        generation: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Vec<(u64, Option<String>)>> {
+        let arg = |v: Option<&Bound<'_, PyAny>>, name, max| match v {
+            Some(v) if !v.is_none() => count_arg(v, name, max),
+            _ => Ok(0),
+        };
+        let individual = arg(individual, "individual", MAX_INDIVIDUAL)? as usize;
+        let generation = arg(generation, "generation", u64::from(u32::MAX))? as u32;
+        let stage = &self.program.stages[self.index];
+        let name = |k: usize| stage.variants.as_ref().and_then(|v| v.list.get(k)).map(|v| v.name.clone());
+        Ok(descriptors::episodes(stage, self.index, self.seed, generation, individual)
+            .into_iter()
+            .map(|e| (e.seed, e.variant.and_then(name)))
+            .collect())
+    }
+
     /// Evaluates each row of `genomes`, an array of shape (n, bits) of 0
     /// and 1 (an integer or bool dtype), as the stage's evolution does: its
     /// `evaluations` episodes of its `actions` actions, in its world,

@@ -18,6 +18,7 @@ AGGREGATION = ROOT / "examples" / "aggregation.bat"
 ROLES = ROOT / "examples" / "aggregation-roles.bat"
 RAB = ROOT / "examples" / "aggregation-rab.bat"
 KHEPERA = ROOT / "examples" / "khepera.bat"
+RECRUIT = ROOT / "examples" / "recruit.bat"
 
 
 def random_genomes(n, bits, seed=1):
@@ -109,26 +110,58 @@ def test_measures_of_one_episode_equal_the_descriptors():
     assert np.all((m["battery"] >= 0) & (m["battery"] <= 1))
 
 
-# The episode seeds of an evaluation, as `runtime/src/evolve/seed.rs`
-# derives them (its module doc): h = splitmix64(run seed), then h =
-# splitmix64(h ^ p) for the domain tag "EVAL" and the stage's index, the
-# generation, the individual and the episode. `replay --seed` takes such a
-# seed as it is.
-_MASK = (1 << 64) - 1
+def test_episode_seeds_are_those_a_run_derives():
+    """`Evaluator.episode_seeds` lists the episodes `evaluate` lives: the
+    seeds `runtime/src/evolve/seed.rs` derives (its module doc: h =
+    splitmix64(run seed), then h = splitmix64(h ^ p) for the tag "EVAL",
+    the stage's index, the generation, the individual and the episode),
+    and the variants of a stage that has them."""
+    mask = (1 << 64) - 1
+
+    def splitmix64(x):
+        z = (x + 0x9E3779B97F4A7C15) & mask
+        z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & mask
+        z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & mask
+        return z ^ (z >> 31)
+
+    def derived(run_seed, stage, generation, individual, episode):
+        h = splitmix64(run_seed)
+        for p in (0x4556414C, stage, generation, individual, episode):
+            h = splitmix64(h ^ p)
+        return h
+
+    ev = shaping.compile(RAB).evaluator("aggregate", seed=5)
+    assert ev.episode_seeds(7, 2) == [(derived(5, 0, 2, 7, e), None) for e in range(3)]
+    assert ev.episode_seeds() == [(derived(5, 0, 0, 0, e), None) for e in range(3)]
+    # A stage that draws one of its four variants per generation (`draw
+    # 1`): the generation's variant, the same for every individual.
+    recruit = shaping.compile(RECRUIT).evaluator("forage", seed=5)
+    drawn = set()
+    for generation in range(8):
+        lives = recruit.episode_seeds(1, generation)
+        assert len(lives) == recruit.episodes == 3
+        [variant] = {v for _, v in lives}
+        assert [v for _, v in recruit.episode_seeds(2, generation)] == [variant] * 3
+        drawn.add(variant)
+    assert drawn <= {"south_west", "south_east", "north_west", "north_east"} and len(drawn) > 1
+    for bad in (-1, 1.5, True, "3"):
+        with pytest.raises(ValueError, match="individual must be an integer"):
+            ev.episode_seeds(bad)
+    with pytest.raises(ValueError, match="generation must be an integer"):
+        ev.episode_seeds(0, -2)
 
 
-def _splitmix64(x):
-    z = (x + 0x9E3779B97F4A7C15) & _MASK
-    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & _MASK
-    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & _MASK
-    return z ^ (z >> 31)
-
-
-def _episode_seed(run_seed, stage, generation, individual, episode):
-    h = _splitmix64(run_seed)
-    for p in (0x4556414C, stage, generation, individual, episode):
-        h = _splitmix64(h ^ p)
-    return h
+def test_a_stage_that_draws_its_variants_is_evaluated_as_its_run(tmp_path):
+    """recruit.bat's `forage` draws one variant per generation: `evaluate`
+    gives a generation's individuals the fitness the run gave them (it ran
+    every variant before)."""
+    out = tmp_path / "run"
+    res = shaping_cli("run", RECRUIT, "--stage", "forage", "--seed", 5, "--out", out, "--no-report",
+                      "--set", "forage.evolve.generations=2", "--set", "forage.evolve.population=4")
+    assert res.returncode == 0, res.stderr
+    genomes, fitness = shaping.Run(out).population("forage")
+    ev = shaping.compile(RECRUIT).evaluator("forage", seed=5)
+    np.testing.assert_array_equal(ev.evaluate(genomes, generation=1)["fitness"], fitness)
 
 
 def _replayed(tmp_path, genome, seed, name):
@@ -204,8 +237,8 @@ def test_a_team_s_descriptors_and_measures_are_those_of_its_trace(tmp_path):
     a = ev.evaluate(genome, generation=generation, individuals=[individual], measures=measures)
     robots, m = a["robots"], a["measures"]
     assert ev.episodes == 3
-    lives = [_replayed(tmp_path, genome[0], _episode_seed(seed, 0, generation, individual, e), f"e{e}")
-             for e in range(ev.episodes)]
+    lives = [_replayed(tmp_path, genome[0], s, f"e{e}")
+             for e, (s, _) in enumerate(ev.episode_seeds(individual, generation))]
     last = lives[-1]
     # Each robot's final pose: its last row of the last episode's trace.
     for i, r in enumerate(last):

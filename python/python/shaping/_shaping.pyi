@@ -160,6 +160,16 @@ class Evaluator:
         """The episodes per individual (the stage's ``evaluations``)."""
     @property
     def seed(self) -> int: ...
+    def episode_seeds(
+        self, individual: Optional[int] = None, generation: Optional[int] = None
+    ) -> list[tuple[int, Optional[str]]]:
+        """The episodes ``evaluate`` gives individual ``individual`` of generation ``generation``.
+
+        A list of ``(seed, variant)``: the episode seed and the name of
+        the world's variant (``None``: the stage's own world), in the order
+        they are lived. ``shaping replay FILE --stage S --genome G --seed
+        SEED [--variant VARIANT]`` lives one of them and traces it.
+        """
     def evaluate(
         self,
         genomes: npt.ArrayLike,
