@@ -423,10 +423,14 @@ impl Lives {
             m.odo.moved(bodies.sim(i).position());
             record_command(&mut m.slots, cmd);
             bodies.sense(i, &mut m.next);
-            Lives::fill_state(self.reads_state, &self.targets, &self.team, m, bodies.sim(i));
             let terms = &self.terms[m.role.min(self.terms.len() - 1)];
-            let env = Env { now: &m.next, prev: &m.now, act: &m.slots, state: &m.state };
-            let mut reward = terms.per_action.as_ref().map_or(0.0, |e| e.eval(&env));
+            // The state only where a term reads it now: a role without a
+            // per-action term reads it at the end of its life (below).
+            let mut reward = 0.0;
+            if let Some(e) = &terms.per_action {
+                Lives::fill_state(self.reads_state, &self.targets, &self.team, m, bodies.sim(i));
+                reward = e.eval(&Env { now: &m.next, prev: &m.now, act: &m.slots, state: &m.state });
+            }
             let counts = [
                 outcome.grips,
                 outcome.releases_outside,
@@ -440,7 +444,11 @@ impl Lives {
             *step = Step { reward, terminated, truncated: !terminated && last, outcome };
         }
         bodies.end_action();
-        if matches!(bodies, Bodies::Team(_)) {
+        // The team's state: for the next action's per-action terms, or for
+        // the `at end` terms of the robots whose life ends now.
+        let ending = steps.iter().any(|s| s.terminated || s.truncated);
+        if matches!(bodies, Bodies::Team(_)) && (ending || self.terms.iter().any(|t| t.per_action.is_some()))
+        {
             self.team = bodies.state(self.reads);
         }
         for (i, (m, step)) in self.members.iter_mut().zip(steps.iter_mut()).enumerate() {
@@ -448,10 +456,13 @@ impl Lives {
                 continue;
             }
             if step.terminated || step.truncated {
-                if self.reads_state {
+                let terms = &self.terms[m.role.min(self.terms.len() - 1)];
+                if terms.per_action.is_none() {
+                    // Where the robot ended its action (it has not moved since).
+                    Lives::fill_state(self.reads_state, &self.targets, &self.team, m, bodies.sim(i));
+                } else if self.reads_state {
                     m.state[ST_SPREAD..ST_SPREAD + TEAM_SLOTS].copy_from_slice(&self.team);
                 }
-                let terms = &self.terms[m.role.min(self.terms.len() - 1)];
                 if let Some(e) = &terms.at_end {
                     let env = Env { now: &m.next, prev: &m.now, act: &m.slots, state: &m.state };
                     step.reward += e.eval(&env);
