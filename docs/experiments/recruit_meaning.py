@@ -20,6 +20,7 @@ Standard library only; reads `episode.json` for each life's food zone (the
 zone of grey 0) and its first action, and `trace.csv`.
 """
 
+import bisect
 import csv
 import json
 import math
@@ -44,24 +45,27 @@ def seed_line(stage_dir: Path) -> str:
             heard = max(float(v) for k, v in row.items() if k.startswith("heard["))
             rows[(int(row["action"]), int(row["robot"]))] = (
                 float(row["x"]), float(row["y"]), float(row["floor[0]"]) < 0.5, heard, float(row["signal[0]"]))
-    ends = [first for first, _, _ in lives[1:]] + [1 + max(a for a, _ in rows)]
+    firsts = [first for first, _, _ in lives]
+    ends = firsts[1:] + [1 + max(a for a, _ in rows)]
     signal = {True: [], False: []}
     hearing = []
     approach = {False: [], True: []}  # silenced -> changes
-    for (first, centre, silenced), end in zip(lives, ends):
-        for (a, r), (x, y, on_food, heard, sent) in rows.items():
-            if not first <= a < end:
-                continue
-            if not silenced:
-                signal[on_food].append(sent)
-                if not on_food:
-                    hearing.append(heard > 0.5)
-            later = rows.get((a + AHEAD, r))
-            if on_food or later is None or a + AHEAD >= end:
-                continue
-            d0 = math.dist((x, y), centre)
-            if BAND[0] <= d0 <= BAND[1]:
-                approach[silenced].append(math.dist(later[:2], centre) - d0)
+    for (a, r), (x, y, on_food, heard, sent) in rows.items():
+        life = bisect.bisect_right(firsts, a) - 1
+        if life < 0:
+            continue
+        _, centre, silenced = lives[life]
+        end = ends[life]
+        if not silenced:
+            signal[on_food].append(sent)
+            if not on_food:
+                hearing.append(heard > 0.5)
+        later = rows.get((a + AHEAD, r))
+        if on_food or later is None or a + AHEAD >= end:
+            continue
+        d0 = math.dist((x, y), centre)
+        if BAND[0] <= d0 <= BAND[1]:
+            approach[silenced].append(math.dist(later[:2], centre) - d0)
     mean = lambda v: statistics.mean(v) if v else float("nan")
     return (f"broadcast on food {mean(signal[True]):.2f}, off {mean(signal[False]):.2f}; "
             f"off food hearing > 0.5 in {mean(hearing):.2f} of actions; "
