@@ -241,9 +241,9 @@ fn time_sim(world: &World, runs: usize) -> SimTimes {
 }
 
 /// A team: every action, each living robot in turn is given the others
-/// within reach, senses and moves; a new team (the next seed) once half
-/// the robots' batteries are empty (until then a dead robot's turn is no
-/// step), and after [`EPISODE_ACTIONS`] actions, as evolution's lives are
+/// within reach, senses and moves, then the board (if any) measures; a
+/// new team (the next seed) once half the robots' batteries are empty
+/// (until then a dead robot's turn is no step), and after [`EPISODE_ACTIONS`] actions, as evolution's lives are
 /// (with time, a robot of this rule can wedge itself in a corner, its back
 /// against one wall while a front sensor sees the other: a long-lived
 /// team would time ever more robots that do not move).
@@ -289,6 +289,8 @@ fn time_team(world: &World, runs: usize) -> SimTimes {
                 alive -= usize::from(!sim.alive());
                 done += 1;
             }
+            // The range-and-bearing board's measurement, as a life's.
+            team.end_action();
         }
         let secs = t.elapsed().as_secs_f64();
         times.world_rates.push(actions as f64 / secs);
