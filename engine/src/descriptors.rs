@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use shaping_runtime::controller::{
     run_episode, run_team_episode_measured, EpisodeOptions, EpisodeResult, TeamResult,
 };
-use shaping_runtime::evolve::{drawn_variants, seed, Episode, Evaluation, Events};
+use shaping_runtime::evolve::{drawn_variants, individual_episodes, seed, Episode, Evaluation, Events};
 use shaping_runtime::expr::Expr;
 use shaping_runtime::genome::Genome;
 use shaping_runtime::program::{Stage, StageRun};
@@ -121,14 +121,9 @@ pub fn episodes(stage: &Stage, index: usize, seed: u64, generation: u32, individ
         StageRun::Evolve(evo) => evo.evaluations.max(1),
         StageRun::Test { .. } | StageRun::Train { .. } => 1,
     };
-    let one = |e| seed::episode_seed(seed, index, generation, individual, e);
-    match &stage.variants {
-        None => (0..episodes).map(|e| Episode::plain(one(e))).collect(),
-        Some(_) => drawn_variants(stage, seed, index, generation)
-            .into_iter()
-            .flat_map(|k| (0..episodes).map(move |e| Episode::in_variant(one(e), k)))
-            .collect(),
-    }
+    let variants = drawn_variants(stage, seed, index, generation);
+    individual_episodes(&variants, episodes, |e| seed::episode_seed(seed, index, generation, individual, e))
+        .collect()
 }
 
 /// The length of the episodes of `stage`: its evolution's `actions`, a

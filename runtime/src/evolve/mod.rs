@@ -222,21 +222,30 @@ pub fn drawn_variants(stage: &Stage, run_seed: u64, index: usize, generation: u3
     all
 }
 
-/// The jobs of one individual: `episodes` episodes per variant of
+/// The episodes of one individual: `episodes` episodes per variant of
 /// `variants` (episode `e` of variant `v`: [`Episode::in_variant`]`(seed(e),
 /// v)`), or `episodes` episodes without variants.
+pub fn individual_episodes<'v>(
+    variants: &'v [usize],
+    episodes: u32,
+    seed: impl Fn(u32) -> u64 + Copy + 'v,
+) -> impl Iterator<Item = Episode> + 'v {
+    let plain = variants.is_empty().then(|| (0..episodes).map(move |e| Episode::plain(seed(e))));
+    let varied = variants
+        .iter()
+        .copied()
+        .flat_map(move |v| (0..episodes).map(move |e| Episode::in_variant(seed(e), v)));
+    plain.into_iter().flatten().chain(varied)
+}
+
+/// The jobs of one individual: its [`individual_episodes`].
 fn individual_jobs<'g>(
     genome: &'g Genome,
     variants: &'g [usize],
     episodes: u32,
     seed: impl Fn(u32) -> u64 + Copy + 'g,
 ) -> impl Iterator<Item = (&'g Genome, Episode)> + 'g {
-    let plain = variants.is_empty().then(|| (0..episodes).map(move |e| (genome, Episode::plain(seed(e)))));
-    let varied = variants
-        .iter()
-        .copied()
-        .flat_map(move |v| (0..episodes).map(move |e| (genome, Episode::in_variant(seed(e), v))));
-    plain.into_iter().flatten().chain(varied)
+    individual_episodes(variants, episodes, seed).map(move |e| (genome, e))
 }
 
 /// An individual's fitness from its episodes' (`episodes` per variant of
